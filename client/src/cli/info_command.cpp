@@ -1,0 +1,110 @@
+#include "info_command.h"
+
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <string>
+
+#include "absl/strings/str_format.h"
+#include "exit_codes.h"
+#include "inscribe/mesh_hash.h"
+#include "inscribe/mesh_io.h"
+#include "inscribe/mesh_validation.h"
+#include "report_json.h"
+
+namespace inscribe::cli {
+namespace {
+
+struct InfoOptions {
+  std::string path;
+  bool json = false;
+  bool skip_self_intersections = false;
+};
+
+void PrintText(const std::string& path, const MeshReport& report, const std::string& sha256,
+               const ReadMeshInfo& read, double seconds) {
+  auto line = [](const char* key, const std::string& value) {
+    std::cout << absl::StrFormat("%-20s %s\n", key, value);
+  };
+  line("mesh", path);
+  line("sha256", sha256.empty() ? "-" : sha256);
+  line("vertices", std::to_string(report.vertices));
+  line("triangles", read.polygons_triangulated > 0
+                        ? absl::StrFormat("%d (%d polygons triangulated)", report.triangles,
+                                          read.polygons_triangulated)
+                        : std::to_string(report.triangles));
+  line("closed", report.closed() ? "yes" : "no");
+  line("components", std::to_string(report.components));
+  line("volume", absl::StrFormat("%.10g", report.volume));
+  const BoundingBox& b = report.bbox;
+  line("bbox min", absl::StrFormat("%.10g %.10g %.10g", b.min.x(), b.min.y(), b.min.z()));
+  line("bbox max", absl::StrFormat("%.10g %.10g %.10g", b.max.x(), b.max.y(), b.max.z()));
+  line("bbox diagonal", absl::StrFormat("%.10g", b.diagonal()));
+  line("self-intersections",
+       report.self_intersections_checked
+           ? (report.self_intersecting_pairs == 0
+                  ? std::string("none")
+                  : absl::StrFormat("%d pairs", report.self_intersecting_pairs))
+           : std::string("not checked"));
+  line("checked in", absl::StrFormat("%.3f s", seconds));
+  if (report.issues.empty()) {
+    line("issues", "none");
+  } else {
+    std::cout << "issues\n";
+    for (const MeshIssue& issue : report.issues) {
+      std::cout << absl::StrFormat("  %-8s %s\n", SeverityName(issue.severity), issue.message);
+    }
+  }
+  line("verdict", report.usable() ? "usable" : "NOT usable: " + report.first_error());
+}
+
+int RunInfo(const InfoOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  ReadMeshInfo read;
+  absl::StatusOr<Mesh> mesh = ReadMesh(options.path, &read);
+  if (!mesh.ok()) {
+    std::cerr << "inscribe: " << mesh.status().message() << "\n";
+    return kExitBadInput;
+  }
+  ValidateOptions validate;
+  validate.check_self_intersections = !options.skip_self_intersections;
+  ValidatedMesh validated = ValidateMesh(*std::move(mesh), validate);
+  const MeshReport& report = validated.report;
+  // The hash is only meaningful for a mesh whose indices and coordinates can be trusted.
+  const std::string sha256 =
+      report.non_finite_vertices == 0 && report.out_of_range_indices == 0
+          ? FormatSha256(MeshSha256(validated.mesh))
+          : std::string();
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (options.json) {
+    nlohmann::json j = MeshReportJson(report, sha256);
+    j["path"] = options.path;
+    j["polygons_triangulated"] = read.polygons_triangulated;
+    j["seconds"] = seconds;
+    std::cout << j.dump() << "\n";
+  } else {
+    PrintText(options.path, report, sha256, read, seconds);
+  }
+  if (!report.usable()) {
+    std::cerr << "inscribe: " << options.path << ": " << report.first_error() << "\n";
+    return kExitUnusableMesh;
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+void AddInfoCommand(CLI::App& app, int* exit_code) {
+  auto options = std::make_shared<InfoOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "info", "Validate a mesh and print its report, content hash, volume and bounding box");
+  cmd->add_option("MESH", options->path, "Mesh file (.off, .obj, .stl, .ply)")->required();
+  cmd->add_flag("--json", options->json, "Print one JSON object on stdout");
+  cmd->add_flag("--skip-self-intersections", options->skip_self_intersections,
+                "Skip the exact self-intersection test (faster on huge meshes)");
+  cmd->callback([options, exit_code] { *exit_code = RunInfo(*options); });
+}
+
+}  // namespace inscribe::cli

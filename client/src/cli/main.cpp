@@ -1,0 +1,29 @@
+// The `inscribe` command line. Each subcommand lives in its own *_command.cpp.
+#include <CLI/CLI.hpp>
+#include <exception>
+#include <iostream>
+
+#include "exit_codes.h"
+#include "info_command.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"inscribe: approximate closed triangle meshes by unions of medial spheres"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "inscribe 0.1.0");
+  int exit_code = inscribe::cli::kExitOk;
+  inscribe::cli::AddInfoCommand(app, &exit_code);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);
+    return inscribe::cli::kExitUsage;
+  } catch (const std::exception& e) {
+    std::cerr << "inscribe: internal error: " << e.what() << "\n";
+    return 70;
+  }
+  return exit_code;
+}

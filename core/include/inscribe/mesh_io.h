@@ -1,0 +1,28 @@
+// Reading mesh files (OFF, OBJ, STL, PLY) through CGAL's IO.
+#pragma once
+
+#include <string>
+
+#include "absl/status/statusor.h"
+#include "inscribe/mesh.h"
+
+namespace inscribe {
+
+struct ReadMeshInfo {
+  std::int64_t polygons = 0;             // faces in the file
+  std::int64_t polygons_triangulated = 0;  // faces with more than 3 corners, split into triangles
+};
+
+// Reads `path`, choosing the format by its extension (.off, .obj, .stl, .ply; case-insensitive).
+// Faces with more than three corners are triangulated (CGAL hole filling, so non-convex
+// polygons are fine). No geometric validation happens here: see ValidateMesh.
+// Errors (all INVALID_ARGUMENT or NOT_FOUND, with the path in the message): missing or
+// unreadable file, empty file, unsupported extension, a file CGAL cannot parse, a face with
+// fewer than three corners, a face index out of range, a non-finite coordinate.
+absl::StatusOr<Mesh> ReadMesh(const std::string& path, ReadMeshInfo* info = nullptr);
+
+// The same, from bytes already in memory; `format` is "off", "obj", "stl" or "ply".
+absl::StatusOr<Mesh> ParseMesh(const std::string& bytes, const std::string& format,
+                               ReadMeshInfo* info = nullptr);
+
+}  // namespace inscribe

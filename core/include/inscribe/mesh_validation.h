@@ -1,0 +1,80 @@
+// Checking that a mesh bounds a solid the generator can work on, and fixing what can be fixed.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "inscribe/mesh.h"
+
+namespace inscribe {
+
+enum class Severity {
+  kError,    // the mesh cannot be used to generate spheres
+  kWarning,  // usable, but results may suffer
+  kFixed,    // was wrong and has been repaired in the returned mesh
+};
+
+struct MeshIssue {
+  Severity severity;
+  std::string code;     // stable identifier, e.g. "not_closed"; for scripts and JSON
+  std::string message;  // one line a user can act on, with counts and a first example
+  std::int64_t count = 0;
+};
+
+// Counts found by ValidateMesh. Every count is about the mesh as given (before any fix).
+struct MeshReport {
+  std::int64_t vertices = 0;
+  std::int64_t triangles = 0;
+  std::int64_t non_finite_vertices = 0;    // a coordinate is NaN or infinite
+  std::int64_t out_of_range_indices = 0;   // triangle corners naming no vertex
+  std::int64_t degenerate_triangles = 0;   // repeated corner or zero area (exact predicate)
+  std::int64_t duplicate_triangles = 0;    // same three corners as an earlier triangle
+  std::int64_t unreferenced_vertices = 0;  // in no triangle (harmless)
+  std::int64_t border_edges = 0;           // edges in exactly one triangle: not closed
+  std::int64_t non_manifold_edges = 0;     // edges in more than two triangles
+  std::int64_t non_manifold_vertices = 0;  // vertices whose triangles form several fans
+  std::int64_t inconsistent_edges = 0;     // edges whose two triangles disagree on orientation
+  std::int64_t components = 0;             // edge-connected components of triangles
+  std::int64_t flipped_triangles = 0;      // triangles whose orientation the fix reversed
+  bool self_intersections_checked = false;
+  std::int64_t self_intersecting_pairs = 0;  // pairs of triangles that cross (exact predicates)
+
+  double volume = 0.0;  // enclosed volume after orientation fixes (mesh units cubed)
+  BoundingBox bbox;
+
+  std::vector<MeshIssue> issues;
+
+  bool closed() const { return border_edges == 0 && triangles > 0; }
+  // True when no issue is an error: the mesh bounds a solid the generator can use.
+  bool usable() const;
+  // The first error as a one-line reason, or "" when usable.
+  std::string first_error() const;
+};
+
+struct ValidateOptions {
+  // Self-intersection testing costs O(#T log #T) with exact predicates; it is skipped (and
+  // reported as unchecked) for meshes that are not closed 2-manifolds, where it means little.
+  bool check_self_intersections = true;
+  // Make orientation consistent within each component and point every normal away from the
+  // solid (outer shells outward, cavities inward).
+  bool fix_orientation = true;
+};
+
+struct ValidatedMesh {
+  Mesh mesh;  // the input, with orientation fixed when options.fix_orientation
+  MeshReport report;
+};
+
+// Validates `mesh` and returns it (possibly re-oriented) with the report. Never fails: every
+// problem becomes an issue in the report, including out-of-range indices and NaN coordinates.
+// Cost O(#T log #T).
+ValidatedMesh ValidateMesh(Mesh mesh, const ValidateOptions& options = {});
+
+// ValidateMesh, then INVALID_ARGUMENT carrying the first error when the mesh is not usable.
+absl::StatusOr<ValidatedMesh> PrepareMesh(Mesh mesh, const ValidateOptions& options = {});
+
+const char* SeverityName(Severity severity);
+
+}  // namespace inscribe

@@ -1,0 +1,335 @@
+#include "inscribe/boundary_oracle.h"
+
+#include <embree3/rtcore.h>
+#include <tbb/parallel_for.h>
+
+#include <cmath>
+#include <limits>
+#include <mutex>
+#include <string>
+
+#include "absl/strings/str_cat.h"
+#include "closest_point_triangle.h"
+#include "mesh_topology.h"
+
+namespace inscribe {
+namespace {
+
+float RoundDown(double x) {
+  float f = static_cast<float>(x);
+  return static_cast<double>(f) > x ? std::nextafter(f, -std::numeric_limits<float>::infinity())
+                                    : f;
+}
+
+float RoundUp(double x) {
+  float f = static_cast<float>(x);
+  return static_cast<double>(f) < x ? std::nextafter(f, std::numeric_limits<float>::infinity())
+                                    : f;
+}
+
+absl::Status CheckVertices(const Vertices& vertices) {
+  for (Eigen::Index v = 0; v < vertices.rows(); ++v) {
+    if (!vertices.row(v).allFinite()) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("vertex ", v, " has a non-finite coordinate"));
+    }
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+struct BoundaryOracle::Impl {
+  Mesh mesh;
+  // Unit face normals (zero for zero-area triangles), angle-weighted vertex pseudonormals and,
+  // per triangle side 3t + k, the sum of the normals of the triangles sharing that edge.
+  std::vector<Vector3> face_normals;
+  std::vector<Vector3> vertex_normals;
+  std::vector<Vector3> edge_normals;
+  // Per triangle side 3t + k: the other triangle across that edge, or -1 (border or
+  // non-manifold edge, where the pseudonormal falls back to the face normal).
+  std::vector<std::int32_t> across;
+
+  RTCDevice device = nullptr;
+  RTCScene scene = nullptr;
+  RTCGeometry geometry = nullptr;
+  std::mutex error_mutex;
+  std::string error;  // the first Embree error, read after build and refit
+
+  ~Impl() {
+    if (scene != nullptr) rtcReleaseScene(scene);
+    if (geometry != nullptr) rtcReleaseGeometry(geometry);
+    if (device != nullptr) rtcReleaseDevice(device);
+  }
+
+  Vector3 Corner(std::int32_t t, int k) const {
+    return mesh.vertices.row(mesh.triangles(t, k)).transpose();
+  }
+
+  struct QueryState;
+  static bool VisitTriangle(RTCPointQueryFunctionArguments* args);
+
+  void ComputeNormals();
+  absl::Status BuildScene();
+  BoundaryPoint Closest(const Vector3& p) const;
+  Side ClassifyFrom(const Vector3& p, const BoundaryPoint& closest) const;
+};
+
+void BoundaryOracle::Impl::ComputeNormals() {
+  const auto nt = static_cast<std::size_t>(mesh.num_triangles());
+  face_normals.assign(nt, Vector3::Zero());
+  vertex_normals.assign(static_cast<std::size_t>(mesh.num_vertices()), Vector3::Zero());
+  edge_normals.assign(3 * nt, Vector3::Zero());
+  for (std::size_t t = 0; t < nt; ++t) {
+    const auto ti = static_cast<std::int32_t>(t);
+    const Vector3 a = Corner(ti, 0), b = Corner(ti, 1), c = Corner(ti, 2);
+    const Vector3 n = (b - a).cross(c - a);
+    const double length = n.norm();
+    if (!(length > 0.0)) continue;
+    face_normals[t] = n / length;
+    const Vector3 corners[3] = {a, b, c};
+    for (int k = 0; k < 3; ++k) {
+      const Vector3 e1 = corners[(k + 1) % 3] - corners[k];
+      const Vector3 e2 = corners[(k + 2) % 3] - corners[k];
+      const double angle = std::atan2(e1.cross(e2).norm(), e1.dot(e2));
+      vertex_normals[static_cast<std::size_t>(mesh.triangles(ti, k))] += angle * face_normals[t];
+    }
+  }
+  for (std::size_t side = 0; side < 3 * nt; ++side) {
+    const Vector3& own = face_normals[side / 3];
+    edge_normals[side] = across[side] >= 0
+                             ? own + face_normals[static_cast<std::size_t>(across[side])]
+                             : own;
+  }
+}
+
+absl::Status BoundaryOracle::Impl::BuildScene() {
+  device = rtcNewDevice("verbose=0");
+  if (device == nullptr) {
+    return absl::InternalError(
+        absl::StrCat("Embree: cannot create a device (error ", rtcGetDeviceError(nullptr), ")"));
+  }
+  rtcSetDeviceErrorFunction(
+      device,
+      [](void* user, RTCError code, const char* message) {
+        auto* self = static_cast<Impl*>(user);
+        std::lock_guard<std::mutex> lock(self->error_mutex);
+        if (self->error.empty()) {
+          self->error = absl::StrCat("Embree error ", static_cast<int>(code), ": ",
+                                     message != nullptr ? message : "");
+        }
+      },
+      this);
+  scene = rtcNewScene(device);
+  // LOW scene quality builds a two-level structure whose per-geometry BVH honours the
+  // geometry's REFIT quality: Refit then updates bounds without re-partitioning.
+  rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_LOW);
+  rtcSetSceneFlags(scene, RTC_SCENE_FLAG_DYNAMIC);
+  geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_USER);
+  rtcSetGeometryUserPrimitiveCount(geometry, static_cast<unsigned>(mesh.num_triangles()));
+  rtcSetGeometryUserData(geometry, this);
+  rtcSetGeometryBuildQuality(geometry, RTC_BUILD_QUALITY_REFIT);
+  // Bounds in single precision, rounded outward so that culling never drops a triangle.
+  rtcSetGeometryBoundsFunction(
+      geometry,
+      [](const RTCBoundsFunctionArguments* args) {
+        const auto* self = static_cast<const Impl*>(args->geometryUserPtr);
+        const auto t = static_cast<std::int32_t>(args->primID);
+        Vector3 lo = self->Corner(t, 0), hi = lo;
+        for (int k = 1; k < 3; ++k) {
+          lo = lo.cwiseMin(self->Corner(t, k));
+          hi = hi.cwiseMax(self->Corner(t, k));
+        }
+        RTCBounds* b = args->bounds_o;
+        b->lower_x = RoundDown(lo.x());
+        b->lower_y = RoundDown(lo.y());
+        b->lower_z = RoundDown(lo.z());
+        b->upper_x = RoundUp(hi.x());
+        b->upper_y = RoundUp(hi.y());
+        b->upper_z = RoundUp(hi.z());
+      },
+      nullptr);
+  // Rays are not used; Embree still wants both callbacks on a user geometry.
+  rtcSetGeometryIntersectFunction(geometry, [](const RTCIntersectFunctionNArguments*) {});
+  rtcSetGeometryOccludedFunction(geometry, [](const RTCOccludedFunctionNArguments*) {});
+  rtcCommitGeometry(geometry);
+  rtcAttachGeometry(scene, geometry);
+  rtcCommitScene(scene);
+  std::lock_guard<std::mutex> lock(error_mutex);
+  if (!error.empty()) return absl::InternalError(error);
+  return absl::OkStatus();
+}
+
+
+struct BoundaryOracle::Impl::QueryState {
+  const Impl* impl;
+  Vector3 p;
+  double pad;  // |p - float(p)|: how far Embree's single-precision query point is off
+  double best_squared = std::numeric_limits<double>::infinity();
+  BoundaryPoint best;
+};
+
+bool BoundaryOracle::Impl::VisitTriangle(RTCPointQueryFunctionArguments* args) {
+  auto* state = static_cast<QueryState*>(args->userPtr);
+  const auto t = static_cast<std::int32_t>(args->primID);
+  Vector3 bary;
+  const Vector3 q = internal::ClosestPointOnTriangle(
+      state->p, state->impl->Corner(t, 0), state->impl->Corner(t, 1), state->impl->Corner(t, 2),
+      &bary);
+  const double d2 = (state->p - q).squaredNorm();
+  // Ties go to the lower triangle index so that results do not depend on traversal order.
+  if (d2 < state->best_squared || (d2 == state->best_squared && t < state->best.triangle)) {
+    state->best_squared = d2;
+    state->best.point = q;
+    state->best.triangle = t;
+    state->best.barycentric = bary;
+    const double d = std::sqrt(d2);
+    // Conservative single-precision search radius: pad for the float query point and a
+    // relative margin for Embree's float box distances.
+    const float radius = RoundUp((d + state->pad) * (1.0 + 1e-6) + 1e-30);
+    if (radius < args->query->radius) {
+      args->query->radius = radius;
+      return true;
+    }
+  }
+  return false;
+}
+
+BoundaryPoint BoundaryOracle::Impl::Closest(const Vector3& p) const {
+  QueryState state{this, p, 0.0, std::numeric_limits<double>::infinity(), BoundaryPoint{}};
+  RTCPointQuery query;
+  query.x = static_cast<float>(p.x());
+  query.y = static_cast<float>(p.y());
+  query.z = static_cast<float>(p.z());
+  query.time = 0.0f;
+  query.radius = std::numeric_limits<float>::infinity();
+  state.pad = (p - Vector3(query.x, query.y, query.z)).norm();
+  RTCPointQueryContext context;
+  rtcInitPointQueryContext(&context);
+  rtcPointQuery(scene, &query, &context, VisitTriangle, &state);
+  state.best.distance = std::sqrt(state.best_squared);
+  return state.best;
+}
+
+Side BoundaryOracle::Impl::ClassifyFrom(const Vector3& p, const BoundaryPoint& closest) const {
+  if (closest.distance == 0.0) return Side::kOnBoundary;
+  const Vector3& w = closest.barycentric;
+  const std::int32_t t = closest.triangle;
+  Vector3 normal;
+  const int zeros = (w[0] == 0.0) + (w[1] == 0.0) + (w[2] == 0.0);
+  if (zeros >= 2) {  // a corner: the one with weight 1
+    const int k = w[0] != 0.0 ? 0 : (w[1] != 0.0 ? 1 : 2);
+    normal = vertex_normals[static_cast<std::size_t>(mesh.triangles(t, k))];
+  } else if (zeros == 1) {  // an edge: the side opposite the zero-weight corner
+    const int k = w[0] == 0.0 ? 0 : (w[1] == 0.0 ? 1 : 2);
+    normal = edge_normals[static_cast<std::size_t>(t) * 3 + (k + 1) % 3];
+  } else {
+    normal = face_normals[static_cast<std::size_t>(t)];
+  }
+  const double s = (p - closest.point).dot(normal);
+  return s < 0.0 ? Side::kInside : Side::kOutside;
+}
+
+BoundaryOracle::BoundaryOracle(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+BoundaryOracle::BoundaryOracle(BoundaryOracle&&) noexcept = default;
+BoundaryOracle& BoundaryOracle::operator=(BoundaryOracle&&) noexcept = default;
+BoundaryOracle::~BoundaryOracle() = default;
+
+absl::StatusOr<BoundaryOracle> BoundaryOracle::Build(const Mesh& mesh) {
+  if (mesh.num_triangles() == 0) {
+    return absl::InvalidArgumentError("boundary oracle: mesh has no triangles");
+  }
+  if (mesh.num_triangles() > std::numeric_limits<std::int32_t>::max() / 3) {
+    return absl::InvalidArgumentError("boundary oracle: too many triangles");
+  }
+  if (absl::Status s = CheckVertices(mesh.vertices); !s.ok()) {
+    return absl::InvalidArgumentError(absl::StrCat("boundary oracle: ", s.message()));
+  }
+  for (Eigen::Index t = 0; t < mesh.triangles.rows(); ++t) {
+    for (int k = 0; k < 3; ++k) {
+      const std::int32_t v = mesh.triangles(t, k);
+      if (v < 0 || v >= mesh.num_vertices()) {
+        return absl::InvalidArgumentError(absl::StrCat("boundary oracle: triangle ", t,
+                                                       " refers to vertex ", v, " of ",
+                                                       mesh.num_vertices()));
+      }
+    }
+  }
+  auto impl = std::make_unique<Impl>();
+  impl->mesh = mesh;
+  impl->across.assign(static_cast<std::size_t>(mesh.num_triangles()) * 3, -1);
+  const std::vector<internal::EdgeUse> uses = internal::SortedEdgeUses(mesh);
+  for (std::size_t i = 0; i < uses.size();) {
+    std::size_t j = i + 1;
+    while (j < uses.size() && uses[j].lo == uses[i].lo && uses[j].hi == uses[i].hi) ++j;
+    if (j - i == 2) {
+      impl->across[static_cast<std::size_t>(uses[i].triangle) * 3 + uses[i].side] =
+          uses[i + 1].triangle;
+      impl->across[static_cast<std::size_t>(uses[i + 1].triangle) * 3 + uses[i + 1].side] =
+          uses[i].triangle;
+    }
+    i = j;
+  }
+  impl->ComputeNormals();
+  if (absl::Status s = impl->BuildScene(); !s.ok()) return s;
+  return BoundaryOracle(std::move(impl));
+}
+
+absl::Status BoundaryOracle::Refit(const Vertices& new_vertices) {
+  if (new_vertices.rows() != impl_->mesh.num_vertices()) {
+    return absl::InvalidArgumentError(absl::StrCat("refit: expected ", impl_->mesh.num_vertices(),
+                                                   " vertices, got ", new_vertices.rows()));
+  }
+  if (absl::Status s = CheckVertices(new_vertices); !s.ok()) {
+    return absl::InvalidArgumentError(absl::StrCat("refit: ", s.message()));
+  }
+  impl_->mesh.vertices = new_vertices;
+  impl_->ComputeNormals();
+  rtcCommitGeometry(impl_->geometry);
+  rtcCommitScene(impl_->scene);
+  std::lock_guard<std::mutex> lock(impl_->error_mutex);
+  if (!impl_->error.empty()) return absl::InternalError(impl_->error);
+  return absl::OkStatus();
+}
+
+const Mesh& BoundaryOracle::mesh() const { return impl_->mesh; }
+
+BoundaryPoint BoundaryOracle::ClosestPoint(const Vector3& query) const {
+  return impl_->Closest(query);
+}
+
+Side BoundaryOracle::Classify(const Vector3& query) const {
+  return impl_->ClassifyFrom(query, impl_->Closest(query));
+}
+
+double BoundaryOracle::SignedDistance(const Vector3& query) const {
+  const BoundaryPoint closest = impl_->Closest(query);
+  return impl_->ClassifyFrom(query, closest) == Side::kInside ? -closest.distance
+                                                               : closest.distance;
+}
+
+std::vector<BoundaryPoint> BoundaryOracle::ClosestPoints(const Vertices& queries) const {
+  std::vector<BoundaryPoint> out(static_cast<std::size_t>(queries.rows()));
+  tbb::parallel_for(Eigen::Index{0}, queries.rows(), [&](Eigen::Index i) {
+    out[static_cast<std::size_t>(i)] = impl_->Closest(queries.row(i).transpose());
+  });
+  return out;
+}
+
+std::vector<Side> BoundaryOracle::ClassifyAll(const Vertices& queries) const {
+  std::vector<Side> out(static_cast<std::size_t>(queries.rows()));
+  tbb::parallel_for(Eigen::Index{0}, queries.rows(), [&](Eigen::Index i) {
+    out[static_cast<std::size_t>(i)] = Classify(queries.row(i).transpose());
+  });
+  return out;
+}
+
+std::vector<double> BoundaryOracle::SignedDistances(const Vertices& queries) const {
+  std::vector<double> out(static_cast<std::size_t>(queries.rows()));
+  tbb::parallel_for(Eigen::Index{0}, queries.rows(), [&](Eigen::Index i) {
+    out[static_cast<std::size_t>(i)] = SignedDistance(queries.row(i).transpose());
+  });
+  return out;
+}
+
+}  // namespace inscribe

@@ -1,0 +1,516 @@
+#include "inscribe/mesh_validation.h"
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <numeric>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "mesh_topology.h"
+#include "self_intersections.h"
+
+namespace inscribe {
+namespace {
+
+using internal::DisjointSets;
+using internal::EdgeUse;
+
+// Above this many components, nesting (which shells are cavities) costs O(#components * #T)
+// and is skipped: every component is then oriented to enclose positive volume.
+constexpr std::int64_t kMaxComponentsForNesting = 256;
+
+void AddIssue(MeshReport& report, Severity severity, std::string code, std::string message,
+              std::int64_t count) {
+  report.issues.push_back(MeshIssue{severity, std::move(code), std::move(message), count});
+}
+
+std::string Plural(std::int64_t n, const char* singular, const char* plural) {
+  return absl::StrCat(n, " ", n == 1 ? singular : plural);
+}
+
+// Generalized winding number of the closed surface made of `triangles` at `p`: the sum of the
+// signed solid angles / 4 pi (Van Oosterom & Strackee). +-1 inside, 0 outside.
+double WindingNumber(const Mesh& mesh, const std::vector<std::int32_t>& triangles,
+                     const Vector3& p) {
+  double total = 0.0;
+  for (std::int32_t t : triangles) {
+    const Vector3 a = mesh.vertices.row(mesh.triangles(t, 0)).transpose() - p;
+    const Vector3 b = mesh.vertices.row(mesh.triangles(t, 1)).transpose() - p;
+    const Vector3 c = mesh.vertices.row(mesh.triangles(t, 2)).transpose() - p;
+    const double la = a.norm(), lb = b.norm(), lc = c.norm();
+    const double numerator = a.dot(b.cross(c));
+    const double denominator = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
+    total += 2.0 * std::atan2(numerator, denominator);
+  }
+  return total / (4.0 * M_PI);
+}
+
+double ComponentVolume(const Mesh& mesh, const std::vector<std::int32_t>& triangles,
+                       const Vector3& origin) {
+  double six_volume = 0.0;
+  for (std::int32_t t : triangles) {
+    const Vector3 a = mesh.vertices.row(mesh.triangles(t, 0)).transpose() - origin;
+    const Vector3 b = mesh.vertices.row(mesh.triangles(t, 1)).transpose() - origin;
+    const Vector3 c = mesh.vertices.row(mesh.triangles(t, 2)).transpose() - origin;
+    six_volume += a.dot(b.cross(c));
+  }
+  return six_volume / 6.0;
+}
+
+void FlipTriangle(Mesh& mesh, Eigen::Index t) { std::swap(mesh.triangles(t, 1), mesh.triangles(t, 2)); }
+
+// Checks that every coordinate is finite and every index names a vertex. Returns false when
+// the mesh cannot be examined further.
+bool CheckIndicesAndCoordinates(const Mesh& mesh, MeshReport& report) {
+  std::int64_t first_bad_vertex = -1;
+  for (Eigen::Index v = 0; v < mesh.vertices.rows(); ++v) {
+    if (!mesh.vertices.row(v).allFinite()) {
+      if (report.non_finite_vertices++ == 0) first_bad_vertex = v;
+    }
+  }
+  if (report.non_finite_vertices > 0) {
+    const auto row = mesh.vertices.row(first_bad_vertex);
+    AddIssue(report, Severity::kError, "non_finite_coordinates",
+             absl::StrFormat("%s non-finite (NaN or infinite) coordinates (first: vertex %d = "
+                             "(%g, %g, %g))",
+                             Plural(report.non_finite_vertices, "vertex has", "vertices have"),
+                             first_bad_vertex, row(0), row(1), row(2)),
+             report.non_finite_vertices);
+  }
+  std::int64_t first_triangle = -1, first_corner = -1, first_value = 0;
+  const auto nv = mesh.num_vertices();
+  for (Eigen::Index t = 0; t < mesh.triangles.rows(); ++t) {
+    for (int k = 0; k < 3; ++k) {
+      const std::int32_t v = mesh.triangles(t, k);
+      if (v < 0 || v >= nv) {
+        if (report.out_of_range_indices++ == 0) {
+          first_triangle = t;
+          first_corner = k;
+          first_value = v;
+        }
+      }
+    }
+  }
+  if (report.out_of_range_indices > 0) {
+    AddIssue(report, Severity::kError, "index_out_of_range",
+             absl::StrCat(Plural(report.out_of_range_indices, "triangle corner refers",
+                                 "triangle corners refer"),
+                          " to no vertex (first: triangle ", first_triangle, " corner ",
+                          first_corner, " = ", first_value, "; valid indices are 0..", nv - 1,
+                          ")"),
+             report.out_of_range_indices);
+  }
+  if (mesh.num_triangles() == 0) {
+    AddIssue(report, Severity::kError, "no_triangles", "mesh has no triangles", 0);
+  }
+  return report.non_finite_vertices == 0 && report.out_of_range_indices == 0 &&
+         mesh.num_triangles() > 0;
+}
+
+void CheckDegenerateAndDuplicate(const Mesh& mesh, MeshReport& report) {
+  std::int64_t repeated = 0, first_repeated = -1;
+  for (Eigen::Index t = 0; t < mesh.triangles.rows(); ++t) {
+    if (!internal::HasDistinctCorners(mesh, t) && repeated++ == 0) first_repeated = t;
+  }
+  std::int64_t first_collinear = -1;
+  const std::int64_t collinear = internal::CountCollinearTriangles(mesh, &first_collinear);
+  report.degenerate_triangles = repeated + collinear;
+  if (report.degenerate_triangles > 0) {
+    const std::int64_t first = first_repeated >= 0 && (first_collinear < 0 || first_repeated < first_collinear)
+                                   ? first_repeated
+                                   : first_collinear;
+    AddIssue(report, Severity::kWarning, "degenerate_triangles",
+             absl::StrCat(Plural(report.degenerate_triangles, "triangle has", "triangles have"),
+                          " zero area (", repeated, " repeat a corner, ", collinear,
+                          " have collinear corners; first: triangle ", first,
+                          "); they are kept but contribute no surface"),
+             report.degenerate_triangles);
+  }
+
+  std::vector<std::array<std::int32_t, 4>> keys;  // sorted corners + triangle
+  keys.reserve(static_cast<std::size_t>(mesh.num_triangles()));
+  for (Eigen::Index t = 0; t < mesh.triangles.rows(); ++t) {
+    std::array<std::int32_t, 3> c = {mesh.triangles(t, 0), mesh.triangles(t, 1),
+                                     mesh.triangles(t, 2)};
+    std::sort(c.begin(), c.end());
+    keys.push_back({c[0], c[1], c[2], static_cast<std::int32_t>(t)});
+  }
+  std::sort(keys.begin(), keys.end());
+  std::int64_t first_duplicate = -1;
+  for (std::size_t i = 1; i < keys.size(); ++i) {
+    if (keys[i][0] == keys[i - 1][0] && keys[i][1] == keys[i - 1][1] &&
+        keys[i][2] == keys[i - 1][2]) {
+      if (report.duplicate_triangles++ == 0 || keys[i][3] < first_duplicate) {
+        first_duplicate = keys[i][3];
+      }
+    }
+  }
+  if (report.duplicate_triangles > 0) {
+    AddIssue(report, Severity::kWarning, "duplicate_triangles",
+             absl::StrCat(Plural(report.duplicate_triangles, "triangle repeats",
+                                 "triangles repeat"),
+                          " the corners of an earlier one (first: triangle ", first_duplicate,
+                          ")"),
+             report.duplicate_triangles);
+  }
+
+  std::vector<char> used(static_cast<std::size_t>(mesh.num_vertices()), 0);
+  for (Eigen::Index t = 0; t < mesh.triangles.rows(); ++t) {
+    for (int k = 0; k < 3; ++k) used[static_cast<std::size_t>(mesh.triangles(t, k))] = 1;
+  }
+  report.unreferenced_vertices = std::count(used.begin(), used.end(), 0);
+  if (report.unreferenced_vertices > 0) {
+    AddIssue(report, Severity::kWarning, "unreferenced_vertices",
+             absl::StrCat(Plural(report.unreferenced_vertices, "vertex is", "vertices are"),
+                          " in no triangle (ignored)"),
+             report.unreferenced_vertices);
+  }
+}
+
+struct EdgeGroups {
+  // Index ranges [begin, end) into the sorted uses, one per undirected edge.
+  std::vector<std::pair<std::size_t, std::size_t>> ranges;
+};
+
+EdgeGroups GroupEdges(const std::vector<EdgeUse>& uses) {
+  EdgeGroups groups;
+  for (std::size_t i = 0; i < uses.size();) {
+    std::size_t j = i + 1;
+    while (j < uses.size() && uses[j].lo == uses[i].lo && uses[j].hi == uses[i].hi) ++j;
+    groups.ranges.emplace_back(i, j);
+    i = j;
+  }
+  return groups;
+}
+
+void CheckEdges(const Mesh& mesh, const std::vector<EdgeUse>& uses, const EdgeGroups& groups,
+                MeshReport& report) {
+  const EdgeUse* first_border = nullptr;
+  const EdgeUse* first_non_manifold = nullptr;
+  std::size_t first_non_manifold_count = 0;
+  const EdgeUse* first_inconsistent = nullptr;
+  for (const auto& [begin, end] : groups.ranges) {
+    const std::size_t n = end - begin;
+    if (n == 1) {
+      if (report.border_edges++ == 0) first_border = &uses[begin];
+    } else if (n > 2) {
+      if (report.non_manifold_edges++ == 0) {
+        first_non_manifold = &uses[begin];
+        first_non_manifold_count = n;
+      }
+    } else if (uses[begin].forward == uses[begin + 1].forward) {
+      if (report.inconsistent_edges++ == 0) first_inconsistent = &uses[begin];
+    }
+  }
+  if (report.border_edges > 0) {
+    AddIssue(report, Severity::kError, "not_closed",
+             absl::StrCat("mesh is not closed: ", Plural(report.border_edges, "border edge", "border edges"),
+                          " (edges in only one triangle; first: vertices ", first_border->lo,
+                          "-", first_border->hi, " in triangle ", first_border->triangle, ")"),
+             report.border_edges);
+  }
+  if (report.non_manifold_edges > 0) {
+    AddIssue(report, Severity::kError, "non_manifold_edges",
+             absl::StrCat("mesh is not edge-manifold: ",
+                          Plural(report.non_manifold_edges, "edge is", "edges are"),
+                          " shared by more than two triangles (first: vertices ",
+                          first_non_manifold->lo, "-", first_non_manifold->hi, ", in ",
+                          first_non_manifold_count, " triangles)"),
+             report.non_manifold_edges);
+  }
+  // Inconsistent orientation is reported by the orientation step, which knows if it is fixed.
+  (void)first_inconsistent;
+  (void)mesh;
+}
+
+void CheckVertexManifold(const Mesh& mesh, const std::vector<EdgeUse>& uses,
+                         const EdgeGroups& groups, MeshReport& report) {
+  // Corners 3t + k of one vertex belong to one fan when linked through manifold edges.
+  DisjointSets corners(static_cast<std::size_t>(mesh.num_triangles()) * 3);
+  auto corner_of = [&](std::int32_t t, std::int32_t v) -> std::size_t {
+    for (int k = 0; k < 3; ++k) {
+      if (mesh.triangles(t, k) == v) return static_cast<std::size_t>(t) * 3 + k;
+    }
+    return static_cast<std::size_t>(t) * 3;  // unreachable for a use of this edge
+  };
+  for (const auto& [begin, end] : groups.ranges) {
+    if (end - begin != 2) continue;
+    const EdgeUse& a = uses[begin];
+    const EdgeUse& b = uses[begin + 1];
+    corners.Union(corner_of(a.triangle, a.lo), corner_of(b.triangle, a.lo));
+    corners.Union(corner_of(a.triangle, a.hi), corner_of(b.triangle, a.hi));
+  }
+  std::vector<std::pair<std::int32_t, std::size_t>> vertex_fan;
+  for (Eigen::Index t = 0; t < mesh.triangles.rows(); ++t) {
+    if (!internal::HasDistinctCorners(mesh, t)) continue;
+    for (int k = 0; k < 3; ++k) {
+      vertex_fan.emplace_back(mesh.triangles(t, k),
+                              corners.Find(static_cast<std::size_t>(t) * 3 + k));
+    }
+  }
+  std::sort(vertex_fan.begin(), vertex_fan.end());
+  vertex_fan.erase(std::unique(vertex_fan.begin(), vertex_fan.end()), vertex_fan.end());
+  std::int64_t first = -1;
+  for (std::size_t i = 1; i < vertex_fan.size(); ++i) {
+    if (vertex_fan[i].first == vertex_fan[i - 1].first &&
+        (i < 2 || vertex_fan[i - 2].first != vertex_fan[i].first)) {
+      if (report.non_manifold_vertices++ == 0) first = vertex_fan[i].first;
+    }
+  }
+  if (report.non_manifold_vertices > 0) {
+    AddIssue(report, Severity::kWarning, "non_manifold_vertices",
+             absl::StrCat(Plural(report.non_manifold_vertices, "vertex joins",
+                                 "vertices join"),
+                          " several separate fans of triangles (first: vertex ", first,
+                          "); inside/outside tests near them may be wrong"),
+             report.non_manifold_vertices);
+  }
+}
+
+// Edge-connected components of the triangles with distinct corners. Returns component id per
+// triangle (-1 for skipped triangles) and fills report.components.
+std::vector<std::int32_t> LabelComponents(const Mesh& mesh, const std::vector<EdgeUse>& uses,
+                                          const EdgeGroups& groups, MeshReport& report) {
+  DisjointSets sets(static_cast<std::size_t>(mesh.num_triangles()));
+  for (const auto& [begin, end] : groups.ranges) {
+    for (std::size_t i = begin + 1; i < end; ++i) {
+      sets.Union(static_cast<std::size_t>(uses[begin].triangle),
+                 static_cast<std::size_t>(uses[i].triangle));
+    }
+  }
+  std::vector<std::int32_t> label(static_cast<std::size_t>(mesh.num_triangles()), -1);
+  std::vector<std::int32_t> root_label(static_cast<std::size_t>(mesh.num_triangles()), -1);
+  std::int32_t next = 0;
+  for (Eigen::Index t = 0; t < mesh.triangles.rows(); ++t) {
+    if (!internal::HasDistinctCorners(mesh, t)) continue;
+    const std::size_t root = sets.Find(static_cast<std::size_t>(t));
+    if (root_label[root] < 0) root_label[root] = next++;
+    label[static_cast<std::size_t>(t)] = root_label[root];
+  }
+  report.components = next;
+  return label;
+}
+
+// Makes orientation consistent across every manifold edge by breadth-first search, keeping
+// the majority orientation of each component; returns false if a component is not orientable.
+bool MakeConsistent(Mesh& mesh, const std::vector<EdgeUse>& uses, const EdgeGroups& groups,
+                    const std::vector<std::int32_t>& component, std::int64_t num_components,
+                    std::vector<char>& flip, std::int64_t* non_orientable_triangle) {
+  const std::size_t nt = static_cast<std::size_t>(mesh.num_triangles());
+  // Adjacency through manifold edges: neighbour and whether the pair currently agrees.
+  std::vector<std::vector<std::pair<std::int32_t, bool>>> adjacent(nt);
+  for (const auto& [begin, end] : groups.ranges) {
+    if (end - begin != 2) continue;
+    const EdgeUse& a = uses[begin];
+    const EdgeUse& b = uses[begin + 1];
+    const bool agree = a.forward != b.forward;
+    adjacent[static_cast<std::size_t>(a.triangle)].emplace_back(b.triangle, agree);
+    adjacent[static_cast<std::size_t>(b.triangle)].emplace_back(a.triangle, agree);
+  }
+  flip.assign(nt, 0);
+  std::vector<char> seen(nt, 0);
+  std::vector<std::int64_t> flips_in(static_cast<std::size_t>(num_components), 0);
+  std::vector<std::int64_t> size_of(static_cast<std::size_t>(num_components), 0);
+  std::deque<std::int32_t> queue;
+  for (std::size_t start = 0; start < nt; ++start) {
+    if (seen[start] || component[start] < 0) continue;
+    seen[start] = 1;
+    queue.push_back(static_cast<std::int32_t>(start));
+    while (!queue.empty()) {
+      const std::int32_t t = queue.front();
+      queue.pop_front();
+      const auto c = static_cast<std::size_t>(component[static_cast<std::size_t>(t)]);
+      ++size_of[c];
+      flips_in[c] += flip[static_cast<std::size_t>(t)];
+      for (const auto& [u, agree] : adjacent[static_cast<std::size_t>(t)]) {
+        // After flipping, t and u agree iff (agree XOR flip[t] XOR flip[u]).
+        const char wanted = static_cast<char>(flip[static_cast<std::size_t>(t)] ^ !agree);
+        if (!seen[static_cast<std::size_t>(u)]) {
+          seen[static_cast<std::size_t>(u)] = 1;
+          flip[static_cast<std::size_t>(u)] = wanted;
+          queue.push_back(u);
+        } else if (flip[static_cast<std::size_t>(u)] != wanted) {
+          *non_orientable_triangle = t;
+          return false;
+        }
+      }
+    }
+  }
+  for (std::size_t t = 0; t < nt; ++t) {
+    if (component[t] < 0) continue;
+    const auto c = static_cast<std::size_t>(component[t]);
+    if (2 * flips_in[c] > size_of[c]) flip[t] ^= 1;  // keep the majority as it is
+    if (flip[t]) FlipTriangle(mesh, static_cast<Eigen::Index>(t));
+  }
+  return true;
+}
+
+// Points every component's normals away from the solid: a shell inside an even number of
+// other shells bounds material from outside (positive volume), one inside an odd number is a
+// cavity (negative volume).
+void OrientOutward(Mesh& mesh, const std::vector<std::int32_t>& component,
+                   std::int64_t num_components, std::vector<char>& flip, MeshReport& report) {
+  std::vector<std::vector<std::int32_t>> members(static_cast<std::size_t>(num_components));
+  for (std::size_t t = 0; t < component.size(); ++t) {
+    if (component[t] >= 0) members[static_cast<std::size_t>(component[t])].push_back(static_cast<std::int32_t>(t));
+  }
+  const BoundingBox box = ComputeBoundingBox(mesh.vertices);
+  const Vector3 origin = 0.5 * (box.min + box.max);
+  const bool nesting = num_components <= kMaxComponentsForNesting;
+  if (!nesting) {
+    AddIssue(report, Severity::kWarning, "nesting_not_checked",
+             absl::StrCat("mesh has ", num_components,
+                          " components; cavities were not detected, every component was "
+                          "oriented to enclose positive volume"),
+             num_components);
+  }
+  for (std::size_t c = 0; c < members.size(); ++c) {
+    const double volume = ComponentVolume(mesh, members[c], origin);
+    int depth = 0;
+    if (nesting && members.size() > 1) {
+      // A point of this shell: the centroid of its first triangle.
+      const std::int32_t t = members[c].front();
+      const Vector3 p = (mesh.vertices.row(mesh.triangles(t, 0)) +
+                         mesh.vertices.row(mesh.triangles(t, 1)) +
+                         mesh.vertices.row(mesh.triangles(t, 2)))
+                            .transpose() /
+                        3.0;
+      for (std::size_t other = 0; other < members.size(); ++other) {
+        if (other != c && std::abs(WindingNumber(mesh, members[other], p)) > 0.5) ++depth;
+      }
+    }
+    const bool want_positive = depth % 2 == 0;
+    if ((volume > 0) != want_positive && volume != 0.0) {
+      for (std::int32_t t : members[c]) {
+        FlipTriangle(mesh, t);
+        flip[static_cast<std::size_t>(t)] ^= 1;
+      }
+    }
+  }
+}
+
+void CheckOrientation(Mesh& mesh, const std::vector<EdgeUse>& uses, const EdgeGroups& groups,
+                      const ValidateOptions& options, MeshReport& report) {
+  const std::vector<std::int32_t> component = LabelComponents(mesh, uses, groups, report);
+  const bool two_manifold_edges = report.border_edges == 0 && report.non_manifold_edges == 0;
+  if (!options.fix_orientation || !two_manifold_edges) {
+    if (report.inconsistent_edges > 0) {
+      AddIssue(report, two_manifold_edges ? Severity::kError : Severity::kWarning,
+               "inconsistent_orientation",
+               absl::StrCat(Plural(report.inconsistent_edges, "edge joins", "edges join"),
+                            " triangles of opposite orientation (not fixed)"),
+               report.inconsistent_edges);
+    }
+    return;
+  }
+  std::vector<char> flip;
+  std::int64_t bad_triangle = -1;
+  if (!MakeConsistent(mesh, uses, groups, component, report.components, flip, &bad_triangle)) {
+    AddIssue(report, Severity::kError, "not_orientable",
+             absl::StrCat("mesh is not orientable (a Moebius-like component contains triangle ",
+                          bad_triangle, ")"),
+             1);
+    return;
+  }
+  OrientOutward(mesh, component, report.components, flip, report);
+  report.flipped_triangles = std::count(flip.begin(), flip.end(), 1);
+  if (report.flipped_triangles > 0) {
+    const bool all = report.flipped_triangles ==
+                     std::count_if(component.begin(), component.end(),
+                                   [](std::int32_t c) { return c >= 0; });
+    std::string what =
+        report.inconsistent_edges > 0
+            ? absl::StrCat("orientation was inconsistent (",
+                           Plural(report.inconsistent_edges, "edge", "edges"), ")")
+            : std::string(all ? "mesh was inside out" : "some shells faced the wrong way");
+    AddIssue(report, Severity::kFixed, "orientation_fixed",
+             absl::StrCat(what, "; reversed ",
+                          Plural(report.flipped_triangles, "triangle", "triangles"),
+                          " so that normals point out of the solid"),
+             report.flipped_triangles);
+  }
+}
+
+}  // namespace
+
+const char* SeverityName(Severity severity) {
+  switch (severity) {
+    case Severity::kError:
+      return "error";
+    case Severity::kWarning:
+      return "warning";
+    case Severity::kFixed:
+      return "fixed";
+  }
+  return "unknown";
+}
+
+bool MeshReport::usable() const {
+  return std::none_of(issues.begin(), issues.end(),
+                      [](const MeshIssue& i) { return i.severity == Severity::kError; });
+}
+
+std::string MeshReport::first_error() const {
+  for (const MeshIssue& issue : issues) {
+    if (issue.severity == Severity::kError) return issue.message;
+  }
+  return "";
+}
+
+ValidatedMesh ValidateMesh(Mesh mesh, const ValidateOptions& options) {
+  MeshReport report;
+  report.vertices = mesh.num_vertices();
+  report.triangles = mesh.num_triangles();
+  if (!CheckIndicesAndCoordinates(mesh, report)) {
+    return ValidatedMesh{std::move(mesh), std::move(report)};
+  }
+  report.bbox = ComputeBoundingBox(mesh.vertices);
+  CheckDegenerateAndDuplicate(mesh, report);
+  const std::vector<EdgeUse> uses = internal::SortedEdgeUses(mesh);
+  const EdgeGroups groups = GroupEdges(uses);
+  CheckEdges(mesh, uses, groups, report);
+  CheckVertexManifold(mesh, uses, groups, report);
+  CheckOrientation(mesh, uses, groups, options, report);
+  report.volume = SignedVolume(mesh);
+
+  if (report.usable() && !(report.volume > 0.0)) {
+    AddIssue(report, Severity::kError, "no_volume",
+             absl::StrFormat("mesh encloses no volume (signed volume %g)", report.volume), 0);
+  }
+  if (options.check_self_intersections && report.usable() && report.non_manifold_vertices == 0) {
+    if (auto pairs = internal::SelfIntersectingPairs(mesh)) {
+      report.self_intersections_checked = true;
+      report.self_intersecting_pairs = static_cast<std::int64_t>(pairs->size());
+      if (!pairs->empty()) {
+        AddIssue(report, Severity::kWarning, "self_intersections",
+                 absl::StrCat("mesh intersects itself: ",
+                              Plural(report.self_intersecting_pairs, "pair", "pairs"),
+                              " of triangles cross (first: triangles ", pairs->front().first,
+                              " and ", pairs->front().second,
+                              "); inside/outside is ill-defined near them"),
+                 report.self_intersecting_pairs);
+      }
+    }
+  }
+  if (!report.self_intersections_checked && options.check_self_intersections &&
+      report.usable()) {
+    AddIssue(report, Severity::kWarning, "self_intersections_not_checked",
+             "self-intersections were not checked (some vertices are not manifold)", 0);
+  }
+  std::stable_sort(report.issues.begin(), report.issues.end(),
+                   [](const MeshIssue& a, const MeshIssue& b) {
+                     return static_cast<int>(a.severity) < static_cast<int>(b.severity);
+                   });
+  return ValidatedMesh{std::move(mesh), std::move(report)};
+}
+
+absl::StatusOr<ValidatedMesh> PrepareMesh(Mesh mesh, const ValidateOptions& options) {
+  ValidatedMesh validated = ValidateMesh(std::move(mesh), options);
+  if (!validated.report.usable()) {
+    return absl::InvalidArgumentError(validated.report.first_error());
+  }
+  return validated;
+}
+
+}  // namespace inscribe

@@ -1,0 +1,24 @@
+// Private: exact self-intersection test of a closed triangle mesh (CGAL).
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <utility>
+#include <vector>
+
+#include "inscribe/mesh.h"
+
+namespace inscribe::internal {
+
+// Pairs (t1 < t2) of triangles of `mesh` that intersect other than along their shared
+// vertices or edge, using exact predicates. Triangles with repeated corners are ignored.
+// Returns nullopt when the mesh is not a polygon mesh CGAL can build (e.g. non-manifold
+// vertices); the caller then reports the check as not done. Cost O(#T log #T) typically.
+std::optional<std::vector<std::pair<std::int32_t, std::int32_t>>> SelfIntersectingPairs(
+    const Mesh& mesh);
+
+// Number of triangles whose corners are distinct but collinear (zero area), exact predicate;
+// `first` receives the first such triangle or -1.
+std::int64_t CountCollinearTriangles(const Mesh& mesh, std::int64_t* first);
+
+}  // namespace inscribe::internal

@@ -3,6 +3,7 @@
 #include <embree3/rtcore.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <mutex>
@@ -50,6 +51,10 @@ struct BoundaryOracle::Impl {
   // non-manifold edge, where the pseudonormal falls back to the face normal).
   std::vector<std::int32_t> across;
 
+  BoundaryOracleOptions options;
+  BoundingBox box;  // of the vertices; queries outside it are outside the solid
+  float pad = 0;    // outward padding of every primitive box (see UpdateBoxAndPad)
+
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;
   RTCGeometry geometry = nullptr;
@@ -73,6 +78,11 @@ struct BoundaryOracle::Impl {
   absl::Status BuildScene();
   BoundaryPoint Closest(const Vector3& p) const;
   Side ClassifyFrom(const Vector3& p, const BoundaryPoint& closest) const;
+  Side ClassifyByParity(const Vector3& p) const;
+  void UpdateBoxAndPad();
+
+  struct ParityContext;
+  static void CountCrossing(const RTCIntersectFunctionNArguments* args);
 };
 
 void BoundaryOracle::Impl::ComputeNormals() {
@@ -141,16 +151,16 @@ absl::Status BoundaryOracle::Impl::BuildScene() {
           hi = hi.cwiseMax(self->Corner(t, k));
         }
         RTCBounds* b = args->bounds_o;
-        b->lower_x = RoundDown(lo.x());
-        b->lower_y = RoundDown(lo.y());
-        b->lower_z = RoundDown(lo.z());
-        b->upper_x = RoundUp(hi.x());
-        b->upper_y = RoundUp(hi.y());
-        b->upper_z = RoundUp(hi.z());
+        b->lower_x = RoundDown(lo.x()) - self->pad;
+        b->lower_y = RoundDown(lo.y()) - self->pad;
+        b->lower_z = RoundDown(lo.z()) - self->pad;
+        b->upper_x = RoundUp(hi.x()) + self->pad;
+        b->upper_y = RoundUp(hi.y()) + self->pad;
+        b->upper_z = RoundUp(hi.z()) + self->pad;
       },
       nullptr);
-  // Rays are not used; Embree still wants both callbacks on a user geometry.
-  rtcSetGeometryIntersectFunction(geometry, [](const RTCIntersectFunctionNArguments*) {});
+  // Rays only count crossings (kRayParity); occlusion rays are not used.
+  rtcSetGeometryIntersectFunction(geometry, CountCrossing);
   rtcSetGeometryOccludedFunction(geometry, [](const RTCOccludedFunctionNArguments*) {});
   rtcCommitGeometry(geometry);
   rtcAttachGeometry(scene, geometry);
@@ -211,8 +221,88 @@ BoundaryPoint BoundaryOracle::Impl::Closest(const Vector3& p) const {
   return state.best;
 }
 
+// The padding makes single-precision culling conservative for rays as well as for point
+// queries: a ray cast from float(p) runs parallel to the exact ray from p, at most |p - float(p)|
+// away from it, and queries outside the bbox never cast rays, so |p| is bounded by the mesh.
+void BoundaryOracle::Impl::UpdateBoxAndPad() {
+  box = ComputeBoundingBox(mesh.vertices);
+  const double magnitude = std::max(box.min.cwiseAbs().maxCoeff(), box.max.cwiseAbs().maxCoeff());
+  pad = RoundUp(1e-6 * magnitude + 1e-30);
+}
+
+struct BoundaryOracle::Impl::ParityContext {
+  RTCIntersectContext base;  // must come first: Embree hands back a pointer to it
+  const Impl* impl;
+  Vector3 origin;
+  Vector3 direction;
+  int crossings;
+};
+
+// Called for every triangle whose (padded) box the ray enters. Never shortens the ray, so
+// traversal visits them all; counts proper crossings with t > 0 (Moeller-Trumbore, double).
+void BoundaryOracle::Impl::CountCrossing(const RTCIntersectFunctionNArguments* args) {
+  if (args->valid[0] == 0) return;
+  auto* ctx = reinterpret_cast<ParityContext*>(args->context);
+  const auto t = static_cast<std::int32_t>(args->primID);
+  const Vector3 a = ctx->impl->Corner(t, 0);
+  const Vector3 e1 = ctx->impl->Corner(t, 1) - a;
+  const Vector3 e2 = ctx->impl->Corner(t, 2) - a;
+  const Vector3 pvec = ctx->direction.cross(e2);
+  const double det = e1.dot(pvec);
+  if (det == 0.0) return;  // ray parallel to the triangle's plane
+  const double inv = 1.0 / det;
+  const Vector3 tvec = ctx->origin - a;
+  const double u = tvec.dot(pvec) * inv;
+  if (u < 0.0 || u > 1.0) return;
+  const Vector3 qvec = tvec.cross(e1);
+  const double v = ctx->direction.dot(qvec) * inv;
+  if (v < 0.0 || u + v > 1.0) return;
+  if (e2.dot(qvec) * inv > 0.0) ++ctx->crossings;
+}
+
+Side BoundaryOracle::Impl::ClassifyByParity(const Vector3& p) const {
+  if ((p.array() < box.min.array()).any() || (p.array() > box.max.array()).any()) {
+    return Side::kOutside;
+  }
+  // Three fixed directions far from the axes and from each other (exact in float), so that a
+  // ray grazing an edge or vertex, where one crossing may count twice or not at all, is
+  // outvoted by the two others.
+  static constexpr float kDirections[3][3] = {{0.5773503f, 0.4082483f, 0.7071068f},
+                                              {-0.6154797f, 0.7071068f, -0.3481553f},
+                                              {0.2672612f, -0.8017837f, 0.5345225f}};
+  int inside_votes = 0;
+  for (const auto& d : kDirections) {
+    ParityContext ctx;
+    rtcInitIntersectContext(&ctx.base);
+    ctx.impl = this;
+    ctx.origin = p;
+    ctx.direction = Vector3(d[0], d[1], d[2]);
+    ctx.crossings = 0;
+    RTCRayHit rayhit;
+    rayhit.ray.org_x = static_cast<float>(p.x());
+    rayhit.ray.org_y = static_cast<float>(p.y());
+    rayhit.ray.org_z = static_cast<float>(p.z());
+    rayhit.ray.dir_x = d[0];
+    rayhit.ray.dir_y = d[1];
+    rayhit.ray.dir_z = d[2];
+    rayhit.ray.tnear = 0.0f;
+    rayhit.ray.tfar = std::numeric_limits<float>::infinity();
+    rayhit.ray.time = 0.0f;
+    rayhit.ray.mask = 0xFFFFFFFFu;
+    rayhit.ray.id = 0;
+    rayhit.ray.flags = 0;
+    rayhit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rayhit.hit.primID = RTC_INVALID_GEOMETRY_ID;
+    rayhit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(scene, &ctx.base, &rayhit);
+    inside_votes += ctx.crossings % 2;
+  }
+  return inside_votes >= 2 ? Side::kInside : Side::kOutside;
+}
+
 Side BoundaryOracle::Impl::ClassifyFrom(const Vector3& p, const BoundaryPoint& closest) const {
   if (closest.distance == 0.0) return Side::kOnBoundary;
+  if (options.inside_test == InsideTest::kRayParity) return ClassifyByParity(p);
   const Vector3& w = closest.barycentric;
   const std::int32_t t = closest.triangle;
   Vector3 normal;
@@ -235,7 +325,8 @@ BoundaryOracle::BoundaryOracle(BoundaryOracle&&) noexcept = default;
 BoundaryOracle& BoundaryOracle::operator=(BoundaryOracle&&) noexcept = default;
 BoundaryOracle::~BoundaryOracle() = default;
 
-absl::StatusOr<BoundaryOracle> BoundaryOracle::Build(const Mesh& mesh) {
+absl::StatusOr<BoundaryOracle> BoundaryOracle::Build(const Mesh& mesh,
+                                                     const BoundaryOracleOptions& options) {
   if (mesh.num_triangles() == 0) {
     return absl::InvalidArgumentError("boundary oracle: mesh has no triangles");
   }
@@ -257,6 +348,8 @@ absl::StatusOr<BoundaryOracle> BoundaryOracle::Build(const Mesh& mesh) {
   }
   auto impl = std::make_unique<Impl>();
   impl->mesh = mesh;
+  impl->options = options;
+  impl->UpdateBoxAndPad();
   impl->across.assign(static_cast<std::size_t>(mesh.num_triangles()) * 3, -1);
   const std::vector<internal::EdgeUse> uses = internal::SortedEdgeUses(mesh);
   for (std::size_t i = 0; i < uses.size();) {
@@ -284,6 +377,7 @@ absl::Status BoundaryOracle::Refit(const Vertices& new_vertices) {
     return absl::InvalidArgumentError(absl::StrCat("refit: ", s.message()));
   }
   impl_->mesh.vertices = new_vertices;
+  impl_->UpdateBoxAndPad();
   impl_->ComputeNormals();
   rtcCommitGeometry(impl_->geometry);
   rtcCommitScene(impl_->scene);

@@ -87,7 +87,8 @@ void Triangulate(const Polygon& polygon, const std::vector<Point>& points,
 }
 
 absl::StatusOr<Mesh> SoupToMesh(const std::vector<Point>& points,
-                                const std::vector<Polygon>& polygons, const std::string& what,
+                                const std::vector<Polygon>& polygons, const std::string& bytes,
+                                const std::string& format, const std::string& what,
                                 ReadMeshInfo* info) {
   constexpr std::int64_t kMaxIndex = std::numeric_limits<std::int32_t>::max();
   if (static_cast<std::int64_t>(points.size()) > kMaxIndex) {
@@ -104,6 +105,16 @@ absl::StatusOr<Mesh> SoupToMesh(const std::vector<Point>& points,
       return absl::InvalidArgumentError(absl::StrCat(what, ": face ", f, " has ",
                                                      polygon.size(),
                                                      " corners; a face needs at least 3"));
+    }
+    for (std::size_t corner : polygon) {
+      if (corner >= points.size()) {
+        std::string why = internal::DiagnoseMeshText(bytes, format);
+        if (why.empty()) {
+          why = absl::StrCat("face ", f, " refers to vertex ", corner, ", but the file has ",
+                             points.size(), " vertices (0-based)");
+        }
+        return absl::InvalidArgumentError(absl::StrCat(what, ": ", why));
+      }
     }
     if (polygon.size() == 3) {
       triangles.push_back({static_cast<std::int64_t>(polygon[0]),
@@ -172,7 +183,7 @@ absl::StatusOr<Mesh> ParseNamed(const std::string& bytes, const std::string& for
     return absl::InvalidArgumentError(absl::StrCat(what, ": no ", points.empty() ? "vertices" : "faces",
                                                    " found in the ", format, " file"));
   }
-  return SoupToMesh(points, polygons, what, info);
+  return SoupToMesh(points, polygons, bytes, format, what, info);
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <limits>
 #include <numeric>
 
 #include "absl/strings/str_cat.h"
@@ -365,20 +366,39 @@ void OrientOutward(Mesh& mesh, const std::vector<std::int32_t>& component,
                           "oriented to enclose positive volume"),
              num_components);
   }
+  // Per component: its bounding box and up to kSamples of its vertices, spread over it.
+  constexpr std::size_t kSamples = 16;
+  std::vector<BoundingBox> boxes(members.size());
+  std::vector<std::vector<Vector3>> samples(members.size());
+  for (std::size_t c = 0; c < members.size(); ++c) {
+    Vector3 lo = Vector3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+    for (std::int32_t t : members[c]) {
+      for (int k = 0; k < 3; ++k) {
+        lo = lo.cwiseMin(mesh.vertices.row(mesh.triangles(t, k)).transpose());
+        hi = hi.cwiseMax(mesh.vertices.row(mesh.triangles(t, k)).transpose());
+      }
+    }
+    boxes[c] = BoundingBox{lo, hi};
+    const std::size_t step = std::max<std::size_t>(1, members[c].size() / kSamples);
+    for (std::size_t i = 0; i < members[c].size() && samples[c].size() < kSamples; i += step) {
+      samples[c].push_back(mesh.vertices.row(mesh.triangles(members[c][i], 0)).transpose());
+    }
+  }
+  auto box_inside = [](const BoundingBox& a, const BoundingBox& b) {
+    return (a.min.array() >= b.min.array()).all() && (a.max.array() <= b.max.array()).all();
+  };
   for (std::size_t c = 0; c < members.size(); ++c) {
     const double volume = ComponentVolume(mesh, members[c], origin);
+    // Depth = how many other shells enclose this one entirely (every sample inside). Shells
+    // that merely overlap (a self-intersecting union) do not count: they are not cavities.
     int depth = 0;
-    if (nesting && members.size() > 1) {
-      // A point of this shell: the centroid of its first triangle.
-      const std::int32_t t = members[c].front();
-      const Vector3 p = (mesh.vertices.row(mesh.triangles(t, 0)) +
-                         mesh.vertices.row(mesh.triangles(t, 1)) +
-                         mesh.vertices.row(mesh.triangles(t, 2)))
-                            .transpose() /
-                        3.0;
-      for (std::size_t other = 0; other < members.size(); ++other) {
-        if (other != c && std::abs(WindingNumber(mesh, members[other], p)) > 0.5) ++depth;
-      }
+    for (std::size_t other = 0; nesting && other < members.size(); ++other) {
+      if (other == c || !box_inside(boxes[c], boxes[other])) continue;
+      const bool enclosed =
+          std::all_of(samples[c].begin(), samples[c].end(), [&](const Vector3& p) {
+            return std::abs(WindingNumber(mesh, members[other], p)) > 0.5;
+          });
+      if (enclosed) ++depth;
     }
     const bool want_positive = depth % 2 == 0;
     if ((volume > 0) != want_positive && volume != 0.0) {

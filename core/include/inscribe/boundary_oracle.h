@@ -21,15 +21,30 @@ struct BoundaryPoint {
 
 enum class Side { kInside, kOutside, kOnBoundary };
 
+// How Classify decides inside from outside.
+enum class InsideTest {
+  // Sign against the angle-weighted pseudonormal of the closest feature (Baerentzen & Aanaes
+  // 2005). Costs nothing beyond the closest-point query. Exact for a closed, outward-oriented
+  // 2-manifold WITHOUT self-intersections; wrong near sheets buried inside the solid.
+  kPseudonormal,
+  // Parity of crossings along three fixed rays (majority vote), each crossing computed in
+  // double precision. Same answer as CGAL's Side_of_triangle_mesh, also for self-intersecting
+  // meshes (where overlapped regions count as outside). About three ray casts per query.
+  kRayParity,
+};
+
+struct BoundaryOracleOptions {
+  // Use kRayParity for meshes whose MeshReport has self_intersecting_pairs > 0.
+  InsideTest inside_test = InsideTest::kPseudonormal;
+};
+
 // Queries against a mesh's boundary. The fast path is an Embree 3 BVH over the triangles (held
 // in single precision for culling only, with bounds rounded outward); every closest point and
 // distance is computed in double precision on the mesh's own coordinates, so results match a
 // brute-force double-precision scan exactly up to ties.
 //
-// Inside/outside comes from the sign of (query - closest point) against the angle-weighted
-// pseudonormal of the closest feature (Baerentzen & Aanaes 2005): exact for a closed,
-// consistently outward-oriented 2-manifold without self-intersections, and costs the same as a
-// closest-point query. Use a mesh that passed PrepareMesh.
+// Inside/outside follows options.inside_test (see InsideTest). Use a mesh that passed
+// PrepareMesh.
 //
 // Thread safety: const methods may be called concurrently from any number of threads. Refit
 // must not overlap any other call. Moves are cheap; copies are not allowed.
@@ -37,7 +52,8 @@ class BoundaryOracle {
  public:
   // Builds the BVH. Errors: empty mesh, out-of-range indices, non-finite coordinates, Embree
   // failures (INTERNAL with Embree's message). Cost O(#T log #T).
-  static absl::StatusOr<BoundaryOracle> Build(const Mesh& mesh);
+  static absl::StatusOr<BoundaryOracle> Build(const Mesh& mesh,
+                                               const BoundaryOracleOptions& options = {});
 
   BoundaryOracle(BoundaryOracle&&) noexcept;
   BoundaryOracle& operator=(BoundaryOracle&&) noexcept;

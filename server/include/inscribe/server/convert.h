@@ -1,0 +1,50 @@
+// Conversion between the wire types of proto/inscribe/v1 and the core types, and between
+// grpc::Status and absl::Status. The only place where the two worlds meet: the server and the
+// client library both go through these functions, so a field is mapped exactly once.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
+#include "grpcpp/support/status.h"
+#include "inscribe/mesh.h"
+#include "inscribe/mesh_validation.h"
+#include "inscribe/v1/mesh.pb.h"
+
+namespace inscribe::server {
+
+// OK when the packed arrays of `mesh` have lengths that are multiples of 3, otherwise
+// INVALID_ARGUMENT naming the field (prefixed by `field`, e.g. "mesh.vertices") and its
+// length. O(1): cheap enough for a gRPC thread, so malformed requests never reach the pool.
+absl::Status CheckMeshShape(const v1::Mesh& mesh, absl::string_view field = "mesh");
+
+// Number of triangles the message describes (length of triangles / 3), O(1); for limit checks
+// before any copy is made.
+std::int64_t TriangleCount(const v1::Mesh& mesh);
+
+// Copies the packed arrays into a core Mesh (#V x 3 doubles, #T x 3 int32, same units, frame and
+// 0-based indices). Fails as CheckMeshShape does; index ranges and coordinates are not
+// checked here (that is ValidateMesh's job, which reports them as issues). Cost O(#V + #T).
+absl::StatusOr<Mesh> MeshFromProto(const v1::Mesh& mesh, absl::string_view field = "mesh");
+
+// The inverse of MeshFromProto: a Mesh always has whole rows, so this cannot fail.
+void MeshToProto(const Mesh& mesh, v1::Mesh* out);
+
+// Every count, measure and issue of `report`; closed and usable are evaluated once here.
+void MeshReportToProto(const MeshReport& report, v1::MeshReport* out);
+
+// The inverse of MeshReportToProto. closed() and usable() of the result are recomputed from the
+// counts and issues (they agree with the wire's closed/usable for reports made by
+// MeshReportToProto). An issue severity this build does not know (a newer server) becomes
+// kWarning. INVALID_ARGUMENT when bbox_min or bbox_max has a length other than 0 or 3.
+absl::StatusOr<MeshReport> MeshReportFromProto(const v1::MeshReport& report);
+
+// absl and gRPC share the canonical status codes (same numbers, same meaning), so these map
+// code and message unchanged; error details are not carried.
+grpc::Status ToGrpcStatus(const absl::Status& status);
+absl::Status FromGrpcStatus(const grpc::Status& status);
+
+}  // namespace inscribe::server

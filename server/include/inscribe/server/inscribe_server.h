@@ -1,0 +1,68 @@
+// A running inscribe gRPC server: the service, its job pool, health and reflection.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "absl/status/statusor.h"
+#include "inscribe/server/inscribe_service.h"
+
+namespace inscribe::server {
+
+struct ServerOptions {
+  // --listen: HOST:PORT to bind, plaintext. Loopback by default; port 0 picks a free port
+  // (read it back from InscribeServer::port()).
+  std::string listen = "127.0.0.1:50051";
+  // --jobs: requests computed at the same time. 0 = one per hardware thread.
+  int jobs = 0;
+  // --max-queue: requests queued or running at once; more get RESOURCE_EXHAUSTED.
+  std::int64_t max_queue = 64;
+  // --max-message-bytes: largest request accepted, in bytes (256 MiB holds a mesh of ~5M
+  // triangles with ~2.5M vertices). gRPC's own default, 4 MiB, is too small for meshes.
+  int max_message_bytes = 256 * 1024 * 1024;
+  ServiceLimits limits;
+  // Told about every finished call; see CallObserver. May be empty.
+  CallObserver on_call;
+};
+
+// Owns the grpc::Server, the service and the pool, and shuts them down in that order. Serves
+// inscribe.v1.Inscribe, grpc.health.v1.Health (the overall status "" and the service name
+// "inscribe.v1.Inscribe" are SERVING until shutdown) and reflection (v1alpha).
+class InscribeServer {
+ public:
+  // Binds and starts serving. UNAVAILABLE when the address cannot be bound, INVALID_ARGUMENT
+  // for options out of range.
+  static absl::StatusOr<std::unique_ptr<InscribeServer>> Start(const ServerOptions& options);
+
+  // Shutdown(now) if not done yet, then waits for running jobs.
+  ~InscribeServer();
+  InscribeServer(const InscribeServer&) = delete;
+  InscribeServer& operator=(const InscribeServer&) = delete;
+
+  // The port actually bound (the one asked for, or the one picked for port 0).
+  int port() const { return port_; }
+  // HOST:PORT with the bound port, e.g. "127.0.0.1:50051"; suitable as a client target.
+  const std::string& address() const { return address_; }
+  // Jobs (requests) used by the pool after resolving jobs = 0.
+  int jobs() const { return jobs_; }
+
+  // Marks health NOT_SERVING, stops accepting calls, lets calls in progress finish until
+  // `deadline` and cancels the rest, then waits for the pool's jobs. Idempotent; thread-safe.
+  void Shutdown(std::chrono::system_clock::time_point deadline);
+
+  // Blocks until Shutdown has completed (from another thread).
+  void Wait();
+
+ private:
+  struct Parts;
+  explicit InscribeServer(std::unique_ptr<Parts> parts, int port, std::string address, int jobs);
+
+  std::unique_ptr<Parts> parts_;
+  int port_ = 0;
+  std::string address_;
+  int jobs_ = 0;
+};
+
+}  // namespace inscribe::server

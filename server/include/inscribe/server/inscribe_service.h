@@ -1,0 +1,59 @@
+// The inscribe.v1.Inscribe gRPC service (callback API).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+
+#include "absl/status/status.h"
+#include "inscribe/server/job_pool.h"
+#include "inscribe/v1/service.grpc.pb.h"
+
+namespace inscribe::server {
+
+// Per-request limits. Each is a flag of `inscribed` with the same name; a breach is
+// RESOURCE_EXHAUSTED with a message naming the flag.
+struct ServiceLimits {
+  // --max-triangles: triangles in one mesh. Validation costs O(#T log #T) time and ~100 bytes
+  // of memory per triangle on top of the request.
+  std::int64_t max_triangles = 5'000'000;
+};
+
+// What the service did with one call, for access logs and metrics. Times in seconds.
+struct CallRecord {
+  const char* method = "";      // RPC name, e.g. "InspectMesh"
+  std::string peer;             // grpc peer string, e.g. "ipv4:127.0.0.1:53412"
+  absl::Status status;          // what the caller was sent
+  std::int64_t triangles = 0;   // size of the request's mesh
+  double queued_seconds = 0.0;  // from arrival to the start of the job (0 if never queued)
+  double run_seconds = 0.0;     // time the job ran on the pool
+};
+
+// Called once per finished call, on a gRPC or pool thread, before the reply is sent; must be
+// thread-safe and fast. Libraries do not log: the `inscribed` binary passes a logger here.
+using CallObserver = std::function<void(const CallRecord&)>;
+
+// Handlers check what is O(1) to check (array shapes, limits, cancellation) on the gRPC thread
+// and hand everything else to `pool`; they never compute on gRPC threads. `pool` must outlive
+// the service and be drained (JobPool::WaitIdle) before the service is destroyed.
+class InscribeService final : public v1::Inscribe::CallbackService {
+ public:
+  InscribeService(JobPool* pool, const ServiceLimits& limits, CallObserver observer = nullptr);
+
+  // Validates the mesh (core ValidateMesh, orientation fixed) and replies with the report and
+  // the hash of the fixed mesh. Errors: see service.proto.
+  grpc::ServerUnaryReactor* InspectMesh(grpc::CallbackServerContext* context,
+                                        const v1::InspectMeshRequest* request,
+                                        v1::InspectMeshResponse* response) override;
+
+ private:
+  // Sends `status` to the caller after telling the observer.
+  void Finish(grpc::ServerUnaryReactor* reactor, CallRecord& record,
+              const absl::Status& status) const;
+
+  JobPool* const pool_;
+  const ServiceLimits limits_;
+  const CallObserver observer_;
+};
+
+}  // namespace inscribe::server

@@ -1,0 +1,108 @@
+#include "inscribe/server/inscribe_service.h"
+
+#include <chrono>
+#include <exception>
+#include <new>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+#include "inscribe/mesh_hash.h"
+#include "inscribe/mesh_validation.h"
+#include "inscribe/server/convert.h"
+
+namespace inscribe::server {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double SecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+absl::Status QueueFullError(const JobPool& pool) {
+  return absl::ResourceExhaustedError(
+      absl::StrCat("server is busy: the job queue is full; this server's limit (--max-queue) is ",
+                   pool.options().max_jobs, " queued or running jobs; retry later"));
+}
+
+// The body of InspectMesh, run on the pool. Only expected failures are returned; the mesh's
+// own problems are issues in the report, not errors.
+absl::Status RunInspectMesh(const v1::InspectMeshRequest& request,
+                            v1::InspectMeshResponse* response) {
+  absl::StatusOr<Mesh> mesh = MeshFromProto(request.mesh());
+  if (!mesh.ok()) return mesh.status();
+  ValidateOptions options;
+  options.check_self_intersections = !request.skip_self_intersections();
+  const ValidatedMesh validated = ValidateMesh(*std::move(mesh), options);
+  const MeshReport& report = validated.report;
+  // As the CLI does: a hash over NaNs or dangling indices would key nothing usable.
+  if (report.non_finite_vertices == 0 && report.out_of_range_indices == 0) {
+    response->set_mesh_sha256(FormatSha256(MeshSha256(validated.mesh)));
+  }
+  MeshReportToProto(report, response->mutable_report());
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+InscribeService::InscribeService(JobPool* pool, const ServiceLimits& limits, CallObserver observer)
+    : pool_(pool), limits_(limits), observer_(std::move(observer)) {}
+
+void InscribeService::Finish(grpc::ServerUnaryReactor* reactor, CallRecord& record,
+                             const absl::Status& status) const {
+  record.status = status;
+  if (observer_) observer_(record);
+  reactor->Finish(ToGrpcStatus(status));
+}
+
+grpc::ServerUnaryReactor* InscribeService::InspectMesh(grpc::CallbackServerContext* context,
+                                                       const v1::InspectMeshRequest* request,
+                                                       v1::InspectMeshResponse* response) {
+  grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+  const Clock::time_point arrived = Clock::now();
+  CallRecord record;
+  record.method = "InspectMesh";
+  record.peer = context->peer();
+  record.triangles = TriangleCount(request->mesh());
+
+  // O(1) checks stay on the gRPC thread, so bad or oversized requests never occupy the queue.
+  if (absl::Status shape = CheckMeshShape(request->mesh()); !shape.ok()) {
+    Finish(reactor, record, shape);
+    return reactor;
+  }
+  if (record.triangles > limits_.max_triangles) {
+    Finish(reactor, record,
+           absl::ResourceExhaustedError(absl::StrCat(
+               "mesh has ", record.triangles,
+               " triangles; this server's limit (--max-triangles) is ", limits_.max_triangles)));
+    return reactor;
+  }
+
+  const bool queued =
+      pool_->TrySubmit([this, context, request, response, reactor, arrived, record]() mutable {
+        record.queued_seconds = SecondsSince(arrived);
+        // The caller may have given up (deadline, cancel, disconnect) while the job waited.
+        if (context->IsCancelled()) {
+          Finish(reactor, record, absl::CancelledError("call was cancelled before work started"));
+          return;
+        }
+        const Clock::time_point started = Clock::now();
+        absl::Status status;
+        // Jobs must not throw (JobPool); running out of memory on a huge mesh is the one exception
+        // worth expecting here, and is the caller's to act on.
+        try {
+          status = RunInspectMesh(*request, response);
+        } catch (const std::bad_alloc&) {
+          status = absl::ResourceExhaustedError(
+              "server ran out of memory inspecting the mesh; send a smaller mesh or retry later");
+        } catch (const std::exception& e) {
+          status = absl::InternalError(absl::StrCat("inspecting the mesh failed: ", e.what()));
+        }
+        record.run_seconds = SecondsSince(started);
+        Finish(reactor, record, status);
+      });
+  if (!queued) Finish(reactor, record, QueueFullError(*pool_));
+  return reactor;
+}
+
+}  // namespace inscribe::server

@@ -1,0 +1,105 @@
+// inscribed: the inscribe gRPC server. Logs go to stderr as key=value pairs; the one plain line
+// "inscribed listening on HOST:PORT" says the server is ready (scripts and tests read it).
+#include <pthread.h>
+#include <signal.h>
+
+#include <chrono>
+#include <climits>
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include "CLI/CLI.hpp"
+#include "absl/status/status.h"
+#include "inscribe/server/inscribe_server.h"
+#include "spdlog/sinks/stdout_sinks.h"
+#include "spdlog/spdlog.h"
+
+namespace {
+
+using inscribe::server::CallRecord;
+using inscribe::server::InscribeServer;
+using inscribe::server::ServerOptions;
+
+void LogCall(const CallRecord& call) {
+  const auto level = call.status.ok() ? spdlog::level::info : spdlog::level::warn;
+  spdlog::log(level,
+              "event=call method={} peer={} code={} triangles={} queued_ms={:.3f} run_ms={:.3f}"
+              " message=\"{}\"",
+              call.method, call.peer, absl::StatusCodeToString(call.status.code()), call.triangles,
+              1e3 * call.queued_seconds, 1e3 * call.run_seconds,
+              std::string(call.status.message()));
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // Block the stop signals before any thread exists so every thread (gRPC's, TBB's) inherits
+  // the mask; this thread then takes them synchronously with sigwait, outside signal context.
+  sigset_t stop_signals;
+  sigemptyset(&stop_signals);
+  sigaddset(&stop_signals, SIGINT);
+  sigaddset(&stop_signals, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
+
+  ServerOptions options;
+  double shutdown_grace_seconds = 10.0;
+  std::string log_level = "info";
+  CLI::App app{"inscribed: serves inscribe.v1.Inscribe over gRPC (plaintext)"};
+  app.add_option("--listen", options.listen, "HOST:PORT to bind; port 0 picks a free port")
+      ->capture_default_str();
+  app.add_option("--jobs", options.jobs, "requests computed at once; 0 = one per hardware thread")
+      ->check(CLI::Range(0, 1024))
+      ->capture_default_str();
+  app.add_option("--max-queue", options.max_queue,
+                 "requests queued or running at once; more get RESOURCE_EXHAUSTED")
+      ->check(CLI::Range(std::int64_t{1}, std::int64_t{1} << 20))
+      ->capture_default_str();
+  app.add_option("--max-message-bytes", options.max_message_bytes, "largest request, in bytes")
+      ->check(CLI::Range(1, INT_MAX))
+      ->capture_default_str();
+  app.add_option("--max-triangles", options.limits.max_triangles, "triangles in one mesh")
+      ->check(CLI::Range(std::int64_t{1}, std::int64_t{INT_MAX}))
+      ->capture_default_str();
+  app.add_option("--shutdown-grace", shutdown_grace_seconds,
+                 "seconds calls in progress get to finish after SIGTERM/SIGINT")
+      ->check(CLI::Range(0.0, 3600.0))
+      ->capture_default_str();
+  app.add_option("--log-level", log_level, "trace, debug, info, warn, error, critical or off")
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}))
+      ->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
+
+  auto logger = spdlog::stderr_logger_mt("inscribed");
+  logger->set_pattern("%Y-%m-%dT%H:%M:%S.%e%z level=%l %v");
+  logger->set_level(spdlog::level::from_str(log_level));
+  logger->flush_on(spdlog::level::info);
+  spdlog::set_default_logger(logger);
+  options.on_call = LogCall;
+
+  absl::StatusOr<std::unique_ptr<InscribeServer>> server = InscribeServer::Start(options);
+  if (!server.ok()) {
+    spdlog::critical("event=start_failed listen={} error=\"{}\"", options.listen,
+                     std::string(server.status().message()));
+    return 1;
+  }
+  spdlog::info(
+      "event=serving address={} jobs={} max_queue={} max_message_bytes={} max_triangles={}",
+      (*server)->address(), (*server)->jobs(), options.max_queue, options.max_message_bytes,
+      options.limits.max_triangles);
+  std::fprintf(stderr, "inscribed listening on %s\n", (*server)->address().c_str());
+  std::fflush(stderr);
+
+  int signal_number = 0;
+  while (sigwait(&stop_signals, &signal_number) != 0) {
+  }
+  spdlog::info("event=draining signal={} grace_s={}",
+               signal_number == SIGTERM ? "SIGTERM" : "SIGINT", shutdown_grace_seconds);
+  const auto deadline = std::chrono::system_clock::now() +
+                        std::chrono::duration_cast<std::chrono::system_clock::duration>(
+                            std::chrono::duration<double>(shutdown_grace_seconds));
+  (*server)->Shutdown(deadline);
+  server->reset();
+  spdlog::info("event=stopped");
+  return 0;
+}

@@ -1,0 +1,74 @@
+#include "inscribe/server/job_pool.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cassert>
+#include <condition_variable>
+#include <mutex>
+#include <utility>
+
+#include "oneapi/tbb/global_control.h"
+#include "oneapi/tbb/task_arena.h"
+
+namespace inscribe::server {
+
+struct JobPool::Impl {
+  explicit Impl(const JobPoolOptions& pool_options)
+      : options(pool_options),
+        // max_allowed_parallelism counts the calling thread too: workers = value - 1.
+        parallelism(tbb::global_control::max_allowed_parallelism,
+                    std::max<std::size_t>(tbb::global_control::active_value(
+                                              tbb::global_control::max_allowed_parallelism),
+                                          static_cast<std::size_t>(pool_options.concurrency) + 1)),
+        // No slot is reserved for an external thread: jobs are enqueued, never waited on inside
+        // the arena, so all `concurrency` slots go to workers.
+        arena(pool_options.concurrency, /*reserved_for_masters=*/0) {}
+
+  void Finish() {
+    // Decrement under the lock so that WaitIdle cannot return (and the pool be destroyed)
+    // between the decrement and the notification.
+    std::lock_guard<std::mutex> lock(idle_mutex);
+    if (in_flight.fetch_sub(1, std::memory_order_acq_rel) == 1) idle.notify_all();
+  }
+
+  const JobPoolOptions options;
+  tbb::global_control parallelism;
+  tbb::task_arena arena;
+  std::atomic<std::int64_t> in_flight{0};
+  std::mutex idle_mutex;
+  std::condition_variable idle;
+};
+
+JobPool::JobPool(const JobPoolOptions& options) : impl_(std::make_unique<Impl>(options)) {
+  assert(options.concurrency >= 1 && options.max_jobs >= 1);
+}
+
+JobPool::~JobPool() { WaitIdle(); }
+
+bool JobPool::TrySubmit(std::function<void()> job) {
+  // Reserve a place first, then give it back if over the limit: the count never exceeds
+  // max_jobs by more than the number of racing submitters, and never admits more than max_jobs.
+  if (impl_->in_flight.fetch_add(1, std::memory_order_acq_rel) >= impl_->options.max_jobs) {
+    impl_->Finish();
+    return false;
+  }
+  Impl* impl = impl_.get();
+  impl->arena.enqueue([impl, job = std::move(job)] {
+    job();
+    impl->Finish();
+  });
+  return true;
+}
+
+std::int64_t JobPool::jobs_in_flight() const {
+  return impl_->in_flight.load(std::memory_order_acquire);
+}
+
+const JobPoolOptions& JobPool::options() const { return impl_->options; }
+
+void JobPool::WaitIdle() {
+  std::unique_lock<std::mutex> lock(impl_->idle_mutex);
+  impl_->idle.wait(lock, [this] { return impl_->in_flight.load() == 0; });
+}
+
+}  // namespace inscribe::server

@@ -1,0 +1,134 @@
+// Runs the real `inscribe` binary, as users do, and checks its output and exit status.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <regex>
+#include <string>
+
+#include "support/test_meshes.h"
+
+namespace inscribe {
+namespace {
+
+using ::testing::HasSubstr;
+namespace fs = std::filesystem;
+
+struct CliRun {
+  int exit_code = -1;
+  std::string out;
+  std::string err;
+};
+
+std::string Slurp(const fs::path& path) {
+  std::ifstream in(path);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+CliRun RunCli(const std::string& args) {
+  const fs::path dir = fs::temp_directory_path();
+  const std::string tag = std::to_string(::getpid());
+  const fs::path out = dir / ("inscribe_cli_out_" + tag), err = dir / ("inscribe_cli_err_" + tag);
+  const std::string command = std::string(INSCRIBE_CLI) + " " + args + " >" + out.string() +
+                              " 2>" + err.string();
+  const int status = std::system(command.c_str());
+  CliRun run;
+  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  run.out = Slurp(out);
+  run.err = Slurp(err);
+  fs::remove(out);
+  fs::remove(err);
+  return run;
+}
+
+std::string Quote(const std::string& s) { return "'" + s + "'"; }
+
+TEST(CliInfo, JsonOnARealMesh) {
+  INSCRIBE_REQUIRE_MESH("eight.off");
+  const CliRun run = RunCli("info --json " + Quote(testing::TestMeshPath("eight.off")));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_EQ(run.err, "");
+  const nlohmann::json j = nlohmann::json::parse(run.out);
+  EXPECT_TRUE(std::regex_match(j.at("mesh_sha256").get<std::string>(),
+                               std::regex("sha256:[0-9a-f]{64}")));
+  EXPECT_EQ(j.at("vertices").get<int>(), 315);  // header of eight.off: 315 634 0
+  EXPECT_EQ(j.at("triangles").get<int>(), 634);
+  EXPECT_TRUE(j.at("closed").get<bool>());
+  EXPECT_TRUE(j.at("usable").get<bool>());
+  EXPECT_GT(j.at("volume").get<double>(), 0.0);
+  EXPECT_EQ(j.at("bbox").at("min").size(), 3u);
+  EXPECT_EQ(j.at("bbox").at("max").size(), 3u);
+  // Exactly one line of JSON.
+  EXPECT_EQ(std::count(run.out.begin(), run.out.end(), '\n'), 1);
+}
+
+TEST(CliInfo, TextReport) {
+  INSCRIBE_REQUIRE_MESH("cow.off");
+  const CliRun run = RunCli("info " + Quote(testing::TestMeshPath("cow.off")));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_THAT(run.out, HasSubstr("sha256:"));
+  EXPECT_THAT(run.out, HasSubstr("self-intersections"));
+  EXPECT_THAT(run.out, HasSubstr("verdict              usable"));
+}
+
+TEST(CliInfo, HashIsStableAcrossRuns) {
+  INSCRIBE_REQUIRE_MESH("knot1.off");
+  const std::string args = "info --json " + Quote(testing::TestMeshPath("knot1.off"));
+  const auto a = nlohmann::json::parse(RunCli(args).out);
+  const auto b = nlohmann::json::parse(RunCli(args).out);
+  EXPECT_EQ(a.at("mesh_sha256"), b.at("mesh_sha256"));
+}
+
+TEST(CliInfo, OpenMeshFailsWithOneLineReason) {
+  INSCRIBE_REQUIRE_MESH("ChineseDragon-10kv.off");
+  const CliRun run = RunCli("info --json " + Quote(testing::TestMeshPath("ChineseDragon-10kv.off")));
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_THAT(run.err, HasSubstr("mesh is not closed: 6 border edges"));
+  EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1);
+  const nlohmann::json j = nlohmann::json::parse(run.out);
+  EXPECT_FALSE(j.at("closed").get<bool>());
+  EXPECT_FALSE(j.at("usable").get<bool>());
+}
+
+TEST(CliInfo, BadFilesFailWithOneLineReason) {
+  const fs::path dir = fs::temp_directory_path() / ("inscribe_cli_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  struct Case {
+    std::string name, contents, expected;
+  };
+  const std::vector<Case> cases = {
+      {"empty.off", "", "file is empty"},
+      {"cut.obj", "v 0 0 0\nv 1 0 0\nv 0 1", "coordinates, expected 3"},
+      {"index.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n", "refers to vertex 3"},
+      {"nan.off", "OFF\n3 1 0\n0 0 0\nnan 0 0\n0 1 0\n3 0 1 2\n", "not a finite number"},
+      {"text.off", "just some words\n", "expected the OFF header"},
+      {"notes.txt", "OFF\n", "unsupported mesh format"},
+  };
+  for (const Case& c : cases) {
+    std::ofstream(dir / c.name) << c.contents;
+    const CliRun run = RunCli("info " + Quote((dir / c.name).string()));
+    EXPECT_EQ(run.exit_code, 2) << c.name;
+    EXPECT_THAT(run.err, HasSubstr(c.expected)) << c.name;
+    EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << c.name << ": " << run.err;
+    EXPECT_EQ(run.out, "") << c.name;
+  }
+  const CliRun missing = RunCli("info " + Quote((dir / "missing.off").string()));
+  EXPECT_EQ(missing.exit_code, 2);
+  EXPECT_THAT(missing.err, HasSubstr("no such file"));
+  fs::remove_all(dir);
+}
+
+TEST(CliInfo, UsageErrors) {
+  EXPECT_NE(RunCli("").exit_code, 0);
+  EXPECT_NE(RunCli("info").exit_code, 0);
+  EXPECT_NE(RunCli("frobnicate x.off").exit_code, 0);
+  EXPECT_EQ(RunCli("--help").exit_code, 0);
+}
+
+}  // namespace
+}  // namespace inscribe

@@ -1,0 +1,221 @@
+#include "inscribe/mesh_io.h"
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/IO/polygon_soup_io.h>
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <array>
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+#include "inscribe/mesh_validation.h"
+#include "support/synthetic_meshes.h"
+#include "support/test_meshes.h"
+
+namespace inscribe {
+namespace {
+
+using ::testing::AllOf;
+using ::testing::HasSubstr;
+
+namespace fs = std::filesystem;
+
+class MeshFileTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("inscribe_io_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  std::string Write(const std::string& name, const std::string& bytes) {
+    const fs::path path = dir_ / name;
+    std::ofstream(path, std::ios::binary) << bytes;
+    return path.string();
+  }
+
+  // Writes `mesh` with CGAL's writer (an independent path from our reader's caller).
+  std::string WriteWithCgal(const std::string& name, const Mesh& mesh, bool binary) {
+    using Point = CGAL::Exact_predicates_inexact_constructions_kernel::Point_3;
+    std::vector<Point> points;
+    for (Eigen::Index v = 0; v < mesh.num_vertices(); ++v) {
+      points.emplace_back(mesh.vertices(v, 0), mesh.vertices(v, 1), mesh.vertices(v, 2));
+    }
+    std::vector<std::array<std::size_t, 3>> faces;
+    for (Eigen::Index t = 0; t < mesh.num_triangles(); ++t) {
+      faces.push_back({static_cast<std::size_t>(mesh.triangles(t, 0)),
+                       static_cast<std::size_t>(mesh.triangles(t, 1)),
+                       static_cast<std::size_t>(mesh.triangles(t, 2))});
+    }
+    const std::string path = (dir_ / name).string();
+    EXPECT_TRUE(CGAL::IO::write_polygon_soup(path, points, faces,
+                                             CGAL::parameters::use_binary_mode(binary)
+                                                 .stream_precision(17)));
+    return path;
+  }
+
+  fs::path dir_;
+};
+
+TEST_F(MeshFileTest, ReadsEveryFormatBack) {
+  const Mesh sphere = testing::Icosphere(2, Vector3(0.5, -1, 2), 1.5);
+  const double expected_volume = SignedVolume(sphere);
+  for (const auto& [name, binary] : std::vector<std::pair<std::string, bool>>{
+           {"a.off", false}, {"a.obj", false}, {"a.stl", false}, {"b.stl", true},
+           {"a.ply", false}, {"b.ply", true}, {"UPPER.OFF", false}}) {
+    SCOPED_TRACE(name);
+    const std::string path = WriteWithCgal(name, sphere, binary);
+    absl::StatusOr<Mesh> mesh = ReadMesh(path);
+    ASSERT_TRUE(mesh.ok()) << mesh.status();
+    EXPECT_EQ(mesh->num_triangles(), sphere.num_triangles());
+    absl::StatusOr<ValidatedMesh> prepared = PrepareMesh(*std::move(mesh));
+    ASSERT_TRUE(prepared.ok()) << prepared.status();
+    // Binary STL stores single precision.
+    EXPECT_NEAR(prepared->report.volume, expected_volume, binary ? 1e-5 : 1e-12);
+  }
+}
+
+TEST_F(MeshFileTest, TriangulatesPolygons) {
+  // A cube of quads, one face given as a non-convex hexagon... of the same square.
+  const std::string path = Write("quads.off",
+                                 "OFF\n8 6 0\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n0 0 1\n1 0 1\n0 1 1\n"
+                                 "1 1 1\n4 0 2 3 1\n4 4 5 7 6\n4 0 1 5 4\n4 2 6 7 3\n4 0 4 6 2\n"
+                                 "4 1 3 7 5\n");
+  ReadMeshInfo info;
+  absl::StatusOr<Mesh> mesh = ReadMesh(path, &info);
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  EXPECT_EQ(info.polygons, 6);
+  EXPECT_EQ(info.polygons_triangulated, 6);
+  EXPECT_EQ(mesh->num_triangles(), 12);
+  absl::StatusOr<ValidatedMesh> prepared = PrepareMesh(*std::move(mesh));
+  ASSERT_TRUE(prepared.ok()) << prepared.status();
+  EXPECT_NEAR(prepared->report.volume, 1.0, 1e-15);
+}
+
+TEST_F(MeshFileTest, CgalQuadCube) {
+  INSCRIBE_REQUIRE_MESH("cube_quad.off");
+  absl::StatusOr<Mesh> mesh = ReadMesh(testing::TestMeshPath("cube_quad.off"));
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  absl::StatusOr<ValidatedMesh> prepared = PrepareMesh(*std::move(mesh));
+  ASSERT_TRUE(prepared.ok()) << prepared.status();
+  EXPECT_GT(prepared->report.volume, 0.0);
+}
+
+// The bad inputs of the foundation issue: each a clear error naming the problem.
+
+TEST_F(MeshFileTest, ChineseDragonIsNotClosed) {
+  INSCRIBE_REQUIRE_MESH("ChineseDragon-10kv.off");
+  absl::StatusOr<Mesh> mesh = ReadMesh(testing::TestMeshPath("ChineseDragon-10kv.off"));
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  absl::StatusOr<ValidatedMesh> prepared = PrepareMesh(*std::move(mesh));
+  ASSERT_FALSE(prepared.ok());
+  EXPECT_EQ(prepared.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(prepared.status().message(),
+              AllOf(HasSubstr("not closed"), HasSubstr("6 border edges")));
+}
+
+TEST_F(MeshFileTest, EmptyFile) {
+  for (const char* name : {"empty.off", "empty.obj", "empty.stl", "empty.ply"}) {
+    absl::StatusOr<Mesh> mesh = ReadMesh(Write(name, ""));
+    ASSERT_FALSE(mesh.ok()) << name;
+    EXPECT_THAT(mesh.status().message(), HasSubstr("file is empty")) << name;
+  }
+}
+
+TEST_F(MeshFileTest, TruncatedObj) {
+  const std::string whole = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\n";
+  // Cut inside a vertex line and inside a face line.
+  absl::StatusOr<Mesh> cut_vertex = ReadMesh(Write("v.obj", whole.substr(0, 20)));
+  ASSERT_FALSE(cut_vertex.ok());
+  EXPECT_THAT(cut_vertex.status().message(),
+              AllOf(HasSubstr("line 3"), HasSubstr("coordinates, expected 3")));
+  absl::StatusOr<Mesh> cut_face = ReadMesh(Write("f.obj", whole.substr(0, whole.size() - 3)));
+  ASSERT_FALSE(cut_face.ok());
+  EXPECT_THAT(std::string(cut_face.status().message()), HasSubstr("face 2 has 2 corners"));
+  // Whole faces missing: the file parses, and validation says the surface is open.
+  absl::StatusOr<Mesh> missing_face = ReadMesh(Write("m.obj", whole));
+  ASSERT_TRUE(missing_face.ok()) << missing_face.status();
+  absl::StatusOr<ValidatedMesh> prepared = PrepareMesh(*std::move(missing_face));
+  ASSERT_FALSE(prepared.ok());
+  EXPECT_THAT(prepared.status().message(), HasSubstr("not closed: 3 border edges"));
+}
+
+TEST_F(MeshFileTest, TruncatedOff) {
+  absl::StatusOr<Mesh> mesh =
+      ReadMesh(Write("t.off", "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n"));
+  ASSERT_FALSE(mesh.ok());
+  EXPECT_THAT(mesh.status().message(), HasSubstr("file ends after 2 of 4 faces"));
+}
+
+TEST_F(MeshFileTest, FaceIndexOutOfRange) {
+  absl::StatusOr<Mesh> off = ReadMesh(Write(
+      "i.off", "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 9\n"));
+  ASSERT_FALSE(off.ok());
+  EXPECT_THAT(off.status().message(),
+              AllOf(HasSubstr("line 10"), HasSubstr("face 3 refers to vertex 9"),
+                    HasSubstr("4 vertices")));
+  absl::StatusOr<Mesh> obj = ReadMesh(
+      Write("i.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 5\n"));
+  ASSERT_FALSE(obj.ok());
+  EXPECT_THAT(obj.status().message(), HasSubstr("face 3 refers to vertex 5"));
+}
+
+TEST_F(MeshFileTest, NanCoordinate) {
+  for (const char* value : {"nan", "NaN", "inf", "-inf"}) {
+    absl::StatusOr<Mesh> mesh = ReadMesh(
+        Write("n.off", std::string("OFF\n4 4 0\n0 0 0\n1 0 0\n") + value +
+                           " 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n"));
+    ASSERT_FALSE(mesh.ok()) << value;
+    EXPECT_THAT(mesh.status().message(),
+                AllOf(HasSubstr("vertex 2"), HasSubstr("not a finite number")))
+        << value;
+  }
+}
+
+TEST_F(MeshFileTest, NotAMesh) {
+  std::mt19937 rng(7);
+  std::string garbage(4096, '\0');
+  for (char& c : garbage) c = static_cast<char>(rng() & 0xff);
+  for (const char* name : {"g.off", "g.obj", "g.stl", "g.ply"}) {
+    absl::StatusOr<Mesh> mesh = ReadMesh(Write(name, garbage));
+    EXPECT_FALSE(mesh.ok()) << name;
+    EXPECT_THAT(mesh.status().message(), HasSubstr(name));
+  }
+  absl::StatusOr<Mesh> text = ReadMesh(Write("readme.obj", "This is a README, not a mesh.\n"));
+  ASSERT_FALSE(text.ok());
+  EXPECT_THAT(text.status().message(), HasSubstr("'This' is not an OBJ statement"));
+  absl::StatusOr<Mesh> off = ReadMesh(Write("readme.off", "This is a README, not a mesh.\n"));
+  ASSERT_FALSE(off.ok());
+  EXPECT_THAT(off.status().message(), HasSubstr("expected the OFF header"));
+}
+
+TEST_F(MeshFileTest, MissingFile) {
+  absl::StatusOr<Mesh> mesh = ReadMesh((dir_ / "nope.off").string());
+  ASSERT_FALSE(mesh.ok());
+  EXPECT_EQ(mesh.status().code(), absl::StatusCode::kNotFound);
+  EXPECT_THAT(mesh.status().message(), HasSubstr("no such file"));
+}
+
+TEST_F(MeshFileTest, UnsupportedExtensionAndDirectory) {
+  absl::StatusOr<Mesh> txt = ReadMesh(Write("mesh.txt", "OFF\n"));
+  ASSERT_FALSE(txt.ok());
+  EXPECT_THAT(txt.status().message(), HasSubstr("unsupported mesh format 'txt'"));
+  absl::StatusOr<Mesh> dir = ReadMesh(dir_.string());
+  ASSERT_FALSE(dir.ok());
+  EXPECT_THAT(dir.status().message(), HasSubstr("is a directory"));
+}
+
+TEST(ParseMesh, FromMemory) {
+  absl::StatusOr<Mesh> mesh = ParseMesh(
+      "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n", "OFF");
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  EXPECT_EQ(mesh->num_vertices(), 4);
+  EXPECT_FALSE(ParseMesh("solid x\n", "3ds").ok());
+}
+
+}  // namespace
+}  // namespace inscribe

@@ -1,0 +1,244 @@
+#include "inscribe/mesh_validation.h"
+#include "inscribe/mesh_io.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "support/synthetic_meshes.h"
+#include "support/test_meshes.h"
+
+namespace inscribe {
+namespace {
+
+using ::testing::HasSubstr;
+using testing::Box;
+using testing::Concatenate;
+using testing::Icosphere;
+using testing::Inverted;
+using testing::UnitCube;
+
+bool HasIssue(const MeshReport& report, const std::string& code, Severity severity) {
+  for (const MeshIssue& issue : report.issues) {
+    if (issue.code == code && issue.severity == severity) return true;
+  }
+  return false;
+}
+
+TEST(ValidateMesh, CleanCube) {
+  const ValidatedMesh v = ValidateMesh(UnitCube());
+  EXPECT_TRUE(v.report.usable());
+  EXPECT_TRUE(v.report.closed());
+  EXPECT_TRUE(v.report.issues.empty()) << v.report.issues.front().message;
+  EXPECT_EQ(v.report.components, 1);
+  EXPECT_TRUE(v.report.self_intersections_checked);
+  EXPECT_NEAR(v.report.volume, 1.0, 1e-15);
+  EXPECT_EQ(v.mesh.triangles, UnitCube().triangles);
+}
+
+TEST(ValidateMesh, InvertedMeshIsFixed) {
+  const Mesh sphere = Icosphere(3);
+  const ValidatedMesh v = ValidateMesh(Inverted(sphere));
+  EXPECT_TRUE(v.report.usable());
+  EXPECT_EQ(v.report.flipped_triangles, sphere.num_triangles());
+  EXPECT_TRUE(HasIssue(v.report, "orientation_fixed", Severity::kFixed));
+  EXPECT_NEAR(v.report.volume, SignedVolume(sphere), 1e-12);
+  EXPECT_EQ(v.mesh.triangles, sphere.triangles);
+}
+
+TEST(ValidateMesh, InconsistentTrianglesAreFixed) {
+  Mesh sphere = Icosphere(2);
+  Mesh broken = sphere;
+  for (int t : {3, 50, 51, 200}) std::swap(broken.triangles(t, 1), broken.triangles(t, 2));
+  const ValidatedMesh v = ValidateMesh(broken);
+  EXPECT_TRUE(v.report.usable()) << v.report.first_error();
+  EXPECT_GT(v.report.inconsistent_edges, 0);
+  EXPECT_EQ(v.report.flipped_triangles, 4);
+  EXPECT_EQ(v.mesh.triangles, sphere.triangles);
+}
+
+TEST(ValidateMesh, NoFixWhenAsked) {
+  ValidateOptions options;
+  options.fix_orientation = false;
+  const ValidatedMesh v = ValidateMesh(Inverted(UnitCube()), options);
+  EXPECT_FALSE(v.report.usable());  // negative volume
+  EXPECT_THAT(v.report.first_error(), HasSubstr("no volume"));
+}
+
+TEST(ValidateMesh, CavityFacesInward) {
+  // A hollow box: the inner shell must face into the cavity, whatever it was given as.
+  const Mesh outer = Box(Vector3(-2, -2, -2), Vector3(2, 2, 2));
+  const Mesh inner = Box(Vector3(-1, -1, -1), Vector3(1, 1, 1));
+  for (const Mesh& given : {Concatenate(outer, inner), Concatenate(Inverted(outer), inner),
+                            Concatenate(outer, Inverted(inner))}) {
+    const ValidatedMesh v = ValidateMesh(given);
+    EXPECT_TRUE(v.report.usable()) << v.report.first_error();
+    EXPECT_EQ(v.report.components, 2);
+    EXPECT_NEAR(v.report.volume, 64.0 - 8.0, 1e-12);
+  }
+  // Two separate boxes both face out.
+  const ValidatedMesh apart = ValidateMesh(
+      Concatenate(Inverted(inner), Box(Vector3(5, 5, 5), Vector3(6, 6, 6))));
+  EXPECT_NEAR(apart.report.volume, 9.0, 1e-12);
+}
+
+TEST(ValidateMesh, OpenMesh) {
+  Mesh open = UnitCube();
+  open.triangles.conservativeResize(11, 3);
+  const ValidatedMesh v = ValidateMesh(open);
+  EXPECT_FALSE(v.report.usable());
+  EXPECT_FALSE(v.report.closed());
+  EXPECT_EQ(v.report.border_edges, 3);
+  EXPECT_THAT(v.report.first_error(), HasSubstr("mesh is not closed: 3 border edges"));
+  EXPECT_FALSE(PrepareMesh(open).ok());
+}
+
+TEST(ValidateMesh, NonManifoldEdge) {
+  // Two cubes sharing one edge (x = 1, y = 1): that edge is in four triangles.
+  const Mesh v = Concatenate(UnitCube(), Box(Vector3(1, 1, 0), Vector3(2, 2, 1)));
+  // Weld the duplicated edge vertices so the edge is really shared.
+  Mesh welded = v;
+  for (Eigen::Index t = 0; t < welded.triangles.rows(); ++t) {
+    for (int k = 0; k < 3; ++k) {
+      const std::int32_t i = welded.triangles(t, k);
+      if (i < 8) continue;
+      for (std::int32_t j = 0; j < 8; ++j) {
+        if (welded.vertices.row(i) == welded.vertices.row(j)) welded.triangles(t, k) = j;
+      }
+    }
+  }
+  const ValidatedMesh r = ValidateMesh(welded);
+  EXPECT_FALSE(r.report.usable());
+  EXPECT_EQ(r.report.non_manifold_edges, 1);
+  EXPECT_THAT(r.report.first_error(), HasSubstr("not edge-manifold: 1 edge is shared by more"));
+}
+
+TEST(ValidateMesh, NonManifoldVertexIsAWarning) {
+  // Two cubes touching at one corner (1, 1, 1), welded there.
+  Mesh touching = Concatenate(UnitCube(), Box(Vector3(1, 1, 1), Vector3(2, 2, 2)));
+  for (Eigen::Index t = 0; t < touching.triangles.rows(); ++t) {
+    for (int k = 0; k < 3; ++k) {
+      if (touching.triangles(t, k) == 8) touching.triangles(t, k) = 7;
+    }
+  }
+  const ValidatedMesh v = ValidateMesh(touching);
+  EXPECT_EQ(v.report.non_manifold_vertices, 1);
+  EXPECT_TRUE(HasIssue(v.report, "non_manifold_vertices", Severity::kWarning));
+  EXPECT_TRUE(v.report.usable());
+}
+
+TEST(ValidateMesh, NonFiniteCoordinates) {
+  Mesh mesh = UnitCube();
+  mesh.vertices(5, 2) = std::numeric_limits<double>::quiet_NaN();
+  mesh.vertices(6, 0) = std::numeric_limits<double>::infinity();
+  const ValidatedMesh v = ValidateMesh(mesh);
+  EXPECT_FALSE(v.report.usable());
+  EXPECT_EQ(v.report.non_finite_vertices, 2);
+  EXPECT_THAT(v.report.first_error(), HasSubstr("2 vertices have non-finite"));
+  EXPECT_THAT(v.report.first_error(), HasSubstr("vertex 5"));
+}
+
+TEST(ValidateMesh, IndicesOutOfRange) {
+  Mesh mesh = UnitCube();
+  mesh.triangles(4, 1) = 8;
+  mesh.triangles(7, 0) = -3;
+  const ValidatedMesh v = ValidateMesh(mesh);
+  EXPECT_FALSE(v.report.usable());
+  EXPECT_EQ(v.report.out_of_range_indices, 2);
+  EXPECT_THAT(v.report.first_error(), HasSubstr("triangle 4 corner 1 = 8"));
+}
+
+TEST(ValidateMesh, EmptyMesh) {
+  const ValidatedMesh v = ValidateMesh(Mesh{});
+  EXPECT_FALSE(v.report.usable());
+  EXPECT_THAT(v.report.first_error(), HasSubstr("no triangles"));
+}
+
+TEST(ValidateMesh, DegenerateTrianglesAreWarnings) {
+  // Split the cube's first triangle (0, 2, 1) at the midpoint of edge 2-1 with a zero-area
+  // sliver so the surface stays closed: add vertex m on edge 2-1.
+  Mesh mesh = UnitCube();
+  mesh.vertices.conservativeResize(9, 3);
+  mesh.vertices.row(8) = 0.5 * (mesh.vertices.row(2) + mesh.vertices.row(1));
+  // (0,2,1) -> (0,2,8) + (0,8,1); neighbour (1,2,3) -> (1,8,3) + (8,2,3).
+  mesh.triangles.row(0) << 0, 2, 8;
+  mesh.triangles.row(1) << 1, 8, 3;
+  mesh.triangles.conservativeResize(15, 3);
+  mesh.triangles.row(12) << 0, 8, 1;
+  mesh.triangles.row(13) << 8, 2, 3;
+  mesh.triangles.row(14) << 2, 8, 2;  // repeats a corner
+  const ValidatedMesh v = ValidateMesh(mesh);
+  EXPECT_TRUE(v.report.usable()) << v.report.first_error();
+  EXPECT_EQ(v.report.degenerate_triangles, 1);
+  EXPECT_TRUE(HasIssue(v.report, "degenerate_triangles", Severity::kWarning));
+  EXPECT_NEAR(v.report.volume, 1.0, 1e-15);
+}
+
+TEST(ValidateMesh, SelfIntersectionsAreReported) {
+  // Corner (1, 1, 1) pushed through the bottom face.
+  Mesh pierced = UnitCube();
+  pierced.vertices.row(7) << 0.3, 0.3, -0.5;
+  const ValidatedMesh v = ValidateMesh(pierced);
+  EXPECT_TRUE(v.report.self_intersections_checked);
+  EXPECT_GT(v.report.self_intersecting_pairs, 0);
+  EXPECT_TRUE(HasIssue(v.report, "self_intersections", Severity::kWarning));
+  EXPECT_TRUE(v.report.usable());
+  ValidateOptions skip;
+  skip.check_self_intersections = false;
+  EXPECT_FALSE(ValidateMesh(pierced, skip).report.self_intersections_checked);
+}
+
+TEST(ValidateMesh, OverlappingShellsAreNotCavities) {
+  // Two overlapping boxes given as one mesh (an unresolved union): both must face out.
+  const Mesh overlapping =
+      Concatenate(UnitCube(), Inverted(Box(Vector3(0.5, 0.5, 0.5), Vector3(1.5, 1.5, 1.5))));
+  const ValidatedMesh v = ValidateMesh(overlapping);
+  EXPECT_TRUE(v.report.usable()) << v.report.first_error();
+  EXPECT_NEAR(v.report.volume, 2.0, 1e-12);
+  EXPECT_EQ(v.report.self_intersecting_pairs, 18);
+}
+
+TEST(ValidateMesh, DuplicatedFaceIsNonManifold) {
+  // A tetrahedron with one face listed again, reversed: its three edges are in three triangles.
+  Mesh tet;
+  tet.vertices.resize(4, 3);
+  tet.vertices << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1;
+  tet.triangles.resize(5, 3);
+  tet.triangles << 0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3, 1, 3, 2;
+  const ValidatedMesh v = ValidateMesh(tet);
+  EXPECT_FALSE(v.report.usable());
+  EXPECT_EQ(v.report.duplicate_triangles, 1);
+  EXPECT_EQ(v.report.non_manifold_edges, 3);
+}
+
+class RealMeshes : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(RealMeshes, AreUsableClosedAndOutward) {
+  INSCRIBE_REQUIRE_MESH(GetParam());
+  const Mesh mesh = testing::LoadTestMesh(GetParam());
+  const ValidatedMesh v = ValidateMesh(mesh);
+  EXPECT_TRUE(v.report.usable()) << v.report.first_error();
+  EXPECT_TRUE(v.report.closed());
+  EXPECT_EQ(v.report.flipped_triangles, 0);  // LoadTestMesh already oriented it
+  EXPECT_GT(v.report.volume, 0.0);
+  EXPECT_LT(v.report.volume, v.report.bbox.extent().prod());
+}
+
+INSTANTIATE_TEST_SUITE_P(Cgal, RealMeshes,
+                         ::testing::Values("eight.off", "cow.off", "elephant.off", "knot1.off",
+                                           "fandisk.off", "bunny00.off"));
+
+TEST(ValidateMesh, CgalPigIsOpen) {
+  // CGAL's pig.off has 891 triangles: an odd count cannot close up.
+  INSCRIBE_REQUIRE_MESH("pig.off");
+  absl::StatusOr<Mesh> pig = ReadMesh(testing::TestMeshPath("pig.off"));
+  ASSERT_TRUE(pig.ok());
+  const ValidatedMesh v = ValidateMesh(*pig);
+  EXPECT_EQ(v.report.border_edges, 55);
+  EXPECT_FALSE(v.report.usable());
+}
+
+}  // namespace
+}  // namespace inscribe

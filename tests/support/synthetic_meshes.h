@@ -1,0 +1,22 @@
+// Small meshes built in code, with known volumes, for tests.
+#pragma once
+
+#include "inscribe/mesh.h"
+
+namespace inscribe::testing {
+
+// Axis-aligned box [lo, hi], 8 vertices, 12 triangles, outward orientation.
+Mesh Box(const Vector3& lo, const Vector3& hi);
+inline Mesh UnitCube() { return Box(Vector3::Zero(), Vector3::Ones()); }
+
+// Icosahedron subdivided `levels` times, vertices projected on the sphere (centre, radius).
+// 20 * 4^levels triangles, outward orientation.
+Mesh Icosphere(int levels, const Vector3& centre = Vector3::Zero(), double radius = 1.0);
+
+// Vertices and triangles of `b` appended to `a` (indices shifted).
+Mesh Concatenate(const Mesh& a, const Mesh& b);
+
+// Every triangle reversed.
+Mesh Inverted(Mesh mesh);
+
+}  // namespace inscribe::testing

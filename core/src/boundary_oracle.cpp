@@ -24,15 +24,13 @@ float RoundDown(double x) {
 
 float RoundUp(double x) {
   float f = static_cast<float>(x);
-  return static_cast<double>(f) < x ? std::nextafter(f, std::numeric_limits<float>::infinity())
-                                    : f;
+  return static_cast<double>(f) < x ? std::nextafter(f, std::numeric_limits<float>::infinity()) : f;
 }
 
 absl::Status CheckVertices(const Vertices& vertices) {
   for (Eigen::Index v = 0; v < vertices.rows(); ++v) {
     if (!vertices.row(v).allFinite()) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("vertex ", v, " has a non-finite coordinate"));
+      return absl::InvalidArgumentError(absl::StrCat("vertex ", v, " has a non-finite coordinate"));
     }
   }
   return absl::OkStatus();
@@ -107,9 +105,8 @@ void BoundaryOracle::Impl::ComputeNormals() {
   }
   for (std::size_t side = 0; side < 3 * nt; ++side) {
     const Vector3& own = face_normals[side / 3];
-    edge_normals[side] = across[side] >= 0
-                             ? own + face_normals[static_cast<std::size_t>(across[side])]
-                             : own;
+    edge_normals[side] =
+        across[side] >= 0 ? own + face_normals[static_cast<std::size_t>(across[side])] : own;
   }
 }
 
@@ -170,7 +167,6 @@ absl::Status BoundaryOracle::Impl::BuildScene() {
   return absl::OkStatus();
 }
 
-
 struct BoundaryOracle::Impl::QueryState {
   const Impl* impl;
   Vector3 p;
@@ -183,9 +179,9 @@ bool BoundaryOracle::Impl::VisitTriangle(RTCPointQueryFunctionArguments* args) {
   auto* state = static_cast<QueryState*>(args->userPtr);
   const auto t = static_cast<std::int32_t>(args->primID);
   Vector3 bary;
-  const Vector3 q = internal::ClosestPointOnTriangle(
-      state->p, state->impl->Corner(t, 0), state->impl->Corner(t, 1), state->impl->Corner(t, 2),
-      &bary);
+  const Vector3 q =
+      internal::ClosestPointOnTriangle(state->p, state->impl->Corner(t, 0),
+                                       state->impl->Corner(t, 1), state->impl->Corner(t, 2), &bary);
   const double d2 = (state->p - q).squaredNorm();
   // Ties go to the lower triangle index so that results do not depend on traversal order.
   if (d2 < state->best_squared || (d2 == state->best_squared && t < state->best.triangle)) {
@@ -340,9 +336,8 @@ absl::StatusOr<BoundaryOracle> BoundaryOracle::Build(const Mesh& mesh,
     for (int k = 0; k < 3; ++k) {
       const std::int32_t v = mesh.triangles(t, k);
       if (v < 0 || v >= mesh.num_vertices()) {
-        return absl::InvalidArgumentError(absl::StrCat("boundary oracle: triangle ", t,
-                                                       " refers to vertex ", v, " of ",
-                                                       mesh.num_vertices()));
+        return absl::InvalidArgumentError(absl::StrCat(
+            "boundary oracle: triangle ", t, " refers to vertex ", v, " of ", mesh.num_vertices()));
       }
     }
   }
@@ -399,7 +394,7 @@ Side BoundaryOracle::Classify(const Vector3& query) const {
 double BoundaryOracle::SignedDistance(const Vector3& query) const {
   const BoundaryPoint closest = impl_->Closest(query);
   return impl_->ClassifyFrom(query, closest) == Side::kInside ? -closest.distance
-                                                               : closest.distance;
+                                                              : closest.distance;
 }
 
 std::vector<BoundaryPoint> BoundaryOracle::ClosestPoints(const Vertices& queries) const {

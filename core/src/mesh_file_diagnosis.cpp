@@ -4,13 +4,13 @@
 #include <cmath>
 #include <cstdlib>
 #include <sstream>
-#include "absl/strings/string_view.h"
 #include <vector>
 
 #include "absl/strings/ascii.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
+#include "absl/strings/string_view.h"
 
 namespace inscribe::internal {
 namespace {
@@ -64,8 +64,7 @@ std::string DiagnoseOff(const std::vector<Line>& lines) {
   std::int64_t nv = 0, nf = 0;
   if (counts.tokens.size() < first + 2 || !absl::SimpleAtoi(counts.tokens[first], &nv) ||
       !absl::SimpleAtoi(counts.tokens[first + 1], &nf) || nv < 0 || nf < 0) {
-    return absl::StrCat("line ", counts.number,
-                        ": expected the vertex, face and edge counts");
+    return absl::StrCat("line ", counts.number, ": expected the vertex, face and edge counts");
   }
   ++i;
   for (std::int64_t v = 0; v < nv; ++v, ++i) {
@@ -101,8 +100,7 @@ std::string DiagnoseOff(const std::vector<Line>& lines) {
       std::int64_t index = 0;
       if (!absl::SimpleAtoi(line.tokens[static_cast<std::size_t>(k)], &index)) {
         return absl::StrCat("line ", line.number, ": face ", f, ": '",
-                            line.tokens[static_cast<std::size_t>(k)],
-                            "' is not a vertex index");
+                            line.tokens[static_cast<std::size_t>(k)], "' is not a vertex index");
       }
       if (index < 0 || index >= nv) {
         return absl::StrCat("line ", line.number, ": face ", f, " refers to vertex ", index,
@@ -142,8 +140,8 @@ std::string DiagnoseObj(const std::vector<Line>& lines) {
         }
         const std::int64_t resolved = index > 0 ? index : vertices + 1 + index;
         if (resolved < 1 || resolved > vertices) {
-          return absl::StrCat("line ", line.number, ": face ", faces, " refers to vertex ",
-                              index, ", but only ", vertices,
+          return absl::StrCat("line ", line.number, ": face ", faces, " refers to vertex ", index,
+                              ", but only ", vertices,
                               " vertices precede it (indices are 1-based)");
         }
       }

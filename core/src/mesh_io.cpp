@@ -92,9 +92,8 @@ absl::StatusOr<Mesh> SoupToMesh(const std::vector<Point>& points,
                                 ReadMeshInfo* info) {
   constexpr std::int64_t kMaxIndex = std::numeric_limits<std::int32_t>::max();
   if (static_cast<std::int64_t>(points.size()) > kMaxIndex) {
-    return absl::InvalidArgumentError(
-        absl::StrCat(what, ": ", points.size(), " vertices is more than inscribe supports (",
-                     kMaxIndex, ")"));
+    return absl::InvalidArgumentError(absl::StrCat(
+        what, ": ", points.size(), " vertices is more than inscribe supports (", kMaxIndex, ")"));
   }
   std::vector<std::array<std::int64_t, 3>> triangles;
   triangles.reserve(polygons.size());
@@ -102,8 +101,7 @@ absl::StatusOr<Mesh> SoupToMesh(const std::vector<Point>& points,
   for (std::size_t f = 0; f < polygons.size(); ++f) {
     const Polygon& polygon = polygons[f];
     if (polygon.size() < 3) {
-      return absl::InvalidArgumentError(absl::StrCat(what, ": face ", f, " has ",
-                                                     polygon.size(),
+      return absl::InvalidArgumentError(absl::StrCat(what, ": face ", f, " has ", polygon.size(),
                                                      " corners; a face needs at least 3"));
     }
     for (std::size_t corner : polygon) {
@@ -126,8 +124,8 @@ absl::StatusOr<Mesh> SoupToMesh(const std::vector<Point>& points,
     }
   }
   if (static_cast<std::int64_t>(triangles.size()) > kMaxIndex) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        what, ": ", triangles.size(), " triangles is more than inscribe supports"));
+    return absl::InvalidArgumentError(
+        absl::StrCat(what, ": ", triangles.size(), " triangles is more than inscribe supports"));
   }
   Mesh mesh;
   mesh.vertices.resize(static_cast<Eigen::Index>(points.size()), 3);
@@ -157,8 +155,8 @@ absl::StatusOr<Mesh> SoupToMesh(const std::vector<Point>& points,
 absl::StatusOr<Mesh> ParseNamed(const std::string& bytes, const std::string& format,
                                 const std::string& what, ReadMeshInfo* info) {
   if (format != "off" && format != "obj" && format != "stl" && format != "ply") {
-    return absl::InvalidArgumentError(absl::StrCat(
-        what, ": unsupported mesh format '", format, "' (expected off, obj, stl or ply)"));
+    return absl::InvalidArgumentError(absl::StrCat(what, ": unsupported mesh format '", format,
+                                                   "' (expected off, obj, stl or ply)"));
   }
   if (bytes.find_first_not_of(" \t\r\n") == std::string::npos) {
     return absl::InvalidArgumentError(absl::StrCat(what, ": file is empty"));
@@ -176,12 +174,11 @@ absl::StatusOr<Mesh> ParseNamed(const std::string& bytes, const std::string& for
   if (!ok) {
     std::string why = internal::DiagnoseMeshText(bytes, format);
     if (why.empty()) why = "the reader stopped on malformed or truncated data";
-    return absl::InvalidArgumentError(
-        absl::StrCat(what, ": not a valid ", format, " file: ", why));
+    return absl::InvalidArgumentError(absl::StrCat(what, ": not a valid ", format, " file: ", why));
   }
   if (points.empty() || polygons.empty()) {
-    return absl::InvalidArgumentError(absl::StrCat(what, ": no ", points.empty() ? "vertices" : "faces",
-                                                   " found in the ", format, " file"));
+    return absl::InvalidArgumentError(absl::StrCat(
+        what, ": no ", points.empty() ? "vertices" : "faces", " found in the ", format, " file"));
   }
   return SoupToMesh(points, polygons, bytes, format, what, info);
 }

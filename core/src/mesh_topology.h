@@ -11,10 +11,10 @@ namespace inscribe::internal {
 
 // One undirected edge and the triangle sides that use it.
 struct EdgeUse {
-  std::int32_t lo, hi;        // vertex indices, lo < hi
-  std::int32_t triangle;      // triangle using it
-  std::int8_t side;           // k: the side from corner k to corner (k + 1) % 3
-  bool forward;               // true when the triangle walks it lo -> hi
+  std::int32_t lo, hi;    // vertex indices, lo < hi
+  std::int32_t triangle;  // triangle using it
+  std::int8_t side;       // k: the side from corner k to corner (k + 1) % 3
+  bool forward;           // true when the triangle walks it lo -> hi
 };
 
 // All sides of all triangles with three distinct in-range corners, sorted by (lo, hi,

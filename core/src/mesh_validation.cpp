@@ -59,7 +59,9 @@ double ComponentVolume(const Mesh& mesh, const std::vector<std::int32_t>& triang
   return six_volume / 6.0;
 }
 
-void FlipTriangle(Mesh& mesh, Eigen::Index t) { std::swap(mesh.triangles(t, 1), mesh.triangles(t, 2)); }
+void FlipTriangle(Mesh& mesh, Eigen::Index t) {
+  std::swap(mesh.triangles(t, 1), mesh.triangles(t, 2));
+}
 
 // Checks that every coordinate is finite and every index names a vertex. Returns false when
 // the mesh cannot be examined further.
@@ -98,8 +100,7 @@ bool CheckIndicesAndCoordinates(const Mesh& mesh, MeshReport& report) {
              absl::StrCat(Plural(report.out_of_range_indices, "triangle corner refers",
                                  "triangle corners refer"),
                           " to no vertex (first: triangle ", first_triangle, " corner ",
-                          first_corner, " = ", first_value, "; valid indices are 0..", nv - 1,
-                          ")"),
+                          first_corner, " = ", first_value, "; valid indices are 0..", nv - 1, ")"),
              report.out_of_range_indices);
   }
   if (mesh.num_triangles() == 0) {
@@ -118,9 +119,10 @@ void CheckDegenerateAndDuplicate(const Mesh& mesh, MeshReport& report) {
   const std::int64_t collinear = internal::CountCollinearTriangles(mesh, &first_collinear);
   report.degenerate_triangles = repeated + collinear;
   if (report.degenerate_triangles > 0) {
-    const std::int64_t first = first_repeated >= 0 && (first_collinear < 0 || first_repeated < first_collinear)
-                                   ? first_repeated
-                                   : first_collinear;
+    const std::int64_t first =
+        first_repeated >= 0 && (first_collinear < 0 || first_repeated < first_collinear)
+            ? first_repeated
+            : first_collinear;
     AddIssue(report, Severity::kWarning, "degenerate_triangles",
              absl::StrCat(Plural(report.degenerate_triangles, "triangle has", "triangles have"),
                           " zero area (", repeated, " repeat a corner, ", collinear,
@@ -148,12 +150,11 @@ void CheckDegenerateAndDuplicate(const Mesh& mesh, MeshReport& report) {
     }
   }
   if (report.duplicate_triangles > 0) {
-    AddIssue(report, Severity::kWarning, "duplicate_triangles",
-             absl::StrCat(Plural(report.duplicate_triangles, "triangle repeats",
-                                 "triangles repeat"),
-                          " the corners of an earlier one (first: triangle ", first_duplicate,
-                          ")"),
-             report.duplicate_triangles);
+    AddIssue(
+        report, Severity::kWarning, "duplicate_triangles",
+        absl::StrCat(Plural(report.duplicate_triangles, "triangle repeats", "triangles repeat"),
+                     " the corners of an earlier one (first: triangle ", first_duplicate, ")"),
+        report.duplicate_triangles);
   }
 
   std::vector<char> used(static_cast<std::size_t>(mesh.num_vertices()), 0);
@@ -206,19 +207,20 @@ void CheckEdges(const Mesh& mesh, const std::vector<EdgeUse>& uses, const EdgeGr
   }
   if (report.border_edges > 0) {
     AddIssue(report, Severity::kError, "not_closed",
-             absl::StrCat("mesh is not closed: ", Plural(report.border_edges, "border edge", "border edges"),
-                          " (edges in only one triangle; first: vertices ", first_border->lo,
-                          "-", first_border->hi, " in triangle ", first_border->triangle, ")"),
+             absl::StrCat(
+                 "mesh is not closed: ", Plural(report.border_edges, "border edge", "border edges"),
+                 " (edges in only one triangle; first: vertices ", first_border->lo, "-",
+                 first_border->hi, " in triangle ", first_border->triangle, ")"),
              report.border_edges);
   }
   if (report.non_manifold_edges > 0) {
-    AddIssue(report, Severity::kError, "non_manifold_edges",
-             absl::StrCat("mesh is not edge-manifold: ",
-                          Plural(report.non_manifold_edges, "edge is", "edges are"),
-                          " shared by more than two triangles (first: vertices ",
-                          first_non_manifold->lo, "-", first_non_manifold->hi, ", in ",
-                          first_non_manifold_count, " triangles)"),
-             report.non_manifold_edges);
+    AddIssue(
+        report, Severity::kError, "non_manifold_edges",
+        absl::StrCat("mesh is not edge-manifold: ",
+                     Plural(report.non_manifold_edges, "edge is", "edges are"),
+                     " shared by more than two triangles (first: vertices ", first_non_manifold->lo,
+                     "-", first_non_manifold->hi, ", in ", first_non_manifold_count, " triangles)"),
+        report.non_manifold_edges);
   }
   // Inconsistent orientation is reported by the orientation step, which knows if it is fixed.
   (void)first_inconsistent;
@@ -261,8 +263,7 @@ void CheckVertexManifold(const Mesh& mesh, const std::vector<EdgeUse>& uses,
   }
   if (report.non_manifold_vertices > 0) {
     AddIssue(report, Severity::kWarning, "non_manifold_vertices",
-             absl::StrCat(Plural(report.non_manifold_vertices, "vertex joins",
-                                 "vertices join"),
+             absl::StrCat(Plural(report.non_manifold_vertices, "vertex joins", "vertices join"),
                           " several separate fans of triangles (first: vertex ", first,
                           "); inside/outside tests near them may be wrong"),
              report.non_manifold_vertices);
@@ -354,7 +355,8 @@ void OrientOutward(Mesh& mesh, const std::vector<std::int32_t>& component,
                    std::int64_t num_components, std::vector<char>& flip, MeshReport& report) {
   std::vector<std::vector<std::int32_t>> members(static_cast<std::size_t>(num_components));
   for (std::size_t t = 0; t < component.size(); ++t) {
-    if (component[t] >= 0) members[static_cast<std::size_t>(component[t])].push_back(static_cast<std::int32_t>(t));
+    if (component[t] >= 0)
+      members[static_cast<std::size_t>(component[t])].push_back(static_cast<std::int32_t>(t));
   }
   const BoundingBox box = ComputeBoundingBox(mesh.vertices);
   const Vector3 origin = 0.5 * (box.min + box.max);
@@ -394,10 +396,9 @@ void OrientOutward(Mesh& mesh, const std::vector<std::int32_t>& component,
     int depth = 0;
     for (std::size_t other = 0; nesting && other < members.size(); ++other) {
       if (other == c || !box_inside(boxes[c], boxes[other])) continue;
-      const bool enclosed =
-          std::all_of(samples[c].begin(), samples[c].end(), [&](const Vector3& p) {
-            return std::abs(WindingNumber(mesh, members[other], p)) > 0.5;
-          });
+      const bool enclosed = std::all_of(
+          samples[c].begin(), samples[c].end(),
+          [&](const Vector3& p) { return std::abs(WindingNumber(mesh, members[other], p)) > 0.5; });
       if (enclosed) ++depth;
     }
     const bool want_positive = depth % 2 == 0;
@@ -436,19 +437,19 @@ void CheckOrientation(Mesh& mesh, const std::vector<EdgeUse>& uses, const EdgeGr
   OrientOutward(mesh, component, report.components, flip, report);
   report.flipped_triangles = std::count(flip.begin(), flip.end(), 1);
   if (report.flipped_triangles > 0) {
-    const bool all = report.flipped_triangles ==
-                     std::count_if(component.begin(), component.end(),
-                                   [](std::int32_t c) { return c >= 0; });
+    const bool all =
+        report.flipped_triangles ==
+        std::count_if(component.begin(), component.end(), [](std::int32_t c) { return c >= 0; });
     std::string what =
         report.inconsistent_edges > 0
             ? absl::StrCat("orientation was inconsistent (",
                            Plural(report.inconsistent_edges, "edge", "edges"), ")")
             : std::string(all ? "mesh was inside out" : "some shells faced the wrong way");
-    AddIssue(report, Severity::kFixed, "orientation_fixed",
-             absl::StrCat(what, "; reversed ",
-                          Plural(report.flipped_triangles, "triangle", "triangles"),
-                          " so that normals point out of the solid"),
-             report.flipped_triangles);
+    AddIssue(
+        report, Severity::kFixed, "orientation_fixed",
+        absl::StrCat(what, "; reversed ", Plural(report.flipped_triangles, "triangle", "triangles"),
+                     " so that normals point out of the solid"),
+        report.flipped_triangles);
   }
 }
 
@@ -503,18 +504,17 @@ ValidatedMesh ValidateMesh(Mesh mesh, const ValidateOptions& options) {
       report.self_intersections_checked = true;
       report.self_intersecting_pairs = static_cast<std::int64_t>(pairs->size());
       if (!pairs->empty()) {
-        AddIssue(report, Severity::kWarning, "self_intersections",
-                 absl::StrCat("mesh intersects itself: ",
-                              Plural(report.self_intersecting_pairs, "pair", "pairs"),
-                              " of triangles cross (first: triangles ", pairs->front().first,
-                              " and ", pairs->front().second,
-                              "); inside/outside is ill-defined near them"),
-                 report.self_intersecting_pairs);
+        AddIssue(
+            report, Severity::kWarning, "self_intersections",
+            absl::StrCat(
+                "mesh intersects itself: ", Plural(report.self_intersecting_pairs, "pair", "pairs"),
+                " of triangles cross (first: triangles ", pairs->front().first, " and ",
+                pairs->front().second, "); inside/outside is ill-defined near them"),
+            report.self_intersecting_pairs);
       }
     }
   }
-  if (!report.self_intersections_checked && options.check_self_intersections &&
-      report.usable()) {
+  if (!report.self_intersections_checked && options.check_self_intersections && report.usable()) {
     AddIssue(report, Severity::kWarning, "self_intersections_not_checked",
              "self-intersections were not checked (some vertices are not manifold)", 0);
   }

@@ -34,8 +34,8 @@ CliRun RunCli(const std::string& args) {
   const fs::path dir = fs::temp_directory_path();
   const std::string tag = std::to_string(::getpid());
   const fs::path out = dir / ("inscribe_cli_out_" + tag), err = dir / ("inscribe_cli_err_" + tag);
-  const std::string command = std::string(INSCRIBE_CLI) + " " + args + " >" + out.string() +
-                              " 2>" + err.string();
+  const std::string command =
+      std::string(INSCRIBE_CLI) + " " + args + " >" + out.string() + " 2>" + err.string();
   const int status = std::system(command.c_str());
   CliRun run;
   run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -54,8 +54,8 @@ TEST(CliInfo, JsonOnARealMesh) {
   ASSERT_EQ(run.exit_code, 0) << run.err;
   EXPECT_EQ(run.err, "");
   const nlohmann::json j = nlohmann::json::parse(run.out);
-  EXPECT_TRUE(std::regex_match(j.at("mesh_sha256").get<std::string>(),
-                               std::regex("sha256:[0-9a-f]{64}")));
+  EXPECT_TRUE(
+      std::regex_match(j.at("mesh_sha256").get<std::string>(), std::regex("sha256:[0-9a-f]{64}")));
   EXPECT_EQ(j.at("vertices").get<int>(), 315);  // header of eight.off: 315 634 0
   EXPECT_EQ(j.at("triangles").get<int>(), 634);
   EXPECT_TRUE(j.at("closed").get<bool>());
@@ -86,7 +86,8 @@ TEST(CliInfo, HashIsStableAcrossRuns) {
 
 TEST(CliInfo, OpenMeshFailsWithOneLineReason) {
   INSCRIBE_REQUIRE_MESH("ChineseDragon-10kv.off");
-  const CliRun run = RunCli("info --json " + Quote(testing::TestMeshPath("ChineseDragon-10kv.off")));
+  const CliRun run =
+      RunCli("info --json " + Quote(testing::TestMeshPath("ChineseDragon-10kv.off")));
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_THAT(run.err, HasSubstr("mesh is not closed: 6 border edges"));
   EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1);

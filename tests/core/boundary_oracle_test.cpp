@@ -58,13 +58,12 @@ Vertices QueryPoints(const Mesh& mesh, int per_kind, std::uint32_t seed) {
     const Vector3 direction = Vector3::Random().normalized();
     points.row(4 * i) = on.transpose();
     points.row(4 * i + 1) = (on + 0.02 * diag * unit(rng) * direction).transpose();
-    points.row(4 * i + 2) = (box.min + box.extent().cwiseProduct(
-                                           Vector3(unit(rng), unit(rng), unit(rng))))
-                                .transpose();
-    points.row(4 * i + 3) = (box.min - 4.5 * box.extent() +
-                             10 * box.extent().cwiseProduct(
-                                      Vector3(unit(rng), unit(rng), unit(rng))))
-                                .transpose();
+    points.row(4 * i + 2) =
+        (box.min + box.extent().cwiseProduct(Vector3(unit(rng), unit(rng), unit(rng)))).transpose();
+    points.row(4 * i + 3) =
+        (box.min - 4.5 * box.extent() +
+         10 * box.extent().cwiseProduct(Vector3(unit(rng), unit(rng), unit(rng))))
+            .transpose();
   }
   return points;
 }
@@ -80,19 +79,18 @@ void ExpectMatchesBruteForce(const Mesh& mesh, const BoundaryOracle& oracle,
     const Vector3 p = points.row(i).transpose();
     const BoundaryPoint& got = batch[static_cast<std::size_t>(i)];
     const double expected = BruteForceDistance(triangles, p);
-    const bool ok =
-        std::abs(got.distance - expected) <= tolerance && got.triangle >= 0 &&
-        got.triangle < mesh.num_triangles() &&
-        std::abs(got.barycentric.sum() - 1.0) < 1e-12 && got.barycentric.minCoeff() >= 0.0 &&
-        (got.point - p).norm() == got.distance &&
-        (got.barycentric[0] * mesh.vertices.row(mesh.triangles(got.triangle, 0)) +
-         got.barycentric[1] * mesh.vertices.row(mesh.triangles(got.triangle, 1)) +
-         got.barycentric[2] * mesh.vertices.row(mesh.triangles(got.triangle, 2)) -
-         got.point.transpose())
-                .norm() <= tolerance &&
-        std::abs(std::sqrt(CGAL::squared_distance(
-                     ToPoint(p), triangles[static_cast<std::size_t>(got.triangle)])) -
-                 expected) <= tolerance;
+    const bool ok = std::abs(got.distance - expected) <= tolerance && got.triangle >= 0 &&
+                    got.triangle < mesh.num_triangles() &&
+                    std::abs(got.barycentric.sum() - 1.0) < 1e-12 &&
+                    got.barycentric.minCoeff() >= 0.0 && (got.point - p).norm() == got.distance &&
+                    (got.barycentric[0] * mesh.vertices.row(mesh.triangles(got.triangle, 0)) +
+                     got.barycentric[1] * mesh.vertices.row(mesh.triangles(got.triangle, 1)) +
+                     got.barycentric[2] * mesh.vertices.row(mesh.triangles(got.triangle, 2)) -
+                     got.point.transpose())
+                            .norm() <= tolerance &&
+                    std::abs(std::sqrt(CGAL::squared_distance(
+                                 ToPoint(p), triangles[static_cast<std::size_t>(got.triangle)])) -
+                             expected) <= tolerance;
     if (!ok) {
       ++failures;
       ADD_FAILURE() << "query " << i << " at " << p.transpose() << ": oracle distance "
@@ -108,8 +106,7 @@ void ExpectMatchesBruteForce(const Mesh& mesh, const BoundaryOracle& oracle,
 }
 
 // Inside/outside against CGAL's exact ray-parity test. Returns the disagreements.
-int CountSideDisagreements(const Mesh& mesh, const BoundaryOracle& oracle,
-                           const Vertices& points) {
+int CountSideDisagreements(const Mesh& mesh, const BoundaryOracle& oracle, const Vertices& points) {
   SurfaceMesh surface;
   std::vector<SurfaceMesh::Vertex_index> v;
   for (Eigen::Index i = 0; i < mesh.num_vertices(); ++i) {
@@ -152,9 +149,9 @@ TEST(BoundaryOracle, UnitCubeExactAnswers) {
 }
 
 TEST(BoundaryOracle, CavityIsOutside) {
-  const Mesh hollow = testing::Concatenate(
-      testing::Box(Vector3(-2, -2, -2), Vector3(2, 2, 2)),
-      testing::Inverted(testing::Box(Vector3(-1, -1, -1), Vector3(1, 1, 1))));
+  const Mesh hollow =
+      testing::Concatenate(testing::Box(Vector3(-2, -2, -2), Vector3(2, 2, 2)),
+                           testing::Inverted(testing::Box(Vector3(-1, -1, -1), Vector3(1, 1, 1))));
   absl::StatusOr<BoundaryOracle> oracle = BoundaryOracle::Build(hollow);
   ASSERT_TRUE(oracle.ok());
   EXPECT_EQ(oracle->Classify(Vector3(0, 0, 0)), Side::kOutside);

@@ -52,9 +52,8 @@ class MeshFileTest : public ::testing::Test {
                        static_cast<std::size_t>(mesh.triangles(t, 2))});
     }
     const std::string path = (dir_ / name).string();
-    EXPECT_TRUE(CGAL::IO::write_polygon_soup(path, points, faces,
-                                             CGAL::parameters::use_binary_mode(binary)
-                                                 .stream_precision(17)));
+    EXPECT_TRUE(CGAL::IO::write_polygon_soup(
+        path, points, faces, CGAL::parameters::use_binary_mode(binary).stream_precision(17)));
     return path;
   }
 
@@ -64,9 +63,14 @@ class MeshFileTest : public ::testing::Test {
 TEST_F(MeshFileTest, ReadsEveryFormatBack) {
   const Mesh sphere = testing::Icosphere(2, Vector3(0.5, -1, 2), 1.5);
   const double expected_volume = SignedVolume(sphere);
-  for (const auto& [name, binary] : std::vector<std::pair<std::string, bool>>{
-           {"a.off", false}, {"a.obj", false}, {"a.stl", false}, {"b.stl", true},
-           {"a.ply", false}, {"b.ply", true}, {"UPPER.OFF", false}}) {
+  for (const auto& [name, binary] :
+       std::vector<std::pair<std::string, bool>>{{"a.off", false},
+                                                 {"a.obj", false},
+                                                 {"a.stl", false},
+                                                 {"b.stl", true},
+                                                 {"a.ply", false},
+                                                 {"b.ply", true},
+                                                 {"UPPER.OFF", false}}) {
     SCOPED_TRACE(name);
     const std::string path = WriteWithCgal(name, sphere, binary);
     absl::StatusOr<Mesh> mesh = ReadMesh(path);
@@ -155,9 +159,9 @@ TEST_F(MeshFileTest, FaceIndexOutOfRange) {
   absl::StatusOr<Mesh> off = ReadMesh(Write(
       "i.off", "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 9\n"));
   ASSERT_FALSE(off.ok());
-  EXPECT_THAT(off.status().message(),
-              AllOf(HasSubstr("line 10"), HasSubstr("face 3 refers to vertex 9"),
-                    HasSubstr("4 vertices")));
+  EXPECT_THAT(
+      off.status().message(),
+      AllOf(HasSubstr("line 10"), HasSubstr("face 3 refers to vertex 9"), HasSubstr("4 vertices")));
   absl::StatusOr<Mesh> obj = ReadMesh(
       Write("i.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 5\n"));
   ASSERT_FALSE(obj.ok());
@@ -166,9 +170,9 @@ TEST_F(MeshFileTest, FaceIndexOutOfRange) {
 
 TEST_F(MeshFileTest, NanCoordinate) {
   for (const char* value : {"nan", "NaN", "inf", "-inf"}) {
-    absl::StatusOr<Mesh> mesh = ReadMesh(
-        Write("n.off", std::string("OFF\n4 4 0\n0 0 0\n1 0 0\n") + value +
-                           " 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n"));
+    absl::StatusOr<Mesh> mesh =
+        ReadMesh(Write("n.off", std::string("OFF\n4 4 0\n0 0 0\n1 0 0\n") + value +
+                                    " 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n"));
     ASSERT_FALSE(mesh.ok()) << value;
     EXPECT_THAT(mesh.status().message(),
                 AllOf(HasSubstr("vertex 2"), HasSubstr("not a finite number")))

@@ -12,9 +12,7 @@ namespace {
 using testing::Box;
 using testing::Icosphere;
 
-TEST(SignedVolume, UnitCubeIsOne) {
-  EXPECT_NEAR(SignedVolume(testing::UnitCube()), 1.0, 1e-15);
-}
+TEST(SignedVolume, UnitCubeIsOne) { EXPECT_NEAR(SignedVolume(testing::UnitCube()), 1.0, 1e-15); }
 
 TEST(SignedVolume, InvertedIsNegative) {
   EXPECT_NEAR(SignedVolume(testing::Inverted(testing::UnitCube())), -1.0, 1e-15);

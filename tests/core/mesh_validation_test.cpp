@@ -1,5 +1,4 @@
 #include "inscribe/mesh_validation.h"
-#include "inscribe/mesh_io.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -7,15 +6,16 @@
 #include <cmath>
 #include <limits>
 
+#include "inscribe/mesh_io.h"
 #include "support/synthetic_meshes.h"
 #include "support/test_meshes.h"
 
 namespace inscribe {
 namespace {
 
-using ::testing::HasSubstr;
 using testing::Box;
 using testing::Concatenate;
+using ::testing::HasSubstr;
 using testing::Icosphere;
 using testing::Inverted;
 using testing::UnitCube;
@@ -79,8 +79,8 @@ TEST(ValidateMesh, CavityFacesInward) {
     EXPECT_NEAR(v.report.volume, 64.0 - 8.0, 1e-12);
   }
   // Two separate boxes both face out.
-  const ValidatedMesh apart = ValidateMesh(
-      Concatenate(Inverted(inner), Box(Vector3(5, 5, 5), Vector3(6, 6, 6))));
+  const ValidatedMesh apart =
+      ValidateMesh(Concatenate(Inverted(inner), Box(Vector3(5, 5, 5), Vector3(6, 6, 6))));
   EXPECT_NEAR(apart.report.volume, 9.0, 1e-12);
 }
 

@@ -12,9 +12,9 @@ namespace inscribe::testing {
 
 std::string TestMeshPath(const std::string& name) {
   const char* env = std::getenv("INSCRIBE_DATA_DIR");
-  const std::filesystem::path dir =
-      env != nullptr && *env != '\0' ? std::filesystem::path(env)
-                                     : std::filesystem::path(INSCRIBE_SOURCE_DIR) / "data";
+  const std::filesystem::path dir = env != nullptr && *env != '\0'
+                                        ? std::filesystem::path(env)
+                                        : std::filesystem::path(INSCRIBE_SOURCE_DIR) / "data";
   const std::filesystem::path path = dir / name;
   return std::filesystem::exists(path) ? path.string() : std::string();
 }

@@ -17,11 +17,11 @@ Mesh LoadTestMesh(const std::string& name);
 
 // Skips the test, loudly, when a demo mesh is missing: this only happens when Debian's
 // libcgal-demo package cannot be had (scripts/fetch-meshes failed).
-#define INSCRIBE_REQUIRE_MESH(name)                                                         \
-  do {                                                                                      \
-    if (::inscribe::testing::TestMeshPath(name).empty()) {                                  \
-      GTEST_SKIP() << "\n\n*** SKIPPED: test mesh '" << (name)                              \
-                   << "' is missing. Run scripts/fetch-meshes (needs Debian's libcgal-demo "   \
-                      "package). ***\n";                                                    \
-    }                                                                                       \
+#define INSCRIBE_REQUIRE_MESH(name)                                                          \
+  do {                                                                                       \
+    if (::inscribe::testing::TestMeshPath(name).empty()) {                                   \
+      GTEST_SKIP() << "\n\n*** SKIPPED: test mesh '" << (name)                               \
+                   << "' is missing. Run scripts/fetch-meshes (needs Debian's libcgal-demo " \
+                      "package). ***\n";                                                     \
+    }                                                                                        \
   } while (0)

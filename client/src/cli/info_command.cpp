@@ -72,10 +72,9 @@ int RunInfo(const InfoOptions& options) {
   ValidatedMesh validated = ValidateMesh(*std::move(mesh), validate);
   const MeshReport& report = validated.report;
   // The hash is only meaningful for a mesh whose indices and coordinates can be trusted.
-  const std::string sha256 =
-      report.non_finite_vertices == 0 && report.out_of_range_indices == 0
-          ? FormatSha256(MeshSha256(validated.mesh))
-          : std::string();
+  const std::string sha256 = report.non_finite_vertices == 0 && report.out_of_range_indices == 0
+                                 ? FormatSha256(MeshSha256(validated.mesh))
+                                 : std::string();
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (options.json) {

@@ -53,7 +53,7 @@ class BoundaryOracle {
   // Builds the BVH. Errors: empty mesh, out-of-range indices, non-finite coordinates, Embree
   // failures (INTERNAL with Embree's message). Cost O(#T log #T).
   static absl::StatusOr<BoundaryOracle> Build(const Mesh& mesh,
-                                               const BoundaryOracleOptions& options = {});
+                                              const BoundaryOracleOptions& options = {});
 
   BoundaryOracle(BoundaryOracle&&) noexcept;
   BoundaryOracle& operator=(BoundaryOracle&&) noexcept;

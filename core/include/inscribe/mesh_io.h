@@ -9,7 +9,7 @@
 namespace inscribe {
 
 struct ReadMeshInfo {
-  std::int64_t polygons = 0;             // faces in the file
+  std::int64_t polygons = 0;               // faces in the file
   std::int64_t polygons_triangulated = 0;  // faces with more than 3 corners, split into triangles
 };
 

@@ -105,9 +105,12 @@ void InscribeServer::Shutdown(std::chrono::system_clock::time_point deadline) {
   }
   // Load balancers and health probes see NOT_SERVING while calls in progress drain.
   parts_->server->GetHealthCheckService()->Shutdown();
-  // Returns once every call has finished: those still running at `deadline` are cancelled,
-  // and the jobs of cancelled calls notice before they start (see InscribeService).
-  parts_->server->Shutdown(deadline);
+  parts_->service.StartDraining();
+  parts_->service.WaitForCalls(deadline);
+  // Every call has been answered, or the grace period is over: cancel what is left (calls past
+  // the deadline, whose jobs notice before they start; health watches; idle connections, which
+  // gRPC would otherwise wait on until the deadline). Returns once every call has finished.
+  parts_->server->Shutdown(std::min(deadline, std::chrono::system_clock::now()));
   // A job may still be returning from its last callback; nothing may be destroyed under it.
   parts_->pool.WaitIdle();
   {

@@ -49,10 +49,19 @@ InscribeService::InscribeService(JobPool* pool, const ServiceLimits& limits, Cal
     : pool_(pool), limits_(limits), observer_(std::move(observer)) {}
 
 void InscribeService::Finish(grpc::ServerUnaryReactor* reactor, CallRecord& record,
-                             const absl::Status& status) const {
+                             const absl::Status& status) {
   record.status = status;
   if (observer_) observer_(record);
   reactor->Finish(ToGrpcStatus(status));
+  std::lock_guard<std::mutex> lock(calls_mutex_);
+  if (--active_calls_ == 0) calls_answered_.notify_all();
+}
+
+void InscribeService::StartDraining() { draining_.store(true); }
+
+bool InscribeService::WaitForCalls(std::chrono::system_clock::time_point deadline) {
+  std::unique_lock<std::mutex> lock(calls_mutex_);
+  return calls_answered_.wait_until(lock, deadline, [this] { return active_calls_ == 0; });
 }
 
 grpc::ServerUnaryReactor* InscribeService::InspectMesh(grpc::CallbackServerContext* context,
@@ -64,6 +73,15 @@ grpc::ServerUnaryReactor* InscribeService::InspectMesh(grpc::CallbackServerConte
   record.method = "InspectMesh";
   record.peer = context->peer();
   record.triangles = TriangleCount(request->mesh());
+  {
+    std::lock_guard<std::mutex> lock(calls_mutex_);
+    ++active_calls_;
+  }
+
+  if (draining_.load()) {
+    Finish(reactor, record, absl::UnavailableError("server is shutting down; retry"));
+    return reactor;
+  }
 
   // O(1) checks stay on the gRPC thread, so bad or oversized requests never occupy the queue.
   if (absl::Status shape = CheckMeshShape(request->mesh()); !shape.ok()) {
@@ -78,29 +96,34 @@ grpc::ServerUnaryReactor* InscribeService::InspectMesh(grpc::CallbackServerConte
     return reactor;
   }
 
-  const bool queued =
-      pool_->TrySubmit([this, context, request, response, reactor, arrived, record]() mutable {
-        record.queued_seconds = SecondsSince(arrived);
-        // The caller may have given up (deadline, cancel, disconnect) while the job waited.
-        if (context->IsCancelled()) {
-          Finish(reactor, record, absl::CancelledError("call was cancelled before work started"));
-          return;
-        }
-        const Clock::time_point started = Clock::now();
-        absl::Status status;
-        // Jobs must not throw (JobPool); running out of memory on a huge mesh is the one exception
-        // worth expecting here, and is the caller's to act on.
-        try {
-          status = RunInspectMesh(*request, response);
-        } catch (const std::bad_alloc&) {
-          status = absl::ResourceExhaustedError(
-              "server ran out of memory inspecting the mesh; send a smaller mesh or retry later");
-        } catch (const std::exception& e) {
-          status = absl::InternalError(absl::StrCat("inspecting the mesh failed: ", e.what()));
-        }
-        record.run_seconds = SecondsSince(started);
-        Finish(reactor, record, status);
-      });
+  const bool queued = pool_->TrySubmit([this, context, request, response, reactor, arrived,
+                                        record]() mutable {
+    record.queued_seconds = SecondsSince(arrived);
+    // The caller may have given up (cancel, disconnect) while the job waited; a passed
+    // deadline counts too, even before gRPC has noticed it and cancelled the call.
+    if (context->IsCancelled()) {
+      Finish(reactor, record, absl::CancelledError("call was cancelled before work started"));
+      return;
+    }
+    if (std::chrono::system_clock::now() >= context->deadline()) {
+      Finish(reactor, record, absl::DeadlineExceededError("deadline passed before work started"));
+      return;
+    }
+    const Clock::time_point started = Clock::now();
+    absl::Status status;
+    // Jobs must not throw (JobPool); running out of memory on a huge mesh is the one exception
+    // worth expecting here, and is the caller's to act on.
+    try {
+      status = RunInspectMesh(*request, response);
+    } catch (const std::bad_alloc&) {
+      status = absl::ResourceExhaustedError(
+          "server ran out of memory inspecting the mesh; send a smaller mesh or retry later");
+    } catch (const std::exception& e) {
+      status = absl::InternalError(absl::StrCat("inspecting the mesh failed: ", e.what()));
+    }
+    record.run_seconds = SecondsSince(started);
+    Finish(reactor, record, status);
+  });
   if (!queued) Finish(reactor, record, QueueFullError(*pool_));
   return reactor;
 }

@@ -5,6 +5,7 @@
 #include <cassert>
 #include <condition_variable>
 #include <mutex>
+#include <new>
 #include <utility>
 
 #include "oneapi/tbb/global_control.h"
@@ -15,6 +16,7 @@ namespace inscribe::server {
 struct JobPool::Impl {
   explicit Impl(const JobPoolOptions& pool_options)
       : options(pool_options),
+        scheduler(tbb::attach{}),
         // max_allowed_parallelism counts the calling thread too: workers = value - 1.
         parallelism(tbb::global_control::max_allowed_parallelism,
                     std::max<std::size_t>(tbb::global_control::active_value(
@@ -32,6 +34,8 @@ struct JobPool::Impl {
   }
 
   const JobPoolOptions options;
+  // Lets the destructor wait for TBB's worker threads to exit (tbb::finalize).
+  tbb::task_scheduler_handle scheduler;
   tbb::global_control parallelism;
   tbb::task_arena arena;
   std::atomic<std::int64_t> in_flight{0};
@@ -43,7 +47,15 @@ JobPool::JobPool(const JobPoolOptions& options) : impl_(std::make_unique<Impl>(o
   assert(options.concurrency >= 1 && options.max_jobs >= 1);
 }
 
-JobPool::~JobPool() { WaitIdle(); }
+JobPool::~JobPool() {
+  WaitIdle();
+  impl_->arena.terminate();
+  // Join TBB's workers when nothing else in the process uses TBB (otherwise this returns false
+  // at once and they live on). Workers left running at exit race the process's teardown: they
+  // may still be running thread-exit handlers (e.g. OpenSSL freeing its per-thread state, used
+  // by the mesh hash) when exit() starts destroying globals.
+  tbb::finalize(impl_->scheduler, std::nothrow);
+}
 
 bool JobPool::TrySubmit(std::function<void()> job) {
   // Reserve a place first, then give it back if over the limit: the count never exceeds

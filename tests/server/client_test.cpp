@@ -1,8 +1,13 @@
-// Client's deadlines and retries, against a mock Connection (no network).
+// Client's deadlines and retries against a mock Connection, and the gRPC Connection against
+// a closed port.
 #include "inscribe/client/client.h"
 
+#include <arpa/inet.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
 
 #include "cube_meshes.h"
 #include "inscribe/mesh_validation.h"
@@ -29,8 +34,7 @@ class MockConnection : public Connection {
 v1::InspectMeshResponse CubeResponse() {
   v1::InspectMeshResponse response;
   response.set_mesh_sha256("sha256:cube");
-  server::MeshReportToProto(ValidateMesh(testing::ServiceUnitCube()).report,
-                            response.mutable_report());
+  server::MeshReportToProto(ValidateMesh(testing::CubeMesh()).report, response.mutable_report());
   return response;
 }
 
@@ -50,7 +54,7 @@ TEST(Client, RetriesUnavailableThenSucceeds) {
       .WillOnce(Return(CubeResponse()));
   Client client(connection, FastRetries());
 
-  absl::StatusOr<InspectMeshResult> result = client.InspectMesh(testing::ServiceUnitCube());
+  absl::StatusOr<InspectMeshResult> result = client.InspectMesh(testing::CubeMesh());
   ASSERT_TRUE(result.ok()) << result.status();
   EXPECT_EQ(result->mesh_sha256, "sha256:cube");
   EXPECT_TRUE(result->report.usable());
@@ -65,7 +69,7 @@ TEST(Client, GivesUpAfterThreeAttempts) {
       .WillRepeatedly(Return(absl::UnavailableError("connection refused")));
   Client client(connection, FastRetries());
 
-  absl::StatusOr<InspectMeshResult> result = client.InspectMesh(testing::ServiceUnitCube());
+  absl::StatusOr<InspectMeshResult> result = client.InspectMesh(testing::CubeMesh());
   EXPECT_EQ(result.status().code(), absl::StatusCode::kUnavailable);
   EXPECT_THAT(result.status().message(), HasSubstr("connection refused"));
   EXPECT_THAT(result.status().message(), HasSubstr("3 attempts"));
@@ -77,7 +81,7 @@ TEST(Client, DoesNotRetryInvalidArgument) {
       .WillOnce(Return(absl::InvalidArgumentError("mesh.vertices has length 7")));
   Client client(connection, FastRetries());
 
-  absl::StatusOr<InspectMeshResult> result = client.InspectMesh(testing::ServiceUnitCube());
+  absl::StatusOr<InspectMeshResult> result = client.InspectMesh(testing::CubeMesh());
   EXPECT_EQ(result.status(), absl::InvalidArgumentError("mesh.vertices has length 7"));
 }
 
@@ -87,7 +91,7 @@ TEST(Client, DoesNotRetryResourceExhaustedOrDeadlineExceeded) {
     auto connection = std::make_shared<MockConnection>();
     EXPECT_CALL(*connection, InspectMesh(_, _)).WillOnce(Return(error));
     Client client(connection, FastRetries());
-    EXPECT_EQ(client.InspectMesh(testing::ServiceUnitCube()).status(), error);
+    EXPECT_EQ(client.InspectMesh(testing::CubeMesh()).status(), error);
   }
 }
 
@@ -108,7 +112,7 @@ TEST(Client, DefaultDeadlineIsPassedToEveryAttempt) {
         return CubeResponse();
       });
   Client client(connection, options);
-  ASSERT_TRUE(client.InspectMesh(testing::ServiceUnitCube()).ok());
+  ASSERT_TRUE(client.InspectMesh(testing::CubeMesh()).ok());
   const Deadline latest = std::chrono::system_clock::now() + options.default_timeout;
   EXPECT_GE(first_deadline, earliest);
   EXPECT_LE(first_deadline, latest);
@@ -129,7 +133,7 @@ TEST(Client, PerCallTimeoutOverridesDefaultAndRequestCarriesTheMesh) {
   InspectMeshOptions call;
   call.timeout = std::chrono::milliseconds(250);
   call.skip_self_intersections = true;
-  EXPECT_TRUE(client.InspectMesh(testing::ServiceUnitCube(), call).ok());
+  EXPECT_TRUE(client.InspectMesh(testing::CubeMesh(), call).ok());
 }
 
 TEST(Client, NoRetryWhenTheBackoffWouldOutliveTheDeadline) {
@@ -140,7 +144,7 @@ TEST(Client, NoRetryWhenTheBackoffWouldOutliveTheDeadline) {
   EXPECT_CALL(*connection, InspectMesh(_, _))
       .WillOnce(Return(absl::UnavailableError("connection refused")));
   Client client(connection, options);
-  EXPECT_EQ(client.InspectMesh(testing::ServiceUnitCube()).status().code(),
+  EXPECT_EQ(client.InspectMesh(testing::CubeMesh()).status().code(),
             absl::StatusCode::kUnavailable);
 }
 
@@ -150,14 +154,27 @@ TEST(Client, MalformedResponseIsInternal) {
   auto connection = std::make_shared<MockConnection>();
   EXPECT_CALL(*connection, InspectMesh(_, _)).WillOnce(Return(response));
   Client client(connection);
-  EXPECT_EQ(client.InspectMesh(testing::ServiceUnitCube()).status().code(),
-            absl::StatusCode::kInternal);
+  EXPECT_EQ(client.InspectMesh(testing::CubeMesh()).status().code(), absl::StatusCode::kInternal);
+}
+
+// A loopback port that was free a moment ago: bound by the kernel's choice, then released.
+int UnusedLoopbackPort() {
+  const int fd = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  socklen_t length = sizeof address;
+  bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof address);
+  getsockname(fd, reinterpret_cast<sockaddr*>(&address), &length);
+  close(fd);
+  return ntohs(address.sin_port);
 }
 
 TEST(GrpcConnection, UnreachableServerIsUnavailable) {
-  // Port 1 on loopback: nothing listens there, so the connection is refused at once.
-  Client client(MakeGrpcConnection("127.0.0.1:1"), FastRetries());
-  absl::StatusOr<InspectMeshResult> result = client.InspectMesh(testing::ServiceUnitCube());
+  // Nothing listens there, so every attempt is refused at once.
+  Client client(MakeGrpcConnection("127.0.0.1:" + std::to_string(UnusedLoopbackPort())),
+                FastRetries());
+  absl::StatusOr<InspectMeshResult> result = client.InspectMesh(testing::CubeMesh());
   EXPECT_EQ(result.status().code(), absl::StatusCode::kUnavailable) << result.status();
 }
 

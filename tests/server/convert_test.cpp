@@ -12,7 +12,7 @@ namespace {
 using ::testing::HasSubstr;
 
 TEST(MeshConvert, RoundTripKeepsEveryValue) {
-  Mesh mesh = testing::ServiceUnitCube();
+  Mesh mesh = testing::CubeMesh();
   mesh.vertices(3, 1) = -0.125;  // values that are not small integers
   mesh.vertices(5, 2) = 1e300;
   v1::Mesh wire;
@@ -49,7 +49,7 @@ TEST(MeshConvert, RejectsVerticesNotMultipleOfThree) {
 
 TEST(MeshConvert, RejectsTrianglesNotMultipleOfThreeNamingTheField) {
   v1::Mesh wire;
-  MeshToProto(testing::ServiceUnitCube(), &wire);
+  MeshToProto(testing::CubeMesh(), &wire);
   wire.add_triangles(0);
   absl::StatusOr<Mesh> mesh = MeshFromProto(wire, "request.mesh");
   EXPECT_EQ(mesh.status().code(), absl::StatusCode::kInvalidArgument);
@@ -58,7 +58,7 @@ TEST(MeshConvert, RejectsTrianglesNotMultipleOfThreeNamingTheField) {
 
 TEST(MeshReportConvert, RoundTripOfAnInvertedOpenMesh) {
   // Validation of a real mesh fills counts, issues of several severities and the box.
-  Mesh open = testing::OpenUnitCube();
+  Mesh open = testing::OpenCubeMesh();
   const MeshReport report = ValidateMesh(open).report;
   ASSERT_FALSE(report.issues.empty());
 
@@ -91,7 +91,7 @@ TEST(MeshReportConvert, RoundTripOfAnInvertedOpenMesh) {
 }
 
 TEST(MeshReportConvert, FixedSeverityRoundTrips) {
-  const MeshReport report = ValidateMesh(testing::InvertedUnitCube()).report;
+  const MeshReport report = ValidateMesh(testing::InvertedCubeMesh()).report;
   v1::MeshReport wire;
   MeshReportToProto(report, &wire);
   ASSERT_EQ(wire.issues_size(), 1);

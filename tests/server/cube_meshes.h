@@ -6,7 +6,7 @@
 namespace inscribe::testing {
 
 // [0, 1]^3: 8 vertices, 12 triangles, counter-clockwise seen from outside, volume 1.
-inline Mesh ServiceUnitCube() {
+inline Mesh CubeMesh() {
   Mesh mesh;
   mesh.vertices.resize(8, 3);
   // Vertex i has x = bit 0, y = bit 1, z = bit 2 of i.
@@ -22,15 +22,15 @@ inline Mesh ServiceUnitCube() {
 }
 
 // The unit cube with every triangle reversed: normals point in.
-inline Mesh InvertedUnitCube() {
-  Mesh mesh = ServiceUnitCube();
+inline Mesh InvertedCubeMesh() {
+  Mesh mesh = CubeMesh();
   mesh.triangles.col(1).swap(mesh.triangles.col(2));
   return mesh;
 }
 
 // The unit cube without its last triangle: 11 triangles, 3 border edges.
-inline Mesh OpenUnitCube() {
-  Mesh mesh = ServiceUnitCube();
+inline Mesh OpenCubeMesh() {
+  Mesh mesh = CubeMesh();
   mesh.triangles.conservativeResize(11, 3);
   return mesh;
 }

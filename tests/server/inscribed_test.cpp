@@ -99,14 +99,16 @@ class Inscribed {
 };
 
 TEST(Inscribed, ServesOnAPickedPortAndStopsCleanlyOnSigterm) {
-  Inscribed inscribed({"--listen", "127.0.0.1:0", "--jobs", "1", "--shutdown-grace", "5"});
+  // A grace period far longer than the stop may take: the client's idle connection must not
+  // hold the server until the grace period ends.
+  Inscribed inscribed({"--listen", "127.0.0.1:0", "--jobs", "1", "--shutdown-grace", "600"});
   ASSERT_TRUE(inscribed.started());
   const std::string address = inscribed.WaitUntilListening();
   ASSERT_THAT(address, ::testing::StartsWith("127.0.0.1:")) << inscribed.log();
   EXPECT_NE(address, "127.0.0.1:0");
 
   client::Client client(client::MakeGrpcConnection(address));
-  absl::StatusOr<client::InspectMeshResult> result = client.InspectMesh(testing::ServiceUnitCube());
+  absl::StatusOr<client::InspectMeshResult> result = client.InspectMesh(testing::CubeMesh());
   ASSERT_TRUE(result.ok()) << result.status();
   EXPECT_TRUE(result->report.usable());
 

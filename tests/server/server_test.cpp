@@ -71,7 +71,7 @@ TEST_F(InscribeServerTest, BindsTheLoopbackPortItPicked) {
 }
 
 TEST_F(InscribeServerTest, UnitCubeIsUsableWithItsHashAndVolume) {
-  const Mesh cube = testing::ServiceUnitCube();
+  const Mesh cube = testing::CubeMesh();
   v1::InspectMeshResponse response;
   const grpc::Status status = Inspect(cube, &response);
   ASSERT_TRUE(status.ok()) << status.error_message();
@@ -92,7 +92,7 @@ TEST_F(InscribeServerTest, UnitCubeIsUsableWithItsHashAndVolume) {
 }
 
 TEST_F(InscribeServerTest, InvertedCubeIsFixedAndHashedAfterTheFix) {
-  const Mesh inverted = testing::InvertedUnitCube();
+  const Mesh inverted = testing::InvertedCubeMesh();
   v1::InspectMeshResponse response;
   const grpc::Status status = Inspect(inverted, &response);
   ASSERT_TRUE(status.ok()) << status.error_message();
@@ -112,7 +112,7 @@ TEST_F(InscribeServerTest, InvertedCubeIsFixedAndHashedAfterTheFix) {
 
 TEST_F(InscribeServerTest, OpenCubeIsNotUsableAndSaysWhy) {
   v1::InspectMeshResponse response;
-  const grpc::Status status = Inspect(testing::OpenUnitCube(), &response);
+  const grpc::Status status = Inspect(testing::OpenCubeMesh(), &response);
   ASSERT_TRUE(status.ok()) << status.error_message();  // a bad mesh is not a failed call
 
   const v1::MeshReport& report = response.report();
@@ -129,7 +129,7 @@ TEST_F(InscribeServerTest, OpenCubeIsNotUsableAndSaysWhy) {
 
 TEST_F(InscribeServerTest, SkipSelfIntersectionsIsHonoured) {
   v1::InspectMeshRequest request;
-  MeshToProto(testing::ServiceUnitCube(), request.mutable_mesh());
+  MeshToProto(testing::CubeMesh(), request.mutable_mesh());
   request.set_skip_self_intersections(true);
   v1::InspectMeshResponse response;
   ASSERT_TRUE(Inspect(request, &response).ok());
@@ -138,7 +138,7 @@ TEST_F(InscribeServerTest, SkipSelfIntersectionsIsHonoured) {
 
 TEST_F(InscribeServerTest, MeshOverTriangleLimitIsResourceExhaustedNamingTheLimit) {
   Mesh big;
-  big.vertices = testing::ServiceUnitCube().vertices;
+  big.vertices = testing::CubeMesh().vertices;
   big.triangles.resize(kMaxTriangles + 1, 3);
   big.triangles.rowwise() = Eigen::RowVector3i(0, 1, 2);
   v1::InspectMeshResponse response;
@@ -174,7 +174,7 @@ TEST_F(InscribeServerTest, HealthIsServingForServerAndService) {
 
 TEST_F(InscribeServerTest, ClientLibraryOverGrpcReturnsCoreTypes) {
   client::Client client(client::MakeGrpcConnection(server_->address()));
-  const Mesh cube = testing::InvertedUnitCube();
+  const Mesh cube = testing::InvertedCubeMesh();
   absl::StatusOr<client::InspectMeshResult> result = client.InspectMesh(cube);
   ASSERT_TRUE(result.ok()) << result.status();
   EXPECT_EQ(result->mesh_sha256, FormatSha256(MeshSha256(ValidateMesh(cube).mesh)));
@@ -185,7 +185,7 @@ TEST_F(InscribeServerTest, ClientLibraryOverGrpcReturnsCoreTypes) {
 
   absl::StatusOr<client::InspectMeshResult> big = client.InspectMesh([] {
     Mesh m;
-    m.vertices = testing::ServiceUnitCube().vertices;
+    m.vertices = testing::CubeMesh().vertices;
     m.triangles.setZero(kMaxTriangles + 1, 3);
     return m;
   }());

@@ -48,8 +48,11 @@ class InscribeServer {
   // Jobs (requests) used by the pool after resolving jobs = 0.
   int jobs() const { return jobs_; }
 
-  // Marks health NOT_SERVING, stops accepting calls, lets calls in progress finish until
-  // `deadline` and cancels the rest, then waits for the pool's jobs. Idempotent; thread-safe.
+  // Graceful stop: marks health NOT_SERVING, answers new calls with UNAVAILABLE, lets accepted
+  // calls finish until `deadline`, then cancels what is left, closes every connection and waits
+  // for the pool's jobs. Returns as soon as the calls are done, not at `deadline`. Jobs already
+  // running are not interrupted (core has no cancellation points yet), so a job that outlives
+  // `deadline` delays the return. Idempotent; thread-safe.
   void Shutdown(std::chrono::system_clock::time_point deadline);
 
   // Blocks until Shutdown has completed (from another thread).

@@ -1,8 +1,12 @@
 // The inscribe.v1.Inscribe gRPC service (callback API).
 #pragma once
 
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
 #include <cstdint>
 #include <functional>
+#include <mutex>
 #include <string>
 
 #include "absl/status/status.h"
@@ -46,14 +50,29 @@ class InscribeService final : public v1::Inscribe::CallbackService {
                                         const v1::InspectMeshRequest* request,
                                         v1::InspectMeshResponse* response) override;
 
+  // Graceful shutdown, first half: from now on new calls get UNAVAILABLE ("server is shutting
+  // down"), which clients retry, later or on another replica; calls already accepted go on.
+  void StartDraining();
+
+  // Blocks until every accepted call has been answered or `deadline` passes; true when all
+  // were answered. gRPC's own Shutdown(deadline) also waits for idle client connections to
+  // close, which long-lived clients never do: waiting here first lets the server then shut
+  // down with an immediate deadline without cutting off any call.
+  bool WaitForCalls(std::chrono::system_clock::time_point deadline);
+
  private:
-  // Sends `status` to the caller after telling the observer.
-  void Finish(grpc::ServerUnaryReactor* reactor, CallRecord& record,
-              const absl::Status& status) const;
+  // Sends `status` to the caller after telling the observer; the call then no longer counts
+  // as active.
+  void Finish(grpc::ServerUnaryReactor* reactor, CallRecord& record, const absl::Status& status);
 
   JobPool* const pool_;
   const ServiceLimits limits_;
   const CallObserver observer_;
+
+  std::atomic<bool> draining_{false};
+  std::mutex calls_mutex_;
+  std::condition_variable calls_answered_;
+  std::int64_t active_calls_ = 0;  // guarded by calls_mutex_
 };
 
 }  // namespace inscribe::server

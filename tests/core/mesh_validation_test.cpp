@@ -85,8 +85,7 @@ TEST(ValidateMesh, CavityFacesInward) {
 }
 
 TEST(ValidateMesh, OpenMesh) {
-  Mesh open = UnitCube();
-  open.triangles.conservativeResize(11, 3);
+  const Mesh open = testing::OpenUnitCube();
   const ValidatedMesh v = ValidateMesh(open);
   EXPECT_FALSE(v.report.usable());
   EXPECT_FALSE(v.report.closed());

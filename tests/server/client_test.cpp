@@ -9,9 +9,9 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
-#include "cube_meshes.h"
 #include "inscribe/mesh_validation.h"
 #include "inscribe/server/convert.h"
+#include "support/synthetic_meshes.h"
 
 namespace inscribe::client {
 namespace {
@@ -34,7 +34,7 @@ class MockConnection : public Connection {
 v1::InspectMeshResponse CubeResponse() {
   v1::InspectMeshResponse response;
   response.set_mesh_sha256("sha256:cube");
-  server::MeshReportToProto(ValidateMesh(testing::CubeMesh()).report, response.mutable_report());
+  server::MeshReportToProto(ValidateMesh(testing::UnitCube()).report, response.mutable_report());
   return response;
 }
 
@@ -54,7 +54,7 @@ TEST(Client, RetriesUnavailableThenSucceeds) {
       .WillOnce(Return(CubeResponse()));
   Client client(connection, FastRetries());
 
-  absl::StatusOr<InspectMeshResult> result = client.InspectMesh(testing::CubeMesh());
+  absl::StatusOr<InspectMeshResult> result = client.InspectMesh(testing::UnitCube());
   ASSERT_TRUE(result.ok()) << result.status();
   EXPECT_EQ(result->mesh_sha256, "sha256:cube");
   EXPECT_TRUE(result->report.usable());
@@ -69,7 +69,7 @@ TEST(Client, GivesUpAfterThreeAttempts) {
       .WillRepeatedly(Return(absl::UnavailableError("connection refused")));
   Client client(connection, FastRetries());
 
-  absl::StatusOr<InspectMeshResult> result = client.InspectMesh(testing::CubeMesh());
+  absl::StatusOr<InspectMeshResult> result = client.InspectMesh(testing::UnitCube());
   EXPECT_EQ(result.status().code(), absl::StatusCode::kUnavailable);
   EXPECT_THAT(result.status().message(), HasSubstr("connection refused"));
   EXPECT_THAT(result.status().message(), HasSubstr("3 attempts"));
@@ -81,7 +81,7 @@ TEST(Client, DoesNotRetryInvalidArgument) {
       .WillOnce(Return(absl::InvalidArgumentError("mesh.vertices has length 7")));
   Client client(connection, FastRetries());
 
-  absl::StatusOr<InspectMeshResult> result = client.InspectMesh(testing::CubeMesh());
+  absl::StatusOr<InspectMeshResult> result = client.InspectMesh(testing::UnitCube());
   EXPECT_EQ(result.status(), absl::InvalidArgumentError("mesh.vertices has length 7"));
 }
 
@@ -91,7 +91,7 @@ TEST(Client, DoesNotRetryResourceExhaustedOrDeadlineExceeded) {
     auto connection = std::make_shared<MockConnection>();
     EXPECT_CALL(*connection, InspectMesh(_, _)).WillOnce(Return(error));
     Client client(connection, FastRetries());
-    EXPECT_EQ(client.InspectMesh(testing::CubeMesh()).status(), error);
+    EXPECT_EQ(client.InspectMesh(testing::UnitCube()).status(), error);
   }
 }
 
@@ -112,7 +112,7 @@ TEST(Client, DefaultDeadlineIsPassedToEveryAttempt) {
         return CubeResponse();
       });
   Client client(connection, options);
-  ASSERT_TRUE(client.InspectMesh(testing::CubeMesh()).ok());
+  ASSERT_TRUE(client.InspectMesh(testing::UnitCube()).ok());
   const Deadline latest = std::chrono::system_clock::now() + options.default_timeout;
   EXPECT_GE(first_deadline, earliest);
   EXPECT_LE(first_deadline, latest);
@@ -133,7 +133,7 @@ TEST(Client, PerCallTimeoutOverridesDefaultAndRequestCarriesTheMesh) {
   InspectMeshOptions call;
   call.timeout = std::chrono::milliseconds(250);
   call.skip_self_intersections = true;
-  EXPECT_TRUE(client.InspectMesh(testing::CubeMesh(), call).ok());
+  EXPECT_TRUE(client.InspectMesh(testing::UnitCube(), call).ok());
 }
 
 TEST(Client, NoRetryWhenTheBackoffWouldOutliveTheDeadline) {
@@ -144,7 +144,7 @@ TEST(Client, NoRetryWhenTheBackoffWouldOutliveTheDeadline) {
   EXPECT_CALL(*connection, InspectMesh(_, _))
       .WillOnce(Return(absl::UnavailableError("connection refused")));
   Client client(connection, options);
-  EXPECT_EQ(client.InspectMesh(testing::CubeMesh()).status().code(),
+  EXPECT_EQ(client.InspectMesh(testing::UnitCube()).status().code(),
             absl::StatusCode::kUnavailable);
 }
 
@@ -154,7 +154,7 @@ TEST(Client, MalformedResponseIsInternal) {
   auto connection = std::make_shared<MockConnection>();
   EXPECT_CALL(*connection, InspectMesh(_, _)).WillOnce(Return(response));
   Client client(connection);
-  EXPECT_EQ(client.InspectMesh(testing::CubeMesh()).status().code(), absl::StatusCode::kInternal);
+  EXPECT_EQ(client.InspectMesh(testing::UnitCube()).status().code(), absl::StatusCode::kInternal);
 }
 
 // A loopback port that was free a moment ago: bound by the kernel's choice, then released.
@@ -174,7 +174,7 @@ TEST(GrpcConnection, UnreachableServerIsUnavailable) {
   // Nothing listens there, so every attempt is refused at once.
   Client client(MakeGrpcConnection("127.0.0.1:" + std::to_string(UnusedLoopbackPort())),
                 FastRetries());
-  absl::StatusOr<InspectMeshResult> result = client.InspectMesh(testing::CubeMesh());
+  absl::StatusOr<InspectMeshResult> result = client.InspectMesh(testing::UnitCube());
   EXPECT_EQ(result.status().code(), absl::StatusCode::kUnavailable) << result.status();
 }
 

@@ -3,8 +3,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include "cube_meshes.h"
 #include "inscribe/mesh_validation.h"
+#include "support/synthetic_meshes.h"
 
 namespace inscribe::server {
 namespace {
@@ -12,7 +12,7 @@ namespace {
 using ::testing::HasSubstr;
 
 TEST(MeshConvert, RoundTripKeepsEveryValue) {
-  Mesh mesh = testing::CubeMesh();
+  Mesh mesh = testing::UnitCube();
   mesh.vertices(3, 1) = -0.125;  // values that are not small integers
   mesh.vertices(5, 2) = 1e300;
   v1::Mesh wire;
@@ -49,7 +49,7 @@ TEST(MeshConvert, RejectsVerticesNotMultipleOfThree) {
 
 TEST(MeshConvert, RejectsTrianglesNotMultipleOfThreeNamingTheField) {
   v1::Mesh wire;
-  MeshToProto(testing::CubeMesh(), &wire);
+  MeshToProto(testing::UnitCube(), &wire);
   wire.add_triangles(0);
   absl::StatusOr<Mesh> mesh = MeshFromProto(wire, "request.mesh");
   EXPECT_EQ(mesh.status().code(), absl::StatusCode::kInvalidArgument);
@@ -58,7 +58,7 @@ TEST(MeshConvert, RejectsTrianglesNotMultipleOfThreeNamingTheField) {
 
 TEST(MeshReportConvert, RoundTripOfAnInvertedOpenMesh) {
   // Validation of a real mesh fills counts, issues of several severities and the box.
-  Mesh open = testing::OpenCubeMesh();
+  Mesh open = testing::OpenUnitCube();
   const MeshReport report = ValidateMesh(open).report;
   ASSERT_FALSE(report.issues.empty());
 
@@ -91,7 +91,7 @@ TEST(MeshReportConvert, RoundTripOfAnInvertedOpenMesh) {
 }
 
 TEST(MeshReportConvert, FixedSeverityRoundTrips) {
-  const MeshReport report = ValidateMesh(testing::InvertedCubeMesh()).report;
+  const MeshReport report = ValidateMesh(testing::Inverted(testing::UnitCube())).report;
   v1::MeshReport wire;
   MeshReportToProto(report, &wire);
   ASSERT_EQ(wire.issues_size(), 1);

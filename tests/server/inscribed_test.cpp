@@ -14,8 +14,8 @@
 #include <thread>
 #include <vector>
 
-#include "cube_meshes.h"
 #include "inscribe/client/client.h"
+#include "support/synthetic_meshes.h"
 
 extern char** environ;
 
@@ -108,7 +108,7 @@ TEST(Inscribed, ServesOnAPickedPortAndStopsCleanlyOnSigterm) {
   EXPECT_NE(address, "127.0.0.1:0");
 
   client::Client client(client::MakeGrpcConnection(address));
-  absl::StatusOr<client::InspectMeshResult> result = client.InspectMesh(testing::CubeMesh());
+  absl::StatusOr<client::InspectMeshResult> result = client.InspectMesh(testing::UnitCube());
   ASSERT_TRUE(result.ok()) << result.status();
   EXPECT_TRUE(result->report.usable());
 

@@ -4,7 +4,6 @@
 
 #include <memory>
 
-#include "cube_meshes.h"
 #include "grpc/health/v1/health.grpc.pb.h"
 #include "grpcpp/create_channel.h"
 #include "grpcpp/security/credentials.h"
@@ -14,6 +13,7 @@
 #include "inscribe/server/convert.h"
 #include "inscribe/server/inscribe_server.h"
 #include "inscribe/v1/service.grpc.pb.h"
+#include "support/synthetic_meshes.h"
 
 namespace inscribe::server {
 namespace {
@@ -71,7 +71,7 @@ TEST_F(InscribeServerTest, BindsTheLoopbackPortItPicked) {
 }
 
 TEST_F(InscribeServerTest, UnitCubeIsUsableWithItsHashAndVolume) {
-  const Mesh cube = testing::CubeMesh();
+  const Mesh cube = testing::UnitCube();
   v1::InspectMeshResponse response;
   const grpc::Status status = Inspect(cube, &response);
   ASSERT_TRUE(status.ok()) << status.error_message();
@@ -92,7 +92,7 @@ TEST_F(InscribeServerTest, UnitCubeIsUsableWithItsHashAndVolume) {
 }
 
 TEST_F(InscribeServerTest, InvertedCubeIsFixedAndHashedAfterTheFix) {
-  const Mesh inverted = testing::InvertedCubeMesh();
+  const Mesh inverted = testing::Inverted(testing::UnitCube());
   v1::InspectMeshResponse response;
   const grpc::Status status = Inspect(inverted, &response);
   ASSERT_TRUE(status.ok()) << status.error_message();
@@ -112,7 +112,7 @@ TEST_F(InscribeServerTest, InvertedCubeIsFixedAndHashedAfterTheFix) {
 
 TEST_F(InscribeServerTest, OpenCubeIsNotUsableAndSaysWhy) {
   v1::InspectMeshResponse response;
-  const grpc::Status status = Inspect(testing::OpenCubeMesh(), &response);
+  const grpc::Status status = Inspect(testing::OpenUnitCube(), &response);
   ASSERT_TRUE(status.ok()) << status.error_message();  // a bad mesh is not a failed call
 
   const v1::MeshReport& report = response.report();
@@ -129,7 +129,7 @@ TEST_F(InscribeServerTest, OpenCubeIsNotUsableAndSaysWhy) {
 
 TEST_F(InscribeServerTest, SkipSelfIntersectionsIsHonoured) {
   v1::InspectMeshRequest request;
-  MeshToProto(testing::CubeMesh(), request.mutable_mesh());
+  MeshToProto(testing::UnitCube(), request.mutable_mesh());
   request.set_skip_self_intersections(true);
   v1::InspectMeshResponse response;
   ASSERT_TRUE(Inspect(request, &response).ok());
@@ -138,7 +138,7 @@ TEST_F(InscribeServerTest, SkipSelfIntersectionsIsHonoured) {
 
 TEST_F(InscribeServerTest, MeshOverTriangleLimitIsResourceExhaustedNamingTheLimit) {
   Mesh big;
-  big.vertices = testing::CubeMesh().vertices;
+  big.vertices = testing::UnitCube().vertices;
   big.triangles.resize(kMaxTriangles + 1, 3);
   big.triangles.rowwise() = Eigen::RowVector3i(0, 1, 2);
   v1::InspectMeshResponse response;
@@ -174,7 +174,7 @@ TEST_F(InscribeServerTest, HealthIsServingForServerAndService) {
 
 TEST_F(InscribeServerTest, ClientLibraryOverGrpcReturnsCoreTypes) {
   client::Client client(client::MakeGrpcConnection(server_->address()));
-  const Mesh cube = testing::InvertedCubeMesh();
+  const Mesh cube = testing::Inverted(testing::UnitCube());
   absl::StatusOr<client::InspectMeshResult> result = client.InspectMesh(cube);
   ASSERT_TRUE(result.ok()) << result.status();
   EXPECT_EQ(result->mesh_sha256, FormatSha256(MeshSha256(ValidateMesh(cube).mesh)));
@@ -185,7 +185,7 @@ TEST_F(InscribeServerTest, ClientLibraryOverGrpcReturnsCoreTypes) {
 
   absl::StatusOr<client::InspectMeshResult> big = client.InspectMesh([] {
     Mesh m;
-    m.vertices = testing::CubeMesh().vertices;
+    m.vertices = testing::UnitCube().vertices;
     m.triangles.setZero(kMaxTriangles + 1, 3);
     return m;
   }());

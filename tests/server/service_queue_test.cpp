@@ -9,7 +9,6 @@
 #include <thread>
 #include <vector>
 
-#include "cube_meshes.h"
 #include "grpcpp/create_channel.h"
 #include "grpcpp/security/credentials.h"
 #include "grpcpp/security/server_credentials.h"
@@ -18,6 +17,7 @@
 #include "inscribe/server/convert.h"
 #include "inscribe/server/inscribe_service.h"
 #include "inscribe/server/job_pool.h"
+#include "support/synthetic_meshes.h"
 
 namespace inscribe::server {
 namespace {
@@ -66,7 +66,7 @@ class ServiceQueueTest : public ::testing::Test {
 
   grpc::Status Inspect(std::chrono::milliseconds timeout) {
     v1::InspectMeshRequest request;
-    MeshToProto(testing::CubeMesh(), request.mutable_mesh());
+    MeshToProto(testing::UnitCube(), request.mutable_mesh());
     grpc::ClientContext context;
     context.set_deadline(std::chrono::system_clock::now() + timeout);
     v1::InspectMeshResponse response;

@@ -25,6 +25,12 @@ Mesh Box(const Vector3& lo, const Vector3& hi) {
   return mesh;
 }
 
+Mesh OpenUnitCube() {
+  Mesh mesh = UnitCube();
+  mesh.triangles.conservativeResize(11, 3);
+  return mesh;
+}
+
 Mesh Icosphere(int levels, const Vector3& centre, double radius) {
   const double t = (1.0 + std::sqrt(5.0)) / 2.0;
   std::vector<Vector3> v = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0},

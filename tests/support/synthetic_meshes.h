@@ -9,6 +9,9 @@ namespace inscribe::testing {
 Mesh Box(const Vector3& lo, const Vector3& hi);
 inline Mesh UnitCube() { return Box(Vector3::Zero(), Vector3::Ones()); }
 
+// The unit cube without its last triangle: 11 triangles, 3 border edges.
+Mesh OpenUnitCube();
+
 // Icosahedron subdivided `levels` times, vertices projected on the sphere (centre, radius).
 // 20 * 4^levels triangles, outward orientation.
 Mesh Icosphere(int levels, const Vector3& centre = Vector3::Zero(), double radius = 1.0);

@@ -63,8 +63,12 @@ std::string DiagnoseOff(const std::vector<Line>& lines) {
   const std::size_t first = i == 0 ? 1 : 0;
   std::int64_t nv = 0, nf = 0;
   if (counts.tokens.size() < first + 2 || !absl::SimpleAtoi(counts.tokens[first], &nv) ||
-      !absl::SimpleAtoi(counts.tokens[first + 1], &nf) || nv < 0 || nf < 0) {
+      !absl::SimpleAtoi(counts.tokens[first + 1], &nf)) {
     return absl::StrCat("line ", counts.number, ": expected the vertex, face and edge counts");
+  }
+  if (nv < 0 || nf < 0) {
+    return absl::StrCat("line ", counts.number, ": header announces ", nv, " vertices and ", nf,
+                        " faces; counts cannot be negative");
   }
   ++i;
   for (std::int64_t v = 0; v < nv; ++v, ++i) {
@@ -158,6 +162,40 @@ std::string DiagnoseObj(const std::vector<Line>& lines) {
 }
 
 }  // namespace
+
+std::string CheckOffCounts(const std::string& bytes) {
+  // Tokens of the header: the keyword, then the vertex and face counts; comments skipped.
+  std::vector<absl::string_view> tokens;
+  std::size_t pos = 0;
+  while (pos < bytes.size() && tokens.size() < 3) {
+    std::size_t end = bytes.find('\n', pos);
+    if (end == std::string::npos) end = bytes.size();
+    absl::string_view line(bytes.data() + pos, end - pos);
+    pos = end + 1;
+    const std::size_t hash = line.find('#');
+    if (hash != absl::string_view::npos) line = line.substr(0, hash);
+    for (absl::string_view token :
+         absl::StrSplit(line, absl::ByAnyChar(" \t\r\f\v"), absl::SkipEmpty())) {
+      if (token == "BINARY") return "";  // counts are binary; CGAL reads them itself
+      if (tokens.size() < 3) tokens.push_back(token);
+    }
+  }
+  if (tokens.size() < 3) return "";  // too short to announce anything: the reader will say
+  std::int64_t vertices = 0, faces = 0;
+  if (!absl::SimpleAtoi(tokens[1], &vertices) || !absl::SimpleAtoi(tokens[2], &faces)) return "";
+  if (vertices < 0 || faces < 0) {
+    return absl::StrCat("header announces ", vertices, " vertices and ", faces,
+                        " faces; counts cannot be negative");
+  }
+  // The shortest text a vertex can take is "0 0 0\n" (6 bytes), a face "3 0 1 2\n" (8).
+  const std::int64_t rest = pos >= bytes.size() ? 0 : static_cast<std::int64_t>(bytes.size() - pos);
+  constexpr std::int64_t kLimit = std::int64_t{1} << 40;
+  if (vertices > kLimit || faces > kLimit || 6 * vertices + 8 * faces - 1 > rest) {
+    return absl::StrCat("header announces ", vertices, " vertices and ", faces,
+                        " faces, more than the remaining ", rest, " bytes can hold (truncated?)");
+  }
+  return "";
+}
 
 std::string DiagnoseMeshText(const std::string& bytes, const std::string& format) {
   if (bytes.find('\0') != std::string::npos) return "file contains binary data";

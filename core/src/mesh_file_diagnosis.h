@@ -11,4 +11,10 @@ namespace inscribe::internal {
 // recognised. Cost O(file size).
 std::string DiagnoseMeshText(const std::string& bytes, const std::string& format);
 
+// For OFF text: "" when the counts in the header can fit in the file, else why not. CGAL's
+// reader reserves memory for the announced counts before reading them, so a 30-byte file
+// announcing a billion vertices would otherwise take tens of GB and minutes. Binary OFF and
+// other formats return "". Cost O(header).
+std::string CheckOffCounts(const std::string& bytes);
+
 }  // namespace inscribe::internal

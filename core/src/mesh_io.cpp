@@ -161,6 +161,15 @@ absl::StatusOr<Mesh> ParseNamed(const std::string& bytes, const std::string& for
   if (bytes.find_first_not_of(" \t\r\n") == std::string::npos) {
     return absl::InvalidArgumentError(absl::StrCat(what, ": file is empty"));
   }
+  if (format == "off") {
+    if (std::string why = internal::CheckOffCounts(bytes); !why.empty()) {
+      // The line-by-line diagnosis, when it finds something, says more precisely where.
+      if (std::string detail = internal::DiagnoseMeshText(bytes, format); !detail.empty()) {
+        why = std::move(detail);
+      }
+      return absl::InvalidArgumentError(absl::StrCat(what, ": not a valid off file: ", why));
+    }
+  }
   std::vector<Point> points;
   std::vector<Polygon> polygons;
   bool ok = false;

@@ -155,6 +155,23 @@ TEST_F(MeshFileTest, TruncatedOff) {
   EXPECT_THAT(mesh.status().message(), HasSubstr("file ends after 2 of 4 faces"));
 }
 
+TEST_F(MeshFileTest, HeaderCountsBeyondTheFile) {
+  // CGAL would reserve memory for a billion vertices before noticing the file is short.
+  absl::StatusOr<Mesh> huge = ReadMesh(Write("h.off", "OFF\n1000000000 1000000000 0\n0 0 0\n"));
+  ASSERT_FALSE(huge.ok());
+  EXPECT_THAT(std::string(huge.status().message()),
+              HasSubstr("file ends after 1 of 1000000000 vertices (truncated?)"));
+  absl::StatusOr<Mesh> same_line = ReadMesh(Write("s.off", "OFF 99 99 0\n"));
+  ASSERT_FALSE(same_line.ok());
+  EXPECT_THAT(std::string(same_line.status().message()),
+              HasSubstr("file ends after 0 of 99 vertices"));
+  absl::StatusOr<Mesh> negative = ReadMesh(Write("n.off", "# made by hand\nOFF\n-4 4 0\n"));
+  ASSERT_FALSE(negative.ok());
+  EXPECT_THAT(std::string(negative.status().message()),
+              HasSubstr("line 3: header announces -4 vertices and 4 faces; counts cannot be "
+                        "negative"));
+}
+
 TEST_F(MeshFileTest, FaceIndexOutOfRange) {
   absl::StatusOr<Mesh> off = ReadMesh(Write(
       "i.off", "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 9\n"));

@@ -11,10 +11,18 @@ namespace inscribe::internal {
 // recognised. Cost O(file size).
 std::string DiagnoseMeshText(const std::string& bytes, const std::string& format);
 
-// For OFF text: "" when the counts in the header can fit in the file, else why not. CGAL's
-// reader reserves memory for the announced counts before reading them, so a 30-byte file
-// announcing a billion vertices would otherwise take tens of GB and minutes. Binary OFF and
-// other formats return "". Cost O(header).
+// Guards for CGAL 5.5's readers, run before them. CGAL sizes arrays from counts in the file
+// before reading what they count, and trusts header structure, so hostile files could make it
+// allocate tens of GB or crash. Each returns "" when the file is safe to hand to CGAL, else why
+// not, with a line number where there is one.
+
+// OFF: the header's vertex and face counts must fit in the file, and every face's corner count
+// in its line. Binary OFF is refused. Cost O(file), nothing stored.
 std::string CheckOffCounts(const std::string& bytes);
+
+// PLY: a well-formed header (CGAL crashes on a "property" before any "element"), and, for
+// lists with counts wider than 16 bits, every list count within the rest of the file.
+// Cost O(header), or O(file) with wide list counts.
+std::string CheckPlyHeader(const std::string& bytes);
 
 }  // namespace inscribe::internal

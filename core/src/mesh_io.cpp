@@ -19,6 +19,7 @@
 #include <sstream>
 #include <vector>
 
+#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "mesh_file_diagnosis.h"
 
@@ -37,12 +38,14 @@ std::string Lowercase(std::string s) {
 
 bool ReadSoup(std::istream& in, const std::string& format, std::vector<Point>& points,
               std::vector<Polygon>& polygons) {
-  if (format == "off") return CGAL::IO::read_OFF(in, points, polygons);
-  if (format == "obj") return CGAL::IO::read_OBJ(in, points, polygons);
-  if (format == "ply") return CGAL::IO::read_PLY(in, points, polygons);
+  // Some of CGAL's readers print to std::cerr unless told not to; library code never prints.
+  const auto quiet = CGAL::parameters::verbose(false);
+  if (format == "off") return CGAL::IO::read_OFF(in, points, polygons, quiet);
+  if (format == "obj") return CGAL::IO::read_OBJ(in, points, polygons, quiet);
+  if (format == "ply") return CGAL::IO::read_PLY(in, points, polygons, quiet);
   if (format == "stl") {
     std::vector<std::array<std::size_t, 3>> facets;
-    if (!CGAL::IO::read_STL(in, points, facets)) return false;
+    if (!CGAL::IO::read_STL(in, points, facets, quiet)) return false;
     polygons.reserve(facets.size());
     for (const auto& f : facets) polygons.push_back({f[0], f[1], f[2]});
     return true;
@@ -163,11 +166,18 @@ absl::StatusOr<Mesh> ParseNamed(const std::string& bytes, const std::string& for
   }
   if (format == "off") {
     if (std::string why = internal::CheckOffCounts(bytes); !why.empty()) {
-      // The line-by-line diagnosis, when it finds something, says more precisely where.
-      if (std::string detail = internal::DiagnoseMeshText(bytes, format); !detail.empty()) {
-        why = std::move(detail);
+      // For a short file, the line-by-line diagnosis says more precisely where it ends.
+      if (absl::StrContains(why, "(truncated?)")) {
+        if (std::string detail = internal::DiagnoseMeshText(bytes, format); !detail.empty()) {
+          why = std::move(detail);
+        }
       }
       return absl::InvalidArgumentError(absl::StrCat(what, ": not a valid off file: ", why));
+    }
+  }
+  if (format == "ply") {
+    if (std::string why = internal::CheckPlyHeader(bytes); !why.empty()) {
+      return absl::InvalidArgumentError(absl::StrCat(what, ": not a valid ply file: ", why));
     }
   }
   std::vector<Point> points;

@@ -172,6 +172,49 @@ TEST_F(MeshFileTest, HeaderCountsBeyondTheFile) {
                         "negative"));
 }
 
+TEST_F(MeshFileTest, HostileCountsAreRefusedBeforeCgalSizesArrays) {
+  struct Case {
+    std::string name, bytes, expected;
+  };
+  std::string binary_ply =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n"
+      "property float y\nproperty float z\nelement face 1\n"
+      "property list int int vertex_indices\nend_header\n";
+  binary_ply += std::string(36, '\0');
+  binary_ply += std::string("\x00\xca\x9a\x3b", 4);  // a face of 10^9 corners
+  binary_ply += std::string(12, '\0');
+  const std::vector<Case> cases = {
+      {"corners.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n999999999 0 1 2\n",
+       "line 6: face 0 announces 999999999 corners but lists 3"},
+      {"binary.off", "OFF BINARY\n", "binary OFF is not supported"},
+      // CGAL 5.5 crashed on this one (found by MeshIoMutation).
+      {"orphan.ply", "ply\nformat ascii 1.0\nproperty float x\nelement vertex 1\nend_header\n1\n",
+       "line 3: property before any element"},
+      {"list.ply",
+       "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+       "property float z\nelement face 1\nproperty list int int vertex_indices\nend_header\n"
+       "0 0 0\n1 0 0\n0 1 0\n1000000000 0 1 2\n",
+       "face 0: a list of 1000000000 items is longer than the rest of the file"},
+      {"binary.ply", binary_ply,
+       "face 0: a list of 1000000000 items is longer than the rest of the file"},
+      {"noformat.ply", "ply\nelement vertex 1\nproperty float x\nend_header\n",
+       "header has no format line"},
+  };
+  for (const Case& c : cases) {
+    absl::StatusOr<Mesh> mesh = ReadMesh(Write(c.name, c.bytes));
+    ASSERT_FALSE(mesh.ok()) << c.name;
+    EXPECT_THAT(std::string(mesh.status().message()), HasSubstr(c.expected)) << c.name;
+  }
+  // The same layouts with honest counts still read.
+  absl::StatusOr<Mesh> honest = ReadMesh(
+      Write("honest.ply",
+            "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+            "property float z\nelement face 4\nproperty list int int vertex_indices\nend_header\n"
+            "0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n"));
+  ASSERT_TRUE(honest.ok()) << honest.status();
+  EXPECT_EQ(honest->num_triangles(), 4);
+}
+
 TEST_F(MeshFileTest, FaceIndexOutOfRange) {
   absl::StatusOr<Mesh> off = ReadMesh(Write(
       "i.off", "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 9\n"));

@@ -192,11 +192,12 @@ void BuildCgalAabbTree(benchmark::State& state, const Fixture& f) {
 }
 
 // One query at a time on this thread, as a caller without its own batching would.
-void OracleClosestPoint(benchmark::State& state, const Fixture& f, const Vertices& queries) {
+void OracleClosestPoint(benchmark::State& state, const BoundaryOracle& oracle,
+                        const Vertices& queries) {
   for (auto _ : state) {
     double sum = 0.0;  // keeps every query observable
     for (Eigen::Index i = 0; i < queries.rows(); ++i) {
-      sum += f.oracle.ClosestPoint(queries.row(i).transpose()).distance;
+      sum += oracle.ClosestPoint(queries.row(i).transpose()).distance;
     }
     benchmark::DoNotOptimize(sum);
   }
@@ -223,6 +224,23 @@ void OracleClosestPointsBatch(benchmark::State& state, const Fixture& f) {
   state.SetItemsProcessed(state.iterations() * f.queries.rows());
 }
 
+// Refit to new positions of the same triangles (alternating between the mesh and a sheared
+// copy, so every call changes every box): compare with BM_BuildOracle.
+void OracleRefit(benchmark::State& state, const Fixture& f) {
+  absl::StatusOr<BoundaryOracle> oracle = BoundaryOracle::Build(f.mesh);
+  Vertices sheared = f.mesh.vertices;
+  sheared.col(0) += 0.05 * sheared.col(1);
+  bool flip = false;
+  for (auto _ : state) {
+    flip = !flip;
+    const absl::Status status = oracle->Refit(flip ? sheared : f.mesh.vertices);
+    if (!status.ok()) {
+      state.SkipWithError(std::string(status.message()).c_str());
+      break;
+    }
+  }
+}
+
 // Wall-clock time everywhere: Embree builds and the batch use several threads, and CPU time of
 // the main thread alone would flatter them. `sets` must outlive the run.
 void RegisterAll(const Fixture& f, const std::vector<QuerySet>& sets) {
@@ -234,7 +252,7 @@ void RegisterAll(const Fixture& f, const std::vector<QuerySet>& sets) {
       ->UseRealTime();
   for (const QuerySet& set : sets) {
     benchmark::RegisterBenchmark(("BM_OracleClosestPoint/" + set.name).c_str(), OracleClosestPoint,
-                                 std::cref(f), std::cref(set.points))
+                                 std::cref(f.oracle), std::cref(set.points))
         ->Unit(benchmark::kMillisecond)
         ->UseRealTime();
     benchmark::RegisterBenchmark(("BM_CgalClosestPoint/" + set.name).c_str(), CgalClosestPoint,
@@ -244,6 +262,9 @@ void RegisterAll(const Fixture& f, const std::vector<QuerySet>& sets) {
   }
   benchmark::RegisterBenchmark("BM_OracleClosestPointsBatch", OracleClosestPointsBatch,
                                std::cref(f))
+      ->Unit(benchmark::kMillisecond)
+      ->UseRealTime();
+  benchmark::RegisterBenchmark("BM_OracleRefit", OracleRefit, std::cref(f))
       ->Unit(benchmark::kMillisecond)
       ->UseRealTime();
 }

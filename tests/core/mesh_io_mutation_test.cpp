@@ -1,8 +1,6 @@
 // Mutated mesh files (flipped bytes, cuts, repeated spans, hostile tokens) through the whole
 // loading path: every outcome is either a mesh or an error naming the file, never a crash, a
 // hang or an allocation the file cannot justify. A deterministic smoke; libFuzzer goes deeper.
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/IO/polygon_soup_io.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -15,6 +13,7 @@
 #include "inscribe/mesh_hash.h"
 #include "inscribe/mesh_io.h"
 #include "inscribe/mesh_validation.h"
+#include "support/cgal_mesh_writer.h"
 #include "support/synthetic_meshes.h"
 
 namespace inscribe {
@@ -23,19 +22,7 @@ namespace {
 namespace fs = std::filesystem;
 
 std::string WriteSeed(const fs::path& path, const Mesh& mesh, bool binary) {
-  using Point = CGAL::Exact_predicates_inexact_constructions_kernel::Point_3;
-  std::vector<Point> points;
-  for (Eigen::Index v = 0; v < mesh.num_vertices(); ++v) {
-    points.emplace_back(mesh.vertices(v, 0), mesh.vertices(v, 1), mesh.vertices(v, 2));
-  }
-  std::vector<std::array<std::size_t, 3>> faces;
-  for (Eigen::Index t = 0; t < mesh.num_triangles(); ++t) {
-    faces.push_back({static_cast<std::size_t>(mesh.triangles(t, 0)),
-                     static_cast<std::size_t>(mesh.triangles(t, 1)),
-                     static_cast<std::size_t>(mesh.triangles(t, 2))});
-  }
-  EXPECT_TRUE(CGAL::IO::write_polygon_soup(path.string(), points, faces,
-                                           CGAL::parameters::use_binary_mode(binary)));
+  EXPECT_TRUE(testing::WriteMeshWithCgal(path.string(), mesh, binary));
   std::ifstream in(path, std::ios::binary);
   std::ostringstream bytes;
   bytes << in.rdbuf();

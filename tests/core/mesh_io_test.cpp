@@ -1,7 +1,5 @@
 #include "inscribe/mesh_io.h"
 
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/IO/polygon_soup_io.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -11,6 +9,7 @@
 #include <random>
 
 #include "inscribe/mesh_validation.h"
+#include "support/cgal_mesh_writer.h"
 #include "support/synthetic_meshes.h"
 #include "support/test_meshes.h"
 
@@ -40,20 +39,8 @@ class MeshFileTest : public ::testing::Test {
 
   // Writes `mesh` with CGAL's writer (an independent path from our reader's caller).
   std::string WriteWithCgal(const std::string& name, const Mesh& mesh, bool binary) {
-    using Point = CGAL::Exact_predicates_inexact_constructions_kernel::Point_3;
-    std::vector<Point> points;
-    for (Eigen::Index v = 0; v < mesh.num_vertices(); ++v) {
-      points.emplace_back(mesh.vertices(v, 0), mesh.vertices(v, 1), mesh.vertices(v, 2));
-    }
-    std::vector<std::array<std::size_t, 3>> faces;
-    for (Eigen::Index t = 0; t < mesh.num_triangles(); ++t) {
-      faces.push_back({static_cast<std::size_t>(mesh.triangles(t, 0)),
-                       static_cast<std::size_t>(mesh.triangles(t, 1)),
-                       static_cast<std::size_t>(mesh.triangles(t, 2))});
-    }
     const std::string path = (dir_ / name).string();
-    EXPECT_TRUE(CGAL::IO::write_polygon_soup(
-        path, points, faces, CGAL::parameters::use_binary_mode(binary).stream_precision(17)));
+    EXPECT_TRUE(testing::WriteMeshWithCgal(path, mesh, binary));
     return path;
   }
 

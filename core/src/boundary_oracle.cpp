@@ -12,20 +12,17 @@
 #include "absl/strings/str_cat.h"
 #include "closest_point_triangle.h"
 #include "mesh_topology.h"
+#include "triangle_bvh.h"
 
 namespace inscribe {
 namespace {
 
-float RoundDown(double x) {
-  float f = static_cast<float>(x);
-  return static_cast<double>(f) > x ? std::nextafter(f, -std::numeric_limits<float>::infinity())
-                                    : f;
-}
+using internal::RoundDown;
+using internal::RoundUp;
 
-float RoundUp(double x) {
-  float f = static_cast<float>(x);
-  return static_cast<double>(f) < x ? std::nextafter(f, std::numeric_limits<float>::infinity()) : f;
-}
+// A bound u is honoured when the squared distance found is at most u^2 (1 + kBoundRelative):
+// the rounding of u = sqrt(d^2) itself (the flat BVH checks the same inside its query).
+constexpr double kBoundRelative = 1e-13;
 
 absl::Status CheckVertices(const Vertices& vertices) {
   for (Eigen::Index v = 0; v < vertices.rows(); ++v) {
@@ -51,8 +48,12 @@ struct BoundaryOracle::Impl {
 
   BoundaryOracleOptions options;
   BoundingBox box;  // of the vertices; queries outside it are outside the solid
-  float pad = 0;    // outward padding of every primitive box (see UpdateBoxAndPad)
 
+  // Backend kFlatBvh.
+  internal::TriangleBvh bvh;
+
+  // Backend kEmbree (all null otherwise).
+  float pad = 0;  // outward padding of every primitive box (see UpdateBoxAndPad)
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;
   RTCGeometry geometry = nullptr;
@@ -74,9 +75,13 @@ struct BoundaryOracle::Impl {
 
   void ComputeNormals();
   absl::Status BuildScene();
-  BoundaryPoint Closest(const Vector3& p) const;
+  // upper_bound: see BoundaryOracle::ClosestPoint; infinity for none.
+  BoundaryPoint Closest(const Vector3& p,
+                        double upper_bound = std::numeric_limits<double>::infinity()) const;
+  BoundaryPoint EmbreeClosest(const Vector3& p, double upper_bound) const;
   Side ClassifyFrom(const Vector3& p, const BoundaryPoint& closest) const;
   Side ClassifyByParity(const Vector3& p) const;
+  int EmbreeCrossings(const Vector3& p, const float direction[3]) const;
   void UpdateBoxAndPad();
 
   struct ParityContext;
@@ -201,20 +206,38 @@ bool BoundaryOracle::Impl::VisitTriangle(RTCPointQueryFunctionArguments* args) {
   return false;
 }
 
-BoundaryPoint BoundaryOracle::Impl::Closest(const Vector3& p) const {
+// Returns triangle -1 when no triangle lies within upper_bound.
+BoundaryPoint BoundaryOracle::Impl::EmbreeClosest(const Vector3& p, double upper_bound) const {
   QueryState state{this, p, 0.0, std::numeric_limits<double>::infinity(), BoundaryPoint{}};
   RTCPointQuery query;
   query.x = static_cast<float>(p.x());
   query.y = static_cast<float>(p.y());
   query.z = static_cast<float>(p.z());
   query.time = 0.0f;
-  query.radius = std::numeric_limits<float>::infinity();
   state.pad = (p - Vector3(query.x, query.y, query.z)).norm();
+  // A negative bound is as broken as any other too-small one; NaN means none.
+  const bool bounded = upper_bound < std::numeric_limits<double>::infinity();
+  if (bounded) upper_bound = std::max(upper_bound, 0.0);
+  // The same conservative radius as VisitTriangle sets once it knows a distance.
+  query.radius = bounded ? RoundUp((upper_bound + state.pad) * (1.0 + 1e-6) + 1e-30)
+                         : std::numeric_limits<float>::infinity();
   RTCPointQueryContext context;
   rtcInitPointQueryContext(&context);
   rtcPointQuery(scene, &query, &context, VisitTriangle, &state);
+  if (bounded && !(state.best_squared <= upper_bound * upper_bound * (1.0 + kBoundRelative))) {
+    return BoundaryPoint{};
+  }
   state.best.distance = std::sqrt(state.best_squared);
   return state.best;
+}
+
+BoundaryPoint BoundaryOracle::Impl::Closest(const Vector3& p, double upper_bound) const {
+  const bool flat = options.backend == BoundaryOracleBackend::kFlatBvh;
+  BoundaryPoint found = flat ? bvh.ClosestPoint(p, upper_bound) : EmbreeClosest(p, upper_bound);
+  if (found.triangle < 0) {  // the caller's bound was too small
+    found = flat ? bvh.ClosestPoint(p) : EmbreeClosest(p, std::numeric_limits<double>::infinity());
+  }
+  return found;
 }
 
 // The padding makes single-precision culling conservative for rays as well as for point
@@ -235,25 +258,42 @@ struct BoundaryOracle::Impl::ParityContext {
 };
 
 // Called for every triangle whose (padded) box the ray enters. Never shortens the ray, so
-// traversal visits them all; counts proper crossings with t > 0 (Moeller-Trumbore, double).
+// traversal visits them all; counts proper crossings with t > 0 (the flat BVH's predicate).
 void BoundaryOracle::Impl::CountCrossing(const RTCIntersectFunctionNArguments* args) {
   if (args->valid[0] == 0) return;
   auto* ctx = reinterpret_cast<ParityContext*>(args->context);
   const auto t = static_cast<std::int32_t>(args->primID);
-  const Vector3 a = ctx->impl->Corner(t, 0);
-  const Vector3 e1 = ctx->impl->Corner(t, 1) - a;
-  const Vector3 e2 = ctx->impl->Corner(t, 2) - a;
-  const Vector3 pvec = ctx->direction.cross(e2);
-  const double det = e1.dot(pvec);
-  if (det == 0.0) return;  // ray parallel to the triangle's plane
-  const double inv = 1.0 / det;
-  const Vector3 tvec = ctx->origin - a;
-  const double u = tvec.dot(pvec) * inv;
-  if (u < 0.0 || u > 1.0) return;
-  const Vector3 qvec = tvec.cross(e1);
-  const double v = ctx->direction.dot(qvec) * inv;
-  if (v < 0.0 || u + v > 1.0) return;
-  if (e2.dot(qvec) * inv > 0.0) ++ctx->crossings;
+  if (internal::RayCrossesTriangle(ctx->origin, ctx->direction, ctx->impl->Corner(t, 0),
+                                   ctx->impl->Corner(t, 1), ctx->impl->Corner(t, 2))) {
+    ++ctx->crossings;
+  }
+}
+
+int BoundaryOracle::Impl::EmbreeCrossings(const Vector3& p, const float direction[3]) const {
+  ParityContext ctx;
+  rtcInitIntersectContext(&ctx.base);
+  ctx.impl = this;
+  ctx.origin = p;
+  ctx.direction = Vector3(direction[0], direction[1], direction[2]);
+  ctx.crossings = 0;
+  RTCRayHit rayhit;
+  rayhit.ray.org_x = static_cast<float>(p.x());
+  rayhit.ray.org_y = static_cast<float>(p.y());
+  rayhit.ray.org_z = static_cast<float>(p.z());
+  rayhit.ray.dir_x = direction[0];
+  rayhit.ray.dir_y = direction[1];
+  rayhit.ray.dir_z = direction[2];
+  rayhit.ray.tnear = 0.0f;
+  rayhit.ray.tfar = std::numeric_limits<float>::infinity();
+  rayhit.ray.time = 0.0f;
+  rayhit.ray.mask = 0xFFFFFFFFu;
+  rayhit.ray.id = 0;
+  rayhit.ray.flags = 0;
+  rayhit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rayhit.hit.primID = RTC_INVALID_GEOMETRY_ID;
+  rayhit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  rtcIntersect1(scene, &ctx.base, &rayhit);
+  return ctx.crossings;
 }
 
 Side BoundaryOracle::Impl::ClassifyByParity(const Vector3& p) const {
@@ -268,30 +308,10 @@ Side BoundaryOracle::Impl::ClassifyByParity(const Vector3& p) const {
                                               {0.2672612f, -0.8017837f, 0.5345225f}};
   int inside_votes = 0;
   for (const auto& d : kDirections) {
-    ParityContext ctx;
-    rtcInitIntersectContext(&ctx.base);
-    ctx.impl = this;
-    ctx.origin = p;
-    ctx.direction = Vector3(d[0], d[1], d[2]);
-    ctx.crossings = 0;
-    RTCRayHit rayhit;
-    rayhit.ray.org_x = static_cast<float>(p.x());
-    rayhit.ray.org_y = static_cast<float>(p.y());
-    rayhit.ray.org_z = static_cast<float>(p.z());
-    rayhit.ray.dir_x = d[0];
-    rayhit.ray.dir_y = d[1];
-    rayhit.ray.dir_z = d[2];
-    rayhit.ray.tnear = 0.0f;
-    rayhit.ray.tfar = std::numeric_limits<float>::infinity();
-    rayhit.ray.time = 0.0f;
-    rayhit.ray.mask = 0xFFFFFFFFu;
-    rayhit.ray.id = 0;
-    rayhit.ray.flags = 0;
-    rayhit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rayhit.hit.primID = RTC_INVALID_GEOMETRY_ID;
-    rayhit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(scene, &ctx.base, &rayhit);
-    inside_votes += ctx.crossings % 2;
+    const int crossings = options.backend == BoundaryOracleBackend::kFlatBvh
+                              ? bvh.CountCrossings(p, Vector3(d[0], d[1], d[2]))
+                              : EmbreeCrossings(p, d);
+    inside_votes += crossings % 2;
   }
   return inside_votes >= 2 ? Side::kInside : Side::kOutside;
 }
@@ -359,7 +379,11 @@ absl::StatusOr<BoundaryOracle> BoundaryOracle::Build(const Mesh& mesh,
     i = j;
   }
   impl->ComputeNormals();
-  if (absl::Status s = impl->BuildScene(); !s.ok()) return s;
+  if (options.backend == BoundaryOracleBackend::kFlatBvh) {
+    impl->bvh = internal::TriangleBvh::Build(impl->mesh);
+  } else if (absl::Status s = impl->BuildScene(); !s.ok()) {
+    return s;
+  }
   return BoundaryOracle(std::move(impl));
 }
 
@@ -374,6 +398,10 @@ absl::Status BoundaryOracle::Refit(const Vertices& new_vertices) {
   impl_->mesh.vertices = new_vertices;
   impl_->UpdateBoxAndPad();
   impl_->ComputeNormals();
+  if (impl_->options.backend == BoundaryOracleBackend::kFlatBvh) {
+    impl_->bvh.Refit(impl_->mesh);
+    return absl::OkStatus();
+  }
   rtcCommitGeometry(impl_->geometry);
   rtcCommitScene(impl_->scene);
   std::lock_guard<std::mutex> lock(impl_->error_mutex);
@@ -385,6 +413,10 @@ const Mesh& BoundaryOracle::mesh() const { return impl_->mesh; }
 
 BoundaryPoint BoundaryOracle::ClosestPoint(const Vector3& query) const {
   return impl_->Closest(query);
+}
+
+BoundaryPoint BoundaryOracle::ClosestPoint(const Vector3& query, double upper_bound) const {
+  return impl_->Closest(query, upper_bound);
 }
 
 Side BoundaryOracle::Classify(const Vector3& query) const {

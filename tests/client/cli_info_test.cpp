@@ -11,6 +11,7 @@
 #include <regex>
 #include <string>
 
+#include "client/cli_run.h"
 #include "support/test_meshes.h"
 
 namespace inscribe {
@@ -18,35 +19,6 @@ namespace {
 
 using ::testing::HasSubstr;
 namespace fs = std::filesystem;
-
-struct CliRun {
-  int exit_code = -1;
-  std::string out;
-  std::string err;
-};
-
-std::string Slurp(const fs::path& path) {
-  std::ifstream in(path);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
-
-CliRun RunCli(const std::string& args) {
-  const fs::path dir = fs::temp_directory_path();
-  const std::string tag = std::to_string(::getpid());
-  const fs::path out = dir / ("inscribe_cli_out_" + tag), err = dir / ("inscribe_cli_err_" + tag);
-  const std::string command =
-      std::string(INSCRIBE_CLI) + " " + args + " >" + out.string() + " 2>" + err.string();
-  const int status = std::system(command.c_str());
-  CliRun run;
-  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  run.out = Slurp(out);
-  run.err = Slurp(err);
-  fs::remove(out);
-  fs::remove(err);
-  return run;
-}
-
-std::string Quote(const std::string& s) { return "'" + s + "'"; }
 
 TEST(CliInfo, JsonOnARealMesh) {
   INSCRIBE_REQUIRE_MESH("eight.off");

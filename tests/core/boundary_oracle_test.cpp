@@ -6,7 +6,9 @@
 #include <gtest/gtest.h>
 
 #include <random>
+#include <string>
 #include <thread>
+#include <tuple>
 
 #include "support/synthetic_meshes.h"
 #include "support/test_meshes.h"
@@ -105,6 +107,18 @@ void ExpectMatchesBruteForce(const Mesh& mesh, const BoundaryOracle& oracle,
   }
 }
 
+bool Identical(const BoundaryPoint& a, const BoundaryPoint& b) {
+  return a.triangle == b.triangle && a.point == b.point && a.barycentric == b.barycentric &&
+         a.distance == b.distance;
+}
+
+constexpr BoundaryOracleBackend kBackends[] = {BoundaryOracleBackend::kFlatBvh,
+                                               BoundaryOracleBackend::kEmbree};
+
+std::string BackendName(BoundaryOracleBackend backend) {
+  return backend == BoundaryOracleBackend::kFlatBvh ? "FlatBvh" : "Embree";
+}
+
 // Inside/outside against CGAL's exact ray-parity test. Returns the disagreements.
 int CountSideDisagreements(const Mesh& mesh, const BoundaryOracle& oracle, const Vertices& points) {
   SurfaceMesh surface;
@@ -134,45 +148,63 @@ int CountSideDisagreements(const Mesh& mesh, const BoundaryOracle& oracle, const
 }
 
 TEST(BoundaryOracle, UnitCubeExactAnswers) {
-  absl::StatusOr<BoundaryOracle> oracle = BoundaryOracle::Build(testing::UnitCube());
-  ASSERT_TRUE(oracle.ok()) << oracle.status();
-  EXPECT_DOUBLE_EQ(oracle->SignedDistance(Vector3(0.5, 0.5, 0.5)), -0.5);
-  EXPECT_NEAR(oracle->SignedDistance(Vector3(0.5, 0.5, 0.9)), -0.1, 1e-15);
-  const BoundaryPoint corner = oracle->ClosestPoint(Vector3(2, 2, 2));
-  EXPECT_EQ(corner.point, Vector3(1, 1, 1));
-  EXPECT_DOUBLE_EQ(corner.distance, std::sqrt(3.0));
-  EXPECT_EQ(oracle->Classify(Vector3(2, 2, 2)), Side::kOutside);
-  EXPECT_EQ(oracle->Classify(Vector3(1.5, 0.5, 1.5)), Side::kOutside);  // edge region
-  EXPECT_EQ(oracle->Classify(Vector3(0.999, 0.5, 0.999)), Side::kInside);
-  EXPECT_EQ(oracle->Classify(Vector3(0.999, 0.999, 0.999)), Side::kInside);
-  EXPECT_EQ(oracle->Classify(Vector3(1, 0.5, 0.5)), Side::kOnBoundary);
+  for (const BoundaryOracleBackend backend : kBackends) {
+    SCOPED_TRACE(BackendName(backend));
+    absl::StatusOr<BoundaryOracle> oracle =
+        BoundaryOracle::Build(testing::UnitCube(), {InsideTest::kPseudonormal, backend});
+    ASSERT_TRUE(oracle.ok()) << oracle.status();
+    EXPECT_DOUBLE_EQ(oracle->SignedDistance(Vector3(0.5, 0.5, 0.5)), -0.5);
+    EXPECT_NEAR(oracle->SignedDistance(Vector3(0.5, 0.5, 0.9)), -0.1, 1e-15);
+    const BoundaryPoint corner = oracle->ClosestPoint(Vector3(2, 2, 2));
+    EXPECT_EQ(corner.point, Vector3(1, 1, 1));
+    EXPECT_DOUBLE_EQ(corner.distance, std::sqrt(3.0));
+    EXPECT_EQ(oracle->Classify(Vector3(2, 2, 2)), Side::kOutside);
+    EXPECT_EQ(oracle->Classify(Vector3(1.5, 0.5, 1.5)), Side::kOutside);  // edge region
+    EXPECT_EQ(oracle->Classify(Vector3(0.999, 0.5, 0.999)), Side::kInside);
+    EXPECT_EQ(oracle->Classify(Vector3(0.999, 0.999, 0.999)), Side::kInside);
+    EXPECT_EQ(oracle->Classify(Vector3(1, 0.5, 0.5)), Side::kOnBoundary);
+  }
 }
 
 TEST(BoundaryOracle, CavityIsOutside) {
   const Mesh hollow =
       testing::Concatenate(testing::Box(Vector3(-2, -2, -2), Vector3(2, 2, 2)),
                            testing::Inverted(testing::Box(Vector3(-1, -1, -1), Vector3(1, 1, 1))));
-  absl::StatusOr<BoundaryOracle> oracle = BoundaryOracle::Build(hollow);
-  ASSERT_TRUE(oracle.ok());
-  EXPECT_EQ(oracle->Classify(Vector3(0, 0, 0)), Side::kOutside);
-  EXPECT_DOUBLE_EQ(oracle->SignedDistance(Vector3(0, 0, 0)), 1.0);
-  EXPECT_EQ(oracle->Classify(Vector3(1.5, 0, 0)), Side::kInside);
-  EXPECT_EQ(oracle->Classify(Vector3(1.5, 1.5, 1.5)), Side::kInside);
-  EXPECT_EQ(oracle->Classify(Vector3(0.9, 0.9, 0.9)), Side::kOutside);
+  for (const BoundaryOracleBackend backend : kBackends) {
+    SCOPED_TRACE(BackendName(backend));
+    absl::StatusOr<BoundaryOracle> oracle =
+        BoundaryOracle::Build(hollow, {InsideTest::kPseudonormal, backend});
+    ASSERT_TRUE(oracle.ok());
+    EXPECT_EQ(oracle->Classify(Vector3(0, 0, 0)), Side::kOutside);
+    EXPECT_DOUBLE_EQ(oracle->SignedDistance(Vector3(0, 0, 0)), 1.0);
+    EXPECT_EQ(oracle->Classify(Vector3(1.5, 0, 0)), Side::kInside);
+    EXPECT_EQ(oracle->Classify(Vector3(1.5, 1.5, 1.5)), Side::kInside);
+    EXPECT_EQ(oracle->Classify(Vector3(0.9, 0.9, 0.9)), Side::kOutside);
+  }
 }
 
-class OracleOnMesh : public ::testing::TestWithParam<const char*> {
+Mesh LoadMesh(const std::string& name) {
+  if (name == "cube") return testing::Box(Vector3(-1, 0, 2), Vector3(2, 0.5, 3));
+  if (name == "icosphere") return testing::Icosphere(4, Vector3(0.3, -0.2, 5), 0.7);
+  return testing::LoadTestMesh(name);
+}
+
+bool MeshMissing(const std::string& name) {
+  return name != "cube" && name != "icosphere" && testing::TestMeshPath(name).empty();
+}
+
+// Every test on every mesh, for each backend.
+class OracleOnMesh
+    : public ::testing::TestWithParam<std::tuple<const char*, BoundaryOracleBackend>> {
  protected:
-  Mesh Load() {
-    const std::string name = GetParam();
-    if (name == "cube") return testing::Box(Vector3(-1, 0, 2), Vector3(2, 0.5, 3));
-    if (name == "icosphere") return testing::Icosphere(4, Vector3(0.3, -0.2, 5), 0.7);
-    return testing::LoadTestMesh(name);
+  std::string MeshName() const { return std::get<0>(GetParam()); }
+  Mesh Load() { return LoadMesh(MeshName()); }
+  BoundaryOracleOptions Options(InsideTest inside_test = InsideTest::kPseudonormal) const {
+    return BoundaryOracleOptions{inside_test, std::get<1>(GetParam())};
   }
   void SkipIfMissing() {
-    const std::string name = GetParam();
-    if (name != "cube" && name != "icosphere" && testing::TestMeshPath(name).empty()) {
-      GTEST_SKIP() << "\n\n*** SKIPPED: " << name
+    if (MeshMissing(MeshName())) {
+      GTEST_SKIP() << "\n\n*** SKIPPED: " << MeshName()
                    << " missing; run scripts/fetch-meshes (needs libcgal-demo) ***\n";
     }
   }
@@ -181,21 +213,21 @@ class OracleOnMesh : public ::testing::TestWithParam<const char*> {
 TEST_P(OracleOnMesh, ClosestPointMatchesBruteForce) {
   SkipIfMissing();
   const Mesh mesh = Load();
-  absl::StatusOr<BoundaryOracle> oracle = BoundaryOracle::Build(mesh);
+  absl::StatusOr<BoundaryOracle> oracle = BoundaryOracle::Build(mesh, Options());
   ASSERT_TRUE(oracle.ok()) << oracle.status();
   ExpectMatchesBruteForce(mesh, *oracle, QueryPoints(mesh, 400, 11));
 }
 
 TEST_P(OracleOnMesh, PseudonormalAgreesWithCgalSideOfTriangleMesh) {
   SkipIfMissing();
-  if (std::string(GetParam()) == "cow.off") {
+  if (MeshName() == "cow.off") {
     // cow.off intersects itself (101 crossing triangle pairs, see `inscribe info`): sheets
     // buried inside the solid flip the pseudonormal's sign near them. That is what
     // InsideTest::kRayParity is for; RayParityAgreesWithCgalSideOfTriangleMesh covers cow.
     GTEST_SKIP() << "cow.off self-intersects; pseudonormal sign is not defined there";
   }
   const Mesh mesh = Load();
-  absl::StatusOr<BoundaryOracle> oracle = BoundaryOracle::Build(mesh);
+  absl::StatusOr<BoundaryOracle> oracle = BoundaryOracle::Build(mesh, Options());
   ASSERT_TRUE(oracle.ok()) << oracle.status();
   EXPECT_EQ(CountSideDisagreements(mesh, *oracle, QueryPoints(mesh, 1000, 12)), 0);
 }
@@ -204,7 +236,7 @@ TEST_P(OracleOnMesh, RayParityAgreesWithCgalSideOfTriangleMesh) {
   SkipIfMissing();
   const Mesh mesh = Load();
   absl::StatusOr<BoundaryOracle> oracle =
-      BoundaryOracle::Build(mesh, BoundaryOracleOptions{InsideTest::kRayParity});
+      BoundaryOracle::Build(mesh, Options(InsideTest::kRayParity));
   ASSERT_TRUE(oracle.ok()) << oracle.status();
   EXPECT_EQ(CountSideDisagreements(mesh, *oracle, QueryPoints(mesh, 1000, 15)), 0);
 }
@@ -212,7 +244,7 @@ TEST_P(OracleOnMesh, RayParityAgreesWithCgalSideOfTriangleMesh) {
 TEST_P(OracleOnMesh, RefitMatchesRebuildAndBruteForce) {
   SkipIfMissing();
   const Mesh mesh = Load();
-  absl::StatusOr<BoundaryOracle> oracle = BoundaryOracle::Build(mesh);
+  absl::StatusOr<BoundaryOracle> oracle = BoundaryOracle::Build(mesh, Options());
   ASSERT_TRUE(oracle.ok());
   // A smooth bend, stretch and shear: same triangles, new positions.
   const BoundingBox box = ComputeBoundingBox(mesh.vertices);
@@ -224,19 +256,27 @@ TEST_P(OracleOnMesh, RefitMatchesRebuildAndBruteForce) {
                                     .transpose();
   }
   ASSERT_TRUE(oracle->Refit(deformed.vertices).ok());
-  absl::StatusOr<BoundaryOracle> rebuilt = BoundaryOracle::Build(deformed);
+  absl::StatusOr<BoundaryOracle> rebuilt = BoundaryOracle::Build(deformed, Options());
   ASSERT_TRUE(rebuilt.ok());
   const Vertices points = QueryPoints(deformed, 250, 13);
   ExpectMatchesBruteForce(deformed, *oracle, points);
   const std::vector<double> refit_sd = oracle->SignedDistances(points);
   const std::vector<double> rebuilt_sd = rebuilt->SignedDistances(points);
   EXPECT_EQ(refit_sd, rebuilt_sd);
+  // Refit's closest points are the fresh build's, bit for bit.
+  const std::vector<BoundaryPoint> refit_points = oracle->ClosestPoints(points);
+  const std::vector<BoundaryPoint> rebuilt_points = rebuilt->ClosestPoints(points);
+  int differences = 0;
+  for (std::size_t i = 0; i < refit_points.size(); ++i) {
+    differences += Identical(refit_points[i], rebuilt_points[i]) ? 0 : 1;
+  }
+  EXPECT_EQ(differences, 0);
 }
 
 TEST_P(OracleOnMesh, ConcurrentQueriesAgree) {
   SkipIfMissing();
   const Mesh mesh = Load();
-  absl::StatusOr<BoundaryOracle> oracle = BoundaryOracle::Build(mesh);
+  absl::StatusOr<BoundaryOracle> oracle = BoundaryOracle::Build(mesh, Options());
   ASSERT_TRUE(oracle.ok());
   const Vertices points = QueryPoints(mesh, 200, 14);
   const std::vector<double> expected = oracle->SignedDistances(points);
@@ -256,33 +296,109 @@ TEST_P(OracleOnMesh, ConcurrentQueriesAgree) {
   EXPECT_EQ(mismatches, std::vector<int>(4, 0));
 }
 
+TEST_P(OracleOnMesh, BoundedClosestPointEqualsUnbounded) {
+  SkipIfMissing();
+  const Mesh mesh = Load();
+  absl::StatusOr<BoundaryOracle> oracle = BoundaryOracle::Build(mesh, Options());
+  ASSERT_TRUE(oracle.ok());
+  const Vertices points = QueryPoints(mesh, 150, 16);
+  std::mt19937_64 rng(17);
+  std::uniform_int_distribution<Eigen::Index> pick(0, mesh.num_vertices() - 1);
+  int differences = 0;
+  for (Eigen::Index i = 0; i < points.rows(); ++i) {
+    const Vector3 p = points.row(i).transpose();
+    const BoundaryPoint expected = oracle->ClosestPoint(p);
+    // Bounds a caller may know (the answer, the distance to a vertex or to the previous query's
+    // boundary point, a loose one) and broken ones (too small, zero, negative, NaN), which the
+    // oracle must detect and answer anyway.
+    const Vector3 previous = points.row(i > 0 ? i - 1 : 0).transpose();
+    const double bounds[] = {expected.distance,
+                             expected.distance * (1 + 1e-12),
+                             (p - mesh.vertices.row(pick(rng)).transpose()).norm(),
+                             (p - oracle->ClosestPoint(previous).point).norm(),
+                             10 * expected.distance + 1,
+                             0.5 * expected.distance,
+                             0.0,
+                             -1.0,
+                             std::numeric_limits<double>::quiet_NaN()};
+    for (const double bound : bounds) {
+      if (!Identical(oracle->ClosestPoint(p, bound), expected) && differences++ < 5) {
+        ADD_FAILURE() << "query " << i << " at " << p.transpose() << " with bound " << bound
+                      << " differs from the unbounded query (distance " << expected.distance << ")";
+      }
+    }
+  }
+  EXPECT_EQ(differences, 0);
+}
+
 INSTANTIATE_TEST_SUITE_P(Meshes, OracleOnMesh,
+                         ::testing::Combine(::testing::Values("cube", "icosphere", "eight.off",
+                                                              "cow.off", "elephant.off",
+                                                              "knot1.off"),
+                                            ::testing::ValuesIn(kBackends)),
+                         [](const auto& param_info) {
+                           const std::string name = std::get<0>(param_info.param);
+                           return name.substr(0, name.find('.')) + "_" +
+                                  BackendName(std::get<1>(param_info.param));
+                         });
+
+// The two backends against each other: closest points and both inside tests bit for bit (the
+// flat BVH's ray parity counts exactly the crossings Embree's does).
+class BackendsOnMesh : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(BackendsOnMesh, AgreeBitForBit) {
+  if (MeshMissing(GetParam())) GTEST_SKIP() << GetParam() << " missing";
+  const Mesh mesh = LoadMesh(GetParam());
+  for (const InsideTest inside_test : {InsideTest::kPseudonormal, InsideTest::kRayParity}) {
+    absl::StatusOr<BoundaryOracle> flat =
+        BoundaryOracle::Build(mesh, {inside_test, BoundaryOracleBackend::kFlatBvh});
+    absl::StatusOr<BoundaryOracle> embree =
+        BoundaryOracle::Build(mesh, {inside_test, BoundaryOracleBackend::kEmbree});
+    ASSERT_TRUE(flat.ok() && embree.ok());
+    const Vertices points = QueryPoints(mesh, 300, 18);
+    const std::vector<BoundaryPoint> flat_points = flat->ClosestPoints(points);
+    const std::vector<BoundaryPoint> embree_points = embree->ClosestPoints(points);
+    int differences = 0;
+    for (std::size_t i = 0; i < flat_points.size(); ++i) {
+      differences += Identical(flat_points[i], embree_points[i]) ? 0 : 1;
+    }
+    EXPECT_EQ(differences, 0);
+    EXPECT_EQ(flat->ClassifyAll(points), embree->ClassifyAll(points));
+    EXPECT_EQ(flat->SignedDistances(points), embree->SignedDistances(points));
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Meshes, BackendsOnMesh,
                          ::testing::Values("cube", "icosphere", "eight.off", "cow.off",
-                                           "elephant.off", "knot1.off"),
+                                           "elephant.off", "fandisk.off", "knot1.off"),
                          [](const auto& param_info) {
                            std::string name = param_info.param;
                            return name.substr(0, name.find('.'));
                          });
 
 TEST(BoundaryOracle, RejectsBadInput) {
-  EXPECT_FALSE(BoundaryOracle::Build(Mesh{}).ok());
-  Mesh bad_index = testing::UnitCube();
-  bad_index.triangles(0, 0) = 99;
-  EXPECT_FALSE(BoundaryOracle::Build(bad_index).ok());
-  Mesh nan = testing::UnitCube();
-  nan.vertices(0, 0) = std::nan("");
-  EXPECT_FALSE(BoundaryOracle::Build(nan).ok());
+  for (const BoundaryOracleBackend backend : kBackends) {
+    SCOPED_TRACE(BackendName(backend));
+    const BoundaryOracleOptions options{InsideTest::kPseudonormal, backend};
+    EXPECT_FALSE(BoundaryOracle::Build(Mesh{}, options).ok());
+    Mesh bad_index = testing::UnitCube();
+    bad_index.triangles(0, 0) = 99;
+    EXPECT_FALSE(BoundaryOracle::Build(bad_index, options).ok());
+    Mesh nan = testing::UnitCube();
+    nan.vertices(0, 0) = std::nan("");
+    EXPECT_FALSE(BoundaryOracle::Build(nan, options).ok());
 
-  absl::StatusOr<BoundaryOracle> oracle = BoundaryOracle::Build(testing::UnitCube());
-  ASSERT_TRUE(oracle.ok());
-  const absl::Status wrong_count = oracle->Refit(Vertices::Zero(7, 3));
-  EXPECT_EQ(wrong_count.code(), absl::StatusCode::kInvalidArgument);
-  EXPECT_NE(wrong_count.message().find("expected 8 vertices, got 7"), std::string::npos);
-  Vertices with_nan = testing::UnitCube().vertices;
-  with_nan(3, 1) = std::nan("");
-  EXPECT_FALSE(oracle->Refit(with_nan).ok());
-  // A failed refit leaves the oracle as it was.
-  EXPECT_DOUBLE_EQ(oracle->SignedDistance(Vector3(0.5, 0.5, 0.5)), -0.5);
+    absl::StatusOr<BoundaryOracle> oracle = BoundaryOracle::Build(testing::UnitCube(), options);
+    ASSERT_TRUE(oracle.ok());
+    const absl::Status wrong_count = oracle->Refit(Vertices::Zero(7, 3));
+    EXPECT_EQ(wrong_count.code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_NE(wrong_count.message().find("expected 8 vertices, got 7"), std::string::npos);
+    Vertices with_nan = testing::UnitCube().vertices;
+    with_nan(3, 1) = std::nan("");
+    EXPECT_FALSE(oracle->Refit(with_nan).ok());
+    // A failed refit leaves the oracle as it was.
+    EXPECT_DOUBLE_EQ(oracle->SignedDistance(Vector3(0.5, 0.5, 0.5)), -0.5);
+  }
 }
 
 }  // namespace

@@ -3,7 +3,9 @@
 #include <exception>
 #include <iostream>
 
+#include "evaluate_command.h"
 #include "exit_codes.h"
+#include "generate_command.h"
 #include "info_command.h"
 
 int main(int argc, char** argv) {
@@ -12,6 +14,8 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "inscribe 0.1.0");
   int exit_code = inscribe::cli::kExitOk;
   inscribe::cli::AddInfoCommand(app, &exit_code);
+  inscribe::cli::AddGenerateCommand(app, &exit_code);
+  inscribe::cli::AddEvaluateCommand(app, &exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -39,3 +39,39 @@ nlohmann::json MeshReportJson(const MeshReport& report, const std::string& sha25
 }
 
 }  // namespace inscribe::cli
+
+namespace inscribe::cli {
+
+nlohmann::json QualityReportJson(const QualityReport& r) {
+  nlohmann::json j;
+  j["spheres"] = r.spheres;
+  j["volume_mesh"] = r.volume_mesh;
+  j["volume_union"] = r.volume_union;
+  j["nerr"] = r.nerr;
+  j["nerr_is_exact"] = r.nerr_is_exact;
+  j["nerr_kind"] = r.nerr_is_exact ? "exact" : "lower_bound";
+  j["protrusion_max"] = r.protrusion_max;
+  j["protrusion_mean"] = r.protrusion_mean;
+  j["protrusion_p95"] = r.protrusion_p95;
+  j["protrusion_max_relative"] = r.bbox_diagonal > 0 ? r.protrusion_max / r.bbox_diagonal : 0.0;
+  j["protruding_spheres"] = r.protruding_spheres;
+  j["protrusion_tolerance"] = r.protrusion_tolerance;
+  j["bbox_diagonal"] = r.bbox_diagonal;
+  j["surface_samples"] = r.surface_samples;
+  j["coverage"] = r.coverage;
+  j["coverage_tolerance"] = r.coverage_tolerance;
+  j["boundary_to_union_mean"] = r.boundary_to_union_mean;
+  j["boundary_to_union_hausdorff"] = r.boundary_to_union_hausdorff;
+  j["radius_min"] = r.radius_min;
+  j["radius_max"] = r.radius_max;
+  j["fat_up_to_voxel_size"] = r.fat_up_to_voxel_size;
+  if (r.voxel_size > 0.0) {
+    j["voxel_size"] = r.voxel_size;
+    j["fat"] = r.fat;
+    j["fraction_radius_over_sqrt3_sigma"] = r.fraction_radius_over_sqrt3_sigma;
+  }
+  j["evaluate_seconds"] = r.seconds;
+  return j;
+}
+
+}  // namespace inscribe::cli

@@ -1,0 +1,128 @@
+#include "evaluate_command.h"
+
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "absl/strings/str_format.h"
+#include "exit_codes.h"
+#include "inscribe/sphere_io.h"
+#include "inscribe/sphere_quality.h"
+#include "report_json.h"
+#include "solid_loading.h"
+
+namespace inscribe::cli {
+namespace {
+
+struct EvaluateCliOptions {
+  std::string mesh_path;
+  std::string spheres_path;
+  std::string format;
+  int sph_level = -1;
+  QualityOptions quality;
+  bool json = false;
+};
+
+void PrintText(const EvaluateCliOptions& options, const QualityReport& r) {
+  auto line = [](const char* key, const std::string& value) {
+    std::cout << absl::StrFormat("%-26s %s\n", key, value);
+  };
+  const double diagonal = r.bbox_diagonal > 0 ? r.bbox_diagonal : 1.0;
+  line("mesh", options.mesh_path);
+  line("spheres", absl::StrFormat("%s (%d)", options.spheres_path, r.spheres));
+  line("volume mesh", absl::StrFormat("%.10g", r.volume_mesh));
+  line("volume union (exact)", absl::StrFormat("%.10g", r.volume_union));
+  line(r.nerr_is_exact ? "nerr (exact)" : "nerr (Lemma 1 lower bound)",
+       absl::StrFormat("%.6f", r.nerr));
+  line("protrusion max/mean/p95",
+       absl::StrFormat("%.6g / %.6g / %.6g (%.3f%% of bbox diagonal at most)", r.protrusion_max,
+                       r.protrusion_mean, r.protrusion_p95, 100.0 * r.protrusion_max / diagonal));
+  line("protruding spheres", std::to_string(r.protruding_spheres));
+  line("coverage", absl::StrFormat("%.4f of %d boundary samples within %.4g", r.coverage,
+                                   r.surface_samples, r.coverage_tolerance));
+  line("boundary to union",
+       absl::StrFormat("mean %.6g, Hausdorff %.6g (%.3f%% of bbox diagonal; sampled)",
+                       r.boundary_to_union_mean, r.boundary_to_union_hausdorff,
+                       100.0 * r.boundary_to_union_hausdorff / diagonal));
+  line("radius min/max", absl::StrFormat("%.6g / %.6g", r.radius_min, r.radius_max));
+  if (r.voxel_size > 0) {
+    line("(sigma, theta)-fat",
+         absl::StrFormat("%s at sigma %.6g (fat up to %.6g)", r.fat ? "yes" : "no", r.voxel_size,
+                         r.fat_up_to_voxel_size));
+  } else {
+    line("(sigma, theta)-fat up to", absl::StrFormat("sigma %.6g", r.fat_up_to_voxel_size));
+  }
+  line("evaluated in", absl::StrFormat("%.3f s", r.seconds));
+}
+
+int RunEvaluate(const EvaluateCliOptions& options) {
+  int exit_code = kExitOk;
+  SphereFileReadOptions read;
+  if (!options.format.empty()) read.format = *ParseSphereFileFormat(options.format);
+  read.sph_level = options.sph_level;
+  absl::StatusOr<SphereFile> file = ReadSphereFile(options.spheres_path, read);
+  if (!file.ok()) {
+    std::cerr << "inscribe: " << file.status().message() << "\n";
+    return kExitBadInput;
+  }
+  std::optional<LoadedSolid> solid = LoadSolid(options.mesh_path, &exit_code);
+  if (!solid) return exit_code;
+  if (!file->mesh_sha256.empty() && file->mesh_sha256 != solid->sha256) {
+    std::cerr << "inscribe: warning: " << options.spheres_path << " was made for mesh "
+              << file->mesh_sha256 << ", not " << solid->sha256 << "\n";
+  }
+  QualityOptions quality = options.quality;
+  if (quality.voxel_size == 0.0) {
+    for (const auto& [key, value] : file->params) {
+      if (key == "voxel_size" && std::holds_alternative<double>(value)) {
+        quality.voxel_size = std::get<double>(value);
+      }
+    }
+  }
+  absl::StatusOr<QualityReport> report = EvaluateSpheres(solid->oracle, file->set.spheres, quality);
+  if (!report.ok()) {
+    std::cerr << "inscribe: " << report.status().message() << "\n";
+    return report.status().code() == absl::StatusCode::kInvalidArgument ? kExitBadInput
+                                                                        : kExitUnusableMesh;
+  }
+  if (options.json) {
+    nlohmann::json j = QualityReportJson(*report);
+    j["mesh"] = options.mesh_path;
+    j["mesh_sha256"] = solid->sha256;
+    j["spheres_path"] = options.spheres_path;
+    std::cout << j.dump() << "\n";
+  } else {
+    PrintText(options, *report);
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+void AddEvaluateCommand(CLI::App& app, int* exit_code) {
+  auto options = std::make_shared<EvaluateCliOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "evaluate",
+      "Quality of any sphere set against a mesh: exact nerr (or its lower bound for spheres "
+      "that stick out), protrusion, coverage, boundary-to-union distance, fatness");
+  cmd->add_option("MESH", options->mesh_path, "Mesh file (.off, .obj, .stl, .ply)")->required();
+  cmd->add_option("SPHERES", options->spheres_path, "Sphere file (.json, .sph, .csv)")->required();
+  cmd->add_option("--format", options->format, "Sphere file format (default: from extension)")
+      ->check(CLI::IsMember({"json", "sph", "csv"}, CLI::ignore_case));
+  cmd->add_option("--sph-level", options->sph_level,
+                  ".sph tree level to evaluate (-1 = the leaves)")
+      ->capture_default_str();
+  cmd->add_option("--samples", options->quality.surface_samples,
+                  "Boundary samples for coverage and Hausdorff distance")
+      ->capture_default_str();
+  cmd->add_option("--coverage-tolerance", options->quality.coverage_tolerance,
+                  "Covered = within this of the union, mesh units (default 1e-3 of the "
+                  "bounding-box diagonal)");
+  cmd->add_option("--voxel-size", options->quality.voxel_size,
+                  "Voxel size for the fatness test (default: the file's, if it has one)");
+  cmd->add_flag("--json", options->json, "Print one JSON object on stdout");
+  cmd->callback([options, exit_code] { *exit_code = RunEvaluate(*options); });
+}
+
+}  // namespace inscribe::cli

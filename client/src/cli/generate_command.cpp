@@ -1,0 +1,215 @@
+#include "generate_command.h"
+
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "absl/strings/str_format.h"
+#include "exit_codes.h"
+#include "inscribe/medial_spheres.h"
+#include "inscribe/sphere_io.h"
+#include "inscribe/sphere_quality.h"
+#include "progress_bar.h"
+#include "report_json.h"
+#include "solid_loading.h"
+
+namespace inscribe::cli {
+namespace {
+
+constexpr std::int64_t kDefaultMaxSpheres = 500;
+
+struct GenerateCliOptions {
+  std::string mesh_path;
+  std::optional<double> voxel_size;
+  std::optional<std::int64_t> max_spheres;
+  MedialSphereOptions medial;
+  std::int64_t quality_samples = 100'000;
+  std::string output_path;
+  std::string format;
+  bool json = false;
+};
+
+// Params and stats of the sphere file (DESIGN.md section 3), in mesh units and radians.
+SphereFile MakeSphereFile(const LoadedSolid& solid, const GenerateCliOptions& options,
+                          const MedialSphereResult& result, const QualityReport& quality,
+                          double seconds, int runs) {
+  SphereFile file;
+  file.set = result.set;
+  file.mesh_sha256 = solid.sha256;
+  file.params = {
+      {"voxel_size", result.voxel_size},
+      {"object_angle", options.medial.object_angle},
+      {"epsilon", result.epsilon},
+      {"samples", static_cast<std::int64_t>(options.medial.samples)},
+      {"screen_samples", static_cast<std::int64_t>(options.medial.screen_samples)},
+      {"pair_angle_margin", options.medial.pair_angle_margin},
+      {"corner_screen", options.medial.corner_screen},
+      {"subdivide_boundary", options.medial.subdivide_boundary},
+  };
+  if (options.max_spheres) file.params.emplace_back("max_spheres", *options.max_spheres);
+  file.stats = {
+      {"seconds", seconds},
+      {"search_runs", static_cast<std::int64_t>(runs)},
+      {"volume_mesh", quality.volume_mesh},
+      {"volume_union", quality.volume_union},
+      {"nerr", quality.nerr},
+      {"nerr_is_exact", quality.nerr_is_exact},
+      {"protrusion_max", quality.protrusion_max},
+      {"coverage", quality.coverage},
+      {"boundary_to_union_hausdorff", quality.boundary_to_union_hausdorff},
+      {"surface_samples", quality.surface_samples},
+      {"fat", quality.fat},
+      {"visited_voxels", result.stats.visited_voxels},
+      {"closest_point_queries", result.stats.closest_point_queries},
+  };
+  return file;
+}
+
+int RunGenerate(GenerateCliOptions options) {
+  int exit_code = kExitOk;
+  std::optional<LoadedSolid> solid = LoadSolid(options.mesh_path, &exit_code);
+  if (!solid) return exit_code;
+
+  ProgressBar progress("generating");
+  GenerationControl control;
+  control.on_progress = [&progress](double fraction) { progress.Update(fraction); };
+
+  const auto start = std::chrono::steady_clock::now();
+  MedialSphereResult result;
+  int runs = 1;
+  if (options.voxel_size) {
+    options.medial.voxel_size = *options.voxel_size;
+    absl::StatusOr<MedialSphereResult> run =
+        GenerateMedialSpheres(solid->oracle, options.medial, control);
+    if (!run.ok()) {
+      std::cerr << "inscribe: " << run.status().message() << "\n";
+      return kExitUsage;
+    }
+    result = *std::move(run);
+  } else {
+    SphereBudgetOptions budget;
+    budget.max_spheres = options.max_spheres.value_or(kDefaultMaxSpheres);
+    options.max_spheres = budget.max_spheres;
+    budget.base = options.medial;
+    absl::StatusOr<SphereBudgetResult> search =
+        GenerateWithSphereBudget(solid->oracle, budget, control);
+    if (!search.ok()) {
+      std::cerr << "inscribe: " << search.status().message() << "\n";
+      return search.status().code() == absl::StatusCode::kInvalidArgument ? kExitUsage
+                                                                          : kExitUnusableMesh;
+    }
+    runs = search->runs;
+    result = std::move(search->best);
+  }
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+  QualityOptions quality_options;
+  quality_options.surface_samples = options.quality_samples;
+  quality_options.voxel_size = result.voxel_size;
+  absl::StatusOr<QualityReport> quality =
+      EvaluateSpheres(solid->oracle, result.set.spheres, quality_options);
+  if (!quality.ok()) {
+    std::cerr << "inscribe: evaluating the result: " << quality.status().message() << "\n";
+    return kExitUnusableMesh;
+  }
+  const SphereFile file = MakeSphereFile(*solid, options, result, *quality, seconds, runs);
+
+  // The sphere file goes to -o, else to stdout unless --json claims stdout for the summary.
+  if (!options.output_path.empty()) {
+    SphereFileWriteOptions write;
+    if (!options.format.empty()) write.format = *ParseSphereFileFormat(options.format);
+    if (absl::Status status = WriteSphereFile(options.output_path, file, write); !status.ok()) {
+      std::cerr << "inscribe: " << status.message() << "\n";
+      return kExitBadInput;
+    }
+  } else if (!options.json) {
+    const SphereFileFormat format =
+        options.format.empty() ? SphereFileFormat::kJson : *ParseSphereFileFormat(options.format);
+    absl::StatusOr<std::string> bytes = FormatSphereFile(file, format);
+    if (!bytes.ok()) {
+      std::cerr << "inscribe: " << bytes.status().message() << "\n";
+      return kExitUnusableMesh;
+    }
+    std::cout << *bytes;
+    if (!bytes->empty() && bytes->back() != '\n') std::cout << "\n";
+  }
+  if (options.json) {
+    nlohmann::json summary = QualityReportJson(*quality);
+    summary["mesh"] = options.mesh_path;
+    summary["mesh_sha256"] = solid->sha256;
+    summary["triangles"] = solid->report.triangles;
+    summary["voxel_size"] = result.voxel_size;
+    summary["object_angle"] = options.medial.object_angle;
+    summary["epsilon"] = result.epsilon;
+    summary["samples"] = options.medial.samples;
+    summary["subdivide_boundary"] = options.medial.subdivide_boundary;
+    if (options.max_spheres) summary["max_spheres"] = *options.max_spheres;
+    summary["search_runs"] = runs;
+    summary["seconds"] = seconds;
+    summary["load_seconds"] = solid->seconds;
+    summary["visited_voxels"] = result.stats.visited_voxels;
+    summary["screened_voxels"] = result.stats.screened_voxels;
+    summary["closest_point_queries"] = result.stats.closest_point_queries;
+    if (!options.output_path.empty()) summary["output"] = options.output_path;
+    std::cout << summary.dump() << "\n";
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+void AddGenerateCommand(CLI::App& app, int* exit_code) {
+  auto options = std::make_shared<GenerateCliOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "generate",
+      "Approximate a closed mesh by internal medial spheres (at most one per voxel); prints "
+      "the sphere-set JSON unless -o or --json says otherwise");
+  cmd->add_option("MESH", options->mesh_path, "Mesh file (.off, .obj, .stl, .ply)")->required();
+  CLI::Option* voxel =
+      cmd->add_option("--voxel-size", options->voxel_size, "Voxel side sigma, mesh units");
+  CLI::Option* budget = cmd->add_option(
+      "--max-spheres", options->max_spheres,
+      "Finest voxel grid giving at most N spheres (default mode, N = 500); the search's runs "
+      "count in the reported time");
+  voxel->excludes(budget);
+  budget->excludes(voxel);
+  cmd->add_option("--object-angle", options->medial.object_angle,
+                  "Drop medial points with a smaller object angle, radians in (0, pi)")
+      ->capture_default_str();
+  cmd->add_option("--epsilon", options->medial.epsilon,
+                  "Centres within this of the medial surface, mesh units (default 1e-4 of the "
+                  "bounding-box diagonal)");
+  cmd->add_option("--samples", options->medial.samples,
+                  "Sample points per voxel on its circumscribed sphere")
+      ->capture_default_str();
+  cmd->add_option("--screen-samples", options->medial.screen_samples,
+                  "Samples tried first per voxel; 0 = every voxel gets the full set")
+      ->capture_default_str();
+  cmd->add_flag("!--no-corner-screen", options->medial.corner_screen,
+                "Sample every voxel, not only those whose corners' boundary directions differ "
+                "by about the object angle");
+  cmd->add_option("--pair-angle-margin", options->medial.pair_angle_margin,
+                  "Search only sample pairs whose angle is within this of the object angle or "
+                  "above, radians (10 = search all)")
+      ->capture_default_str();
+  cmd->add_flag("--subdivide-boundary", options->medial.subdivide_boundary,
+                "Split voxels the boundary may cross into 8 (up to 8 spheres there)");
+  cmd->add_option("--max-voxels", options->medial.max_voxels,
+                  "Refuse grids with more voxels than this")
+      ->capture_default_str();
+  cmd->add_option("--quality-samples", options->quality_samples,
+                  "Boundary samples for coverage and Hausdorff distance in the stats")
+      ->capture_default_str();
+  cmd->add_option("-o,--output", options->output_path,
+                  "Write the sphere set here (format from --format or the extension)");
+  cmd->add_option("--format", options->format, "Sphere file format")
+      ->check(CLI::IsMember({"json", "sph", "csv", "obj", "yaml", "yml"}, CLI::ignore_case));
+  cmd->add_flag("--json", options->json,
+                "Print one JSON summary on stdout (spheres, voxel_size, seconds, volumes, nerr, "
+                "quality figures)");
+  cmd->callback([options, exit_code] { *exit_code = RunGenerate(*options); });
+}
+
+}  // namespace inscribe::cli

@@ -1,0 +1,44 @@
+#include "solid_loading.h"
+
+#include <chrono>
+#include <iostream>
+
+#include "exit_codes.h"
+#include "inscribe/mesh_hash.h"
+#include "inscribe/mesh_io.h"
+
+namespace inscribe::cli {
+
+std::optional<LoadedSolid> LoadSolid(const std::string& path, int* exit_code) {
+  const auto start = std::chrono::steady_clock::now();
+  absl::StatusOr<Mesh> mesh = ReadMesh(path, nullptr);
+  if (!mesh.ok()) {
+    std::cerr << "inscribe: " << mesh.status().message() << "\n";
+    *exit_code = kExitBadInput;
+    return std::nullopt;
+  }
+  absl::StatusOr<ValidatedMesh> validated = PrepareMesh(*std::move(mesh));
+  if (!validated.ok()) {
+    std::cerr << "inscribe: " << path << ": " << validated.status().message() << "\n";
+    *exit_code = kExitUnusableMesh;
+    return std::nullopt;
+  }
+  BoundaryOracleOptions oracle_options;
+  // The pseudonormal sign is wrong near sheets buried inside a self-intersecting solid.
+  if (validated->report.self_intersecting_pairs > 0) {
+    oracle_options.inside_test = InsideTest::kRayParity;
+  }
+  const std::string sha256 = FormatSha256(MeshSha256(validated->mesh));
+  absl::StatusOr<BoundaryOracle> oracle =
+      BoundaryOracle::Build(std::move(validated->mesh), oracle_options);
+  if (!oracle.ok()) {
+    std::cerr << "inscribe: " << path << ": " << oracle.status().message() << "\n";
+    *exit_code = kExitUnusableMesh;
+    return std::nullopt;
+  }
+  return LoadedSolid{
+      std::move(validated->report), sha256, *std::move(oracle),
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()};
+}
+
+}  // namespace inscribe::cli

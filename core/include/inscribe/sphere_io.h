@@ -1,0 +1,126 @@
+// Sphere-set files: inscribe's own JSON (read + write), spheretree `.sph` (read + write), CSV
+// `x,y,z,r` (read + write), and, for viewing or for other tools, OBJ meshes of the spheres and
+// cuRobo-style YAML (write only). Coordinates and radii are in the mesh's own units and frame.
+//
+// Every reader refuses bad input with INVALID_ARGUMENT and a message naming the line or the
+// index and the problem (`line 4: expected 4 numbers x,y,z,r, found 3`, `sphere 12: radius -1
+// is not positive`); no reader allocates from a count the file declares. Spheres read back are
+// always finite with radius > 0, and contacts are empty or one per sphere.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <utility>
+#include <variant>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
+#include "inscribe/sphere.h"
+
+namespace inscribe {
+
+enum class SphereFileFormat {
+  // {"format": "inscribe.spheres", "version": 1, "mesh_sha256", "params", "spheres",
+  //  "contacts", "stats"}: everything in a SphereFile, doubles bit-exact. Read + write.
+  // Written one sphere per line; mesh_sha256 and contacts are left out when empty. Readers
+  // ignore unknown keys.
+  kJson,
+  // spheretree (Bradshaw & O'Sullivan) sphere tree: "levels degree", then level by level
+  // (level l holds degree^l slots) one "x y z r ..." line per slot; r <= 0 marks an unused
+  // slot. Read + write; only spheres survive. Written as spheretree's own flat-set writer
+  // does: "2 N", a root sphere around all the others, then the N spheres, "x y z r 1" each.
+  kSph,
+  // One "x,y,z,r" line per sphere, optional "x,y,z,r" header. Read + write; only spheres.
+  kCsv,
+  // Each sphere as a triangulated icosphere (vertices on the sphere), for viewers. Write only.
+  kObj,
+  // cuRobo's `collision_spheres:` block for one link. Write only.
+  kYaml,
+};
+
+// "json", "sph", "csv", "obj", "yaml" (also "yml"); case-insensitive.
+absl::StatusOr<SphereFileFormat> ParseSphereFileFormat(absl::string_view name);
+
+// The canonical name: "json", "sph", "csv", "obj" or "yaml".
+absl::string_view SphereFileFormatName(SphereFileFormat format);
+
+// From the extension of `path` (.json, .sph, .csv, .obj, .yaml, .yml; case-insensitive).
+// INVALID_ARGUMENT for any other extension.
+absl::StatusOr<SphereFileFormat> SphereFileFormatFromPath(const std::string& path);
+
+// kJson, kSph and kCsv can be read; kObj and kYaml are write-only.
+bool IsReadableSphereFileFormat(SphereFileFormat format);
+
+// A parameter or statistic value; a JSON number with a fraction or exponent is a double, one
+// without is an int64 (so 2.0 and 2 keep their types through a round trip).
+using ScalarValue = std::variant<bool, std::int64_t, double, std::string>;
+
+// Named values in file order (names are unique when written).
+using NamedValues = std::vector<std::pair<std::string, ScalarValue>>;
+
+// What a sphere file holds. Only kJson carries more than `set.spheres`.
+struct SphereFile {
+  SphereSet set;
+  // Content hash of the mesh the spheres approximate ("sha256:" + 64 lowercase hex digits, see
+  // FormatSha256), or empty when unknown.
+  std::string mesh_sha256;
+  // Generation parameters (e.g. voxel_size in mesh units, object_angle in radians).
+  NamedValues params;
+  // Figures about the run and the result (e.g. seconds, nerr).
+  NamedValues stats;
+};
+
+struct SphereFileReadOptions {
+  // The format; when unset, ReadSphereFile takes it from the extension, or for an unknown
+  // extension sniffs the bytes ('{' -> json, a first line of two integers -> sph, a comma ->
+  // csv). Ignored by ParseSphereFile, which takes the format as an argument.
+  std::optional<SphereFileFormat> format;
+  // kSph: the tree level to return (0 = the root); -1 returns the deepest level, the leaves
+  // that users compare. Either way only slots with radius > 0 are returned, in file order.
+  int sph_level = -1;
+};
+
+struct SphereFileWriteOptions {
+  // The format; when unset, WriteSphereFile takes it from the extension. Ignored by
+  // FormatSphereFile, which takes the format as an argument.
+  std::optional<SphereFileFormat> format;
+  // kCsv: write the "x,y,z,r" header line first.
+  bool csv_header = true;
+  // kObj: icosphere subdivision level per sphere, 0..5: 10 * 4^level + 2 vertices and
+  // 20 * 4^level triangles each (level 1: 42 and 80).
+  int obj_subdivision = 1;
+  // kYaml: the link name the spheres are listed under (letters, digits, _ - . /).
+  std::string yaml_link_name = "mesh";
+};
+
+// The bytes of `file` in `format`. Numbers are written as the shortest decimal that reads
+// back as the same double. INVALID_ARGUMENT (naming the sphere, contact or value) when the
+// file could not be read back: a non-finite coordinate, a radius <= 0, contacts neither empty
+// nor one per sphere, a negative contact triangle or non-finite weight, a malformed
+// mesh_sha256, a repeated or non-finite param/stat (kJson), an option out of range.
+// Cost O(#spheres), O(#spheres * 4^obj_subdivision) for kObj.
+absl::StatusOr<std::string> FormatSphereFile(const SphereFile& file, SphereFileFormat format,
+                                             const SphereFileWriteOptions& options = {});
+
+// Parses `bytes` (a whole file) in `format`. INVALID_ARGUMENT for a write-only format and for
+// any malformed content; messages start with "<format> data: " (ReadSphereFile puts the path
+// there instead). Cost O(size of bytes).
+absl::StatusOr<SphereFile> ParseSphereFile(absl::string_view bytes, SphereFileFormat format,
+                                           const SphereFileReadOptions& options = {});
+
+// Reads and parses `path`. NOT_FOUND when it does not exist; INVALID_ARGUMENT, with the path
+// in the message, for a directory, an unreadable file or malformed content.
+absl::StatusOr<SphereFile> ReadSphereFile(const std::string& path,
+                                          const SphereFileReadOptions& options = {});
+
+// Formats `file` and writes it to `path` atomically: into a temporary file in the same
+// directory, flushed to disk, then renamed over `path`, so readers see the old file or the
+// whole new one, never a part. Errors: as FormatSphereFile; NOT_FOUND when the directory does
+// not exist; PERMISSION_DENIED; INTERNAL for other I/O failures (message names the path).
+absl::Status WriteSphereFile(const std::string& path, const SphereFile& file,
+                             const SphereFileWriteOptions& options = {});
+
+}  // namespace inscribe

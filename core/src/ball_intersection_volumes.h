@@ -1,0 +1,30 @@
+// Private: closed-form volumes of the intersection of 1, 2, 3 and 4 balls, the terms of the
+// inclusion-exclusion over a dual complex (union_of_balls.cpp). Units: mesh units cubed.
+#pragma once
+
+#include "inscribe/sphere.h"
+
+namespace inscribe::internal {
+
+// vol(b), 4/3 pi r^3.
+double BallVolume(const Sphere& b);
+
+// vol(a ∩ b) in every configuration: disjoint or touching (0), overlapping (lens: two caps),
+// nested (the smaller ball), equal.
+double TwoBallIntersectionVolume(const Sphere& a, const Sphere& b);
+
+// vol(a ∩ b ∩ c) for balls with non-collinear centres whose three spheres share two points
+// y ± h n (h >= 0): the configuration of every triangle of a dual complex, where the power
+// edge meets the union. Right wherever those two points lie, also when the point y is outside
+// the triangle of centres. If the spheres share no point (h^2 < 0, only by rounding for a dual
+// complex triangle) h is taken as 0, which is the limit. Cost: 6 atan2 plus O(1) arithmetic.
+double ThreeBallIntersectionVolume(const Sphere& a, const Sphere& b, const Sphere& c);
+
+// vol(a ∩ b ∩ c ∩ d) for balls with non-coplanar centres whose power point (equal power to all
+// four) lies in all four balls: the configuration of every tetrahedron of a dual complex. The
+// intersection is then a curved tetrahedron: four spherical triangles, six circular arcs, four
+// corners. Cost: 30 atan2 and 6 sin plus O(1) arithmetic.
+double FourBallIntersectionVolume(const Sphere& a, const Sphere& b, const Sphere& c,
+                                  const Sphere& d);
+
+}  // namespace inscribe::internal

@@ -1,0 +1,577 @@
+// Medial-sphere generation, paper Section III. See medial_spheres.h for the contract.
+//
+// Per voxel v (side s, centre c, circumradius R = s*sqrt(3)/2): for each sample p on the sphere
+// S(c, R), with B(p) its nearest boundary point, q is the other intersection of the line
+// p + g (p - B(p)) with S. The medial surface crosses segment (p, q) iff B(p) != B(q) (paper, after
+// [17]), so for those pairs a bracketing search locates the crossing to within epsilon. The
+// crossing's object angle is the angle at it between the nearest boundary points of the two
+// bracket ends. Of the candidates that pass the angle test, lie in v and lie inside the mesh, v
+// keeps the one with the largest radius: the paper leaves the choice open, and the largest ball
+// removes the most volume error.
+#include "inscribe/medial_spheres.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+
+namespace inscribe {
+namespace {
+
+constexpr double kSqrt3 = 1.7320508075688772;
+
+using Clock = std::chrono::steady_clock;
+
+double SecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+bool Cancelled(const GenerationControl& control) {
+  return control.cancel != nullptr && control.cancel->load(std::memory_order_relaxed);
+}
+
+// K directions spread evenly over the unit sphere (Fibonacci lattice). The same set serves every
+// voxel, so a voxel's result depends only on its position.
+std::vector<Vector3> FibonacciDirections(int count) {
+  std::vector<Vector3> directions;
+  directions.reserve(static_cast<std::size_t>(count));
+  const double golden_angle = M_PI * (3.0 - std::sqrt(5.0));
+  for (int i = 0; i < count; ++i) {
+    const double z = 1.0 - (2.0 * i + 1.0) / count;
+    const double rho = std::sqrt(std::max(0.0, 1.0 - z * z));
+    const double phi = golden_angle * i;
+    directions.emplace_back(rho * std::cos(phi), rho * std::sin(phi), z);
+  }
+  return directions;
+}
+
+// The voxel grid: voxel (i, j, k) covers origin + [i, i+1) x [j, j+1) x [k, k+1) times size. The
+// grid is centred on the mesh's bounding box.
+struct Grid {
+  Vector3 origin = Vector3::Zero();
+  double size = 0.0;
+  std::array<std::int64_t, 3> dims = {0, 0, 0};
+
+  std::int64_t count() const { return dims[0] * dims[1] * dims[2]; }
+  Vector3 corner(std::int64_t i, std::int64_t j, std::int64_t k) const {
+    return origin +
+           size * Vector3(static_cast<double>(i), static_cast<double>(j), static_cast<double>(k));
+  }
+};
+
+// A voxel that survived culling. `boundary` when the boundary may cross it.
+struct VisitedVoxel {
+  std::int64_t linear = 0;  // i + nx * (j + ny * k)
+  std::array<std::int64_t, 3> index = {0, 0, 0};
+  bool boundary = false;
+};
+
+struct Candidate {
+  Sphere sphere;
+  SurfaceContact contact;
+  bool valid = false;
+};
+
+struct VoxelCounters {
+  std::int64_t crossing_pairs = 0;
+  std::int64_t searched_pairs = 0;
+  std::int64_t candidates = 0;
+  std::int64_t queries = 0;
+};
+
+struct SearchParams {
+  double object_angle = 0.0;
+  double epsilon = 0.0;
+  // Two nearest boundary points closer than this count as the same point.
+  double same_point_tolerance = 0.0;
+  double pair_angle_margin = 0.0;
+};
+
+class VoxelSearch {
+ public:
+  VoxelSearch(const BoundaryOracle& oracle, const std::vector<Vector3>& screen_directions,
+              const std::vector<Vector3>& directions, const SearchParams& params)
+      : oracle_(oracle),
+        screen_directions_(screen_directions),
+        directions_(directions),
+        params_(params) {}
+
+  // Best candidate in the cube [corner, corner + size)^3. The screening set runs first; a voxel
+  // where none of its pairs crosses the medial surface is left empty without the full set.
+  Candidate Run(const Vector3& corner, double size, VoxelCounters& counters) const {
+    Candidate best;
+    best.sphere.radius = -1.0;
+    const std::int64_t searched_before = counters.searched_pairs;
+    if (!screen_directions_.empty()) {
+      Sample(screen_directions_, corner, size, best, counters);
+      if (counters.searched_pairs == searched_before) return best;
+    }
+    Sample(directions_, corner, size, best, counters);
+    return best;
+  }
+
+ private:
+  void Sample(const std::vector<Vector3>& directions, const Vector3& corner, double size,
+              Candidate& best, VoxelCounters& counters) const {
+    const Vector3 centre = corner + Vector3::Constant(0.5 * size);
+    const double circumradius = 0.5 * kSqrt3 * size;
+    // The previous sample's nearest boundary point bounds the next sample's query.
+    std::optional<Vector3> previous_foot;
+    for (const Vector3& direction : directions) {
+      const Vector3 p = centre + circumradius * direction;
+      const BoundaryPoint bp =
+          previous_foot ? Query(p, *previous_foot, counters) : Query(p, counters);
+      previous_foot = bp.point;
+      const Vector3 away = p - bp.point;
+      const double away_length = away.norm();
+      if (!(away_length > 1e-12 * circumradius)) continue;  // p on the boundary
+      const Vector3 unit = away / away_length;
+      // p + t*unit meets S again at t = -2 (p - c).unit.
+      const double t = -2.0 * (p - centre).dot(unit);
+      if (!(std::abs(t) > 1e-9 * circumradius)) continue;  // the line only touches S
+      const Vector3 q = p + t * unit;
+      const BoundaryPoint bq = Query(q, bp.point, counters);
+      if ((bq.point - bp.point).norm() <= params_.same_point_tolerance) continue;
+      ++counters.crossing_pairs;
+      // The angle between the two ends' directions to their nearest boundary points equals the
+      // crossing's object angle when both nearest features are faces, and is close to it near
+      // edges and vertices: pairs far below theta are not searched.
+      const Vector3 from_p = bp.point - p;
+      const Vector3 from_q = bq.point - q;
+      const double pair_angle = std::atan2(from_p.cross(from_q).norm(), from_p.dot(from_q));
+      if (pair_angle < params_.object_angle - params_.pair_angle_margin) continue;
+      ++counters.searched_pairs;
+      // No point of the segment is farther than this from the boundary: skip searches that
+      // cannot beat the best radius so far.
+      const double radius_bound = 0.5 * (bp.distance + bq.distance + std::abs(t));
+      if (radius_bound <= best.sphere.radius) continue;
+      TryCrossing(p, bp, q, bq, corner, size, best, counters);
+    }
+  }
+
+  BoundaryPoint Query(const Vector3& x, VoxelCounters& counters) const {
+    ++counters.queries;
+    return oracle_.ClosestPoint(x);
+  }
+
+  // The same answer, faster: `known` is a boundary point, so the nearest one is no farther
+  // than it (padded for rounding in the norm).
+  BoundaryPoint Query(const Vector3& x, const Vector3& known, VoxelCounters& counters) const {
+    ++counters.queries;
+    return oracle_.ClosestPoint(x, (x - known).norm() * (1.0 + 1e-12) + 1e-300);
+  }
+
+  // Locates the medial crossing on (p, q) to within epsilon and keeps it in `best` if it passes.
+  void TryCrossing(const Vector3& p, const BoundaryPoint& bp, const Vector3& q,
+                   const BoundaryPoint& bq, const Vector3& corner, double size, Candidate& best,
+                   VoxelCounters& counters) const {
+    const Vector3 segment = q - p;
+    const double length = segment.norm();
+    // Parameter s in [0, 1] along the segment; the bracket [lo, hi] has nearest boundary points
+    // a (the p side) and b (the q side).
+    double lo = 0.0;
+    double hi = 1.0;
+    BoundaryPoint a = bp;
+    BoundaryPoint b = bq;
+    const double tolerance = params_.epsilon / length;  // bracket width to reach, in s
+    const double half_step = 0.49 * tolerance;
+    int misses = 0;
+    // A point's nearest boundary point belongs to the p side if it is closer to a than to b.
+    auto on_p_side = [&](const BoundaryPoint& f) {
+      return (f.point - a.point).squaredNorm() <= (f.point - b.point).squaredNorm();
+    };
+    auto probe = [&](double s) {
+      const Vector3 x = p + s * segment;
+      const BoundaryPoint f =
+          Query(x, (x - a.point).squaredNorm() < (x - b.point).squaredNorm() ? a.point : b.point,
+                counters);
+      if (on_p_side(f)) {
+        lo = s;
+        a = f;
+        return true;
+      }
+      hi = s;
+      b = f;
+      return false;
+    };
+    while (hi - lo > tolerance) {
+      double estimate = std::numeric_limits<double>::quiet_NaN();
+      if (misses < 3) estimate = CrossingEstimate(p, segment, lo, a, hi, b);
+      if (std::isfinite(estimate) && estimate > lo && estimate < hi) {
+        // Probe just before and just after the estimate: when it is right (the usual case for
+        // locally flat boundary), two queries close the bracket to within epsilon.
+        const double before = std::max(lo, estimate - half_step);
+        const double after = std::min(hi, estimate + half_step);
+        if (before > lo && !probe(before)) {
+          ++misses;
+          continue;
+        }
+        if (after < hi && probe(after)) ++misses;
+      } else {
+        probe(0.5 * (lo + hi));
+      }
+    }
+    const Vector3 m = p + 0.5 * (lo + hi) * segment;
+    const Vector3 to_a = a.point - m;
+    const Vector3 to_b = b.point - m;
+    const double angle = std::atan2(to_a.cross(to_b).norm(), to_a.dot(to_b));
+    if (!(angle >= params_.object_angle)) return;
+    for (int axis = 0; axis < 3; ++axis) {
+      if (!(m[axis] >= corner[axis] && m[axis] < corner[axis] + size)) return;
+    }
+    const BoundaryPoint contact =
+        Query(m, to_a.squaredNorm() < to_b.squaredNorm() ? a.point : b.point, counters);
+    if (!(contact.distance > best.sphere.radius) || !(contact.distance > 0.0)) return;
+    if (oracle_.Classify(m) != Side::kInside) return;
+    ++counters.candidates;
+    best.valid = true;
+    best.sphere = Sphere{m, contact.distance};
+    best.contact = SurfaceContact{contact.triangle, contact.barycentric};
+  }
+
+  // Where the two sides' distance functions, each linearised at its own bracket end (distance
+  // to the tangent plane through its nearest boundary point), are equal. Exact when both
+  // nearest features are planar faces; NaN when undefined.
+  static double CrossingEstimate(const Vector3& p, const Vector3& segment, double lo,
+                                 const BoundaryPoint& a, double hi, const BoundaryPoint& b) {
+    const Vector3 x_lo = p + lo * segment;
+    const Vector3 x_hi = p + hi * segment;
+    const double d_lo = (x_lo - a.point).norm();
+    const double d_hi = (x_hi - b.point).norm();
+    if (!(d_lo > 0.0) || !(d_hi > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+    const double slope_lo = (x_lo - a.point).dot(segment) / d_lo;
+    const double slope_hi = (x_hi - b.point).dot(segment) / d_hi;
+    const double denominator = slope_lo - slope_hi;
+    if (!(std::abs(denominator) > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+    return (d_hi - d_lo + slope_lo * lo - slope_hi * hi) / denominator;
+  }
+
+  const BoundaryOracle& oracle_;
+  const std::vector<Vector3>& screen_directions_;
+  const std::vector<Vector3>& directions_;
+  SearchParams params_;
+};
+
+absl::Status ValidateOptions(const MedialSphereOptions& options, bool need_voxel_size) {
+  if (need_voxel_size && !(std::isfinite(options.voxel_size) && options.voxel_size > 0.0)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("voxel size must be a positive finite number, got ", options.voxel_size));
+  }
+  if (!(options.object_angle > 0.0 && options.object_angle < M_PI)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("object angle must lie in (0, pi) radians, got ", options.object_angle));
+  }
+  if (!(std::isfinite(options.epsilon) && options.epsilon >= 0.0)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("epsilon must be a finite number >= 0, got ", options.epsilon));
+  }
+  if (options.samples < 2 || options.samples > 4096) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("samples per voxel must lie in [2, 4096], got ", options.samples));
+  }
+  if (options.screen_samples < 0 || options.screen_samples > 4096) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "screening samples per voxel must lie in [0, 4096], got ", options.screen_samples));
+  }
+  if (!(options.pair_angle_margin >= 0.0)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "the pair-angle margin must be a number >= 0, got ", options.pair_angle_margin));
+  }
+  if (options.max_voxels <= 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("the voxel limit must be positive, got ", options.max_voxels));
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<Grid> MakeGrid(const BoundingBox& box, double size, std::int64_t max_voxels) {
+  Grid grid;
+  grid.size = size;
+  double total = 1.0;
+  Vector3 padding;
+  for (int axis = 0; axis < 3; ++axis) {
+    const double extent = box.max[axis] - box.min[axis];
+    const double cells = std::max(1.0, std::ceil(extent / size));
+    total *= cells;
+    if (!(total <= static_cast<double>(max_voxels))) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "voxel size %g gives a grid of more than %d voxels over the bounding box (%g x %g x "
+          "%g); use a larger voxel size or raise the voxel limit",
+          size, max_voxels, box.extent().x(), box.extent().y(), box.extent().z()));
+    }
+    grid.dims[axis] = static_cast<std::int64_t>(cells);
+    padding[axis] = 0.5 * (cells * size - extent);
+  }
+  grid.origin = box.min - padding;
+  return grid;
+}
+
+// Voxels inside the mesh or possibly crossed by its boundary, by octree-style culling over
+// blocks of voxels: a block whose centre lies outside by more than the block's circumradius is
+// dropped whole; one inside by more than that is kept whole without further queries.
+std::vector<VisitedVoxel> CullVoxels(const BoundaryOracle& oracle, const Grid& grid,
+                                     std::int64_t& queries) {
+  struct Block {
+    std::array<std::int64_t, 3> start;
+    std::int64_t size;  // power of two, in voxels
+  };
+  std::int64_t top = 1;
+  while (top < std::max({grid.dims[0], grid.dims[1], grid.dims[2]})) top *= 2;
+  std::vector<Block> blocks = {Block{{0, 0, 0}, top}};
+  std::vector<VisitedVoxel> visited;
+  auto block_end = [&](const Block& block, int axis) {
+    return std::min(block.start[axis] + block.size, grid.dims[axis]);
+  };
+  auto add_voxels = [&](const Block& block, bool boundary) {
+    for (std::int64_t k = block.start[2]; k < block_end(block, 2); ++k) {
+      for (std::int64_t j = block.start[1]; j < block_end(block, 1); ++j) {
+        for (std::int64_t i = block.start[0]; i < block_end(block, 0); ++i) {
+          visited.push_back(
+              VisitedVoxel{i + grid.dims[0] * (j + grid.dims[1] * k), {i, j, k}, boundary});
+        }
+      }
+    }
+  };
+  while (!blocks.empty()) {
+    std::vector<double> distances(blocks.size());
+    std::vector<double> radii(blocks.size());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks.size(), 64),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+                        for (std::size_t b = range.begin(); b != range.end(); ++b) {
+                          const Block& block = blocks[b];
+                          Vector3 lo = grid.corner(block.start[0], block.start[1], block.start[2]);
+                          Vector3 hi = grid.corner(block_end(block, 0), block_end(block, 1),
+                                                   block_end(block, 2));
+                          radii[b] = 0.5 * (hi - lo).norm();
+                          distances[b] = oracle.SignedDistance(0.5 * (lo + hi));
+                        }
+                      });
+    queries += static_cast<std::int64_t>(blocks.size());
+    std::vector<Block> next;
+    for (std::size_t b = 0; b < blocks.size(); ++b) {
+      const Block& block = blocks[b];
+      if (distances[b] > radii[b]) continue;  // wholly outside
+      if (block.size == 1) {
+        add_voxels(block, distances[b] >= -radii[b]);
+      } else if (distances[b] < -radii[b]) {
+        add_voxels(block, false);  // wholly inside
+      } else {
+        const std::int64_t half = block.size / 2;
+        for (int octant = 0; octant < 8; ++octant) {
+          Block child{{block.start[0] + ((octant & 1) ? half : 0),
+                       block.start[1] + ((octant & 2) ? half : 0),
+                       block.start[2] + ((octant & 4) ? half : 0)},
+                      half};
+          if (child.start[0] < grid.dims[0] && child.start[1] < grid.dims[1] &&
+              child.start[2] < grid.dims[2]) {
+            next.push_back(child);
+          }
+        }
+      }
+    }
+    blocks = std::move(next);
+  }
+  std::sort(visited.begin(), visited.end(),
+            [](const VisitedVoxel& x, const VisitedVoxel& y) { return x.linear < y.linear; });
+  return visited;
+}
+
+// Inward normal direction "seen" from x: the unit vector from x's nearest boundary point
+// towards x for x inside, away from x for x outside, i.e. the inward normal at the foot for
+// any x near a face. The side comes from the foot triangle's own normal, so no inside test is
+// needed: at a face the sign of (x - foot) . inward normal tells it, and at a convex edge or
+// vertex (x - foot) lies in the normal cone of the adjacent faces, so the sign agrees.
+Vector3 InwardDirectionAtFoot(const Mesh& mesh, const Vector3& x, const BoundaryPoint& foot) {
+  const Vector3 a = mesh.vertices.row(mesh.triangles(foot.triangle, 0));
+  const Vector3 b = mesh.vertices.row(mesh.triangles(foot.triangle, 1));
+  const Vector3 c = mesh.vertices.row(mesh.triangles(foot.triangle, 2));
+  const Vector3 inward = (c - a).cross(b - a);  // triangles are counter-clockwise from outside
+  const Vector3 away = x - foot.point;
+  const double length = away.norm();
+  if (!(length > 0.0)) {
+    const double n = inward.norm();
+    return n > 0.0 ? Vector3(inward / n) : Vector3::Zero();
+  }
+  return away.dot(inward) >= 0.0 ? Vector3(away / length) : Vector3(-away / length);
+}
+
+// Corner screening: one closest-point query per grid vertex, shared by the 8 voxels around it.
+// A medial sheet of object angle phi that cuts a voxel separates its corners into two groups
+// whose inward directions differ by about phi; a voxel whose 8 corner directions are all
+// within (theta - margin) of each other is skipped. Returns one flag per visited voxel.
+std::vector<char> ScreenByCorners(const BoundaryOracle& oracle, const Grid& grid,
+                                  const std::vector<VisitedVoxel>& voxels, double min_angle,
+                                  std::int64_t& queries) {
+  const std::int64_t vx = grid.dims[0] + 1;
+  const std::int64_t vy = grid.dims[1] + 1;
+  auto vertex_id = [&](std::int64_t i, std::int64_t j, std::int64_t k) {
+    return i + vx * (j + vy * k);
+  };
+  std::vector<std::int64_t> vertices;
+  vertices.reserve(voxels.size() * 8);
+  for (const VisitedVoxel& voxel : voxels) {
+    for (int corner = 0; corner < 8; ++corner) {
+      vertices.push_back(vertex_id(voxel.index[0] + (corner & 1),
+                                   voxel.index[1] + ((corner >> 1) & 1),
+                                   voxel.index[2] + ((corner >> 2) & 1)));
+    }
+  }
+  std::sort(vertices.begin(), vertices.end());
+  vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+  std::vector<Vector3> directions(vertices.size());
+  const Mesh& mesh = oracle.mesh();
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, vertices.size(), 256),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t v = range.begin(); v != range.end(); ++v) {
+                        const std::int64_t id = vertices[v];
+                        const Vector3 x = grid.corner(id % vx, (id / vx) % vy, id / (vx * vy));
+                        directions[v] = InwardDirectionAtFoot(mesh, x, oracle.ClosestPoint(x));
+                      }
+                    });
+  queries += static_cast<std::int64_t>(vertices.size());
+  const double max_cosine = std::cos(std::max(0.0, min_angle));
+  std::vector<char> pass(voxels.size(), 0);
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, voxels.size(), 256),
+      [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t n = range.begin(); n != range.end(); ++n) {
+          const VisitedVoxel& voxel = voxels[n];
+          std::array<Vector3, 8> corner_directions;
+          for (int corner = 0; corner < 8; ++corner) {
+            const std::int64_t id =
+                vertex_id(voxel.index[0] + (corner & 1), voxel.index[1] + ((corner >> 1) & 1),
+                          voxel.index[2] + ((corner >> 2) & 1));
+            corner_directions[corner] = directions[static_cast<std::size_t>(
+                std::lower_bound(vertices.begin(), vertices.end(), id) - vertices.begin())];
+          }
+          for (int x = 0; x < 8 && !pass[n]; ++x) {
+            for (int y = x + 1; y < 8; ++y) {
+              if (corner_directions[x].dot(corner_directions[y]) <= max_cosine) {
+                pass[n] = 1;
+                break;
+              }
+            }
+          }
+        }
+      });
+  return pass;
+}
+
+}  // namespace
+
+absl::StatusOr<MedialSphereResult> GenerateMedialSpheres(const BoundaryOracle& oracle,
+                                                         const MedialSphereOptions& options,
+                                                         const GenerationControl& control) {
+  const Clock::time_point start = Clock::now();
+  if (absl::Status status = ValidateOptions(options, /*need_voxel_size=*/true); !status.ok()) {
+    return status;
+  }
+  const Mesh& mesh = oracle.mesh();
+  const BoundingBox box = ComputeBoundingBox(mesh.vertices);
+  const double diagonal = box.diagonal();
+  if (!(diagonal > 0.0) || !std::isfinite(diagonal)) {
+    return absl::InvalidArgumentError("mesh has an empty or non-finite bounding box");
+  }
+  absl::StatusOr<Grid> grid = MakeGrid(box, options.voxel_size, options.max_voxels);
+  if (!grid.ok()) return grid.status();
+
+  MedialSphereResult result;
+  result.voxel_size = options.voxel_size;
+  result.epsilon = options.epsilon > 0.0 ? options.epsilon : 1e-4 * diagonal;
+  result.stats.grid_voxels = grid->count();
+  result.grid_origin = grid->origin;
+  result.grid_dims = grid->dims;
+
+  SearchParams params;
+  params.object_angle = options.object_angle;
+  params.epsilon = result.epsilon;
+  params.same_point_tolerance = 1e-9 * diagonal;
+  params.pair_angle_margin = options.pair_angle_margin;
+  const std::vector<Vector3> directions = FibonacciDirections(options.samples);
+  const std::vector<Vector3> screen_directions =
+      options.screen_samples > 0 && options.screen_samples < options.samples
+          ? FibonacciDirections(options.screen_samples)
+          : std::vector<Vector3>();
+  const VoxelSearch search(oracle, screen_directions, directions, params);
+
+  if (Cancelled(control)) return absl::CancelledError("medial-sphere generation cancelled");
+  std::int64_t queries = 0;
+  const std::vector<VisitedVoxel> voxels = CullVoxels(oracle, *grid, queries);
+  result.stats.visited_voxels = static_cast<std::int64_t>(voxels.size());
+  for (const VisitedVoxel& voxel : voxels) result.stats.boundary_voxels += voxel.boundary;
+
+  // Each voxel (or each of its 8 halves) yields at most one candidate, stored in its slot so
+  // that the output order, and so the output, do not depend on scheduling.
+  std::vector<char> screened_in;
+  if (options.corner_screen) {
+    screened_in = ScreenByCorners(oracle, *grid, voxels,
+                                  options.object_angle - options.pair_angle_margin, queries);
+  }
+  for (char pass : screened_in) result.stats.screened_voxels += pass == 0;
+  const int slots = options.subdivide_boundary ? 8 : 1;
+  const double size = grid->size;
+  const std::size_t batch = 2048;
+  for (std::size_t first = 0; first < voxels.size(); first += batch) {
+    if (Cancelled(control)) return absl::CancelledError("medial-sphere generation cancelled");
+    const std::size_t last = std::min(voxels.size(), first + batch);
+    std::vector<Candidate> found((last - first) * static_cast<std::size_t>(slots));
+    std::vector<VoxelCounters> counters(last - first);
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(first, last, 8),
+        [&](const tbb::blocked_range<std::size_t>& range) {
+          for (std::size_t v = range.begin(); v != range.end(); ++v) {
+            if (Cancelled(control)) return;
+            if (!screened_in.empty() && !screened_in[v]) continue;
+            const VisitedVoxel& voxel = voxels[v];
+            const Vector3 corner = grid->corner(voxel.index[0], voxel.index[1], voxel.index[2]);
+            VoxelCounters& count = counters[v - first];
+            Candidate* out = &found[(v - first) * static_cast<std::size_t>(slots)];
+            if (!options.subdivide_boundary || !voxel.boundary) {
+              out[0] = search.Run(corner, size, count);
+              continue;
+            }
+            const double half = 0.5 * size;
+            for (int octant = 0; octant < 8; ++octant) {
+              const Vector3 sub_corner =
+                  corner + half * Vector3((octant & 1) ? 1.0 : 0.0, (octant & 2) ? 1.0 : 0.0,
+                                          (octant & 4) ? 1.0 : 0.0);
+              ++count.queries;
+              const double distance =
+                  oracle.SignedDistance(sub_corner + Vector3::Constant(0.5 * half));
+              if (distance > 0.5 * kSqrt3 * half) continue;  // this half is wholly outside
+              out[octant] = search.Run(sub_corner, half, count);
+            }
+          }
+        });
+    if (Cancelled(control)) return absl::CancelledError("medial-sphere generation cancelled");
+    for (const Candidate& candidate : found) {
+      if (!candidate.valid) continue;
+      result.set.spheres.push_back(candidate.sphere);
+      result.set.contacts.push_back(candidate.contact);
+    }
+    for (const VoxelCounters& count : counters) {
+      result.stats.crossing_pairs += count.crossing_pairs;
+      result.stats.searched_pairs += count.searched_pairs;
+      result.stats.candidates += count.candidates;
+      queries += count.queries;
+    }
+    if (control.on_progress) {
+      control.on_progress(static_cast<double>(last) / static_cast<double>(voxels.size()));
+    }
+  }
+  if (voxels.empty() && control.on_progress) control.on_progress(1.0);
+  result.stats.closest_point_queries = queries;
+  result.stats.seconds = SecondsSince(start);
+  return result;
+}
+
+}  // namespace inscribe

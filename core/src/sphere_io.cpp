@@ -1,0 +1,388 @@
+// Sphere-set files: format names, dispatch, the checks every writer shares, and the file
+// system side (reading whole files, atomic replacement). The formats themselves live in
+// sphere_formats_json.cpp (JSON), sphere_formats_text.cpp (.sph, CSV) and
+// sphere_formats_view.cpp (OBJ, YAML).
+#include "inscribe/sphere_io.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <system_error>
+
+#include "absl/strings/ascii.h"
+#include "absl/strings/str_cat.h"
+#include "sphere_formats.h"
+
+namespace inscribe {
+namespace internal {
+
+std::string FormatDouble(double value) {
+  // 24 bytes hold the longest shortest form ("-2.2250738585072014e-308" is 24 characters).
+  char buffer[32];
+  const std::to_chars_result result = std::to_chars(buffer, buffer + sizeof buffer, value);
+  return std::string(buffer, result.ptr);
+}
+
+bool ParseDouble(absl::string_view token, double* value, std::string* why) {
+  absl::string_view digits = token;
+  if (digits.size() > 1 && digits[0] == '+' && digits[1] != '-' && digits[1] != '+') {
+    digits.remove_prefix(1);
+  }
+  const char* end = digits.data() + digits.size();
+  const std::from_chars_result result = std::from_chars(digits.data(), end, *value);
+  if (result.ec == std::errc::result_out_of_range) {
+    *why = absl::StrCat(QuoteToken(token), " is out of the range of a double");
+    return false;
+  }
+  if (result.ec != std::errc() || result.ptr != end) {
+    *why = token.empty() ? std::string("empty field")
+                         : absl::StrCat(QuoteToken(token), " is not a number");
+    return false;
+  }
+  return true;
+}
+
+std::string QuoteToken(absl::string_view token) {
+  constexpr std::size_t kMaxBytes = 24;
+  std::string out = "'";
+  for (std::size_t i = 0; i < token.size() && i < kMaxBytes; ++i) {
+    const unsigned char c = static_cast<unsigned char>(token[i]);
+    if (c >= 0x20 && c < 0x7f && c != '\\' && c != '\'') {
+      out.push_back(static_cast<char>(c));
+    } else {
+      static constexpr char kHex[] = "0123456789abcdef";
+      out += "\\x";
+      out.push_back(kHex[c >> 4]);
+      out.push_back(kHex[c & 15]);
+    }
+  }
+  if (token.size() > kMaxBytes) out += "...";
+  out += "'";
+  return out;
+}
+
+absl::Status CheckSphere(std::size_t index, const Sphere& sphere) {
+  static constexpr const char* kAxis[] = {"x", "y", "z"};
+  for (int k = 0; k < 3; ++k) {
+    if (!std::isfinite(sphere.center[k])) {
+      return absl::InvalidArgumentError(absl::StrCat("sphere ", index, ": center ", kAxis[k], " ",
+                                                     FormatDouble(sphere.center[k]),
+                                                     " is not finite"));
+    }
+  }
+  if (!std::isfinite(sphere.radius)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("sphere ", index, ": radius ", FormatDouble(sphere.radius), " is not finite"));
+  }
+  if (!(sphere.radius > 0)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "sphere ", index, ": radius ", FormatDouble(sphere.radius), " is not positive"));
+  }
+  return absl::OkStatus();
+}
+
+absl::Status CheckMeshSha256(absl::string_view hash) {
+  if (hash.empty()) return absl::OkStatus();
+  constexpr absl::string_view kPrefix = "sha256:";
+  bool ok = hash.size() == kPrefix.size() + 64 && hash.substr(0, kPrefix.size()) == kPrefix;
+  for (std::size_t i = kPrefix.size(); ok && i < hash.size(); ++i) {
+    const char c = hash[i];
+    ok = (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f');
+  }
+  if (!ok) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("mesh_sha256 ", QuoteToken(hash),
+                     " is not \"sha256:\" followed by 64 lowercase hex digits"));
+  }
+  return absl::OkStatus();
+}
+
+absl::Status CheckSphereSetForWrite(const SphereFile& file) {
+  const SphereSet& set = file.set;
+  for (std::size_t i = 0; i < set.spheres.size(); ++i) {
+    if (absl::Status status = CheckSphere(i, set.spheres[i]); !status.ok()) return status;
+  }
+  if (set.has_contacts() && set.contacts.size() != set.spheres.size()) {
+    return absl::InvalidArgumentError(absl::StrCat(set.contacts.size(), " contacts for ",
+                                                   set.spheres.size(),
+                                                   " spheres (need one per sphere, or none)"));
+  }
+  for (std::size_t i = 0; i < set.contacts.size(); ++i) {
+    const SurfaceContact& contact = set.contacts[i];
+    if (contact.triangle < 0) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("contact ", i, ": triangle ", contact.triangle, " is negative"));
+    }
+    if (!contact.barycentric.allFinite()) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("contact ", i, ": barycentric weights are not finite"));
+    }
+  }
+  return CheckMeshSha256(file.mesh_sha256);
+}
+
+absl::string_view StripCommentAndBlanks(absl::string_view line) {
+  line = line.substr(0, line.find('#'));
+  const std::size_t first = line.find_first_not_of(" \t");
+  if (first == absl::string_view::npos) return {};
+  const std::size_t last = line.find_last_not_of(" \t");
+  return line.substr(first, last - first + 1);
+}
+
+}  // namespace internal
+
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string LowercaseAscii(absl::string_view s) { return absl::AsciiStrToLower(s); }
+
+absl::Status Prefixed(const absl::Status& status, absl::string_view what) {
+  return absl::Status(status.code(), absl::StrCat(what, ": ", status.message()));
+}
+
+// The format of a file whose extension says nothing: JSON starts with '{'; a .sph file's first
+// line is two integers; anything else with a comma on its first meaningful line is CSV.
+absl::StatusOr<SphereFileFormat> SniffFormat(absl::string_view bytes) {
+  absl::string_view first;
+  (void)internal::ForEachLine(bytes, [&](std::size_t, absl::string_view line) {
+    first = internal::StripCommentAndBlanks(line);
+    // Stop (with any non-OK status) at the first line with content.
+    return first.empty() ? absl::OkStatus() : absl::CancelledError();
+  });
+  if (first.size() >= 3 && first.substr(0, 3) == "\xEF\xBB\xBF") first.remove_prefix(3);
+  if (!first.empty() && first[0] == '{') return SphereFileFormat::kJson;
+  if (first.find(',') != absl::string_view::npos) return SphereFileFormat::kCsv;
+  const bool only_digits_and_blanks =
+      !first.empty() && std::all_of(first.begin(), first.end(), [](char c) {
+        return (c >= '0' && c <= '9') || c == ' ' || c == '\t';
+      });
+  const std::size_t gap = first.find_first_of(" \t");
+  if (only_digits_and_blanks && gap != absl::string_view::npos &&
+      first.find_first_not_of(" \t", gap) != absl::string_view::npos) {
+    return SphereFileFormat::kSph;
+  }
+  return absl::InvalidArgumentError(
+      "cannot tell the sphere file format from the extension or the contents (expected json, "
+      "sph or csv)");
+}
+
+absl::Status IoError(int error, const std::string& what) {
+  const std::string message = absl::StrCat(what, " (", std::strerror(error), ")");
+  switch (error) {
+    case ENOENT:
+    case ENOTDIR:
+      return absl::NotFoundError(message);
+    case EACCES:
+    case EPERM:
+    case EROFS:
+      return absl::PermissionDeniedError(message);
+    default:
+      return absl::InternalError(message);
+  }
+}
+
+// Writes all of `bytes` to `fd`, retrying short writes and EINTR.
+bool WriteAll(int fd, absl::string_view bytes) {
+  while (!bytes.empty()) {
+    const ssize_t n = ::write(fd, bytes.data(), bytes.size());
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      return false;
+    }
+    bytes.remove_prefix(static_cast<std::size_t>(n));
+  }
+  return true;
+}
+
+// Messages without a prefix; the callers add "<format> data" or the path.
+absl::StatusOr<SphereFile> ParseReadable(absl::string_view bytes, SphereFileFormat format,
+                                         const SphereFileReadOptions& options) {
+  switch (format) {
+    case SphereFileFormat::kJson:
+      return internal::ParseJsonSphereFile(bytes);
+    case SphereFileFormat::kSph:
+      return internal::ParseSphSphereFile(bytes, options.sph_level);
+    case SphereFileFormat::kCsv:
+      return internal::ParseCsvSphereFile(bytes);
+    case SphereFileFormat::kObj:
+    case SphereFileFormat::kYaml:
+      break;
+  }
+  return absl::InvalidArgumentError(
+      absl::StrCat(SphereFileFormatName(format), " sphere files are write-only"));
+}
+
+}  // namespace
+
+absl::StatusOr<SphereFileFormat> ParseSphereFileFormat(absl::string_view name) {
+  const std::string lower = LowercaseAscii(name);
+  if (lower == "json") return SphereFileFormat::kJson;
+  if (lower == "sph") return SphereFileFormat::kSph;
+  if (lower == "csv") return SphereFileFormat::kCsv;
+  if (lower == "obj") return SphereFileFormat::kObj;
+  if (lower == "yaml" || lower == "yml") return SphereFileFormat::kYaml;
+  return absl::InvalidArgumentError(absl::StrCat("unknown sphere file format ",
+                                                 internal::QuoteToken(name),
+                                                 " (expected json, sph, csv, obj or yaml)"));
+}
+
+absl::string_view SphereFileFormatName(SphereFileFormat format) {
+  switch (format) {
+    case SphereFileFormat::kJson:
+      return "json";
+    case SphereFileFormat::kSph:
+      return "sph";
+    case SphereFileFormat::kCsv:
+      return "csv";
+    case SphereFileFormat::kObj:
+      return "obj";
+    case SphereFileFormat::kYaml:
+      return "yaml";
+  }
+  return "unknown";
+}
+
+absl::StatusOr<SphereFileFormat> SphereFileFormatFromPath(const std::string& path) {
+  std::string ext = LowercaseAscii(fs::path(path).extension().string());
+  if (!ext.empty()) ext.erase(0, 1);
+  absl::StatusOr<SphereFileFormat> format = ParseSphereFileFormat(ext);
+  if (!format.ok()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(path, ": unknown sphere file extension '", ext.empty() ? "(none)" : ext,
+                     "' (expected .json, .sph, .csv, .obj, .yaml or .yml)"));
+  }
+  return format;
+}
+
+bool IsReadableSphereFileFormat(SphereFileFormat format) {
+  return format == SphereFileFormat::kJson || format == SphereFileFormat::kSph ||
+         format == SphereFileFormat::kCsv;
+}
+
+absl::StatusOr<std::string> FormatSphereFile(const SphereFile& file, SphereFileFormat format,
+                                             const SphereFileWriteOptions& options) {
+  if (absl::Status status = internal::CheckSphereSetForWrite(file); !status.ok()) return status;
+  switch (format) {
+    case SphereFileFormat::kJson:
+      return internal::FormatJsonSphereFile(file);
+    case SphereFileFormat::kSph:
+      return internal::FormatSphSphereFile(file);
+    case SphereFileFormat::kCsv:
+      return internal::FormatCsvSphereFile(file, options.csv_header);
+    case SphereFileFormat::kObj:
+      if (options.obj_subdivision < 0 || options.obj_subdivision > 5) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("obj subdivision level ", options.obj_subdivision, " is outside 0..5"));
+      }
+      return internal::FormatObjSphereFile(file, options.obj_subdivision);
+    case SphereFileFormat::kYaml:
+      if (options.yaml_link_name.empty() ||
+          !std::all_of(options.yaml_link_name.begin(), options.yaml_link_name.end(), [](char c) {
+            return absl::ascii_isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' ||
+                   c == '.' || c == '/';
+          })) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("yaml link name ", internal::QuoteToken(options.yaml_link_name),
+                         " is not a non-empty run of letters, digits and _ - . /"));
+      }
+      return internal::FormatYamlSphereFile(file, options.yaml_link_name);
+  }
+  return absl::InvalidArgumentError("unknown sphere file format");
+}
+
+absl::StatusOr<SphereFile> ParseSphereFile(absl::string_view bytes, SphereFileFormat format,
+                                           const SphereFileReadOptions& options) {
+  absl::StatusOr<SphereFile> file = ParseReadable(bytes, format, options);
+  if (!file.ok()) {
+    return Prefixed(file.status(), absl::StrCat(SphereFileFormatName(format), " data"));
+  }
+  return file;
+}
+
+absl::StatusOr<SphereFile> ReadSphereFile(const std::string& path,
+                                          const SphereFileReadOptions& options) {
+  std::error_code ec;
+  const fs::file_status status = fs::status(path, ec);
+  if (ec || !fs::exists(status)) {
+    return absl::NotFoundError(absl::StrCat(path, ": no such file"));
+  }
+  if (fs::is_directory(status)) {
+    return absl::InvalidArgumentError(absl::StrCat(path, ": is a directory, not a sphere file"));
+  }
+  std::optional<SphereFileFormat> format = options.format;
+  if (!format.has_value()) {
+    absl::StatusOr<SphereFileFormat> by_extension = SphereFileFormatFromPath(path);
+    if (by_extension.ok()) format = *by_extension;
+  }
+  if (format.has_value() && !IsReadableSphereFileFormat(*format)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(path, ": ", SphereFileFormatName(*format), " sphere files are write-only"));
+  }
+  std::ifstream in(path, std::ios::in | std::ios::binary);
+  if (!in) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(path, ": cannot open (", std::strerror(errno), ")"));
+  }
+  std::ostringstream contents;
+  contents << in.rdbuf();
+  if (in.bad()) return absl::InvalidArgumentError(absl::StrCat(path, ": read error"));
+  const std::string bytes = std::move(contents).str();
+  if (!format.has_value()) {
+    absl::StatusOr<SphereFileFormat> sniffed = SniffFormat(bytes);
+    if (!sniffed.ok()) return Prefixed(sniffed.status(), path);
+    format = *sniffed;
+  }
+  absl::StatusOr<SphereFile> file = ParseReadable(bytes, *format, options);
+  if (!file.ok()) return Prefixed(file.status(), path);
+  return file;
+}
+
+absl::Status WriteSphereFile(const std::string& path, const SphereFile& file,
+                             const SphereFileWriteOptions& options) {
+  std::optional<SphereFileFormat> format = options.format;
+  if (!format.has_value()) {
+    absl::StatusOr<SphereFileFormat> by_extension = SphereFileFormatFromPath(path);
+    if (!by_extension.ok()) return by_extension.status();
+    format = *by_extension;
+  }
+  absl::StatusOr<std::string> bytes = FormatSphereFile(file, *format, options);
+  if (!bytes.ok()) return Prefixed(bytes.status(), path);
+
+  // A unique sibling name: rename() is atomic only within one file system, so the temporary
+  // file lives in the target's directory. O_EXCL makes a clash (another writer) a retry.
+  static std::atomic<unsigned> counter{0};
+  std::string temp;
+  int fd = -1;
+  for (int attempt = 0; attempt < 100 && fd < 0; ++attempt) {
+    temp = absl::StrCat(path, ".tmp.", ::getpid(), ".", counter.fetch_add(1));
+    fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    if (fd < 0 && errno != EEXIST) break;
+  }
+  if (fd < 0) return IoError(errno, absl::StrCat(path, ": cannot create ", temp));
+  const bool written = WriteAll(fd, *bytes) && ::fsync(fd) == 0;
+  const int write_errno = errno;
+  const bool closed = ::close(fd) == 0;
+  if (!written || !closed) {
+    const int error = written ? errno : write_errno;
+    ::unlink(temp.c_str());
+    return IoError(error, absl::StrCat(path, ": cannot write ", temp));
+  }
+  if (::rename(temp.c_str(), path.c_str()) != 0) {
+    const int error = errno;
+    ::unlink(temp.c_str());
+    return IoError(error, absl::StrCat(path, ": cannot replace the file"));
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace inscribe

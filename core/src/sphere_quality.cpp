@@ -1,0 +1,193 @@
+// EvaluateSpheres: see sphere_quality.h.
+#include "inscribe/sphere_quality.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "absl/strings/str_cat.h"
+#include "inscribe/union_of_balls.h"
+
+namespace inscribe {
+namespace {
+
+constexpr double kSqrt3 = 1.7320508075688772;
+
+// `count` points uniformly distributed by area over the mesh's triangles. Deterministic for a
+// given seed: each point draws from its own generator seeded by (seed, index), so the points do
+// not depend on scheduling.
+Vertices SampleSurface(const Mesh& mesh, std::int64_t count, std::uint64_t seed) {
+  const std::int64_t triangles = mesh.num_triangles();
+  std::vector<double> cumulative(static_cast<std::size_t>(triangles));
+  double total = 0.0;
+  for (std::int64_t t = 0; t < triangles; ++t) {
+    const Vector3 a = mesh.vertices.row(mesh.triangles(t, 0));
+    const Vector3 b = mesh.vertices.row(mesh.triangles(t, 1));
+    const Vector3 c = mesh.vertices.row(mesh.triangles(t, 2));
+    total += 0.5 * (b - a).cross(c - a).norm();
+    cumulative[static_cast<std::size_t>(t)] = total;
+  }
+  Vertices points(count, 3);
+  tbb::parallel_for(
+      tbb::blocked_range<std::int64_t>(0, count, 1024),
+      [&](const tbb::blocked_range<std::int64_t>& range) {
+        for (std::int64_t i = range.begin(); i != range.end(); ++i) {
+          std::mt19937_64 random(seed * 0x9E3779B97F4A7C15ull + static_cast<std::uint64_t>(i));
+          auto uniform = [&random] { return static_cast<double>(random() >> 11) * 0x1.0p-53; };
+          const double pick = uniform() * total;
+          const std::int64_t t = std::min<std::int64_t>(
+              triangles - 1,
+              std::upper_bound(cumulative.begin(), cumulative.end(), pick) - cumulative.begin());
+          double u = uniform();
+          double v = uniform();
+          if (u + v > 1.0) {
+            u = 1.0 - u;
+            v = 1.0 - v;
+          }
+          const Vector3 a = mesh.vertices.row(mesh.triangles(t, 0));
+          const Vector3 b = mesh.vertices.row(mesh.triangles(t, 1));
+          const Vector3 c = mesh.vertices.row(mesh.triangles(t, 2));
+          points.row(i) = a + u * (b - a) + v * (c - a);
+        }
+      });
+  return points;
+}
+
+// Distance from x to the union of the balls (0 inside one). Brute force over the balls, with
+// an early exit once x is inside one.
+double DistanceToUnion(const Vector3& x, const std::vector<Sphere>& spheres) {
+  double best = std::numeric_limits<double>::infinity();
+  for (const Sphere& sphere : spheres) {
+    const double gap = (x - sphere.center).norm() - sphere.radius;
+    if (gap < best) {
+      best = gap;
+      if (best <= 0.0) return 0.0;
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
+absl::StatusOr<QualityReport> EvaluateSpheres(const BoundaryOracle& oracle,
+                                              const std::vector<Sphere>& spheres,
+                                              const QualityOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  const Mesh& mesh = oracle.mesh();
+  for (std::size_t i = 0; i < spheres.size(); ++i) {
+    const Sphere& s = spheres[i];
+    if (!s.center.allFinite() || !std::isfinite(s.radius)) {
+      return absl::InvalidArgumentError(absl::StrCat("sphere ", i, " is not finite"));
+    }
+    if (!(s.radius > 0.0)) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("sphere ", i, ": radius ", s.radius, " is not positive"));
+    }
+  }
+  if (options.surface_samples < 0 || options.surface_samples > 100'000'000) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("surface samples must lie in [0, 100000000], got ", options.surface_samples));
+  }
+  if (!std::isfinite(options.voxel_size) || options.voxel_size < 0.0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("voxel size must be finite and >= 0, got ", options.voxel_size));
+  }
+  QualityReport report;
+  report.spheres = static_cast<std::int64_t>(spheres.size());
+  report.bbox_diagonal = ComputeBoundingBox(mesh.vertices).diagonal();
+  report.volume_mesh = SignedVolume(mesh);
+  if (!(report.volume_mesh > 0.0)) {
+    return absl::InvalidArgumentError(absl::StrCat("mesh volume is ", report.volume_mesh,
+                                                   "; a closed, outward-oriented mesh is needed"));
+  }
+  report.protrusion_tolerance = options.protrusion_tolerance >= 0.0 ? options.protrusion_tolerance
+                                                                    : 1e-9 * report.bbox_diagonal;
+  report.coverage_tolerance =
+      options.coverage_tolerance >= 0.0 ? options.coverage_tolerance : 1e-3 * report.bbox_diagonal;
+
+  absl::StatusOr<double> union_volume = UnionVolume(spheres);
+  if (!union_volume.ok()) return union_volume.status();
+  report.volume_union = *union_volume;
+
+  // Protrusion per sphere.
+  std::vector<double> protrusion(spheres.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, spheres.size(), 64),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                        protrusion[i] = std::max(
+                            0.0, spheres[i].radius + oracle.SignedDistance(spheres[i].center));
+                      }
+                    });
+  if (!spheres.empty()) {
+    double sum = 0.0;
+    for (double p : protrusion) {
+      sum += p;
+      report.protrusion_max = std::max(report.protrusion_max, p);
+      report.protruding_spheres += p > report.protrusion_tolerance;
+    }
+    report.protrusion_mean = sum / static_cast<double>(spheres.size());
+    std::vector<double> sorted = protrusion;
+    const std::size_t rank = static_cast<std::size_t>(std::ceil(0.95 * sorted.size())) - 1;
+    std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(rank),
+                     sorted.end());
+    report.protrusion_p95 = sorted[rank];
+  }
+  report.nerr_is_exact = report.protruding_spheres == 0;
+  report.nerr = report.nerr_is_exact
+                    ? (report.volume_mesh - report.volume_union) / report.volume_mesh
+                    : std::abs(report.volume_union - report.volume_mesh) / report.volume_mesh;
+
+  // Sampled boundary measures.
+  report.surface_samples = options.surface_samples;
+  if (options.surface_samples > 0 && mesh.num_triangles() > 0) {
+    const Vertices samples = SampleSurface(mesh, options.surface_samples, options.seed);
+    // Per-sample distances first, then serial sums: the report is the same bit for bit on
+    // every run.
+    std::vector<double> distances(static_cast<std::size_t>(samples.rows()));
+    tbb::parallel_for(tbb::blocked_range<std::int64_t>(0, samples.rows(), 256),
+                      [&](const tbb::blocked_range<std::int64_t>& range) {
+                        for (std::int64_t i = range.begin(); i != range.end(); ++i) {
+                          distances[static_cast<std::size_t>(i)] =
+                              spheres.empty()
+                                  ? std::numeric_limits<double>::infinity()
+                                  : DistanceToUnion(samples.row(i).transpose(), spheres);
+                        }
+                      });
+    double sum = 0.0;
+    std::int64_t covered = 0;
+    for (double distance : distances) {
+      sum += distance;
+      report.boundary_to_union_hausdorff = std::max(report.boundary_to_union_hausdorff, distance);
+      covered += distance <= report.coverage_tolerance;
+    }
+    report.boundary_to_union_mean = sum / static_cast<double>(distances.size());
+    report.coverage = static_cast<double>(covered) / static_cast<double>(distances.size());
+  }
+
+  // Fatness.
+  if (!spheres.empty()) {
+    report.radius_min = std::numeric_limits<double>::infinity();
+    for (const Sphere& s : spheres) {
+      report.radius_min = std::min(report.radius_min, s.radius);
+      report.radius_max = std::max(report.radius_max, s.radius);
+    }
+    report.fat_up_to_voxel_size = report.radius_min / kSqrt3;
+  }
+  report.voxel_size = options.voxel_size;
+  if (options.voxel_size > 0.0 && !spheres.empty()) {
+    report.fat = options.voxel_size <= report.fat_up_to_voxel_size;
+    std::int64_t large = 0;
+    for (const Sphere& s : spheres) large += s.radius >= kSqrt3 * options.voxel_size;
+    report.fraction_radius_over_sqrt3_sigma =
+        static_cast<double>(large) / static_cast<double>(spheres.size());
+  }
+  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return report;
+}
+
+}  // namespace inscribe

@@ -1,0 +1,152 @@
+// `inscribe generate` and `inscribe evaluate`, run as users run them.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "client/cli_run.h"
+#include "support/test_meshes.h"
+
+namespace inscribe {
+namespace {
+
+using ::testing::HasSubstr;
+namespace fs = std::filesystem;
+
+std::string Eight() { return Quote(testing::TestMeshPath("eight.off")); }
+
+fs::path TempDir() {
+  const fs::path dir =
+      fs::temp_directory_path() / ("inscribe_cli_spheres_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  return dir;
+}
+
+TEST(CliGenerate, JsonSummaryHasTheFiguresUsersNeed) {
+  INSCRIBE_REQUIRE_MESH("eight.off");
+  const CliRun run = RunCli("generate " + Eight() + " --max-spheres 120 --json");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const nlohmann::json j = nlohmann::json::parse(run.out);
+  EXPECT_LE(j.at("spheres").get<int>(), 120);
+  EXPECT_GT(j.at("spheres").get<int>(), 90);
+  EXPECT_GT(j.at("voxel_size").get<double>(), 0.0);
+  EXPECT_GT(j.at("seconds").get<double>(), 0.0);
+  const double mesh = j.at("volume_mesh").get<double>();
+  const double ball_union = j.at("volume_union").get<double>();
+  EXPECT_GT(ball_union, 0.0);
+  EXPECT_LT(ball_union, mesh);
+  EXPECT_NEAR(j.at("nerr").get<double>(), (mesh - ball_union) / mesh, 1e-12);
+  EXPECT_EQ(j.at("nerr_kind"), "exact");
+  EXPECT_EQ(j.at("protruding_spheres").get<int>(), 0);
+  EXPECT_GT(j.at("search_runs").get<int>(), 1);
+  EXPECT_EQ(j.at("surface_samples").get<int>(), 100000);
+}
+
+TEST(CliGenerate, DefaultOutputIsTheSphereSetJson) {
+  INSCRIBE_REQUIRE_MESH("eight.off");
+  const CliRun run = RunCli("generate " + Eight() + " --voxel-size 0.1");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const nlohmann::json j = nlohmann::json::parse(run.out);
+  EXPECT_EQ(j.at("format"), "inscribe.spheres");
+  EXPECT_EQ(j.at("version"), 1);
+  EXPECT_THAT(j.at("mesh_sha256").get<std::string>(), HasSubstr("sha256:"));
+  EXPECT_DOUBLE_EQ(j.at("params").at("voxel_size").get<double>(), 0.1);
+  EXPECT_DOUBLE_EQ(j.at("params").at("object_angle").get<double>(), 0.6);
+  ASSERT_GT(j.at("spheres").size(), 10u);
+  EXPECT_EQ(j.at("spheres").at(0).size(), 4u);
+  EXPECT_EQ(j.at("contacts").size(), j.at("spheres").size());
+  EXPECT_EQ(j.at("contacts").at(0).size(), 4u);
+  EXPECT_TRUE(j.at("stats").contains("nerr"));
+  EXPECT_TRUE(j.at("stats").contains("seconds"));
+}
+
+TEST(CliGenerate, EveryFormatIsWrittenAndReadableOnesEvaluateAlike) {
+  INSCRIBE_REQUIRE_MESH("eight.off");
+  const fs::path dir = TempDir();
+  double nerr = -1.0;
+  for (const char* extension : {"json", "sph", "csv", "obj", "yaml"}) {
+    SCOPED_TRACE(extension);
+    const fs::path out = dir / (std::string("eight.") + extension);
+    const CliRun run =
+        RunCli("generate " + Eight() + " --voxel-size 0.08 -o " + Quote(out.string()));
+    ASSERT_EQ(run.exit_code, 0) << run.err;
+    EXPECT_EQ(run.out, "");  // the spheres went to the file
+    ASSERT_TRUE(fs::exists(out));
+    EXPECT_GT(fs::file_size(out), 100u);
+    if (std::string(extension) == "obj" || std::string(extension) == "yaml") continue;
+    const CliRun evaluated = RunCli("evaluate --json " + Eight() + " " + Quote(out.string()));
+    ASSERT_EQ(evaluated.exit_code, 0) << evaluated.err;
+    const nlohmann::json j = nlohmann::json::parse(evaluated.out);
+    EXPECT_EQ(j.at("nerr_kind"), "exact");
+    // Every readable format keeps the spheres exactly, so the exact nerr is identical.
+    if (nerr < 0) nerr = j.at("nerr").get<double>();
+    EXPECT_EQ(j.at("nerr").get<double>(), nerr);
+  }
+  const CliRun text = RunCli("evaluate " + Eight() + " " + Quote((dir / "eight.json").string()));
+  EXPECT_EQ(text.exit_code, 0);
+  EXPECT_THAT(text.out, HasSubstr("nerr (exact)"));
+  EXPECT_THAT(text.out, HasSubstr("(sigma, theta)-fat"));
+  fs::remove_all(dir);
+}
+
+TEST(CliEvaluate, ProtrudingSpheresFromAnotherToolGetABound) {
+  INSCRIBE_REQUIRE_MESH("eight.off");
+  const fs::path dir = TempDir();
+  const fs::path csv = dir / "big.csv";
+  std::ofstream(csv) << "x,y,z,r\n0,0,0,0.5\n0.2,0.1,0,0.3\n";
+  const CliRun run = RunCli("evaluate --json " + Eight() + " " + Quote(csv.string()));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const nlohmann::json j = nlohmann::json::parse(run.out);
+  EXPECT_EQ(j.at("nerr_kind"), "lower_bound");
+  EXPECT_GT(j.at("protrusion_max").get<double>(), 0.0);
+  fs::remove_all(dir);
+}
+
+TEST(CliGenerate, BadOptionsAreClearErrorsNotHangs) {
+  INSCRIBE_REQUIRE_MESH("eight.off");
+  struct Case {
+    std::string args;
+    int exit_code;
+    std::string message;
+  };
+  const Case cases[] = {
+      {"--voxel-size 0", 64, "voxel size must be a positive"},
+      {"--voxel-size -2", 64, "voxel size must be a positive"},
+      {"--voxel-size 1e-7", 64, "more than 20000000 voxels"},
+      {"--voxel-size 0.01 --max-voxels 1000", 64, "more than 1000 voxels"},
+      {"--object-angle 3.5", 64, "object angle must lie in (0, pi)"},
+      {"--object-angle 0", 64, "object angle"},
+      {"--max-spheres 0", 64, "at least 1"},
+      {"--samples 1", 64, "samples per voxel"},
+      {"--voxel-size 0.1 --max-spheres 10", 64, "excludes"},
+      {"--format pdf", 64, "pdf"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.args);
+    const CliRun run = RunCli("generate " + Eight() + " " + c.args);
+    EXPECT_EQ(run.exit_code, c.exit_code) << run.err;
+    EXPECT_THAT(run.err, HasSubstr(c.message));
+    EXPECT_EQ(run.out, "");
+  }
+}
+
+TEST(CliGenerate, UnusableMeshesAndFilesAreNamed) {
+  INSCRIBE_REQUIRE_MESH("pig.off");
+  CliRun run = RunCli("generate " + Quote(testing::TestMeshPath("pig.off")));
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_THAT(run.err, HasSubstr("not closed: 55 border edges"));
+  run = RunCli("generate /nonexistent/mesh.off");
+  EXPECT_EQ(run.exit_code, 2);
+  const fs::path dir = TempDir();
+  const fs::path garbage = dir / "garbage.json";
+  std::ofstream(garbage) << "{\"format\": \"inscribe.spheres\", \"version\": 1, \"spheres\": [[1,2";
+  run = RunCli("evaluate " + Eight() + " " + Quote(garbage.string()));
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_THAT(run.err, HasSubstr("garbage.json"));
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace inscribe

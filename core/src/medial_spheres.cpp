@@ -29,6 +29,10 @@ namespace {
 
 constexpr double kSqrt3 = 1.7320508075688772;
 
+// The corner screen passes a voxel whose corner directions differ by theta minus this (radians):
+// corners sit up to sqrt(3) sigma from the sheet, where the directions have turned a little.
+constexpr double kCornerScreenMargin = 0.1;
+
 using Clock = std::chrono::steady_clock;
 
 double SecondsSince(Clock::time_point start) {
@@ -139,23 +143,36 @@ class VoxelSearch {
       const double t = -2.0 * (p - centre).dot(unit);
       if (!(std::abs(t) > 1e-9 * circumradius)) continue;  // the line only touches S
       const Vector3 q = p + t * unit;
+      // Only a crossing inside the voxel is kept: a segment that misses the voxel (padded by
+      // epsilon) needs neither q's query nor a search.
+      std::array<double, 2> inside_voxel;
+      if (!ClipToBox(p, q - p, corner, size, params_.epsilon, inside_voxel)) continue;
       const BoundaryPoint bq = Query(q, bp.point, counters);
       if ((bq.point - bp.point).norm() <= params_.same_point_tolerance) continue;
       ++counters.crossing_pairs;
-      // The angle between the two ends' directions to their nearest boundary points equals the
-      // crossing's object angle when both nearest features are faces, and is close to it near
-      // edges and vertices: pairs far below theta are not searched.
-      const Vector3 from_p = bp.point - p;
-      const Vector3 from_q = bq.point - q;
-      const double pair_angle = std::atan2(from_p.cross(from_q).norm(), from_p.dot(from_q));
-      if (pair_angle < params_.object_angle - params_.pair_angle_margin) continue;
+      // When both nearest boundary points lie inside faces, the angle between the two ends'
+      // directions to them is the crossing's object angle (if the crossing's own nearest points
+      // lie on those faces): pairs far below theta are not searched. Near edges and corners
+      // the directions can differ much from the crossing's, so those pairs are always searched.
+      if (InFaceInterior(bp) && InFaceInterior(bq)) {
+        const Vector3 from_p = bp.point - p;
+        const Vector3 from_q = bq.point - q;
+        const double pair_angle = std::atan2(from_p.cross(from_q).norm(), from_p.dot(from_q));
+        if (pair_angle < params_.object_angle - params_.pair_angle_margin) continue;
+      }
       ++counters.searched_pairs;
       // No point of the segment is farther than this from the boundary: skip searches that
       // cannot beat the best radius so far.
       const double radius_bound = 0.5 * (bp.distance + bq.distance + std::abs(t));
       if (radius_bound <= best.sphere.radius) continue;
-      TryCrossing(p, bp, q, bq, corner, size, best, counters);
+      TryCrossing(p, bp, q, bq, inside_voxel, corner, size, best, counters);
     }
+  }
+
+  // Inside a triangle, off its edges and corners (the closest-point routine gives exact zero
+  // weights on edges and corners).
+  static bool InFaceInterior(const BoundaryPoint& foot) {
+    return foot.barycentric.minCoeff() > 0.0;
   }
 
   BoundaryPoint Query(const Vector3& x, VoxelCounters& counters) const {
@@ -171,8 +188,35 @@ class VoxelSearch {
   }
 
   // Locates the medial crossing on (p, q) to within epsilon and keeps it in `best` if it passes.
+  // The part of segment p + s*d, s in [0, 1], inside the cube [corner, corner + size]^3
+  // grown by `pad` on every side, as [s_in, s_out] in `interval`; false if it misses.
+  static bool ClipToBox(const Vector3& p, const Vector3& d, const Vector3& corner, double size,
+                        double pad, std::array<double, 2>& interval) {
+    double s_in = 0.0;
+    double s_out = 1.0;
+    for (int axis = 0; axis < 3; ++axis) {
+      const double lo = corner[axis] - pad;
+      const double hi = corner[axis] + size + pad;
+      if (d[axis] == 0.0) {
+        if (p[axis] < lo || p[axis] > hi) return false;
+        continue;
+      }
+      double a = (lo - p[axis]) / d[axis];
+      double b = (hi - p[axis]) / d[axis];
+      if (a > b) std::swap(a, b);
+      s_in = std::max(s_in, a);
+      s_out = std::min(s_out, b);
+      if (s_in > s_out) return false;
+    }
+    interval = {s_in, s_out};
+    return true;
+  }
+
+  // `inside_voxel`: the segment parameters inside the (padded) voxel; once the bracket leaves
+  // that interval the crossing it converges to lies outside the voxel, and the search stops.
   void TryCrossing(const Vector3& p, const BoundaryPoint& bp, const Vector3& q,
-                   const BoundaryPoint& bq, const Vector3& corner, double size, Candidate& best,
+                   const BoundaryPoint& bq, const std::array<double, 2>& inside_voxel,
+                   const Vector3& corner, double size, Candidate& best,
                    VoxelCounters& counters) const {
     const Vector3 segment = q - p;
     const double length = segment.norm();
@@ -204,6 +248,7 @@ class VoxelSearch {
       return false;
     };
     while (hi - lo > tolerance) {
+      if (hi < inside_voxel[0] || lo > inside_voxel[1]) return;
       double estimate = std::numeric_limits<double>::quiet_NaN();
       if (misses < 3) estimate = CrossingEstimate(p, segment, lo, a, hi, b);
       if (std::isfinite(estimate) && estimate > lo && estimate < hi) {
@@ -513,8 +558,8 @@ absl::StatusOr<MedialSphereResult> GenerateMedialSpheres(const BoundaryOracle& o
   // that the output order, and so the output, do not depend on scheduling.
   std::vector<char> screened_in;
   if (options.corner_screen) {
-    screened_in = ScreenByCorners(oracle, *grid, voxels,
-                                  options.object_angle - options.pair_angle_margin, queries);
+    screened_in =
+        ScreenByCorners(oracle, *grid, voxels, options.object_angle - kCornerScreenMargin, queries);
   }
   for (char pass : screened_in) result.stats.screened_voxels += pass == 0;
   const int slots = options.subdivide_boundary ? 8 : 1;

@@ -12,6 +12,7 @@
 #include <tuple>
 
 #include "../../core/src/closest_point_triangle.h"
+#include "inscribe/union_of_balls.h"
 #include "support/synthetic_meshes.h"
 #include "support/test_meshes.h"
 
@@ -178,6 +179,51 @@ TEST(MedialSpheres, RealMeshesGiveInternalTangentSpheres) {
     ASSERT_GT(result.set.size(), 10u);
     ExpectInternalAndTangent(oracle, result);
   }
+}
+
+// The screens are accelerations of the paper's per-voxel method: against the plain method
+// (every voxel, every sample) they must find nearly the same voxels and the same volume.
+TEST(MedialSpheres, ScreensKeepNearlyEverySphereOfThePlainMethod) {
+  for (const char* name : {"eight.off", "elephant.off", "fandisk.off"}) {
+    SCOPED_TRACE(name);
+    const Mesh mesh = LoadTestMesh(name);
+    const BoundaryOracle oracle = MakeOracle(mesh);
+    MedialSphereOptions fast;
+    fast.voxel_size = 0.04 * ComputeBoundingBox(mesh.vertices).diagonal();
+    MedialSphereOptions plain = fast;
+    plain.corner_screen = false;
+    plain.screen_samples = 0;
+    plain.pair_angle_margin = M_PI;
+    const absl::StatusOr<MedialSphereResult> a = GenerateMedialSpheres(oracle, fast);
+    const absl::StatusOr<MedialSphereResult> b = GenerateMedialSpheres(oracle, plain);
+    ASSERT_TRUE(a.ok() && b.ok());
+    std::set<VoxelKey> fast_voxels;
+    for (const Sphere& s : a->set.spheres)
+      fast_voxels.insert(VoxelOf(*a, s.center, fast.voxel_size));
+    int shared = 0;
+    for (const Sphere& s : b->set.spheres)
+      shared += fast_voxels.count(VoxelOf(*b, s.center, fast.voxel_size));
+    EXPECT_GE(shared, 0.93 * static_cast<double>(b->set.size()))
+        << shared << " of the plain method's " << b->set.size() << " voxels";
+    const double volume_fast = *UnionVolume(a->set.spheres);
+    const double volume_plain = *UnionVolume(b->set.spheres);
+    EXPECT_NEAR(volume_fast / SignedVolume(mesh), volume_plain / SignedVolume(mesh), 0.005);
+  }
+}
+
+// Where the corner screen pays: a thin tube at a fine grid, most of whose voxels see no sheet.
+TEST(MedialSpheres, CornerScreenSkipsMostVoxelsOfAThinTube) {
+  const Mesh mesh = LoadTestMesh("knot1.off");
+  const BoundaryOracle oracle = MakeOracle(mesh);
+  MedialSphereOptions options;
+  options.voxel_size = 0.012 * ComputeBoundingBox(mesh.vertices).diagonal();
+  const absl::StatusOr<MedialSphereResult> fast = GenerateMedialSpheres(oracle, options);
+  options.corner_screen = false;
+  const absl::StatusOr<MedialSphereResult> unscreened = GenerateMedialSpheres(oracle, options);
+  ASSERT_TRUE(fast.ok() && unscreened.ok());
+  EXPECT_GT(fast->stats.screened_voxels, fast->stats.visited_voxels / 2);
+  EXPECT_LT(2 * fast->stats.closest_point_queries, unscreened->stats.closest_point_queries);
+  EXPECT_GE(fast->set.size(), unscreened->set.size() * 97 / 100);
 }
 
 TEST(MedialSpheres, SphereMeshGivesOneBigSphereNearItsCentre) {

@@ -58,6 +58,25 @@ std::vector<Vector3> FibonacciDirections(int count) {
   return directions;
 }
 
+// The same directions, reordered so that the first `count` are spread over the whole sphere
+// (every (K / count)-th point of the Fibonacci spiral, which runs from pole to pole).
+std::vector<Vector3> ScreeningSubsetFirst(const std::vector<Vector3>& directions,
+                                          std::size_t count) {
+  if (count == 0) return directions;
+  std::vector<char> taken(directions.size(), 0);
+  std::vector<Vector3> ordered;
+  ordered.reserve(directions.size());
+  for (std::size_t i = 0; i < count; ++i) {
+    const std::size_t index = (2 * i + 1) * directions.size() / (2 * count);
+    taken[index] = 1;
+    ordered.push_back(directions[index]);
+  }
+  for (std::size_t i = 0; i < directions.size(); ++i) {
+    if (!taken[i]) ordered.push_back(directions[i]);
+  }
+  return ordered;
+}
+
 // The voxel grid: voxel (i, j, k) covers origin + [i, i+1) x [j, j+1) x [k, k+1) times size. The
 // grid is centred on the mesh's bounding box.
 struct Grid {
@@ -102,36 +121,34 @@ struct SearchParams {
 
 class VoxelSearch {
  public:
-  VoxelSearch(const BoundaryOracle& oracle, const std::vector<Vector3>& screen_directions,
-              const std::vector<Vector3>& directions, const SearchParams& params)
-      : oracle_(oracle),
-        screen_directions_(screen_directions),
-        directions_(directions),
-        params_(params) {}
+  // `directions`: the K sample directions, the first `screen_count` of them an evenly spread
+  // subset used for screening (0: no screening).
+  VoxelSearch(const BoundaryOracle& oracle, const std::vector<Vector3>& directions,
+              std::size_t screen_count, const SearchParams& params)
+      : oracle_(oracle), directions_(directions), screen_count_(screen_count), params_(params) {}
 
-  // Best candidate in the cube [corner, corner + size)^3. The screening set runs first; a voxel
-  // where none of its pairs crosses the medial surface is left empty without the full set.
+  // Best candidate in the cube [corner, corner + size)^3. The screening subset runs first; a
+  // voxel where none of its segments crosses the medial surface inside the voxel is left empty
+  // without the other samples.
   Candidate Run(const Vector3& corner, double size, VoxelCounters& counters) const {
     Candidate best;
     best.sphere.radius = -1.0;
     const std::int64_t searched_before = counters.searched_pairs;
-    if (!screen_directions_.empty()) {
-      Sample(screen_directions_, corner, size, best, counters);
-      if (counters.searched_pairs == searched_before) return best;
-    }
-    Sample(directions_, corner, size, best, counters);
+    Sample(0, screen_count_, corner, size, best, counters);
+    if (screen_count_ > 0 && counters.searched_pairs == searched_before) return best;
+    Sample(screen_count_, directions_.size(), corner, size, best, counters);
     return best;
   }
 
  private:
-  void Sample(const std::vector<Vector3>& directions, const Vector3& corner, double size,
+  void Sample(std::size_t first, std::size_t last, const Vector3& corner, double size,
               Candidate& best, VoxelCounters& counters) const {
     const Vector3 centre = corner + Vector3::Constant(0.5 * size);
     const double circumradius = 0.5 * kSqrt3 * size;
     // The previous sample's nearest boundary point bounds the next sample's query.
     std::optional<Vector3> previous_foot;
-    for (const Vector3& direction : directions) {
-      const Vector3 p = centre + circumradius * direction;
+    for (std::size_t d = first; d < last; ++d) {
+      const Vector3 p = centre + circumradius * directions_[d];
       const BoundaryPoint bp =
           previous_foot ? Query(p, *previous_foot, counters) : Query(p, counters);
       previous_foot = bp.point;
@@ -301,8 +318,8 @@ class VoxelSearch {
   }
 
   const BoundaryOracle& oracle_;
-  const std::vector<Vector3>& screen_directions_;
   const std::vector<Vector3>& directions_;
+  std::size_t screen_count_;
   SearchParams params_;
 };
 
@@ -541,12 +558,13 @@ absl::StatusOr<MedialSphereResult> GenerateMedialSpheres(const BoundaryOracle& o
   params.epsilon = result.epsilon;
   params.same_point_tolerance = 1e-9 * diagonal;
   params.pair_angle_margin = options.pair_angle_margin;
-  const std::vector<Vector3> directions = FibonacciDirections(options.samples);
-  const std::vector<Vector3> screen_directions =
+  const std::size_t screen_count =
       options.screen_samples > 0 && options.screen_samples < options.samples
-          ? FibonacciDirections(options.screen_samples)
-          : std::vector<Vector3>();
-  const VoxelSearch search(oracle, screen_directions, directions, params);
+          ? static_cast<std::size_t>(options.screen_samples)
+          : 0;
+  const std::vector<Vector3> directions =
+      ScreeningSubsetFirst(FibonacciDirections(options.samples), screen_count);
+  const VoxelSearch search(oracle, directions, screen_count, params);
 
   if (Cancelled(control)) return absl::CancelledError("medial-sphere generation cancelled");
   std::int64_t queries = 0;

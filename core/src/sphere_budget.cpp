@@ -4,7 +4,8 @@
 // surface's salient sheets), but not monotonically. The search first brackets the budget N
 // (a sigma with n <= N, the "accepted" side, and a smaller one with n > N), stepping by the
 // power law fitted to the runs so far, then narrows the bracket by interpolating log n against
-// log sigma, kept inside the bracket's middle 80% so each run shrinks it.
+// log sigma, kept inside the bracket's middle 80%, and bisects whenever a run failed to
+// halve the bracket (the count jumps where the grid's alignment changes).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -66,6 +67,7 @@ absl::StatusOr<SphereBudgetResult> GenerateWithSphereBudget(const BoundaryOracle
   std::optional<Run> rejected;                 // largest sigma with n > N
   std::optional<Run> previous;
   double slope = -2.0;
+  double previous_gap = 0.0;  // relative bracket width before the last run, once bracketed
   // First guess: the medial surface of a solid of this size, met by voxels of side sigma,
   // gives about (diagonal / sigma)^2 / 4 spheres.
   double sigma = std::max(finest, 0.5 * diagonal / std::sqrt(target));
@@ -114,17 +116,21 @@ absl::StatusOr<SphereBudgetResult> GenerateWithSphereBudget(const BoundaryOracle
           Run{accepted->voxel_size, static_cast<std::int64_t>(accepted_count)}, *rejected, slope);
       double guess = log_hi + (std::log(target) - std::log(accepted_count)) / local;
       guess = std::clamp(guess, log_lo + 0.1 * (log_hi - log_lo), log_lo + 0.9 * (log_hi - log_lo));
+      // Safeguard: the count jumps where the grid's alignment changes, and interpolation across
+      // a jump creeps; when the last run did not halve the bracket, bisect instead.
+      if (previous_gap > 0.0 && gap > 0.5 * previous_gap) guess = 0.5 * (log_lo + log_hi);
+      previous_gap = gap;
       sigma = std::exp(guess);
     } else if (accepted) {
       // Every run so far fits: refine, aiming a little past the budget to find its edge.
       if (accepted->voxel_size <= finest) break;  // the voxel limit stops refinement here
       const double count = static_cast<double>(std::max<std::size_t>(accepted->set.size(), 1));
-      const double factor = std::pow(1.1 * target / count, 1.0 / slope);
+      const double factor = std::pow(1.03 * target / count, 1.0 / slope);
       sigma = std::max(finest, accepted->voxel_size * std::clamp(factor, 0.25, 0.95));
     } else {
       // Every run so far has too many spheres: coarsen, aiming a little under the budget.
       const double factor =
-          std::pow(0.9 * target / static_cast<double>(current.count), 1.0 / slope);
+          std::pow(0.97 * target / static_cast<double>(current.count), 1.0 / slope);
       sigma *= std::clamp(factor, 1.05, 4.0);
       if (sigma > 4.0 * diagonal) {
         return absl::ResourceExhaustedError(absl::StrCat(

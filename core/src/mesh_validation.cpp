@@ -8,6 +8,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "hole_filling.h"
 #include "mesh_topology.h"
 #include "self_intersections.h"
 
@@ -411,6 +412,28 @@ void OrientOutward(Mesh& mesh, const std::vector<std::int32_t>& component,
   }
 }
 
+// Reports the triangles that the orientation fixes reversed: flip[t] for each triangle t of the
+// mesh as given; component[t] < 0 marks triangles without three distinct corners.
+void ReportFlips(const std::vector<char>& flip, const std::vector<std::int32_t>& component,
+                 MeshReport& report) {
+  report.flipped_triangles = std::count(flip.begin(), flip.end(), 1);
+  if (report.flipped_triangles > 0) {
+    const bool all =
+        report.flipped_triangles ==
+        std::count_if(component.begin(), component.end(), [](std::int32_t c) { return c >= 0; });
+    std::string what =
+        report.inconsistent_edges > 0
+            ? absl::StrCat("orientation was inconsistent (",
+                           Plural(report.inconsistent_edges, "edge", "edges"), ")")
+            : std::string(all ? "mesh was inside out" : "some shells faced the wrong way");
+    AddIssue(
+        report, Severity::kFixed, "orientation_fixed",
+        absl::StrCat(what, "; reversed ", Plural(report.flipped_triangles, "triangle", "triangles"),
+                     " so that normals point out of the solid"),
+        report.flipped_triangles);
+  }
+}
+
 void CheckOrientation(Mesh& mesh, const std::vector<EdgeUse>& uses, const EdgeGroups& groups,
                       const ValidateOptions& options, MeshReport& report) {
   const std::vector<std::int32_t> component = LabelComponents(mesh, uses, groups, report);
@@ -435,22 +458,96 @@ void CheckOrientation(Mesh& mesh, const std::vector<EdgeUse>& uses, const EdgeGr
     return;
   }
   OrientOutward(mesh, component, report.components, flip, report);
-  report.flipped_triangles = std::count(flip.begin(), flip.end(), 1);
-  if (report.flipped_triangles > 0) {
-    const bool all =
-        report.flipped_triangles ==
-        std::count_if(component.begin(), component.end(), [](std::int32_t c) { return c >= 0; });
-    std::string what =
-        report.inconsistent_edges > 0
-            ? absl::StrCat("orientation was inconsistent (",
-                           Plural(report.inconsistent_edges, "edge", "edges"), ")")
-            : std::string(all ? "mesh was inside out" : "some shells faced the wrong way");
-    AddIssue(
-        report, Severity::kFixed, "orientation_fixed",
-        absl::StrCat(what, "; reversed ", Plural(report.flipped_triangles, "triangle", "triangles"),
-                     " so that normals point out of the solid"),
-        report.flipped_triangles);
+  ReportFlips(flip, component, report);
+}
+
+// Appends why the holes stay open to the "not closed" error, the one line users see.
+void NoteHolesNotFilled(MeshReport& report, const std::string& why) {
+  for (MeshIssue& issue : report.issues) {
+    if (issue.code == "not_closed") absl::StrAppend(&issue.message, "; ", why);
   }
+}
+
+// options.fill_holes on a mesh with border edges: makes orientation consistent on a copy,
+// closes every hole of the copy (internal::FillHoles), then orients the closed copy outward
+// and returns it in `mesh`. When any hole cannot be closed, `mesh` is left as given, checked
+// as without fill_holes, and the "not closed" error says why. Cost O(#T log #T) plus CGAL's.
+void FillHolesAndOrient(Mesh& mesh, const std::vector<EdgeUse>& uses, const EdgeGroups& groups,
+                        const ValidateOptions& options, MeshReport& report) {
+  auto keep_open = [&](const std::string& why) {
+    CheckOrientation(mesh, uses, groups, options, report);
+    NoteHolesNotFilled(report, why);
+  };
+  if (report.non_manifold_edges > 0) {
+    return keep_open("holes were not filled: the mesh is not edge-manifold");
+  }
+  if (report.inconsistent_edges > 0 && !options.fix_orientation) {
+    return keep_open("holes were not filled: orientation is inconsistent and is not to be fixed");
+  }
+  const std::vector<std::int32_t> component = LabelComponents(mesh, uses, groups, report);
+  Mesh closed = mesh;
+  std::vector<char> flip(static_cast<std::size_t>(mesh.num_triangles()), 0);
+  std::int64_t bad_triangle = -1;
+  if (options.fix_orientation &&
+      !MakeConsistent(closed, uses, groups, component, report.components, flip, &bad_triangle)) {
+    return keep_open(
+        absl::StrCat("holes were not filled: a component is not orientable "
+                     "(it contains triangle ",
+                     bad_triangle, ")"));
+  }
+  internal::HoleFillingLimits limits;
+  limits.max_hole_edges = options.max_hole_edges;
+  limits.max_total_hole_edges = options.max_total_hole_edges;
+  const internal::HoleFilling filling = internal::FillHoles(closed, limits);
+  if (filling.holes_left_open > 0 || filling.holes == 0) {
+    return keep_open(filling.refused || filling.holes == 1
+                         ? absl::StrCat("holes were not filled: ", filling.failure)
+                         : absl::StrCat("hole filling failed for ", filling.holes_left_open, " of ",
+                                        Plural(filling.holes, "loop", "loops"),
+                                        filling.holes_filled > 0 ? ", so none was filled" : "",
+                                        " (first: ", filling.failure, ")"));
+  }
+  const Eigen::Index given = closed.triangles.rows();
+  closed.triangles.conservativeResize(given + filling.patch.rows(), 3);
+  closed.triangles.bottomRows(filling.patch.rows()) = filling.patch;
+
+  // The patch is checked, not trusted: every edge of the closed copy must join exactly two
+  // triangles that walk it in opposite directions before the copy replaces the mesh.
+  const std::vector<EdgeUse> closed_uses = internal::SortedEdgeUses(closed);
+  const EdgeGroups closed_groups = GroupEdges(closed_uses);
+  const std::int64_t bad_edges =
+      std::count_if(closed_groups.ranges.begin(), closed_groups.ranges.end(),
+                    [&closed_uses](const std::pair<std::size_t, std::size_t>& r) {
+                      return r.second - r.first != 2 ||
+                             closed_uses[r.first].forward == closed_uses[r.first + 1].forward;
+                    });
+  if (bad_edges > 0) {
+    return keep_open(absl::StrCat("holes were not filled: the patches left ",
+                                  Plural(bad_edges, "edge", "edges"),
+                                  " not shared by two consistently oriented triangles"));
+  }
+  MeshReport closed_report;
+  const std::vector<std::int32_t> closed_component =
+      LabelComponents(closed, closed_uses, closed_groups, closed_report);
+  flip.resize(static_cast<std::size_t>(closed.num_triangles()), 0);
+  if (options.fix_orientation) {
+    OrientOutward(closed, closed_component, closed_report.components, flip, report);
+  }
+  // Only the triangles as given count as flipped; the patch was made facing its neighbours.
+  flip.resize(static_cast<std::size_t>(given));
+  ReportFlips(flip, component, report);
+
+  report.holes_filled = filling.holes_filled;
+  report.hole_triangles_added = filling.patch.rows();
+  report.issues.erase(std::remove_if(report.issues.begin(), report.issues.end(),
+                                     [](const MeshIssue& i) { return i.code == "not_closed"; }),
+                      report.issues.end());
+  AddIssue(report, Severity::kFixed, "holes_filled",
+           absl::StrCat("filled ", Plural(report.holes_filled, "hole", "holes"), " (",
+                        Plural(filling.filled_border_edges, "border edge", "border edges"),
+                        ") with ", Plural(report.hole_triangles_added, "triangle", "triangles")),
+           report.holes_filled);
+  mesh = std::move(closed);
 }
 
 }  // namespace
@@ -492,7 +589,11 @@ ValidatedMesh ValidateMesh(Mesh mesh, const ValidateOptions& options) {
   const EdgeGroups groups = GroupEdges(uses);
   CheckEdges(mesh, uses, groups, report);
   CheckVertexManifold(mesh, uses, groups, report);
-  CheckOrientation(mesh, uses, groups, options, report);
+  if (options.fill_holes && report.border_edges > 0) {
+    FillHolesAndOrient(mesh, uses, groups, options, report);
+  } else {
+    CheckOrientation(mesh, uses, groups, options, report);
+  }
   report.volume = SignedVolume(mesh);
 
   if (report.usable() && !(report.volume > 0.0)) {
@@ -504,12 +605,25 @@ ValidatedMesh ValidateMesh(Mesh mesh, const ValidateOptions& options) {
       report.self_intersections_checked = true;
       report.self_intersecting_pairs = static_cast<std::int64_t>(pairs->size());
       if (!pairs->empty()) {
+        // Hole-filling triangles follow the given ones: a pair involves one when its second
+        // (larger) index is past them.
+        const std::int64_t patch_pairs =
+            report.hole_triangles_added == 0
+                ? 0
+                : std::count_if(pairs->begin(), pairs->end(),
+                                [&report](const std::pair<std::int32_t, std::int32_t>& p) {
+                                  return p.second >= report.triangles;
+                                });
         AddIssue(
             report, Severity::kWarning, "self_intersections",
             absl::StrCat(
                 "mesh intersects itself: ", Plural(report.self_intersecting_pairs, "pair", "pairs"),
                 " of triangles cross (first: triangles ", pairs->front().first, " and ",
-                pairs->front().second, "); inside/outside is ill-defined near them"),
+                pairs->front().second,
+                patch_pairs > 0
+                    ? absl::StrCat("; ", patch_pairs, " involve triangles that fill holes")
+                    : std::string(),
+                "); inside/outside is ill-defined near them"),
             report.self_intersecting_pairs);
       }
     }

@@ -68,6 +68,37 @@ TEST(CliInfo, OpenMeshFailsWithOneLineReason) {
   EXPECT_FALSE(j.at("usable").get<bool>());
 }
 
+TEST(CliInfo, FillHolesMakesTheOpenPigUsable) {
+  INSCRIBE_REQUIRE_MESH("pig.off");
+  const std::string pig = Quote(testing::TestMeshPath("pig.off"));
+  const CliRun open = RunCli("info --json " + pig);
+  EXPECT_EQ(open.exit_code, 1);
+  const CliRun run = RunCli("info --json --fill-holes " + pig);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_EQ(run.err, "");
+  const nlohmann::json j = nlohmann::json::parse(run.out);
+  EXPECT_TRUE(j.at("closed").get<bool>());
+  EXPECT_TRUE(j.at("usable").get<bool>());
+  EXPECT_EQ(j.at("triangles").get<int>(), 891);  // as given
+  EXPECT_EQ(j.at("counts").at("border_edges").get<int>(), 55);
+  EXPECT_EQ(j.at("holes_filled").get<int>(), 7);
+  EXPECT_EQ(j.at("hole_triangles_added").get<int>(), 41);
+  EXPECT_GT(j.at("volume").get<double>(), 0.0);
+  bool reported = false;
+  for (const auto& issue : j.at("issues")) {
+    if (issue.at("code") == "holes_filled") {
+      EXPECT_EQ(issue.at("severity"), "fixed");
+      EXPECT_EQ(issue.at("message"), "filled 7 holes (55 border edges) with 41 triangles");
+      reported = true;
+    }
+  }
+  EXPECT_TRUE(reported) << run.out;
+  // The hash is the repaired mesh's, not the file's.
+  EXPECT_NE(j.at("mesh_sha256"), nlohmann::json::parse(open.out).at("mesh_sha256"));
+  EXPECT_THAT(RunCli("info --fill-holes " + pig).out,
+              HasSubstr("triangles            891 + 41 filling 7 holes"));
+}
+
 TEST(CliInfo, BadFilesFailWithOneLineReason) {
   const fs::path dir = fs::temp_directory_path() / ("inscribe_cli_" + std::to_string(::getpid()));
   fs::create_directories(dir);

@@ -22,6 +22,7 @@ struct EvaluateCliOptions {
   int sph_level = -1;
   QualityOptions quality;
   bool json = false;
+  bool fill_holes = false;
 };
 
 void PrintText(const EvaluateCliOptions& options, const QualityReport& r) {
@@ -66,7 +67,8 @@ int RunEvaluate(const EvaluateCliOptions& options) {
     std::cerr << "inscribe: " << file.status().message() << "\n";
     return kExitBadInput;
   }
-  std::optional<LoadedSolid> solid = LoadSolid(options.mesh_path, &exit_code);
+  std::optional<LoadedSolid> solid =
+      LoadSolid(options.mesh_path, &exit_code, LoadSolidOptions{options.fill_holes});
   if (!solid) return exit_code;
   if (!file->mesh_sha256.empty() && file->mesh_sha256 != solid->sha256) {
     std::cerr << "inscribe: warning: " << options.spheres_path << " was made for mesh "
@@ -121,6 +123,8 @@ void AddEvaluateCommand(CLI::App& app, int* exit_code) {
                   "bounding-box diagonal)");
   cmd->add_option("--voxel-size", options->quality.voxel_size,
                   "Voxel size for the fatness test (default: the file's, if it has one)");
+  cmd->add_flag("--fill-holes", options->fill_holes,
+                "Close the mesh's holes first (see inscribe info --fill-holes)");
   cmd->add_flag("--json", options->json, "Print one JSON object on stdout");
   cmd->callback([options, exit_code] { *exit_code = RunEvaluate(*options); });
 }

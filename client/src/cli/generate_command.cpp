@@ -28,6 +28,7 @@ struct GenerateCliOptions {
   std::string output_path;
   std::string format;
   bool json = false;
+  bool fill_holes = false;
 };
 
 // Params and stats of the sphere file (DESIGN.md section 3), in mesh units and radians.
@@ -68,7 +69,8 @@ SphereFile MakeSphereFile(const LoadedSolid& solid, const GenerateCliOptions& op
 
 int RunGenerate(GenerateCliOptions options) {
   int exit_code = kExitOk;
-  std::optional<LoadedSolid> solid = LoadSolid(options.mesh_path, &exit_code);
+  std::optional<LoadedSolid> solid =
+      LoadSolid(options.mesh_path, &exit_code, LoadSolidOptions{options.fill_holes});
   if (!solid) return exit_code;
 
   ProgressBar progress("generating");
@@ -206,6 +208,8 @@ void AddGenerateCommand(CLI::App& app, int* exit_code) {
                   "Write the sphere set here (format from --format or the extension)");
   cmd->add_option("--format", options->format, "Sphere file format")
       ->check(CLI::IsMember({"json", "sph", "csv", "obj", "yaml", "yml"}, CLI::ignore_case));
+  cmd->add_flag("--fill-holes", options->fill_holes,
+                "Close the mesh's holes first (see inscribe info --fill-holes)");
   cmd->add_flag("--json", options->json,
                 "Print one JSON summary on stdout (spheres, voxel_size, seconds, volumes, nerr, "
                 "quality figures)");

@@ -20,6 +20,7 @@ struct InfoOptions {
   std::string path;
   bool json = false;
   bool skip_self_intersections = false;
+  bool fill_holes = false;
 };
 
 void PrintText(const std::string& path, const MeshReport& report, const std::string& sha256,
@@ -30,10 +31,15 @@ void PrintText(const std::string& path, const MeshReport& report, const std::str
   line("mesh", path);
   line("sha256", sha256.empty() ? "-" : sha256);
   line("vertices", std::to_string(report.vertices));
-  line("triangles", read.polygons_triangulated > 0
-                        ? absl::StrFormat("%d (%d polygons triangulated)", report.triangles,
-                                          read.polygons_triangulated)
-                        : std::to_string(report.triangles));
+  std::string triangles = std::to_string(report.triangles);
+  if (read.polygons_triangulated > 0) {
+    triangles += absl::StrFormat(" (%d polygons triangulated)", read.polygons_triangulated);
+  }
+  if (report.hole_triangles_added > 0) {
+    triangles += absl::StrFormat(" + %d filling %d %s", report.hole_triangles_added,
+                                 report.holes_filled, report.holes_filled == 1 ? "hole" : "holes");
+  }
+  line("triangles", triangles);
   line("closed", report.closed() ? "yes" : "no");
   line("components", std::to_string(report.components));
   line("volume", absl::StrFormat("%.10g", report.volume));
@@ -69,6 +75,7 @@ int RunInfo(const InfoOptions& options) {
   }
   ValidateOptions validate;
   validate.check_self_intersections = !options.skip_self_intersections;
+  validate.fill_holes = options.fill_holes;
   ValidatedMesh validated = ValidateMesh(*std::move(mesh), validate);
   const MeshReport& report = validated.report;
   // The hash is only meaningful for a mesh whose indices and coordinates can be trusted.
@@ -81,6 +88,12 @@ int RunInfo(const InfoOptions& options) {
     nlohmann::json j = MeshReportJson(report, sha256);
     j["path"] = options.path;
     j["polygons_triangulated"] = read.polygons_triangulated;
+    // With --fill-holes the hash, volume and self-intersections describe the repaired mesh;
+    // these two say how it was repaired.
+    if (options.fill_holes) {
+      j["holes_filled"] = report.holes_filled;
+      j["hole_triangles_added"] = report.hole_triangles_added;
+    }
     j["seconds"] = seconds;
     std::cout << j.dump() << "\n";
   } else {
@@ -103,6 +116,9 @@ void AddInfoCommand(CLI::App& app, int* exit_code) {
   cmd->add_flag("--json", options->json, "Print one JSON object on stdout");
   cmd->add_flag("--skip-self-intersections", options->skip_self_intersections,
                 "Skip the exact self-intersection test (faster on huge meshes)");
+  cmd->add_flag("--fill-holes", options->fill_holes,
+                "Close every hole (border loop) with triangles between its border vertices, "
+                "then validate, hash and describe the repaired mesh");
   cmd->callback([options, exit_code] { *exit_code = RunInfo(*options); });
 }
 

@@ -9,7 +9,8 @@
 
 namespace inscribe::cli {
 
-std::optional<LoadedSolid> LoadSolid(const std::string& path, int* exit_code) {
+std::optional<LoadedSolid> LoadSolid(const std::string& path, int* exit_code,
+                                     const LoadSolidOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   absl::StatusOr<Mesh> mesh = ReadMesh(path, nullptr);
   if (!mesh.ok()) {
@@ -17,11 +18,19 @@ std::optional<LoadedSolid> LoadSolid(const std::string& path, int* exit_code) {
     *exit_code = kExitBadInput;
     return std::nullopt;
   }
-  absl::StatusOr<ValidatedMesh> validated = PrepareMesh(*std::move(mesh));
+  ValidateOptions validate;
+  validate.fill_holes = options.fill_holes;
+  absl::StatusOr<ValidatedMesh> validated = PrepareMesh(*std::move(mesh), validate);
   if (!validated.ok()) {
     std::cerr << "inscribe: " << path << ": " << validated.status().message() << "\n";
     *exit_code = kExitUnusableMesh;
     return std::nullopt;
+  }
+  // The solid is no longer the file's: say so, since hashes and results now differ from it.
+  for (const MeshIssue& issue : validated->report.issues) {
+    if (issue.code == "holes_filled") {
+      std::cerr << "inscribe: " << path << ": " << issue.message << "\n";
+    }
   }
   BoundaryOracleOptions oracle_options;
   // The pseudonormal sign is wrong near sheets buried inside a self-intersecting solid.

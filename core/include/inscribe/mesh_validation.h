@@ -23,7 +23,8 @@ struct MeshIssue {
   std::int64_t count = 0;
 };
 
-// Counts found by ValidateMesh. Every count is about the mesh as given (before any fix).
+// Counts found by ValidateMesh. Every count is about the mesh as given (before any fix), except
+// where a field says otherwise.
 struct MeshReport {
   std::int64_t vertices = 0;
   std::int64_t triangles = 0;
@@ -40,13 +41,20 @@ struct MeshReport {
   std::int64_t flipped_triangles = 0;      // triangles whose orientation the fix reversed
   bool self_intersections_checked = false;
   std::int64_t self_intersecting_pairs = 0;  // pairs of triangles that cross (exact predicates)
+  // ValidateOptions::fill_holes: the border loops closed (all of them or none) and the
+  // triangles that took, beyond `triangles`, in the returned mesh.
+  std::int64_t holes_filled = 0;
+  std::int64_t hole_triangles_added = 0;
 
-  double volume = 0.0;  // enclosed volume after orientation fixes (mesh units cubed)
+  // Enclosed volume of the returned mesh, after every fix (mesh units cubed). The
+  // self-intersection figures are about the returned mesh too.
+  double volume = 0.0;
   BoundingBox bbox;
 
   std::vector<MeshIssue> issues;
 
-  bool closed() const { return border_edges == 0 && triangles > 0; }
+  // True when the returned mesh has no border: as given, or once its holes were filled.
+  bool closed() const { return triangles > 0 && (border_edges == 0 || holes_filled > 0); }
   // True when no issue is an error: the mesh bounds a solid the generator can use.
   bool usable() const;
   // The first error as a one-line reason, or "" when usable.
@@ -60,16 +68,33 @@ struct ValidateOptions {
   // Make orientation consistent within each component and point every normal away from the
   // solid (outer shells outward, cavities inward).
   bool fix_orientation = true;
+  // Close every hole (border loop) with triangles between its own border vertices (no vertex
+  // is added; CGAL's triangulate_hole: the constrained Delaunay triangulation of a near-planar
+  // loop, else the triangulation with the smallest largest dihedral angle, then the smallest
+  // area), after orientation is made consistent and before the closedness check. All holes
+  // are filled or none: nothing is when the mesh is not edge-manifold, a vertex is on the
+  // border twice, a loop exceeds the caps below (or, when not near planar, 1,000 edges or a
+  // fixed work budget shared by all loops) or CGAL finds no triangulation for it; the mesh
+  // then stays "not closed", and that error says why. Off by default so that a user's solid
+  // is never changed silently; needs fix_orientation unless the orientation is consistent.
+  bool fill_holes = false;
+  // Caps on hole filling's work, in border edges: per loop and in all.
+  std::int64_t max_hole_edges = 10'000;
+  std::int64_t max_total_hole_edges = 100'000;
 };
 
 struct ValidatedMesh {
-  Mesh mesh;  // the input, with orientation fixed when options.fix_orientation
+  // The input, with orientation fixed when options.fix_orientation and, when
+  // options.fill_holes closed them, the patches' triangles appended (same vertices).
+  Mesh mesh;
   MeshReport report;
 };
 
-// Validates `mesh` and returns it (possibly re-oriented) with the report. Never fails: every
-// problem becomes an issue in the report, including out-of-range indices and NaN coordinates.
-// Cost O(#T log #T).
+// Validates `mesh` and returns it (possibly re-oriented, possibly with its holes filled) with
+// the report. Never fails: every problem becomes an issue in the report, including
+// out-of-range indices and NaN coordinates. Cost O(#T log #T), plus hole filling's when asked
+// for: O(n log n) for a near-planar loop of n edges, up to O(n^2) for another (at most 1,000
+// edges), all loops' searches together within a fixed budget (under 3 s on hostile input).
 ValidatedMesh ValidateMesh(Mesh mesh, const ValidateOptions& options = {});
 
 // ValidateMesh, then INVALID_ARGUMENT carrying the first error when the mesh is not usable.

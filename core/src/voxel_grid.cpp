@@ -1,0 +1,190 @@
+// The voxel grid, culling and corner screen of medial-sphere generation; see voxel_grid.h.
+#include "voxel_grid.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "absl/strings/str_format.h"
+
+namespace inscribe::internal {
+namespace {
+
+// Inward normal direction "seen" from x: the unit vector from x's nearest boundary point
+// towards x for x inside, away from x for x outside, i.e. the inward normal at the foot for
+// any x near a face. The side comes from the foot triangle's own normal, so no inside test is
+// needed: at a face the sign of (x - foot) . inward normal tells it, and at a convex edge or
+// vertex (x - foot) lies in the normal cone of the adjacent faces, so the sign agrees.
+Vector3 InwardDirectionAtFoot(const Mesh& mesh, const Vector3& x, const BoundaryPoint& foot) {
+  const Vector3 a = mesh.vertices.row(mesh.triangles(foot.triangle, 0));
+  const Vector3 b = mesh.vertices.row(mesh.triangles(foot.triangle, 1));
+  const Vector3 c = mesh.vertices.row(mesh.triangles(foot.triangle, 2));
+  const Vector3 inward = (c - a).cross(b - a);  // triangles are counter-clockwise from outside
+  const Vector3 away = x - foot.point;
+  const double length = away.norm();
+  if (!(length > 0.0)) {
+    const double n = inward.norm();
+    return n > 0.0 ? Vector3(inward / n) : Vector3::Zero();
+  }
+  return away.dot(inward) >= 0.0 ? Vector3(away / length) : Vector3(-away / length);
+}
+
+}  // namespace
+
+absl::StatusOr<Grid> MakeGrid(const BoundingBox& box, double size, std::int64_t max_voxels) {
+  Grid grid;
+  grid.size = size;
+  double total = 1.0;
+  Vector3 padding;
+  for (int axis = 0; axis < 3; ++axis) {
+    const double extent = box.max[axis] - box.min[axis];
+    const double cells = std::max(1.0, std::ceil(extent / size));
+    total *= cells;
+    if (!(total <= static_cast<double>(max_voxels))) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "voxel size %g gives a grid of more than %d voxels over the bounding box (%g x %g x "
+          "%g); use a larger voxel size or raise the voxel limit",
+          size, max_voxels, box.extent().x(), box.extent().y(), box.extent().z()));
+    }
+    grid.dims[axis] = static_cast<std::int64_t>(cells);
+    padding[axis] = 0.5 * (cells * size - extent);
+  }
+  grid.origin = box.min - padding;
+  return grid;
+}
+
+// Voxels inside the mesh or possibly crossed by its boundary, by octree-style culling over
+// blocks of voxels: a block whose centre lies outside by more than the block's circumradius is
+// dropped whole; one inside by more than that is kept whole without further queries.
+std::vector<VisitedVoxel> CullVoxels(const BoundaryOracle& oracle, const Grid& grid,
+                                     std::int64_t& queries) {
+  struct Block {
+    std::array<std::int64_t, 3> start;
+    std::int64_t size;  // power of two, in voxels
+  };
+  std::int64_t top = 1;
+  while (top < std::max({grid.dims[0], grid.dims[1], grid.dims[2]})) top *= 2;
+  std::vector<Block> blocks = {Block{{0, 0, 0}, top}};
+  std::vector<VisitedVoxel> visited;
+  auto block_end = [&](const Block& block, int axis) {
+    return std::min(block.start[axis] + block.size, grid.dims[axis]);
+  };
+  auto add_voxels = [&](const Block& block, bool boundary) {
+    for (std::int64_t k = block.start[2]; k < block_end(block, 2); ++k) {
+      for (std::int64_t j = block.start[1]; j < block_end(block, 1); ++j) {
+        for (std::int64_t i = block.start[0]; i < block_end(block, 0); ++i) {
+          visited.push_back(
+              VisitedVoxel{i + grid.dims[0] * (j + grid.dims[1] * k), {i, j, k}, boundary});
+        }
+      }
+    }
+  };
+  while (!blocks.empty()) {
+    std::vector<double> distances(blocks.size());
+    std::vector<double> radii(blocks.size());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks.size(), 64),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+                        for (std::size_t b = range.begin(); b != range.end(); ++b) {
+                          const Block& block = blocks[b];
+                          Vector3 lo = grid.corner(block.start[0], block.start[1], block.start[2]);
+                          Vector3 hi = grid.corner(block_end(block, 0), block_end(block, 1),
+                                                   block_end(block, 2));
+                          radii[b] = 0.5 * (hi - lo).norm();
+                          distances[b] = oracle.SignedDistance(0.5 * (lo + hi));
+                        }
+                      });
+    queries += static_cast<std::int64_t>(blocks.size());
+    std::vector<Block> next;
+    for (std::size_t b = 0; b < blocks.size(); ++b) {
+      const Block& block = blocks[b];
+      if (distances[b] > radii[b]) continue;  // wholly outside
+      if (block.size == 1) {
+        add_voxels(block, distances[b] >= -radii[b]);
+      } else if (distances[b] < -radii[b]) {
+        add_voxels(block, false);  // wholly inside
+      } else {
+        const std::int64_t half = block.size / 2;
+        for (int octant = 0; octant < 8; ++octant) {
+          Block child{{block.start[0] + ((octant & 1) ? half : 0),
+                       block.start[1] + ((octant & 2) ? half : 0),
+                       block.start[2] + ((octant & 4) ? half : 0)},
+                      half};
+          if (child.start[0] < grid.dims[0] && child.start[1] < grid.dims[1] &&
+              child.start[2] < grid.dims[2]) {
+            next.push_back(child);
+          }
+        }
+      }
+    }
+    blocks = std::move(next);
+  }
+  std::sort(visited.begin(), visited.end(),
+            [](const VisitedVoxel& x, const VisitedVoxel& y) { return x.linear < y.linear; });
+  return visited;
+}
+
+// Corner screening: one closest-point query per grid vertex, shared by the 8 voxels around it.
+// A medial sheet of object angle phi that cuts a voxel separates its corners into two groups
+// whose inward directions differ by about phi; a voxel whose 8 corner directions are all
+// within (theta - margin) of each other is skipped. Returns one flag per visited voxel.
+std::vector<char> ScreenByCorners(const BoundaryOracle& oracle, const Grid& grid,
+                                  const std::vector<VisitedVoxel>& voxels, double min_angle,
+                                  std::int64_t& queries) {
+  const std::int64_t vx = grid.dims[0] + 1;
+  const std::int64_t vy = grid.dims[1] + 1;
+  auto vertex_id = [&](std::int64_t i, std::int64_t j, std::int64_t k) {
+    return i + vx * (j + vy * k);
+  };
+  std::vector<std::int64_t> vertices;
+  vertices.reserve(voxels.size() * 8);
+  for (const VisitedVoxel& voxel : voxels) {
+    for (int corner = 0; corner < 8; ++corner) {
+      vertices.push_back(vertex_id(voxel.index[0] + (corner & 1),
+                                   voxel.index[1] + ((corner >> 1) & 1),
+                                   voxel.index[2] + ((corner >> 2) & 1)));
+    }
+  }
+  std::sort(vertices.begin(), vertices.end());
+  vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+  std::vector<Vector3> directions(vertices.size());
+  const Mesh& mesh = oracle.mesh();
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, vertices.size(), 256),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t v = range.begin(); v != range.end(); ++v) {
+                        const std::int64_t id = vertices[v];
+                        const Vector3 x = grid.corner(id % vx, (id / vx) % vy, id / (vx * vy));
+                        directions[v] = InwardDirectionAtFoot(mesh, x, oracle.ClosestPoint(x));
+                      }
+                    });
+  queries += static_cast<std::int64_t>(vertices.size());
+  const double max_cosine = std::cos(std::max(0.0, min_angle));
+  std::vector<char> pass(voxels.size(), 0);
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, voxels.size(), 256),
+      [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t n = range.begin(); n != range.end(); ++n) {
+          const VisitedVoxel& voxel = voxels[n];
+          std::array<Vector3, 8> corner_directions;
+          for (int corner = 0; corner < 8; ++corner) {
+            const std::int64_t id =
+                vertex_id(voxel.index[0] + (corner & 1), voxel.index[1] + ((corner >> 1) & 1),
+                          voxel.index[2] + ((corner >> 2) & 1));
+            corner_directions[corner] = directions[static_cast<std::size_t>(
+                std::lower_bound(vertices.begin(), vertices.end(), id) - vertices.begin())];
+          }
+          for (int x = 0; x < 8 && !pass[n]; ++x) {
+            for (int y = x + 1; y < 8; ++y) {
+              if (corner_directions[x].dot(corner_directions[y]) <= max_cosine) {
+                pass[n] = 1;
+                break;
+              }
+            }
+          }
+        }
+      });
+  return pass;
+}
+
+}  // namespace inscribe::internal

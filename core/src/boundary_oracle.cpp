@@ -411,6 +411,10 @@ absl::Status BoundaryOracle::Refit(const Vertices& new_vertices) {
 
 const Mesh& BoundaryOracle::mesh() const { return impl_->mesh; }
 
+const std::vector<Vector3>& BoundaryOracle::face_normals() const { return impl_->face_normals; }
+
+const std::vector<Vector3>& BoundaryOracle::vertex_normals() const { return impl_->vertex_normals; }
+
 BoundaryPoint BoundaryOracle::ClosestPoint(const Vector3& query) const {
   return impl_->Closest(query);
 }
@@ -421,6 +425,10 @@ BoundaryPoint BoundaryOracle::ClosestPoint(const Vector3& query, double upper_bo
 
 Side BoundaryOracle::Classify(const Vector3& query) const {
   return impl_->ClassifyFrom(query, impl_->Closest(query));
+}
+
+Side BoundaryOracle::Classify(const Vector3& query, const BoundaryPoint& closest) const {
+  return impl_->ClassifyFrom(query, closest);
 }
 
 double BoundaryOracle::SignedDistance(const Vector3& query) const {

@@ -6,6 +6,7 @@
 #include <CGAL/IO/OFF.h>
 #include <CGAL/IO/PLY.h>
 #include <CGAL/IO/STL.h>
+#include <CGAL/IO/polygon_soup_io.h>
 #include <CGAL/Polygon_mesh_processing/triangulate_hole.h>
 
 #include <algorithm>
@@ -21,6 +22,7 @@
 
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
+#include "atomic_file.h"
 #include "mesh_file_diagnosis.h"
 
 namespace inscribe {
@@ -238,6 +240,44 @@ absl::StatusOr<Mesh> ReadMesh(const std::string& path, ReadMeshInfo* info) {
     return absl::InvalidArgumentError(absl::StrCat(path, ": read error"));
   }
   return ParseNamed(contents.str(), ext, path, info);
+}
+
+absl::Status WriteMesh(const std::string& path, const Mesh& mesh) {
+  const std::string ext = Lowercase(std::filesystem::path(path).extension().string());
+  if (ext != ".off" && ext != ".obj" && ext != ".ply" && ext != ".stl") {
+    return absl::InvalidArgumentError(absl::StrCat(
+        path, ": cannot write mesh format '", ext.empty() ? std::string("(no extension)") : ext,
+        "' (use .off, .obj, .ply or .stl)"));
+  }
+  if (!mesh.vertices.allFinite()) {
+    return absl::InvalidArgumentError(absl::StrCat(path, ": the mesh has non-finite coordinates"));
+  }
+  if (mesh.num_triangles() > 0 &&
+      (mesh.triangles.minCoeff() < 0 || mesh.triangles.maxCoeff() >= mesh.num_vertices())) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(path, ": the mesh has triangle corners naming no vertex"));
+  }
+  std::vector<Point> points;
+  points.reserve(static_cast<std::size_t>(mesh.num_vertices()));
+  for (Eigen::Index v = 0; v < mesh.num_vertices(); ++v) {
+    points.emplace_back(mesh.vertices(v, 0), mesh.vertices(v, 1), mesh.vertices(v, 2));
+  }
+  std::vector<std::array<std::size_t, 3>> faces;
+  faces.reserve(static_cast<std::size_t>(mesh.num_triangles()));
+  for (Eigen::Index t = 0; t < mesh.num_triangles(); ++t) {
+    faces.push_back({static_cast<std::size_t>(mesh.triangles(t, 0)),
+                     static_cast<std::size_t>(mesh.triangles(t, 1)),
+                     static_cast<std::size_t>(mesh.triangles(t, 2))});
+  }
+  std::ostringstream out;
+  const auto np = CGAL::parameters::stream_precision(17).use_binary_mode(false);
+  bool ok = false;
+  if (ext == ".off") ok = CGAL::IO::write_OFF(out, points, faces, np);
+  if (ext == ".obj") ok = CGAL::IO::write_OBJ(out, points, faces, np);
+  if (ext == ".ply") ok = CGAL::IO::write_PLY(out, points, faces, np);
+  if (ext == ".stl") ok = CGAL::IO::write_STL(out, points, faces, np);
+  if (!ok) return absl::InternalError(absl::StrCat(path, ": CGAL could not format the mesh"));
+  return internal::WriteFileAtomically(path, out.str());
 }
 
 }  // namespace inscribe

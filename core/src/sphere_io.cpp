@@ -20,6 +20,7 @@
 
 #include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
+#include "atomic_file.h"
 #include "sphere_formats.h"
 
 namespace inscribe {
@@ -176,34 +177,6 @@ absl::StatusOr<SphereFileFormat> SniffFormat(absl::string_view bytes) {
       "sph or csv)");
 }
 
-absl::Status IoError(int error, const std::string& what) {
-  const std::string message = absl::StrCat(what, " (", std::strerror(error), ")");
-  switch (error) {
-    case ENOENT:
-    case ENOTDIR:
-      return absl::NotFoundError(message);
-    case EACCES:
-    case EPERM:
-    case EROFS:
-      return absl::PermissionDeniedError(message);
-    default:
-      return absl::InternalError(message);
-  }
-}
-
-// Writes all of `bytes` to `fd`, retrying short writes and EINTR.
-bool WriteAll(int fd, absl::string_view bytes) {
-  while (!bytes.empty()) {
-    const ssize_t n = ::write(fd, bytes.data(), bytes.size());
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      return false;
-    }
-    bytes.remove_prefix(static_cast<std::size_t>(n));
-  }
-  return true;
-}
-
 // Messages without a prefix; the callers add "<format> data" or the path.
 absl::StatusOr<SphereFile> ParseReadable(absl::string_view bytes, SphereFileFormat format,
                                          const SphereFileReadOptions& options) {
@@ -358,31 +331,7 @@ absl::Status WriteSphereFile(const std::string& path, const SphereFile& file,
   absl::StatusOr<std::string> bytes = FormatSphereFile(file, *format, options);
   if (!bytes.ok()) return Prefixed(bytes.status(), path);
 
-  // A unique sibling name: rename() is atomic only within one file system, so the temporary
-  // file lives in the target's directory. O_EXCL makes a clash (another writer) a retry.
-  static std::atomic<unsigned> counter{0};
-  std::string temp;
-  int fd = -1;
-  for (int attempt = 0; attempt < 100 && fd < 0; ++attempt) {
-    temp = absl::StrCat(path, ".tmp.", ::getpid(), ".", counter.fetch_add(1));
-    fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-    if (fd < 0 && errno != EEXIST) break;
-  }
-  if (fd < 0) return IoError(errno, absl::StrCat(path, ": cannot create ", temp));
-  const bool written = WriteAll(fd, *bytes) && ::fsync(fd) == 0;
-  const int write_errno = errno;
-  const bool closed = ::close(fd) == 0;
-  if (!written || !closed) {
-    const int error = written ? errno : write_errno;
-    ::unlink(temp.c_str());
-    return IoError(error, absl::StrCat(path, ": cannot write ", temp));
-  }
-  if (::rename(temp.c_str(), path.c_str()) != 0) {
-    const int error = errno;
-    ::unlink(temp.c_str());
-    return IoError(error, absl::StrCat(path, ": cannot replace the file"));
-  }
-  return absl::OkStatus();
+  return internal::WriteFileAtomically(path, *bytes);
 }
 
 }  // namespace inscribe

@@ -3,6 +3,7 @@
 #include <exception>
 #include <iostream>
 
+#include "deform_command.h"
 #include "evaluate_command.h"
 #include "exit_codes.h"
 #include "generate_command.h"
@@ -16,6 +17,7 @@ int main(int argc, char** argv) {
   inscribe::cli::AddInfoCommand(app, &exit_code);
   inscribe::cli::AddGenerateCommand(app, &exit_code);
   inscribe::cli::AddEvaluateCommand(app, &exit_code);
+  inscribe::cli::AddDeformCommand(app, &exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

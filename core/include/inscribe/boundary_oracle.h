@@ -85,6 +85,10 @@ class BoundaryOracle {
   // detected and answered by the unbounded query: still right, but slower than either.
   BoundaryPoint ClosestPoint(const Vector3& query, double upper_bound) const;
   Side Classify(const Vector3& query) const;
+  // The same answer as Classify(query), given `closest` = ClosestPoint(query) (with or without
+  // a bound), so the pseudonormal test costs no second query. The ray-parity test casts its
+  // rays as usual.
+  Side Classify(const Vector3& query, const BoundaryPoint& closest) const;
   // Distance to the boundary, negative inside, 0 on it.
   double SignedDistance(const Vector3& query) const;
 
@@ -100,6 +104,13 @@ class BoundaryOracle {
   absl::Status Refit(const Vertices& new_vertices);
 
   const Mesh& mesh() const;
+
+  // Outward normals as of the last Build or Refit, in the mesh frame. Per triangle: unit
+  // length, zero for a zero-area triangle. Per vertex: the angle-weighted sum of the unit
+  // normals of its triangles (Baerentzen & Aanaes' pseudonormal; not unit length, zero for a
+  // vertex in no triangle of positive area). Sizes #T and #V.
+  const std::vector<Vector3>& face_normals() const;
+  const std::vector<Vector3>& vertex_normals() const;
 
  private:
   struct Impl;

@@ -1,8 +1,9 @@
-// Reading mesh files (OFF, OBJ, STL, PLY) through CGAL's IO.
+// Reading and writing mesh files (OFF, OBJ, STL, PLY) through CGAL's IO.
 #pragma once
 
 #include <string>
 
+#include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "inscribe/mesh.h"
 
@@ -24,5 +25,12 @@ absl::StatusOr<Mesh> ReadMesh(const std::string& path, ReadMeshInfo* info = null
 // The same, from bytes already in memory; `format` is "off", "obj", "stl" or "ply".
 absl::StatusOr<Mesh> ParseMesh(const std::string& bytes, const std::string& format,
                                ReadMeshInfo* info = nullptr);
+
+// Writes `mesh` to `path` as text, the format chosen by the extension (.off, .obj, .ply, .stl;
+// case-insensitive), through CGAL's writers with 17 significant digits, so ReadMesh gives back
+// the same doubles. The file is replaced atomically (a temporary sibling, then rename).
+// Errors: INVALID_ARGUMENT for another extension or a mesh with out-of-range indices or
+// non-finite coordinates; NOT_FOUND, PERMISSION_DENIED or INTERNAL from the file system.
+absl::Status WriteMesh(const std::string& path, const Mesh& mesh);
 
 }  // namespace inscribe

@@ -1,0 +1,276 @@
+#include "deform_command.h"
+
+#include <chrono>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "absl/strings/str_format.h"
+#include "exit_codes.h"
+#include "inscribe/mesh_hash.h"
+#include "inscribe/mesh_io.h"
+#include "inscribe/mesh_validation.h"
+#include "inscribe/sphere_deformation.h"
+#include "inscribe/sphere_io.h"
+#include "nlohmann/json.hpp"
+
+namespace inscribe::cli {
+namespace {
+
+struct DeformCliOptions {
+  std::string reference_path;
+  std::string spheres_path;
+  std::string deformed_path;
+  double xi = 0.0;
+  bool strict = false;
+  bool interpolated_normal = false;
+  bool fill_holes = false;
+  std::string output_path;
+  std::string format;
+  bool json = false;
+};
+
+// The deformed file must be the reference file with its vertices moved: same vertex count,
+// same triangles in the same order. Returns "" when it is, else what differs.
+std::string DescribeTopologyDifference(const Mesh& reference, const Mesh& deformed) {
+  if (deformed.num_vertices() != reference.num_vertices()) {
+    return absl::StrFormat("it has %d vertices; the reference has %d", deformed.num_vertices(),
+                           reference.num_vertices());
+  }
+  if (deformed.num_triangles() != reference.num_triangles()) {
+    return absl::StrFormat("it has %d triangles; the reference has %d", deformed.num_triangles(),
+                           reference.num_triangles());
+  }
+  for (Eigen::Index t = 0; t < reference.num_triangles(); ++t) {
+    if (deformed.triangles.row(t) != reference.triangles.row(t)) {
+      return absl::StrFormat("triangle %d is (%d, %d, %d); in the reference it is (%d, %d, %d)", t,
+                             deformed.triangles(t, 0), deformed.triangles(t, 1),
+                             deformed.triangles(t, 2), reference.triangles(t, 0),
+                             reference.triangles(t, 1), reference.triangles(t, 2));
+    }
+  }
+  return "";
+}
+
+void PrintText(const DeformCliOptions& options, const DeformedSpheres& result,
+               const DeformationErrorBounds& bounds) {
+  auto line = [](const char* key, const std::string& value) {
+    std::cout << absl::StrFormat("%-26s %s\n", key, value);
+  };
+  line("reference", options.reference_path);
+  line("deformed", options.deformed_path);
+  line("spheres", absl::StrFormat("%d (%d shrunk, %d dropped)", result.set.size(), result.shrunk,
+                                  result.dropped));
+  line("xi", absl::StrFormat("%.6g", result.xi));
+  line("max protrusion", absl::StrFormat("%.6g", result.max_protrusion));
+  line(bounds.exact ? "nerr (exact)" : "nerr bounds (Lemmas 1, 2)",
+       bounds.exact ? absl::StrFormat("%.6f", bounds.nerr_lower)
+                    : absl::StrFormat("%.6f .. %.6f", bounds.nerr_lower, bounds.nerr_upper));
+  line("update", absl::StrFormat("%.4f s (%d closest-point queries)", result.seconds,
+                                 result.closest_point_queries));
+  line("bounds", absl::StrFormat("%.4f s", bounds.seconds));
+}
+
+int RunDeform(const DeformCliOptions& options) {
+  const auto load_start = std::chrono::steady_clock::now();
+  SphereFileReadOptions read;
+  if (!options.format.empty()) read.format = *ParseSphereFileFormat(options.format);
+  absl::StatusOr<SphereFile> file = ReadSphereFile(options.spheres_path, read);
+  if (!file.ok()) {
+    std::cerr << "inscribe: " << file.status().message() << "\n";
+    return kExitBadInput;
+  }
+  if (!file->set.has_contacts()) {
+    std::cerr << "inscribe: " << options.spheres_path
+              << ": no contact points; deform needs the JSON sphere file inscribe generate "
+                 "writes (contacts are where each sphere touches the reference mesh)\n";
+    return kExitBadInput;
+  }
+  absl::StatusOr<Mesh> reference = ReadMesh(options.reference_path);
+  if (!reference.ok()) {
+    std::cerr << "inscribe: " << reference.status().message() << "\n";
+    return kExitBadInput;
+  }
+  absl::StatusOr<Mesh> deformed_file = ReadMesh(options.deformed_path);
+  if (!deformed_file.ok()) {
+    std::cerr << "inscribe: " << deformed_file.status().message() << "\n";
+    return kExitBadInput;
+  }
+  if (const std::string why = DescribeTopologyDifference(*reference, *deformed_file);
+      !why.empty()) {
+    std::cerr << "inscribe: " << options.deformed_path << " is not a deformation of "
+              << options.reference_path << ": " << why
+              << " (a deformed mesh keeps the reference's vertices and triangles, in order, "
+                 "and only moves the vertices)\n";
+    return kExitBadInput;
+  }
+  ValidateOptions validate;
+  validate.fill_holes = options.fill_holes;
+  absl::StatusOr<ValidatedMesh> solid = PrepareMesh(*std::move(reference), validate);
+  if (!solid.ok()) {
+    std::cerr << "inscribe: " << options.reference_path << ": " << solid.status().message() << "\n";
+    return kExitUnusableMesh;
+  }
+  const std::string reference_sha256 = FormatSha256(MeshSha256(solid->mesh));
+  if (!file->mesh_sha256.empty() && file->mesh_sha256 != reference_sha256) {
+    std::cerr << "inscribe: " << options.spheres_path << " was made for mesh " << file->mesh_sha256
+              << ", but " << options.reference_path << " is " << reference_sha256
+              << (options.fill_holes ? ""
+                                     : " (if the spheres were made with --fill-holes, "
+                                       "pass it here too)")
+              << "\n";
+    return kExitBadInput;
+  }
+  // The reference's triangles as validated (orientation fixed, holes filled) on the moved
+  // vertices: the deformed solid is that of the reference, deformed.
+  Mesh deformed{deformed_file->vertices, solid->mesh.triangles};
+  ValidateOptions check;
+  check.fix_orientation = false;
+  const ValidatedMesh deformed_check = ValidateMesh(deformed, check);
+  const std::string deformed_sha256 = FormatSha256(MeshSha256(deformed));
+
+  DeformationOptions deform;
+  deform.xi = options.xi;
+  deform.strict = options.strict;
+  deform.direction = options.interpolated_normal ? ContactDirection::kInterpolatedNormal
+                                                 : ContactDirection::kCarriedFrame;
+  // Ray parity when either pose self-intersects: the pseudonormal sign fails near buried
+  // sheets.
+  if (solid->report.self_intersecting_pairs > 0 ||
+      deformed_check.report.self_intersecting_pairs > 0) {
+    deform.oracle.inside_test = InsideTest::kRayParity;
+  }
+  absl::StatusOr<SphereDeformer> deformer =
+      SphereDeformer::Create(std::move(solid->mesh), std::move(file->set), deform);
+  if (!deformer.ok()) {
+    std::cerr << "inscribe: " << options.spheres_path << ": " << deformer.status().message()
+              << "\n";
+    return kExitBadInput;
+  }
+  const double load_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - load_start).count();
+  absl::StatusOr<DeformedSpheres> result = deformer->Update(deformed.vertices);
+  if (!result.ok()) {
+    std::cerr << "inscribe: " << options.deformed_path << ": " << result.status().message() << "\n";
+    return kExitUnusableMesh;
+  }
+  absl::StatusOr<DeformationErrorBounds> bounds =
+      BoundDeformationError(deformer->oracle(), result->set.spheres, result->xi);
+  if (!bounds.ok()) {
+    std::cerr << "inscribe: bounding the error: " << bounds.status().message() << "\n";
+    return kExitUnusableMesh;
+  }
+
+  SphereFile out;
+  out.set = result->set;
+  out.mesh_sha256 = deformed_sha256;
+  out.params = {
+      {"reference_mesh_sha256", reference_sha256},
+      {"xi", result->xi},
+      {"strict", options.strict},
+      {"direction",
+       std::string(options.interpolated_normal ? "interpolated_normal" : "carried_frame")},
+  };
+  out.stats = {
+      {"seconds", result->seconds},         {"bounds_seconds", bounds->seconds},
+      {"volume_mesh", bounds->volume_mesh}, {"volume_union", bounds->volume_union},
+      {"nerr_lower", bounds->nerr_lower},   {"nerr_upper", bounds->nerr_upper},
+      {"nerr_is_exact", bounds->exact},     {"max_protrusion", result->max_protrusion},
+      {"shrunk", result->shrunk},           {"dropped", result->dropped},
+  };
+  // As with generate: the sphere file goes to -o, else to stdout unless --json claims it.
+  if (!options.output_path.empty()) {
+    SphereFileWriteOptions write;
+    if (!options.format.empty()) write.format = *ParseSphereFileFormat(options.format);
+    if (absl::Status status = WriteSphereFile(options.output_path, out, write); !status.ok()) {
+      std::cerr << "inscribe: " << status.message() << "\n";
+      return kExitBadInput;
+    }
+  } else if (!options.json) {
+    const SphereFileFormat format =
+        options.format.empty() ? SphereFileFormat::kJson : *ParseSphereFileFormat(options.format);
+    absl::StatusOr<std::string> bytes = FormatSphereFile(out, format);
+    if (!bytes.ok()) {
+      std::cerr << "inscribe: " << bytes.status().message() << "\n";
+      return kExitUnusableMesh;
+    }
+    std::cout << *bytes;
+    if (!bytes->empty() && bytes->back() != '\n') std::cout << "\n";
+  }
+  if (options.json) {
+    nlohmann::json summary;
+    summary["reference_mesh"] = options.reference_path;
+    summary["reference_mesh_sha256"] = reference_sha256;
+    summary["deformed_mesh"] = options.deformed_path;
+    summary["mesh_sha256"] = deformed_sha256;
+    summary["spheres"] = result->set.size();
+    summary["reference_spheres"] = deformer->reference_spheres().size();
+    summary["shrunk"] = result->shrunk;
+    summary["dropped"] = result->dropped;
+    summary["xi"] = result->xi;
+    summary["strict"] = options.strict;
+    summary["max_protrusion"] = result->max_protrusion;
+    summary["max_shrink_steps"] = result->max_shrink_steps;
+    summary["closest_point_queries"] = result->closest_point_queries;
+    summary["seconds"] = result->seconds;
+    summary["bounds_seconds"] = bounds->seconds;
+    summary["load_seconds"] = load_seconds;
+    summary["volume_mesh"] = bounds->volume_mesh;
+    summary["volume_union"] = bounds->volume_union;
+    summary["nerr_lower"] = bounds->nerr_lower;
+    summary["nerr_upper"] = bounds->nerr_upper;
+    // JSON has no infinity: null when Lemma 2's uniform-xi premise fails.
+    summary["nerr_upper_uniform_xi"] =
+        bounds->uniform_xi_holds ? nlohmann::json(bounds->nerr_upper_uniform_xi) : nullptr;
+    summary["nerr_is_exact"] = bounds->exact;
+    summary["self_intersecting_pairs"] = deformed_check.report.self_intersecting_pairs;
+    if (!options.output_path.empty()) summary["output"] = options.output_path;
+    std::cout << summary.dump() << "\n";
+  } else if (!options.output_path.empty()) {
+    PrintText(options, *result, *bounds);
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+void AddDeformCommand(CLI::App& app, int* exit_code) {
+  auto options = std::make_shared<DeformCliOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "deform",
+      "Move a generated sphere set onto a deformed version of its mesh (same triangles, moved "
+      "vertices) and bound the new set's volumetric error; prints the sphere-set JSON unless "
+      "-o or --json says otherwise");
+  cmd->add_option("REFERENCE_MESH", options->reference_path,
+                  "The mesh the spheres were generated for")
+      ->required();
+  cmd->add_option("SPHERES", options->spheres_path,
+                  "Its sphere set, with contacts (the JSON inscribe generate writes)")
+      ->required();
+  cmd->add_option("DEFORMED_MESH", options->deformed_path,
+                  "The reference mesh with its vertices moved")
+      ->required();
+  cmd->add_option("--xi", options->xi,
+                  "No sphere sticks out this much or more, mesh units (default 0.25% of the "
+                  "reference's largest bounding-box extent)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_flag("--strict", options->strict,
+                "Internal and tangent output: radius = distance from the centre to the "
+                "deformed boundary (nerr is then exact)");
+  cmd->add_flag("--interpolated-normal", options->interpolated_normal,
+                "Place centres along the interpolated vertex normal alone (the paper's formula "
+                "as printed) instead of carrying each sphere's direction in its contact frame");
+  cmd->add_flag("--fill-holes", options->fill_holes,
+                "Close the reference's holes first, as generate --fill-holes did");
+  cmd->add_option("-o,--output", options->output_path,
+                  "Write the moved spheres here (format from --format or the extension)");
+  cmd->add_option("--format", options->format, "Sphere file format (output; input by extension)")
+      ->check(CLI::IsMember({"json", "sph", "csv", "obj", "yaml", "yml"}, CLI::ignore_case));
+  cmd->add_flag("--json", options->json,
+                "Print one JSON summary on stdout (spheres, seconds, nerr_lower, nerr_upper, "
+                "max_protrusion, ...)");
+  cmd->callback([options, exit_code] { *exit_code = RunDeform(*options); });
+}
+
+}  // namespace inscribe::cli

@@ -309,7 +309,7 @@ absl::StatusOr<DeformedSpheres> SphereDeformer::Update(const Vertices& deformed_
       ++result.dropped;
       continue;
     }
-    if (m.sphere.radius < ref.spheres.spheres[i].radius) ++result.shrunk;
+    if (m.steps > 0) ++result.shrunk;
     result.max_protrusion = std::max(result.max_protrusion, m.protrusion);
     result.set.spheres.push_back(m.sphere);
     result.set.contacts.push_back(m.contact);

@@ -5,6 +5,8 @@
 #include <CGAL/Surface_mesh.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <random>
 #include <string>
 #include <thread>
@@ -329,6 +331,61 @@ TEST_P(OracleOnMesh, BoundedClosestPointEqualsUnbounded) {
     }
   }
   EXPECT_EQ(differences, 0);
+}
+
+// Classify(query, closest) reuses a closest point the caller already has: the same side as
+// Classify(query) for both inside tests, whether the closest point came with a bound or not.
+TEST_P(OracleOnMesh, ClassifyGivenClosestPointAgrees) {
+  SkipIfMissing();
+  const Mesh mesh = Load();
+  for (InsideTest inside : {InsideTest::kPseudonormal, InsideTest::kRayParity}) {
+    absl::StatusOr<BoundaryOracle> oracle = BoundaryOracle::Build(mesh, Options(inside));
+    ASSERT_TRUE(oracle.ok());
+    const Vertices points = QueryPoints(mesh, 300, 18);
+    for (Eigen::Index i = 0; i < points.rows(); ++i) {
+      const Vector3 p = points.row(i).transpose();
+      const BoundaryPoint closest = oracle->ClosestPoint(p);
+      const BoundaryPoint bounded = oracle->ClosestPoint(p, 2 * closest.distance + 1e-9);
+      EXPECT_EQ(oracle->Classify(p, closest), oracle->Classify(p)) << "query " << i;
+      EXPECT_EQ(oracle->Classify(p, bounded), oracle->Classify(p)) << "query " << i;
+    }
+  }
+}
+
+// The normals the oracle exposes, against a direct computation: unit face normals from the
+// corners' cross product, and per vertex the sum of its triangles' normals weighted by their
+// angles there; after a refit too.
+TEST_P(OracleOnMesh, NormalsMatchDirectComputation) {
+  SkipIfMissing();
+  Mesh mesh = Load();
+  absl::StatusOr<BoundaryOracle> oracle = BoundaryOracle::Build(mesh, Options());
+  ASSERT_TRUE(oracle.ok());
+  for (int pass = 0; pass < 2; ++pass) {
+    if (pass == 1) {
+      for (Eigen::Index v = 0; v < mesh.num_vertices(); ++v) {
+        mesh.vertices(v, 0) += 0.1 * std::sin(3.0 * mesh.vertices(v, 1));
+      }
+      ASSERT_TRUE(oracle->Refit(mesh.vertices).ok());
+    }
+    ASSERT_EQ(oracle->face_normals().size(), static_cast<std::size_t>(mesh.num_triangles()));
+    ASSERT_EQ(oracle->vertex_normals().size(), static_cast<std::size_t>(mesh.num_vertices()));
+    std::vector<Vector3> expected(static_cast<std::size_t>(mesh.num_vertices()), Vector3::Zero());
+    for (Eigen::Index t = 0; t < mesh.num_triangles(); ++t) {
+      Vector3 c[3];
+      for (int k = 0; k < 3; ++k) c[k] = mesh.vertices.row(mesh.triangles(t, k)).transpose();
+      const Vector3 n = (c[1] - c[0]).cross(c[2] - c[0]).normalized();
+      EXPECT_LE((oracle->face_normals()[static_cast<std::size_t>(t)] - n).norm(), 1e-12);
+      for (int k = 0; k < 3; ++k) {
+        const Vector3 e1 = (c[(k + 1) % 3] - c[k]).normalized();
+        const Vector3 e2 = (c[(k + 2) % 3] - c[k]).normalized();
+        const double angle = std::acos(std::clamp(e1.dot(e2), -1.0, 1.0));
+        expected[static_cast<std::size_t>(mesh.triangles(t, k))] += angle * n;
+      }
+    }
+    for (std::size_t v = 0; v < expected.size(); ++v) {
+      EXPECT_LE((oracle->vertex_normals()[v] - expected[v]).norm(), 1e-9) << "vertex " << v;
+    }
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Meshes, OracleOnMesh,

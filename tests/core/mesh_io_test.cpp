@@ -70,6 +70,58 @@ TEST_F(MeshFileTest, ReadsEveryFormatBack) {
   }
 }
 
+// WriteMesh then ReadMesh gives back the same doubles and triangles (OFF, OBJ, PLY; STL has
+// no shared vertices, so only the solid is compared), with random coordinates that need all
+// 17 digits.
+TEST_F(MeshFileTest, WriteMeshRoundTripsExactly) {
+  Mesh mesh = testing::Icosphere(2, Vector3(0.5, -1, 2), 1.5);
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> jitter(-1e-3, 1e-3);
+  for (Eigen::Index v = 0; v < mesh.num_vertices(); ++v) {
+    for (int k = 0; k < 3; ++k) mesh.vertices(v, k) += jitter(rng) / 3.0;
+  }
+  for (const std::string name : {"w.off", "w.obj", "w.ply", "W.OFF", "w.stl"}) {
+    SCOPED_TRACE(name);
+    const std::string path = (dir_ / name).string();
+    ASSERT_TRUE(WriteMesh(path, mesh).ok());
+    absl::StatusOr<Mesh> back = ReadMesh(path);
+    ASSERT_TRUE(back.ok()) << back.status();
+    ASSERT_EQ(back->num_triangles(), mesh.num_triangles());
+    if (name == "w.stl") {
+      EXPECT_NEAR(SignedVolume(*back), SignedVolume(mesh), 1e-12);
+      continue;
+    }
+    EXPECT_EQ(back->vertices, mesh.vertices);
+    EXPECT_EQ(back->triangles, mesh.triangles);
+  }
+  // Writing again replaces the file whole.
+  const std::string path = (dir_ / "w.off").string();
+  ASSERT_TRUE(WriteMesh(path, testing::UnitCube()).ok());
+  absl::StatusOr<Mesh> cube = ReadMesh(path);
+  ASSERT_TRUE(cube.ok());
+  EXPECT_EQ(cube->num_triangles(), 12);
+}
+
+TEST_F(MeshFileTest, WriteMeshRefusesBadInput) {
+  const Mesh cube = testing::UnitCube();
+  absl::Status s = WriteMesh((dir_ / "a.xyz").string(), cube);
+  EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(s.message()), HasSubstr("'.xyz'"));
+  Mesh nan = cube;
+  nan.vertices(2, 1) = std::nan("");
+  s = WriteMesh((dir_ / "nan.off").string(), nan);
+  EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(std::string(s.message()), HasSubstr("non-finite"));
+  Mesh bad_index = cube;
+  bad_index.triangles(3, 2) = 99;
+  s = WriteMesh((dir_ / "idx.off").string(), bad_index);
+  EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_FALSE(fs::exists(dir_ / "idx.off"));
+  s = WriteMesh((dir_ / "no" / "such" / "dir.off").string(), cube);
+  EXPECT_EQ(s.code(), absl::StatusCode::kNotFound);
+  EXPECT_THAT(std::string(s.message()), HasSubstr("dir.off"));
+}
+
 TEST_F(MeshFileTest, TriangulatesPolygons) {
   // A cube of quads, one face given as a non-convex hexagon... of the same square.
   const std::string path = Write("quads.off",

@@ -120,12 +120,12 @@ inline double FrameBoxSquaredDistance(const Scalar lo[3], const Scalar hi[3], co
   return (l - x.array()).max(x.array() - h).max(0.0).square().sum();
 }
 
-// Frame and extents of an oriented box around `n` corners: normal axis along the
+// Frame of an oriented box around `n` corners: normal axis along the
 // area-weighted normal, in-plane axes along the corners' principal directions (closed-form 2 x 2
 // eigenvectors); identity if the normal vanishes. Axes are unit to within a few ulps, and
 // projections round by a few ulps of |corner|, both far inside kCullRelative / kCullAbsolute,
 // so the box is a conservative lower bound at the culling margins.
-void FitOrientedBox(const Vector3* corners, int n, TriangleBvhLeaf* leaf) {
+void FitLeafFrame(const Vector3* corners, int n, TriangleBvhLeaf* leaf) {
   Vector3 normal = Vector3::Zero();
   Vector3 centroid = Vector3::Zero();
   for (int i = 0; i < n; i += 3) {
@@ -157,31 +157,31 @@ void FitOrientedBox(const Vector3* corners, int n, TriangleBvhLeaf* leaf) {
   }
   for (int k = 0; k < 3; ++k) {
     for (int j = 0; j < 3; ++j) leaf->axes[k][j] = axes(k, j);
-    leaf->lo[k] = std::numeric_limits<double>::infinity();
-    leaf->hi[k] = -std::numeric_limits<double>::infinity();
-  }
-  for (int i = 0; i < n; ++i) {
-    const Vector3 x = ToLeafFrame(*leaf, corners[i]);
-    for (int k = 0; k < 3; ++k) {
-      leaf->lo[k] = std::min(leaf->lo[k], x[k]);
-      leaf->hi[k] = std::max(leaf->hi[k], x[k]);
-    }
   }
 }
 
-// Boxes of the leaf's slots in its frame, rounded outward.
-void FitSlotBoxes(const TriangleBvhLeaf& leaf, const Vector3* corners, TriangleBvhSlotBox* boxes) {
-  for (int s = 0; s < leaf.count; ++s) {
-    Vector3 lo = ToLeafFrame(leaf, corners[3 * s]), hi = lo;
+// The leaf's extents in its frame and its slots' boxes (rounded outward), projecting each
+// corner once.
+void FitExtents(TriangleBvhLeaf* leaf, const Vector3* corners, TriangleBvhSlotBox* boxes) {
+  Vector3 leaf_lo = Vector3::Constant(std::numeric_limits<double>::infinity());
+  Vector3 leaf_hi = -leaf_lo;
+  for (int s = 0; s < leaf->count; ++s) {
+    Vector3 lo = ToLeafFrame(*leaf, corners[3 * s]), hi = lo;
     for (int k = 1; k < 3; ++k) {
-      const Vector3 x = ToLeafFrame(leaf, corners[3 * s + k]);
+      const Vector3 x = ToLeafFrame(*leaf, corners[3 * s + k]);
       lo = lo.cwiseMin(x);
       hi = hi.cwiseMax(x);
     }
+    leaf_lo = leaf_lo.cwiseMin(lo);
+    leaf_hi = leaf_hi.cwiseMax(hi);
     for (int k = 0; k < 3; ++k) {
       boxes[s].lo[k] = RoundDown(lo[k]);
       boxes[s].hi[k] = RoundUp(hi[k]);
     }
+  }
+  for (int k = 0; k < 3; ++k) {
+    leaf->lo[k] = leaf_lo[k];
+    leaf->hi[k] = leaf_hi[k];
   }
 }
 
@@ -375,8 +375,8 @@ void TriangleBvh::Fit(const Mesh& mesh) {
               magnitude = std::max(magnitude, c.cwiseAbs().maxCoeff());
             }
           }
-          FitOrientedBox(&corners_[3 * first], 3 * leaf.count, &leaf);
-          FitSlotBoxes(leaf, &corners_[3 * first], &slot_boxes_[first]);
+          FitLeafFrame(&corners_[3 * first], 3 * leaf.count, &leaf);
+          FitExtents(&leaf, &corners_[3 * first], &slot_boxes_[first]);
         }
         return magnitude;
       },

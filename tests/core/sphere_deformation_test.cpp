@@ -329,6 +329,58 @@ INSTANTIATE_TEST_SUITE_P(RealMeshes, BoundsBracket,
                                            SequenceCase{"fandisk.off", DeformationKind::kTwist}),
                          SequenceCaseName);
 
+// Random smooth displacement fields (sums of three sinusoids of random direction, wavelength
+// and phase, amplitude 1.5% of the diagonal): no sphere protrudes xi (fresh oracle), strict
+// spheres are tangent (brute force), and the bounds bracket Monte Carlo's error.
+TEST(SphereDeformer, RandomSmoothFields) {
+  for (const char* name : {"eight.off", "knot1.off"}) {
+    INSCRIBE_REQUIRE_MESH(name);
+    const Reference& ref = ReferenceFor(name);
+    const double diagonal = ComputeBoundingBox(ref.mesh.vertices).diagonal();
+    std::mt19937_64 rng(23);
+    std::normal_distribution<double> normal;
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    for (int field = 0; field < 3; ++field) {
+      Vertices moved = ref.mesh.vertices;
+      for (int wave = 0; wave < 3; ++wave) {
+        const Vector3 k = Vector3(normal(rng), normal(rng), normal(rng)).normalized() *
+                          (2.0 + 4.0 * unit(rng)) / diagonal;
+        const Vector3 direction = Vector3(normal(rng), normal(rng), normal(rng)).normalized();
+        const double phase = 6.283185307179586 * unit(rng);
+        for (Eigen::Index v = 0; v < moved.rows(); ++v) {
+          const double s = std::sin(k.dot(ref.mesh.vertices.row(v).transpose()) + phase);
+          moved.row(v) += (0.005 * diagonal * s * direction).transpose();
+        }
+      }
+      const Mesh deformed = WithVertices(ref.mesh, moved);
+      const BoundaryOracle fresh = BuildOracle(deformed);
+      for (bool strict : {false, true}) {
+        DeformationOptions options;
+        options.strict = strict;
+        SphereDeformer deformer = MakeDeformer(ref, options);
+        absl::StatusOr<DeformedSpheres> out = deformer.Update(moved);
+        ASSERT_TRUE(out.ok()) << out.status();
+        for (std::size_t i = 0; i < out->set.size(); ++i) {
+          const Sphere& sphere = out->set.spheres[i];
+          ASSERT_LT(sphere.radius - Depth(fresh, sphere.center), out->xi * (1 + 1e-9))
+              << name << " field " << field << " sphere " << i;
+          if (strict && i % 8 == 0) {
+            EXPECT_NEAR(sphere.radius, BruteForceDistance(deformed, sphere.center), 1e-12);
+          }
+        }
+        if (field > 0) continue;
+        absl::StatusOr<DeformationErrorBounds> bounds =
+            BoundDeformationError(deformer.oracle(), out->set.spheres, out->xi);
+        ASSERT_TRUE(bounds.ok());
+        const ErrorEstimate mc =
+            MonteCarloError(fresh, out->set.spheres, bounds->volume_mesh, 300'000);
+        EXPECT_GE(mc.nerr, bounds->nerr_lower - 4 * mc.standard_error) << name;
+        EXPECT_LE(mc.nerr, bounds->nerr_upper + 4 * mc.standard_error) << name;
+      }
+    }
+  }
+}
+
 // ---- Synthetic cases with known answers -------------------------------------------------
 
 // A box scaled by 1/2 about its centre: every contact moves to half its distance from the

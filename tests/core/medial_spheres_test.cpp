@@ -11,8 +11,8 @@
 #include <string>
 #include <tuple>
 
-#include "../../core/src/closest_point_triangle.h"
 #include "inscribe/union_of_balls.h"
+#include "support/brute_force_closest_point.h"
 #include "support/synthetic_meshes.h"
 #include "support/test_meshes.h"
 
@@ -20,21 +20,9 @@ namespace inscribe {
 namespace {
 
 using testing::Box;
+using testing::BruteForceDistance;
 using testing::Icosphere;
 using testing::LoadTestMesh;
-
-// Distance from x to the mesh boundary by scanning every triangle: the slow, obvious reference.
-double BruteForceDistance(const Mesh& mesh, const Vector3& x) {
-  double best = std::numeric_limits<double>::infinity();
-  for (std::int64_t t = 0; t < mesh.num_triangles(); ++t) {
-    Vector3 weights;
-    const Vector3 closest = internal::ClosestPointOnTriangle(
-        x, mesh.vertices.row(mesh.triangles(t, 0)), mesh.vertices.row(mesh.triangles(t, 1)),
-        mesh.vertices.row(mesh.triangles(t, 2)), &weights);
-    best = std::min(best, (closest - x).norm());
-  }
-  return best;
-}
 
 BoundaryOracle MakeOracle(const Mesh& mesh, InsideTest inside = InsideTest::kPseudonormal) {
   BoundaryOracleOptions options;

@@ -11,10 +11,10 @@
 #include <string>
 #include <tuple>
 
-#include "../../core/src/closest_point_triangle.h"
 #include "deformation_sequences.h"
 #include "inscribe/medial_spheres.h"
 #include "inscribe/union_of_balls.h"
+#include "support/brute_force_closest_point.h"
 #include "support/synthetic_meshes.h"
 #include "support/test_meshes.h"
 #include "support/union_volume_reference.h"
@@ -23,20 +23,8 @@ namespace inscribe {
 namespace {
 
 using sequences::DeformationKind;
+using testing::BruteForceDistance;
 using testing::LoadTestMesh;
-
-// Distance from x to the boundary by scanning every triangle: the slow, obvious reference.
-double BruteForceDistance(const Mesh& mesh, const Vector3& x) {
-  double best = std::numeric_limits<double>::infinity();
-  for (std::int64_t t = 0; t < mesh.num_triangles(); ++t) {
-    Vector3 weights;
-    const Vector3 closest = internal::ClosestPointOnTriangle(
-        x, mesh.vertices.row(mesh.triangles(t, 0)), mesh.vertices.row(mesh.triangles(t, 1)),
-        mesh.vertices.row(mesh.triangles(t, 2)), &weights);
-    best = std::min(best, (closest - x).norm());
-  }
-  return best;
-}
 
 BoundaryOracle BuildOracle(const Mesh& mesh) {
   absl::StatusOr<BoundaryOracle> oracle = BoundaryOracle::Build(mesh);

@@ -16,37 +16,19 @@
 #include <vector>
 
 #include "closest_point_triangle.h"
+#include "support/brute_force_closest_point.h"
 #include "support/synthetic_meshes.h"
 #include "support/test_meshes.h"
 
 namespace inscribe::internal {
 namespace {
 
+using ::inscribe::testing::BruteForceClosest;
+
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
 Vector3 Corner(const Mesh& mesh, Eigen::Index t, int k) {
   return mesh.vertices.row(mesh.triangles(t, k)).transpose();
-}
-
-// The slow obvious answer: ClosestPointOnTriangle on every triangle in index order, keeping
-// the first of equal squared distances (so the lowest index wins ties).
-BoundaryPoint BruteForceClosest(const Mesh& mesh, const Vector3& p) {
-  BoundaryPoint best;
-  double best_squared = kInfinity;
-  for (Eigen::Index t = 0; t < mesh.num_triangles(); ++t) {
-    Vector3 bary;
-    const Vector3 q = ClosestPointOnTriangle(p, Corner(mesh, t, 0), Corner(mesh, t, 1),
-                                             Corner(mesh, t, 2), &bary);
-    const double d2 = (p - q).squaredNorm();
-    if (d2 < best_squared) {
-      best_squared = d2;
-      best.point = q;
-      best.triangle = static_cast<std::int32_t>(t);
-      best.barycentric = bary;
-    }
-  }
-  best.distance = std::sqrt(best_squared);
-  return best;
 }
 
 int BruteForceCrossings(const Mesh& mesh, const Vector3& origin, const Vector3& direction) {

@@ -15,7 +15,6 @@
 #include <string>
 #include <vector>
 
-#include "closest_point_triangle.h"
 #include "support/brute_force_closest_point.h"
 #include "support/synthetic_meshes.h"
 #include "support/test_meshes.h"

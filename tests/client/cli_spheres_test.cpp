@@ -148,5 +148,52 @@ TEST(CliGenerate, UnusableMeshesAndFilesAreNamed) {
   fs::remove_all(dir);
 }
 
+TEST(CliGenerate, DilateGrowsTheSpheresAndReportsABound) {
+  INSCRIBE_REQUIRE_MESH("eight.off");
+  const fs::path dir = TempDir();
+  const std::string base = "generate " + Eight() + " --voxel-size 0.08 --subdivide-boundary ";
+  const fs::path plain_path = dir / "plain.json";
+  const fs::path dilated_path = dir / "dilated.json";
+  ASSERT_EQ(RunCli(base + "-o " + Quote(plain_path.string())).exit_code, 0);
+  const CliRun run = RunCli(base + "--dilate --json -o " + Quote(dilated_path.string()));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const nlohmann::json summary = nlohmann::json::parse(run.out);
+  EXPECT_EQ(summary.at("dilated"), true);
+  EXPECT_EQ(summary.at("nerr_kind"), "lower_bound");
+  EXPECT_GT(summary.at("v_points").get<int>(), 100);
+  EXPECT_GT(summary.at("grown").get<int>(), 100);
+  EXPECT_GT(summary.at("dilation_seconds").get<double>(), 0.0);
+
+  const nlohmann::json plain = nlohmann::json::parse(std::ifstream(plain_path));
+  const nlohmann::json dilated = nlohmann::json::parse(std::ifstream(dilated_path));
+  EXPECT_FALSE(plain.at("params").contains("dilated"));
+  EXPECT_EQ(dilated.at("params").at("dilated"), true);
+  EXPECT_FALSE(dilated.contains("contacts"));
+  EXPECT_FALSE(dilated.at("stats").at("nerr_is_exact").get<bool>());
+  EXPECT_GT(dilated.at("stats").at("coverage").get<double>(),
+            plain.at("stats").at("coverage").get<double>());
+  // Same spheres, same order, same centres; radii never smaller, grown by max_growth at most.
+  ASSERT_EQ(dilated.at("spheres").size(), plain.at("spheres").size());
+  double max_growth = 0.0;
+  int grown = 0;
+  for (std::size_t s = 0; s < plain.at("spheres").size(); ++s) {
+    const auto& a = plain.at("spheres").at(s);
+    const auto& b = dilated.at("spheres").at(s);
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(a.at(k).get<double>(), b.at(k).get<double>());
+    const double growth = b.at(3).get<double>() - a.at(3).get<double>();
+    EXPECT_GE(growth, 0.0);
+    grown += growth > 0.0;
+    max_growth = std::max(max_growth, growth);
+  }
+  EXPECT_EQ(dilated.at("stats").at("grown").get<int>(), grown);
+  EXPECT_EQ(dilated.at("stats").at("max_growth").get<double>(), max_growth);
+
+  const CliRun evaluated =
+      RunCli("evaluate --json " + Eight() + " " + Quote(dilated_path.string()));
+  ASSERT_EQ(evaluated.exit_code, 0) << evaluated.err;
+  EXPECT_EQ(nlohmann::json::parse(evaluated.out).at("nerr_kind"), "lower_bound");
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace inscribe

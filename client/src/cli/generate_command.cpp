@@ -4,10 +4,13 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
+#include <variant>
 
 #include "absl/strings/str_format.h"
 #include "exit_codes.h"
 #include "inscribe/medial_spheres.h"
+#include "inscribe/sphere_dilation.h"
 #include "inscribe/sphere_io.h"
 #include "inscribe/sphere_quality.h"
 #include "progress_bar.h"
@@ -29,12 +32,23 @@ struct GenerateCliOptions {
   std::string format;
   bool json = false;
   bool fill_holes = false;
+  bool dilate = false;
 };
 
+// What --dilate adds to the file's stats and the JSON summary (mesh units, seconds).
+NamedValues DilationStats(const DilationResult& dilation) {
+  return {{"v_points", dilation.v_points},
+          {"edge_points", dilation.edge_points},
+          {"grown", dilation.grown},
+          {"max_growth", dilation.max_growth},
+          {"dilation_seconds", dilation.seconds}};
+}
+
 // Params and stats of the sphere file (DESIGN.md section 3), in mesh units and radians.
+// With --dilate, `result.set` holds the grown spheres (no contacts) and `dilation` is set.
 SphereFile MakeSphereFile(const LoadedSolid& solid, const GenerateCliOptions& options,
                           const MedialSphereResult& result, const QualityReport& quality,
-                          double seconds, int runs) {
+                          double seconds, int runs, const std::optional<DilationResult>& dilation) {
   SphereFile file;
   file.set = result.set;
   file.mesh_sha256 = solid.sha256;
@@ -49,6 +63,7 @@ SphereFile MakeSphereFile(const LoadedSolid& solid, const GenerateCliOptions& op
       {"subdivide_boundary", options.medial.subdivide_boundary},
   };
   if (options.max_spheres) file.params.emplace_back("max_spheres", *options.max_spheres);
+  if (dilation) file.params.emplace_back("dilated", true);
   file.stats = {
       {"seconds", seconds},
       {"search_runs", static_cast<std::int64_t>(runs)},
@@ -64,6 +79,9 @@ SphereFile MakeSphereFile(const LoadedSolid& solid, const GenerateCliOptions& op
       {"visited_voxels", result.stats.visited_voxels},
       {"closest_point_queries", result.stats.closest_point_queries},
   };
+  if (dilation) {
+    for (auto& stat : DilationStats(*dilation)) file.stats.push_back(std::move(stat));
+  }
   return file;
 }
 
@@ -107,6 +125,18 @@ int RunGenerate(GenerateCliOptions options) {
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
+  // S_D+ (Section VI-A) replaces S_D from here on: it is what gets evaluated and written.
+  std::optional<DilationResult> dilation;
+  if (options.dilate) {
+    absl::StatusOr<DilationResult> dilated = DilateSpheres(solid->oracle, result.set);
+    if (!dilated.ok()) {
+      std::cerr << "inscribe: dilating the spheres: " << dilated.status().message() << "\n";
+      return kExitUnusableMesh;
+    }
+    result.set = dilated->set;
+    dilation = *std::move(dilated);
+  }
+
   QualityOptions quality_options;
   quality_options.surface_samples = options.quality_samples;
   quality_options.voxel_size = result.voxel_size;
@@ -116,7 +146,8 @@ int RunGenerate(GenerateCliOptions options) {
     std::cerr << "inscribe: evaluating the result: " << quality.status().message() << "\n";
     return kExitUnusableMesh;
   }
-  const SphereFile file = MakeSphereFile(*solid, options, result, *quality, seconds, runs);
+  const SphereFile file =
+      MakeSphereFile(*solid, options, result, *quality, seconds, runs, dilation);
 
   // The sphere file goes to -o, else to stdout unless --json claims stdout for the summary.
   if (!options.output_path.empty()) {
@@ -154,6 +185,12 @@ int RunGenerate(GenerateCliOptions options) {
     summary["visited_voxels"] = result.stats.visited_voxels;
     summary["screened_voxels"] = result.stats.screened_voxels;
     summary["closest_point_queries"] = result.stats.closest_point_queries;
+    summary["dilated"] = dilation.has_value();
+    if (dilation) {
+      for (const auto& [name, value] : DilationStats(*dilation)) {
+        std::visit([&summary, &name = name](const auto& v) { summary[name] = v; }, value);
+      }
+    }
     if (!options.output_path.empty()) summary["output"] = options.output_path;
     std::cout << summary.dump() << "\n";
   }
@@ -208,6 +245,9 @@ void AddGenerateCommand(CLI::App& app, int* exit_code) {
                   "Write the sphere set here (format from --format or the extension)");
   cmd->add_option("--format", options->format, "Sphere file format")
       ->check(CLI::IsMember({"json", "sph", "csv", "obj", "yaml", "yml"}, CLI::ignore_case));
+  cmd->add_flag("--dilate", options->dilate,
+                "Grow the spheres to cover more of the boundary (conservative dilation, S_D+); "
+                "they then protrude, contacts are not written and nerr is a lower bound");
   cmd->add_flag("--fill-holes", options->fill_holes,
                 "Close the mesh's holes first (see inscribe info --fill-holes)");
   cmd->add_flag("--json", options->json,

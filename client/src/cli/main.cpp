@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "deform_command.h"
+#include "distance_command.h"
 #include "evaluate_command.h"
 #include "exit_codes.h"
 #include "generate_command.h"
@@ -18,6 +19,7 @@ int main(int argc, char** argv) {
   inscribe::cli::AddGenerateCommand(app, &exit_code);
   inscribe::cli::AddEvaluateCommand(app, &exit_code);
   inscribe::cli::AddDeformCommand(app, &exit_code);
+  inscribe::cli::AddDistanceCommand(app, &exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -1,0 +1,55 @@
+#include "pose_file.h"
+
+#include <fstream>
+#include <vector>
+
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_split.h"
+#include "absl/strings/strip.h"
+
+namespace inscribe::cli {
+
+absl::StatusOr<std::vector<RigidPose>> ReadPoseFile(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) return absl::NotFoundError(absl::StrCat(path, ": cannot open the pose file"));
+  std::vector<RigidPose> poses;
+  std::string line;
+  for (std::int64_t number = 1; std::getline(in, line); ++number) {
+    auto fail = [&](const std::string& why) {
+      return absl::InvalidArgumentError(absl::StrCat(path, ": line ", number, ": ", why));
+    };
+    absl::string_view text = line;
+    if (const auto hash = text.find('#'); hash != absl::string_view::npos) {
+      text = text.substr(0, hash);
+    }
+    const std::vector<absl::string_view> tokens =
+        absl::StrSplit(text, absl::ByAnyChar(" \t\r,"), absl::SkipEmpty());
+    if (tokens.empty()) continue;
+    if (tokens.size() != 7) {
+      return fail(absl::StrCat("expected 7 numbers qw qx qy qz tx ty tz, found ", tokens.size()));
+    }
+    double v[7];
+    for (int k = 0; k < 7; ++k) {
+      if (!absl::SimpleAtod(tokens[static_cast<std::size_t>(k)], &v[k])) {
+        return fail(absl::StrCat("'", tokens[static_cast<std::size_t>(k)], "' is not a number"));
+      }
+    }
+    if (static_cast<std::int64_t>(poses.size()) >= kMaxPoses) {
+      return fail(absl::StrCat("more than ", kMaxPoses, " poses; split the file"));
+    }
+    RigidPose pose{Eigen::Quaterniond(v[0], v[1], v[2], v[3]), Vector3(v[4], v[5], v[6])};
+    absl::StatusOr<RigidPose> normalized = NormalizedPose(pose);
+    if (!normalized.ok()) return fail(std::string(normalized.status().message()));
+    poses.push_back(*normalized);
+  }
+  if (in.bad()) return absl::InvalidArgumentError(absl::StrCat(path, ": read error"));
+  if (poses.empty()) {
+    return absl::InvalidArgumentError(absl::StrCat(path,
+                                                   ": no poses (one per line: qw qx qy qz "
+                                                   "tx ty tz)"));
+  }
+  return poses;
+}
+
+}  // namespace inscribe::cli

@@ -1,0 +1,22 @@
+// Pose files: one rigid pose per line, `qw qx qy qz tx ty tz` (a unit quaternion, then a
+// translation in mesh units), blank lines and `#` comments ignored.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "inscribe/rigid_pose.h"
+
+namespace inscribe::cli {
+
+// More poses than this in one file are refused (the results of one call stay in memory).
+inline constexpr std::int64_t kMaxPoses = 2'000'000;
+
+// Reads the file line by line. Quaternions are normalised when within 1e-3 of unit length
+// (rounded values such as 0.7071), refused otherwise. INVALID_ARGUMENT / NOT_FOUND naming the
+// path and line: `poses.txt: line 4: expected 7 numbers qw qx qy qz tx ty tz, found 6`.
+absl::StatusOr<std::vector<RigidPose>> ReadPoseFile(const std::string& path);
+
+}  // namespace inscribe::cli

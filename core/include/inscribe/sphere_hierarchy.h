@@ -1,0 +1,84 @@
+// Bounding-volume hierarchies over sphere sets (paper Section VI-C), for fast separation
+// distance between unions of spheres (separation_distance.h).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
+#include "inscribe/rss.h"
+#include "inscribe/sphere.h"
+
+namespace inscribe {
+
+enum class HierarchyVolume {
+  // Rectangle swept spheres fitted to the spheres below each node (FitRss): tight around the
+  // flat sheets of medial spheres, the paper's faster choice.
+  kRss,
+  // The smallest sphere enclosing the spheres below each node (CGAL Min_sphere_of_spheres_d),
+  // padded outward by a few ulps.
+  kSphere,
+};
+
+// "rss" or "sphere".
+const char* HierarchyVolumeName(HierarchyVolume volume);
+
+// A reference to a node or to a leaf: >= 0 an internal node, < 0 the leaf holding sphere
+// (-1 - ref). Leaves hold one sphere each, which bounds itself exactly.
+using HierarchyRef = std::int32_t;
+inline bool IsLeaf(HierarchyRef ref) { return ref < 0; }
+inline std::int32_t LeafSphere(HierarchyRef ref) { return -1 - ref; }
+
+// A binary hierarchy built top down: each internal node splits its spheres by the plane
+// through their centres' mean, normal to their principal axis (the least-squares line fit of
+// the centres), falling back to the median when one side would be empty. Flat arrays linked
+// by index: n spheres give n - 1 internal nodes (none for one sphere), each holding its two
+// children and one bounding volume of the chosen kind. Immutable once built; cheap to move,
+// copyable; safe to query from many threads at once.
+class SphereHierarchy {
+ public:
+  // Errors: INVALID_ARGUMENT for an empty set, a non-finite centre or radius, a radius <= 0,
+  // or more than 2^30 spheres. Cost O(n log n) on balanced splits.
+  static absl::StatusOr<SphereHierarchy> Build(std::vector<Sphere> spheres, HierarchyVolume volume);
+
+  HierarchyVolume volume() const { return volume_; }
+  const std::vector<Sphere>& spheres() const { return spheres_; }
+  std::size_t num_nodes() const { return left_.size(); }
+  HierarchyRef root() const { return root_; }
+  HierarchyRef left(std::int32_t node) const { return left_[static_cast<std::size_t>(node)]; }
+  HierarchyRef right(std::int32_t node) const { return right_[static_cast<std::size_t>(node)]; }
+  // The node's bounding volume; only the one of volume()'s kind is stored.
+  const Rss& rss(std::int32_t node) const { return rss_[static_cast<std::size_t>(node)]; }
+  const Sphere& bounding_sphere(std::int32_t node) const {
+    return bounding_spheres_[static_cast<std::size_t>(node)];
+  }
+  // Longest path from the root to a leaf, in edges.
+  int depth() const { return depth_; }
+
+  // A self-contained byte string ("inscribe.hierarchy" v1, little-endian), so that a server
+  // can cache it and ship it. Deserialize refuses anything Serialize would not write:
+  // INVALID_ARGUMENT naming the problem for bad magic, version or kind, truncation or trailing
+  // bytes, non-finite or negative numbers, child references out of range or not forming one
+  // tree over every sphere exactly once, and any sphere not inside every bounding volume above
+  // it (checked, so that a tampered file cannot make queries wrong). Cost O(n depth).
+  std::string Serialize() const;
+  static absl::StatusOr<SphereHierarchy> Deserialize(absl::string_view bytes);
+
+ private:
+  SphereHierarchy() = default;
+  // Deserialize's tree and containment checks; sets *depth.
+  absl::Status CheckStructure(int* depth) const;
+
+  HierarchyVolume volume_ = HierarchyVolume::kRss;
+  std::vector<Sphere> spheres_;
+  HierarchyRef root_ = -1;
+  std::vector<HierarchyRef> left_, right_;
+  std::vector<Rss> rss_;
+  std::vector<Sphere> bounding_spheres_;
+  int depth_ = 0;
+};
+
+}  // namespace inscribe

@@ -1,0 +1,207 @@
+#include "inscribe/separation_distance.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "support/sphere_sets.h"
+#include "support/test_meshes.h"
+
+namespace inscribe {
+namespace {
+
+using testing::RandomPose;
+using testing::RandomSpheres;
+using testing::RealSphereSet;
+
+SphereHierarchy Build(const std::vector<Sphere>& spheres, HierarchyVolume volume) {
+  absl::StatusOr<SphereHierarchy> h = SphereHierarchy::Build(spheres, volume);
+  EXPECT_TRUE(h.ok()) << h.status();
+  return *std::move(h);
+}
+
+// The witnesses are on their spheres, in the world frame, facing each other: |pa - pb| equals
+// |distance| and pa - c_a is along c_b - c_a.
+void ExpectWitnesses(const DistanceResult& r, const std::vector<Sphere>& a, const RigidPose& pose_a,
+                     const std::vector<Sphere>& b, const RigidPose& pose_b) {
+  ASSERT_GE(r.sphere_a, 0);
+  ASSERT_GE(r.sphere_b, 0);
+  const Sphere& sa = a[static_cast<std::size_t>(r.sphere_a)];
+  const Sphere& sb = b[static_cast<std::size_t>(r.sphere_b)];
+  const Vector3 ca = pose_a * sa.center, cb = pose_b * sb.center;
+  EXPECT_NEAR((r.point_a - ca).norm(), sa.radius, 1e-9);
+  EXPECT_NEAR((r.point_b - cb).norm(), sb.radius, 1e-9);
+  EXPECT_NEAR((r.point_a - r.point_b).norm(), std::abs(r.distance), 1e-9);
+  EXPECT_NEAR((cb - ca).norm() - sa.radius - sb.radius, r.distance, 1e-9);
+}
+
+using Case = std::tuple<std::string, HierarchyVolume>;
+
+class AgainstBruteForce : public ::testing::TestWithParam<Case> {
+ protected:
+  // Random sets (by seed) or a real mesh's medial spheres (by name), a copy for b.
+  std::vector<Sphere> Set(int which) const {
+    const std::string& name = std::get<0>(GetParam());
+    if (name == "random") return RandomSpheres(which == 0 ? 400 : 250, which == 0 ? 5 : 6);
+    return RealSphereSet(name);
+  }
+  void SkipIfMissing() {
+    const std::string& name = std::get<0>(GetParam());
+    if (name != "random" && testing::TestMeshPath(name).empty()) {
+      GTEST_SKIP() << name << " is missing; run scripts/fetch-meshes";
+    }
+  }
+};
+
+// With zero tolerance the hierarchy's answer is the minimum over all sphere pairs, on 2,000
+// random poses spread so that about a third of them overlap, both sets posed.
+TEST_P(AgainstBruteForce, ExactDistanceOnRandomPoses) {
+  SkipIfMissing();
+  const std::vector<Sphere> a = Set(0), b = Set(1);
+  ASSERT_FALSE(a.empty());
+  const SphereHierarchy ha = Build(a, std::get<1>(GetParam()));
+  const SphereHierarchy hb = Build(b, std::get<1>(GetParam()));
+  double diameter = 0.0;
+  for (const Sphere& s : a) diameter = std::max(diameter, (s.center - a[0].center).norm());
+  std::mt19937_64 rng(17);
+  int overlapping = 0;
+  for (int trial = 0; trial < 2000; ++trial) {
+    const RigidPose pose_a = trial % 2 ? RandomPose(rng, diameter) : RigidPose{};
+    const RigidPose pose_b = RandomPose(rng, 1.5 * diameter);
+    absl::StatusOr<DistanceResult> fast = SeparationDistance(ha, pose_a, hb, pose_b);
+    absl::StatusOr<DistanceResult> slow = BruteForceSeparationDistance(a, pose_a, b, pose_b);
+    ASSERT_TRUE(fast.ok() && slow.ok());
+    ASSERT_NEAR(fast->distance, slow->distance, 1e-9) << "trial " << trial;
+    overlapping += slow->distance < 0.0;
+    if (trial % 50 == 0) ExpectWitnesses(*fast, a, pose_a, b, pose_b);
+    EXPECT_LT(fast->sphere_tests, static_cast<std::int64_t>(a.size() * b.size()));
+  }
+  EXPECT_GT(overlapping, 100);
+  EXPECT_LT(overlapping, 1900);
+}
+
+// With tolerances the answer is a real pair's value, within max(abs, rel |D|) above the truth.
+TEST_P(AgainstBruteForce, TolerancesBoundTheError) {
+  SkipIfMissing();
+  const std::vector<Sphere> a = Set(0), b = Set(1);
+  const SphereHierarchy ha = Build(a, std::get<1>(GetParam()));
+  const SphereHierarchy hb = Build(b, std::get<1>(GetParam()));
+  std::mt19937_64 rng(19);
+  std::int64_t exact_work = 0, loose_work = 0;
+  for (int trial = 0; trial < 500; ++trial) {
+    const RigidPose pose = RandomPose(rng, 3.0);
+    DistanceRequest request;
+    request.abs_err = trial % 2 ? 0.05 : 0.0;
+    request.rel_err = trial % 3 ? 0.1 : 0.0;
+    absl::StatusOr<DistanceResult> loose = SeparationDistance(ha, {}, hb, pose, request);
+    absl::StatusOr<DistanceResult> exact = SeparationDistance(ha, {}, hb, pose);
+    ASSERT_TRUE(loose.ok() && exact.ok());
+    const double allowed = std::max(request.abs_err, request.rel_err * std::abs(loose->distance));
+    EXPECT_GE(loose->distance, exact->distance - 1e-12);
+    EXPECT_LE(loose->distance - exact->distance, allowed + 1e-12) << "trial " << trial;
+    ExpectWitnesses(*loose, a, {}, b, pose);
+    exact_work += exact->volume_tests;
+    loose_work += loose->volume_tests;
+  }
+  EXPECT_LT(loose_work, exact_work);
+}
+
+// closer_than answers yes exactly when the full query's distance is below the threshold,
+// for thresholds around the true distance and negative ones (overlap depth).
+TEST_P(AgainstBruteForce, CloserThanAgreesWithFullQuery) {
+  SkipIfMissing();
+  const std::vector<Sphere> a = Set(0), b = Set(1);
+  const SphereHierarchy ha = Build(a, std::get<1>(GetParam()));
+  const SphereHierarchy hb = Build(b, std::get<1>(GetParam()));
+  std::mt19937_64 rng(23);
+  std::uniform_real_distribution<double> offset(-0.2, 0.2);
+  for (int trial = 0; trial < 1000; ++trial) {
+    const RigidPose pose = RandomPose(rng, 3.0);
+    absl::StatusOr<DistanceResult> full = SeparationDistance(ha, {}, hb, pose);
+    ASSERT_TRUE(full.ok());
+    DistanceRequest request;
+    request.closer_than = full->distance + (trial % 5 == 0 ? 0.0 : offset(rng));
+    absl::StatusOr<DistanceResult> test = SeparationDistance(ha, {}, hb, pose, request);
+    absl::StatusOr<DistanceResult> slow = BruteForceSeparationDistance(a, {}, b, pose, request);
+    ASSERT_TRUE(test.ok() && slow.ok());
+    const bool expected = full->distance < request.closer_than;
+    ASSERT_EQ(test->closer, expected) << "trial " << trial;
+    ASSERT_EQ(slow->closer, expected) << "trial " << trial;
+    if (expected) {
+      EXPECT_LT(test->distance, request.closer_than);
+      ExpectWitnesses(*test, a, {}, b, pose);
+    } else {
+      EXPECT_EQ(test->distance, request.closer_than);
+      EXPECT_EQ(test->sphere_a, -1);
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Sets, AgainstBruteForce,
+    ::testing::Combine(::testing::Values("random", "eight.off", "knot1.off", "fandisk.off"),
+                       ::testing::Values(HierarchyVolume::kRss, HierarchyVolume::kSphere)),
+    [](const ::testing::TestParamInfo<Case>& param) {
+      std::string name = std::get<0>(param.param);
+      name = name.substr(0, name.find('.'));
+      return name + "_" + HierarchyVolumeName(std::get<1>(param.param));
+    });
+
+TEST(SeparationDistance, MixedVolumesAndBatchAgree) {
+  const std::vector<Sphere> a = RandomSpheres(200, 31), b = RandomSpheres(150, 32);
+  const SphereHierarchy rss = Build(a, HierarchyVolume::kRss);
+  const SphereHierarchy spheres = Build(b, HierarchyVolume::kSphere);
+  std::mt19937_64 rng(5);
+  std::vector<RigidPose> poses;
+  for (int i = 0; i < 300; ++i) poses.push_back(RandomPose(rng, 2.0));
+  absl::StatusOr<std::vector<DistanceResult>> batch = SeparationDistances(rss, spheres, poses);
+  ASSERT_TRUE(batch.ok());
+  ASSERT_EQ(batch->size(), poses.size());
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    absl::StatusOr<DistanceResult> slow = BruteForceSeparationDistance(a, {}, b, poses[i]);
+    ASSERT_TRUE(slow.ok());
+    EXPECT_NEAR((*batch)[i].distance, slow->distance, 1e-9) << i;
+  }
+}
+
+TEST(SeparationDistance, SingleSpheres) {
+  const SphereHierarchy a = Build({{Vector3(0, 0, 0), 1.0}}, HierarchyVolume::kRss);
+  const SphereHierarchy b = Build({{Vector3(0, 0, 0), 0.5}}, HierarchyVolume::kSphere);
+  const RigidPose pose{Eigen::Quaterniond::Identity(), Vector3(3, 0, 0)};
+  absl::StatusOr<DistanceResult> r = SeparationDistance(a, {}, b, pose);
+  ASSERT_TRUE(r.ok());
+  EXPECT_DOUBLE_EQ(r->distance, 1.5);
+  EXPECT_TRUE(r->point_a.isApprox(Vector3(1, 0, 0)));
+  EXPECT_TRUE(r->point_b.isApprox(Vector3(2.5, 0, 0)));
+  // Concentric: the deepest overlap is -(1 + 0.5).
+  r = SeparationDistance(a, {}, b, {});
+  ASSERT_TRUE(r.ok());
+  EXPECT_DOUBLE_EQ(r->distance, -1.5);
+}
+
+TEST(SeparationDistance, RefusesBadPosesAndTolerances) {
+  const SphereHierarchy a = Build(RandomSpheres(20, 1), HierarchyVolume::kRss);
+  RigidPose nan_pose;
+  nan_pose.translation.x() = std::nan("");
+  EXPECT_FALSE(SeparationDistance(a, {}, a, nan_pose).ok());
+  RigidPose long_quaternion{Eigen::Quaterniond(2, 0, 0, 0), Vector3::Zero()};
+  absl::StatusOr<DistanceResult> r = SeparationDistance(a, {}, a, long_quaternion);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.status().message().find("norm"), std::string::npos) << r.status();
+  DistanceRequest negative;
+  negative.abs_err = -1;
+  EXPECT_FALSE(SeparationDistance(a, {}, a, {}, negative).ok());
+  DistanceRequest nan_threshold;
+  nan_threshold.closer_than = std::nan("");
+  EXPECT_FALSE(SeparationDistance(a, {}, a, {}, nan_threshold).ok());
+  absl::StatusOr<std::vector<DistanceResult>> batch =
+      SeparationDistances(a, a, {RigidPose{}, nan_pose});
+  ASSERT_FALSE(batch.ok());
+  EXPECT_NE(batch.status().message().find("pose 1"), std::string::npos) << batch.status();
+}
+
+}  // namespace
+}  // namespace inscribe

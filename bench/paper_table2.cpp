@@ -78,6 +78,7 @@ struct Options {
   std::uint64_t seed = 1;
   int check_every = 25;
   std::string data_dir;
+  double growth = 1.0;  // DilationOptions::growth
 };
 
 // Where copy b's centre may be: a centre distance drawn uniformly from [lo, hi] bounding-box
@@ -265,7 +266,9 @@ absl::StatusOr<Model> PrepareModel(const std::string& name, const Options& optio
       SphereHierarchy::Build(generated->best.set.spheres, HierarchyVolume::kSphere);
   if (!undilated.ok()) return undilated.status();
 
-  absl::StatusOr<DilationResult> dilated = DilateSpheres(*oracle, generated->best.set);
+  DilationOptions dilation;
+  dilation.growth = options.growth;
+  absl::StatusOr<DilationResult> dilated = DilateSpheres(*oracle, generated->best.set, dilation);
   if (!dilated.ok()) return dilated.status();
   row.dilation_seconds = dilated->seconds;
   row.grown = dilated->grown;
@@ -563,6 +566,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--poses", options.poses, "Random pose pairs per set (near, far)")
       ->check(CLI::Range(1, 1'000'000))
+      ->capture_default_str();
+  app.add_option("--growth", options.growth,
+                 "DilationOptions::growth: fraction of the paper's growth (1 = the paper's rule)")
+      ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
   app.add_option("--seed", options.seed, "Seed of the pose sets ('far' uses seed + 1)")
       ->capture_default_str();

@@ -35,26 +35,27 @@ class Side {
  public:
   explicit Side(const SphereHierarchy& h) : h_(h) {}
   bool rss() const { return h_.volume() == HierarchyVolume::kRss; }
+  // The leaf's sphere, or the sphere around the node's volume.
   const Sphere& sphere(HierarchyRef ref) const {
     return IsLeaf(ref) ? h_.spheres()[static_cast<std::size_t>(LeafSphere(ref))]
-                       : h_.bounding_sphere(ref);
+                       : h_.outer_sphere(ref);
   }
-  Rss AsRss(HierarchyRef ref) const {
-    if (IsLeaf(ref)) return PointRss(h_.spheres()[static_cast<std::size_t>(LeafSphere(ref))]);
-    return rss() ? h_.rss(ref) : PointRss(h_.bounding_sphere(ref));
+  // The volume as an RSS: the node's own, or a point RSS built in *scratch.
+  const Rss& AsRss(HierarchyRef ref, Rss* scratch) const {
+    if (!IsLeaf(ref) && rss()) return h_.rss(ref);
+    *scratch = PointRss(sphere(ref));
+    return *scratch;
   }
   // How big the volume is: the side to descend is the bigger one.
-  double Size(HierarchyRef ref) const {
-    if (IsLeaf(ref)) return h_.spheres()[static_cast<std::size_t>(LeafSphere(ref))].radius;
-    if (!rss()) return h_.bounding_sphere(ref).radius;
-    const Rss& r = h_.rss(ref);
-    return r.radius + 0.5 * std::hypot(r.length[0], r.length[1]);
-  }
+  double Size(HierarchyRef ref) const { return sphere(ref).radius; }
   const SphereHierarchy& hierarchy() const { return h_; }
 
  private:
   const SphereHierarchy& h_;
 };
+
+// Node pairs with at most this many sphere pairs below them are compared pair by pair.
+constexpr std::int32_t kAllPairs = 16;
 
 class Search {
  public:
@@ -75,11 +76,12 @@ class Search {
     std::vector<Pair> stack;
     stack.reserve(128);
     const HierarchyRef ra = a_.hierarchy().root(), rb = b_.hierarchy().root();
-    stack.push_back({ra, rb, Bound(ra, rb, &out)});
+    stack.push_back({ra, rb, Bound(ra, rb, Threshold(), &out)});
     while (!stack.empty()) {
       const Pair p = stack.back();
       stack.pop_back();
-      if (p.bound >= Threshold()) continue;
+      const double threshold = Threshold();
+      if (p.bound >= threshold) continue;
       if (IsLeaf(p.a) && IsLeaf(p.b)) {
         // The bound of two leaves is their exact value.
         best_ = p.bound;
@@ -88,21 +90,29 @@ class Search {
         if (yes_no_ && best_ < request_.closer_than) break;
         continue;
       }
+      // Few sphere pairs left below: compare them all rather than test more volumes.
+      const std::int32_t na = a_.hierarchy().count(p.a), nb = b_.hierarchy().count(p.b);
+      if (na * nb <= kAllPairs) {
+        CompareAll(p.a, p.b, &out);
+        if (yes_no_ && best_ < request_.closer_than) break;
+        continue;
+      }
       const bool split_a = !IsLeaf(p.a) && (IsLeaf(p.b) || a_.Size(p.a) >= b_.Size(p.b));
       Pair first, second;
       if (split_a) {
         const HierarchyRef l = a_.hierarchy().left(p.a), r = a_.hierarchy().right(p.a);
-        first = {l, p.b, Bound(l, p.b, &out)};
-        second = {r, p.b, Bound(r, p.b, &out)};
+        first = {l, p.b, Bound(l, p.b, threshold, &out)};
+        second = {r, p.b, Bound(r, p.b, threshold, &out)};
       } else {
         const HierarchyRef l = b_.hierarchy().left(p.b), r = b_.hierarchy().right(p.b);
-        first = {p.a, l, Bound(p.a, l, &out)};
-        second = {p.a, r, Bound(p.a, r, &out)};
+        first = {p.a, l, Bound(p.a, l, threshold, &out)};
+        second = {p.a, r, Bound(p.a, r, threshold, &out)};
       }
-      // The nearer pair is searched first (pushed last).
+      // The nearer pair is searched first (pushed last). The threshold has not moved since
+      // the pop: only leaf pairs move it.
       if (first.bound < second.bound) std::swap(first, second);
-      if (first.bound < Threshold()) stack.push_back(first);
-      if (second.bound < Threshold()) stack.push_back(second);
+      if (first.bound < threshold) stack.push_back(first);
+      if (second.bound < threshold) stack.push_back(second);
     }
     if (best_a_ >= 0) {
       out.distance = best_;
@@ -114,6 +124,33 @@ class Search {
   }
 
  private:
+  // Every sphere of a against every sphere of b, keeping pairs below the threshold.
+  void CompareAll(HierarchyRef a, HierarchyRef b, DistanceResult* out) {
+    const SphereHierarchy& ha = a_.hierarchy();
+    const SphereHierarchy& hb = b_.hierarchy();
+    const std::int32_t* ia = &ha.leaf_order()[static_cast<std::size_t>(ha.first(a))];
+    const std::int32_t* ib = &hb.leaf_order()[static_cast<std::size_t>(hb.first(b))];
+    const std::int32_t na = ha.count(a), nb = hb.count(b);
+    Vector3 moved[kAllPairs];
+    for (std::int32_t j = 0; j < nb; ++j) {
+      moved[j] =
+          rel_.rotation * hb.spheres()[static_cast<std::size_t>(ib[j])].center + rel_.translation;
+    }
+    out->sphere_tests += na * nb;
+    for (std::int32_t i = 0; i < na; ++i) {
+      const Sphere& sa = ha.spheres()[static_cast<std::size_t>(ia[i])];
+      for (std::int32_t j = 0; j < nb; ++j) {
+        const double d = (sa.center - moved[j]).norm() - sa.radius -
+                         hb.spheres()[static_cast<std::size_t>(ib[j])].radius;
+        if (d < Threshold()) {
+          best_ = d;
+          best_a_ = ia[i];
+          best_b_ = ib[j];
+        }
+      }
+    }
+  }
+
   // Node pairs bounded at or above this cannot improve the answer beyond the tolerance, or
   // cannot answer a closer_than query yes.
   double Threshold() const {
@@ -123,23 +160,24 @@ class Search {
   }
 
   // A lower bound on |c_a - c_b| - r_a - r_b over the spheres below a and b; exact for two
-  // leaves.
-  double Bound(HierarchyRef a, HierarchyRef b, DistanceResult* out) const {
+  // leaves. The spheres around the two volumes give a cheap bound first; the RSS test (several
+  // times dearer) runs only when that bound would not already prune the pair.
+  double Bound(HierarchyRef a, HierarchyRef b, double threshold, DistanceResult* out) const {
+    const Sphere& sa = a_.sphere(a);
+    const Sphere& sb = b_.sphere(b);
+    const double cheap =
+        (sa.center - (rel_.rotation * sb.center + rel_.translation)).norm() - sa.radius - sb.radius;
     if (IsLeaf(a) && IsLeaf(b)) {
       ++out->sphere_tests;
-      const Sphere& sa = a_.sphere(a);
-      const Sphere& sb = b_.sphere(b);
-      return (sa.center - (rel_.rotation * sb.center + rel_.translation)).norm() - sa.radius -
-             sb.radius;
+      return cheap;
     }
     ++out->volume_tests;
-    if (!a_.rss() && !b_.rss()) {
-      const Sphere& sa = a_.sphere(a);
-      const Sphere& sb = b_.sphere(b);
-      return (sa.center - (rel_.rotation * sb.center + rel_.translation)).norm() - sa.radius -
-             sb.radius;
-    }
-    return RssDistance(a_.AsRss(a), rel_.rotation, rel_.translation, b_.AsRss(b));
+    if ((!a_.rss() || IsLeaf(a)) && (!b_.rss() || IsLeaf(b))) return cheap;
+    if (cheap >= threshold) return cheap;
+    ++out->rss_tests;
+    Rss scratch_a, scratch_b;
+    return std::max(cheap, RssDistance(a_.AsRss(a, &scratch_a), rel_.rotation, rel_.translation,
+                                       b_.AsRss(b, &scratch_b)));
   }
 
   Side a_, b_;

@@ -344,6 +344,10 @@ absl::StatusOr<EnvelopePoints> ComputeEnvelopePoints(const std::vector<Sphere>& 
 
 absl::StatusOr<DilationResult> DilateSpheres(const BoundaryOracle& oracle, const SphereSet& spheres,
                                              const DilationOptions& options) {
+  if (!(options.growth >= 0.0 && options.growth <= 1.0)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("dilation growth must lie in [0, 1], got ", options.growth));
+  }
   const Clock::time_point start = Clock::now();
   const std::vector<Sphere>& balls = spheres.spheres;
   absl::StatusOr<EnvelopePoints> envelope = ComputeEnvelopePoints(balls, options);
@@ -404,6 +408,9 @@ absl::StatusOr<DilationResult> DilateSpheres(const BoundaryOracle& oracle, const
     }
   }
   for (std::size_t s = 0; s < balls.size(); ++s) {
+    if (options.growth != 1.0 && grown[s].radius > balls[s].radius) {
+      grown[s].radius = balls[s].radius + options.growth * (grown[s].radius - balls[s].radius);
+    }
     const double growth = grown[s].radius - balls[s].radius;
     if (growth > 0.0) {
       ++result.grown;

@@ -221,7 +221,53 @@ absl::StatusOr<SphereHierarchy> SphereHierarchy::Build(std::vector<Sphere> spher
     }
     *task.slot = ref;
   }
+  h.ComputeDerived();
   return h;
+}
+
+void SphereHierarchy::ComputeDerived() {
+  // Leaf order and ranges: children are visited left first, so each node's leaves are
+  // contiguous; a node's count is known once its subtree is done (post-order pass).
+  const std::size_t nodes = left_.size();
+  leaf_order_.clear();
+  leaf_order_.reserve(spheres_.size());
+  leaf_position_.assign(spheres_.size(), 0);
+  first_.assign(nodes, 0);
+  count_.assign(nodes, 0);
+  std::vector<std::pair<HierarchyRef, bool>> stack = {{root_, false}};
+  while (!stack.empty()) {
+    auto [ref, done] = stack.back();
+    stack.pop_back();
+    if (IsLeaf(ref)) {
+      leaf_position_[static_cast<std::size_t>(LeafSphere(ref))] =
+          static_cast<std::int32_t>(leaf_order_.size());
+      leaf_order_.push_back(LeafSphere(ref));
+      continue;
+    }
+    const auto node = static_cast<std::size_t>(ref);
+    if (done) {
+      count_[node] = static_cast<std::int32_t>(leaf_order_.size()) - first_[node];
+      continue;
+    }
+    first_[node] = static_cast<std::int32_t>(leaf_order_.size());
+    stack.push_back({ref, true});
+    stack.push_back({right_[node], false});
+    stack.push_back({left_[node], false});
+  }
+  if (volume_ == HierarchyVolume::kSphere) {
+    outer_spheres_ = bounding_spheres_;
+    return;
+  }
+  outer_spheres_.resize(rss_.size());
+  for (std::size_t i = 0; i < rss_.size(); ++i) {
+    const Rss& r = rss_[i];
+    const double half0 = 0.5 * r.length[0], half1 = 0.5 * r.length[1];
+    Sphere& s = outer_spheres_[i];
+    s.center = r.origin + half0 * r.axes.col(0) + half1 * r.axes.col(1);
+    // Padded: the corners' distance from the centre, computed, may round below the true one.
+    s.radius = (r.radius + std::sqrt(half0 * half0 + half1 * half1)) *
+               (1.0 + 8.0 * std::numeric_limits<double>::epsilon());
+  }
 }
 
 std::string SphereHierarchy::Serialize() const {
@@ -323,6 +369,7 @@ absl::StatusOr<SphereHierarchy> SphereHierarchy::Deserialize(absl::string_view b
     }
   }
   if (absl::Status s = h.CheckStructure(&h.depth_); !s.ok()) return s;
+  h.ComputeDerived();
   return h;
 }
 

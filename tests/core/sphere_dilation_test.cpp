@@ -524,6 +524,30 @@ TEST(DilateSpheres, GrowthMatchesBruteForceOnMedialSpheresOfRealMeshes) {
   }
 }
 
+// A partial growth moves each radius that fraction of the way to the paper's; 0 changes
+// nothing; values outside [0, 1] are refused.
+TEST(DilateSpheres, PartialGrowthScalesEveryIncrease) {
+  INSCRIBE_REQUIRE_MESH("eight.off");
+  const MedialSet& medial = Medial("eight.off");
+  const BoundaryOracle oracle = BuildOracle(medial.mesh);
+  const absl::StatusOr<DilationResult> full = DilateSpheres(oracle, medial.set);
+  DilationOptions half_options, none_options, bad_options;
+  half_options.growth = 0.5;
+  none_options.growth = 0.0;
+  bad_options.growth = 1.5;
+  const absl::StatusOr<DilationResult> half = DilateSpheres(oracle, medial.set, half_options);
+  const absl::StatusOr<DilationResult> none = DilateSpheres(oracle, medial.set, none_options);
+  ASSERT_TRUE(full.ok() && half.ok() && none.ok());
+  for (std::size_t i = 0; i < medial.set.size(); ++i) {
+    const double r = medial.set.spheres[i].radius;
+    EXPECT_NEAR(half->set.spheres[i].radius, r + 0.5 * (full->set.spheres[i].radius - r),
+                1e-15 * (1 + r));
+    EXPECT_EQ(none->set.spheres[i].radius, r);
+  }
+  EXPECT_NEAR(half->max_growth, 0.5 * full->max_growth, 1e-15);
+  EXPECT_FALSE(DilateSpheres(oracle, medial.set, bad_options).ok());
+}
+
 // Section VI-A's claim: better boundary coverage. Figures are printed for the report.
 TEST(DilateSpheres, CoverageRisesAndHausdorffFallsOnRealMeshes) {
   for (const std::string name : {"eight.off", "knot1.off", "fandisk.off", "elephant.off"}) {

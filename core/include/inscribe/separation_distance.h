@@ -38,8 +38,9 @@ struct DistanceResult {
   Vector3 point_a = Vector3::Zero(), point_b = Vector3::Zero();
   // closer_than queries: true when some pair is closer than closer_than.
   bool closer = false;
-  // Work done: bounding-volume pairs tested, sphere pairs compared.
-  std::int64_t volume_tests = 0, sphere_tests = 0;
+  // Work done: bounding-volume pairs tested (of which rss_tests needed the RSS distance after
+  // the cheap test of the spheres around the volumes), sphere pairs compared.
+  std::int64_t volume_tests = 0, rss_tests = 0, sphere_tests = 0;
 };
 
 // Branch and bound over the two hierarchies (descending the larger volume, nearer pair first,

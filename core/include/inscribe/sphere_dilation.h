@@ -23,6 +23,12 @@ struct DilationOptions {
   // Chooses the angle of each singleton edge's pair of circle points: a hash of (seed, i, j),
   // so the points are the same for the same seed and edge whatever the thread count.
   std::uint64_t seed = 1;
+  // How far towards the paper's radius each sphere grows, in [0, 1]: r' = r + growth (R - r)
+  // with R the paper's max over the sphere's envelope points of |c - m|. A tangent sphere that
+  // grows by g sticks out by g at its own contact point while it closes a gap of about g at the
+  // envelope point, so the full growth (1, the paper) trades gaps for protrusions one for one;
+  // less keeps part of each gap and part of the protrusion. bench/run-table2 measures both.
+  double growth = 1.0;
 };
 
 // A point where two or three spheres of a set meet on the envelope of their union.

@@ -55,6 +55,23 @@ class SphereHierarchy {
   const Sphere& bounding_sphere(std::int32_t node) const {
     return bounding_spheres_[static_cast<std::size_t>(node)];
   }
+  // A sphere around the node's volume: the volume itself for kSphere, the sphere around the
+  // RSS (centred on its rectangle, radius = half its diagonal plus its radius) for kRss. The
+  // query's cheap first test; derived, not serialised.
+  const Sphere& outer_sphere(std::int32_t node) const {
+    return outer_spheres_[static_cast<std::size_t>(node)];
+  }
+  // The spheres below a reference, as a range of leaf_order(): [first, first + count).
+  // Derived from the tree (depth-first, left first), not serialised.
+  std::int32_t first(HierarchyRef ref) const {
+    return IsLeaf(ref) ? leaf_position_[static_cast<std::size_t>(LeafSphere(ref))]
+                       : first_[static_cast<std::size_t>(ref)];
+  }
+  std::int32_t count(HierarchyRef ref) const {
+    return IsLeaf(ref) ? 1 : count_[static_cast<std::size_t>(ref)];
+  }
+  // Sphere indices in the order the leaves are met depth-first.
+  const std::vector<std::int32_t>& leaf_order() const { return leaf_order_; }
   // Longest path from the root to a leaf, in edges.
   int depth() const { return depth_; }
 
@@ -71,6 +88,9 @@ class SphereHierarchy {
   SphereHierarchy() = default;
   // Deserialize's tree and containment checks; sets *depth.
   absl::Status CheckStructure(int* depth) const;
+  // Fills the derived arrays: outer_spheres_ from the stored volumes, and the leaf order with
+  // each node's range in it.
+  void ComputeDerived();
 
   HierarchyVolume volume_ = HierarchyVolume::kRss;
   std::vector<Sphere> spheres_;
@@ -78,6 +98,8 @@ class SphereHierarchy {
   std::vector<HierarchyRef> left_, right_;
   std::vector<Rss> rss_;
   std::vector<Sphere> bounding_spheres_;
+  std::vector<Sphere> outer_spheres_;
+  std::vector<std::int32_t> leaf_order_, leaf_position_, first_, count_;
   int depth_ = 0;
 };
 

@@ -99,7 +99,7 @@ TEST_F(CliDistance, JsonSummaryAndCsvFile) {
   EXPECT_EQ(j.at("queries"), 4);
   EXPECT_GT(j.at("seconds").get<double>(), 0.0);
   EXPECT_GT(j.at("us_per_query").get<double>(), 0.0);
-  EXPECT_EQ(j.at("hierarchy"), "rss");
+  EXPECT_EQ(j.at("hierarchy"), "sphere");
   EXPECT_EQ(j.at("touching"), 2);
   std::ifstream in(out);
   std::stringstream text;

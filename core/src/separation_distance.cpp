@@ -55,7 +55,7 @@ class Side {
 };
 
 // Node pairs with at most this many sphere pairs below them are compared pair by pair.
-constexpr std::int32_t kAllPairs = 16;
+constexpr std::int32_t kAllPairs = 32;
 
 class Search {
  public:

@@ -19,11 +19,14 @@
 #include "inscribe/sphere_quality.h"
 #include "inscribe/union_of_balls.h"
 #include "support/brute_force_closest_point.h"
+#include "support/sphere_sets.h"
 #include "support/synthetic_meshes.h"
 #include "support/test_meshes.h"
 
 namespace inscribe {
 namespace {
+
+using testing::RandomBalls;
 
 using testing::BruteForceClosest;
 using testing::BruteForceDistance;
@@ -46,19 +49,6 @@ EnvelopePoints Envelope(const std::vector<Sphere>& spheres, const DilationOption
   absl::StatusOr<EnvelopePoints> points = ComputeEnvelopePoints(spheres, options);
   EXPECT_TRUE(points.ok()) << points.status();
   return points.ok() ? *std::move(points) : EnvelopePoints{};
-}
-
-// Centres uniform in [0, side]^3, radii uniform in [rmin, rmax].
-std::vector<Sphere> RandomBalls(int n, double side, double rmin, double rmax, std::uint64_t seed) {
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> coord(0.0, side);
-  std::uniform_real_distribution<double> radius(rmin, rmax);
-  std::vector<Sphere> balls;
-  for (int i = 0; i < n; ++i) {
-    const Vector3 c(coord(rng), coord(rng), coord(rng));
-    balls.push_back({c, radius(rng)});
-  }
-  return balls;
 }
 
 // Smallest (|x - c| - r) / r over the spheres not in `own`: > 0 outside them all.

@@ -16,12 +16,14 @@
 #include <utility>
 #include <vector>
 
+#include "support/sphere_sets.h"
 #include "support/test_meshes.h"
 #include "support/union_volume_reference.h"
 
 namespace inscribe {
 namespace {
 
+using testing::RandomBalls;
 // References independent of the library: slice quadrature and Monte Carlo.
 using testing::BallGrid;
 using testing::MonteCarloEstimate;
@@ -53,19 +55,6 @@ DualComplex Complex(const std::vector<Sphere>& balls) {
   absl::StatusOr<DualComplex> c = ComputeDualComplex(balls);
   EXPECT_TRUE(c.ok()) << c.status();
   return c.ok() ? *std::move(c) : DualComplex{};
-}
-
-// Centres uniform in [0, side]^3, radii uniform in [rmin, rmax].
-std::vector<Sphere> RandomBalls(int n, double side, double rmin, double rmax, std::uint64_t seed) {
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> coord(0.0, side);
-  std::uniform_real_distribution<double> radius(rmin, rmax);
-  std::vector<Sphere> balls;
-  for (int i = 0; i < n; ++i) {
-    const Vector3 c(coord(rng), coord(rng), coord(rng));
-    balls.push_back({c, radius(rng)});
-  }
-  return balls;
 }
 
 // Random sets dense enough that their complexes have many triangles and tetrahedra (about

@@ -28,6 +28,18 @@ std::vector<Sphere> RandomSpheres(int n, std::uint64_t seed) {
   return out;
 }
 
+std::vector<Sphere> RandomBalls(int n, double side, double rmin, double rmax, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> coord(0.0, side);
+  std::uniform_real_distribution<double> radius(rmin, rmax);
+  std::vector<Sphere> balls;
+  for (int i = 0; i < n; ++i) {
+    const Vector3 c(coord(rng), coord(rng), coord(rng));
+    balls.push_back({c, radius(rng)});
+  }
+  return balls;
+}
+
 RigidPose RandomPose(std::mt19937_64& rng, double spread) {
   std::normal_distribution<double> normal(0.0, 1.0);
   std::uniform_real_distribution<double> unit(0.0, 1.0);

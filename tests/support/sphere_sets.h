@@ -14,6 +14,9 @@ namespace inscribe::testing {
 // cube (like medial sheets), radii in [0.02, 0.12]. Deterministic per seed.
 std::vector<Sphere> RandomSpheres(int n, std::uint64_t seed);
 
+// n balls with centres uniform in [0, side]^3 and radii uniform in [rmin, rmax].
+std::vector<Sphere> RandomBalls(int n, double side, double rmin, double rmax, std::uint64_t seed);
+
 // A uniformly random rotation and a translation uniform in the ball of radius `spread`.
 RigidPose RandomPose(std::mt19937_64& rng, double spread);
 

@@ -14,6 +14,7 @@
 #include "inscribe/sphere_deformation.h"
 #include "inscribe/sphere_io.h"
 #include "nlohmann/json.hpp"
+#include "sphere_output.h"
 
 namespace inscribe::cli {
 namespace {
@@ -179,24 +180,9 @@ int RunDeform(const DeformCliOptions& options) {
       {"nerr_is_exact", bounds->exact},     {"max_protrusion", result->max_protrusion},
       {"shrunk", result->shrunk},           {"dropped", result->dropped},
   };
-  // As with generate: the sphere file goes to -o, else to stdout unless --json claims it.
-  if (!options.output_path.empty()) {
-    SphereFileWriteOptions write;
-    if (!options.format.empty()) write.format = *ParseSphereFileFormat(options.format);
-    if (absl::Status status = WriteSphereFile(options.output_path, out, write); !status.ok()) {
-      std::cerr << "inscribe: " << status.message() << "\n";
-      return kExitBadInput;
-    }
-  } else if (!options.json) {
-    const SphereFileFormat format =
-        options.format.empty() ? SphereFileFormat::kJson : *ParseSphereFileFormat(options.format);
-    absl::StatusOr<std::string> bytes = FormatSphereFile(out, format);
-    if (!bytes.ok()) {
-      std::cerr << "inscribe: " << bytes.status().message() << "\n";
-      return kExitUnusableMesh;
-    }
-    std::cout << *bytes;
-    if (!bytes->empty() && bytes->back() != '\n') std::cout << "\n";
+  if (const int code = EmitSphereFile(out, options.output_path, options.format, options.json);
+      code != kExitOk) {
+    return code;
   }
   if (options.json) {
     nlohmann::json summary;

@@ -16,6 +16,7 @@
 #include "progress_bar.h"
 #include "report_json.h"
 #include "solid_loading.h"
+#include "sphere_output.h"
 
 namespace inscribe::cli {
 namespace {
@@ -154,24 +155,11 @@ int RunGenerate(GenerateCliOptions options) {
   const SphereFile file =
       MakeSphereFile(*solid, options, result, *quality, seconds, runs, dilation);
 
-  // The sphere file goes to -o, else to stdout unless --json claims stdout for the summary.
-  if (!options.output_path.empty()) {
-    SphereFileWriteOptions write;
-    if (!options.format.empty()) write.format = *ParseSphereFileFormat(options.format);
-    if (absl::Status status = WriteSphereFile(options.output_path, file, write); !status.ok()) {
-      std::cerr << "inscribe: " << status.message() << "\n";
-      return kExitBadInput;
-    }
-  } else if (!options.json) {
-    const SphereFileFormat format =
-        options.format.empty() ? SphereFileFormat::kJson : *ParseSphereFileFormat(options.format);
-    absl::StatusOr<std::string> bytes = FormatSphereFile(file, format);
-    if (!bytes.ok()) {
-      std::cerr << "inscribe: " << bytes.status().message() << "\n";
-      return kExitUnusableMesh;
-    }
-    std::cout << *bytes;
-    if (!bytes->empty() && bytes->back() != '\n') std::cout << "\n";
+  // The sphere file goes to -o, else to stdout unless --json claims stdout for the summary
+  // (as with deform).
+  if (const int code = EmitSphereFile(file, options.output_path, options.format, options.json);
+      code != kExitOk) {
+    return code;
   }
   if (options.json) {
     nlohmann::json summary = QualityReportJson(*quality);

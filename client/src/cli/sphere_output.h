@@ -1,0 +1,18 @@
+// Where a subcommand's sphere file goes: shared by generate and deform.
+#pragma once
+
+#include <string>
+
+#include "inscribe/sphere_io.h"
+
+namespace inscribe::cli {
+
+// Writes `file` to `output_path` (format from `format`, else the extension) when one is given;
+// otherwise prints it on stdout (format `format`, default JSON) unless `json_summary` claims
+// stdout for a summary. Returns kExitOk, or prints the reason on stderr and returns
+// kExitBadInput (the file cannot be written) or kExitUnusableMesh (the set cannot be
+// formatted). `format` has been checked by the command line.
+int EmitSphereFile(const SphereFile& file, const std::string& output_path,
+                   const std::string& format, bool json_summary);
+
+}  // namespace inscribe::cli

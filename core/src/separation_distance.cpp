@@ -73,8 +73,9 @@ class Search {
       HierarchyRef a, b;
       double bound;
     };
-    std::vector<Pair> stack;
-    stack.reserve(128);
+    // One stack per thread, kept between queries: no allocation per query.
+    thread_local std::vector<Pair> stack;
+    stack.clear();
     const HierarchyRef ra = a_.hierarchy().root(), rb = b_.hierarchy().root();
     stack.push_back({ra, rb, Bound(ra, rb, Threshold(), &out)});
     while (!stack.empty()) {
@@ -137,15 +138,17 @@ class Search {
           rel_.rotation * hb.spheres()[static_cast<std::size_t>(ib[j])].center + rel_.translation;
     }
     out->sphere_tests += na * nb;
+    double threshold = Threshold();
     for (std::int32_t i = 0; i < na; ++i) {
       const Sphere& sa = ha.spheres()[static_cast<std::size_t>(ia[i])];
       for (std::int32_t j = 0; j < nb; ++j) {
         const double d = (sa.center - moved[j]).norm() - sa.radius -
                          hb.spheres()[static_cast<std::size_t>(ib[j])].radius;
-        if (d < Threshold()) {
+        if (d < threshold) {
           best_ = d;
           best_a_ = ia[i];
           best_b_ = ib[j];
+          threshold = Threshold();
         }
       }
     }

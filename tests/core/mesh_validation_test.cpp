@@ -16,6 +16,7 @@
 #include "inscribe/mesh_io.h"
 #include "mesh_topology.h"       // private: core/src
 #include "self_intersections.h"  // private: core/src
+#include "support/mesh_issues.h"
 #include "support/synthetic_meshes.h"
 #include "support/test_meshes.h"
 
@@ -24,17 +25,11 @@ namespace {
 
 using testing::Box;
 using testing::Concatenate;
+using testing::HasIssue;
 using ::testing::HasSubstr;
 using testing::Icosphere;
 using testing::Inverted;
 using testing::UnitCube;
-
-bool HasIssue(const MeshReport& report, const std::string& code, Severity severity) {
-  for (const MeshIssue& issue : report.issues) {
-    if (issue.code == code && issue.severity == severity) return true;
-  }
-  return false;
-}
 
 TEST(ValidateMesh, CleanCube) {
   const ValidatedMesh v = ValidateMesh(UnitCube());

@@ -63,6 +63,16 @@ SphereDeformer MakeDeformer(const Reference& ref, const DeformationOptions& opti
   return *std::move(deformer);
 }
 
+// The point of `mesh` a contact names: its barycentric combination of the triangle's corners.
+Vector3 PointOf(const Mesh& mesh, const SurfaceContact& contact) {
+  Vector3 point = Vector3::Zero();
+  for (int k = 0; k < 3; ++k) {
+    point +=
+        contact.barycentric[k] * mesh.vertices.row(mesh.triangles(contact.triangle, k)).transpose();
+  }
+  return point;
+}
+
 Mesh WithVertices(const Mesh& mesh, const Vertices& vertices) {
   return Mesh{vertices, mesh.triangles};
 }
@@ -171,11 +181,7 @@ TEST_P(DeformationSequence, NoSphereProtrudesXi) {
         }
         // The contact rides along: |c - A'| = r.
         const SurfaceContact& contact = out->set.contacts[i];
-        Vector3 a = Vector3::Zero();
-        for (int k = 0; k < 3; ++k) {
-          a += contact.barycentric[k] *
-               deformed.vertices.row(deformed.triangles(contact.triangle, k)).transpose();
-        }
+        const Vector3 a = PointOf(deformed, contact);
         EXPECT_NEAR((s.center - a).norm(), s.radius, 1e-9 * s.radius);
       }
     }
@@ -205,11 +211,7 @@ TEST_P(DeformationSequence, StrictModeIsInternalAndTangent) {
           << "sphere " << i;
     }
     const SurfaceContact& contact = out->set.contacts[i];
-    Vector3 a = Vector3::Zero();
-    for (int k = 0; k < 3; ++k) {
-      a += contact.barycentric[k] *
-           deformed.vertices.row(deformed.triangles(contact.triangle, k)).transpose();
-    }
+    const Vector3 a = PointOf(deformed, contact);
     EXPECT_NEAR((s.center - a).norm(), s.radius, 1e-9 * s.radius) << "sphere " << i;
   }
   // Internal spheres: the bounds meet at the exact error.

@@ -60,6 +60,12 @@ constexpr double kTargetMeanError = 0.05;  // mean |d_sph - d_exact|, bbox 10
 // differ only by the rounding of how each transforms the centres.
 constexpr double kAgreement = 1e-9;
 
+// How far a query answering `answer` may lie above the exact minimum under `request`'s
+// tolerances (the search stops refining once no pair can beat it by more than this).
+double Allowance(const DistanceRequest& request, double answer) {
+  return std::max(request.abs_err, request.rel_err * std::abs(answer)) + kAgreement;
+}
+
 double SecondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
@@ -78,7 +84,8 @@ struct Options {
   std::uint64_t seed = 1;
   int check_every = 25;
   std::string data_dir;
-  double growth = 1.0;  // DilationOptions::growth
+  double growth = 1.0;      // DilationOptions::growth
+  DistanceRequest request;  // tolerances of the timed sphere queries
 };
 
 // Where copy b's centre may be: a centre distance drawn uniformly from [lo, hi] bounding-box
@@ -171,6 +178,7 @@ struct PoseSetRow {
   double undilated_mean_error = 0.0;  // the same mean error for S_D (before dilation)
   double rss_us = 0.0, sphere_us = 0.0, fcl_us = 0.0;        // medians of one query each
   double rss_volume_tests = 0.0, sphere_volume_tests = 0.0;  // means
+  double rss_sphere_tests = 0.0, sphere_sphere_tests = 0.0;  // sphere pairs compared, means
   double speedup() const { return fcl_us / rss_us; }
 };
 
@@ -358,11 +366,11 @@ void RunPoseSet(const Model& model, const ModelRow& model_row, const PoseSetSpec
 
   // Each query is timed alone, so the median describes one query, not a batch.
   std::vector<double> rss_us(n), sphere_us(n), fcl_us(n), d_rss(n), d_sphere(n), d_fcl(n);
-  double rss_tests = 0.0, sphere_tests = 0.0;
+  double rss_tests = 0.0, sphere_tests = 0.0, rss_leaf_tests = 0.0, sphere_leaf_tests = 0.0;
   for (std::size_t i = 0; i < n; ++i) {
     const auto start = Clock::now();
     absl::StatusOr<DistanceResult> r =
-        SeparationDistance(model.rss, poses[i].a, model.rss, poses[i].b);
+        SeparationDistance(model.rss, poses[i].a, model.rss, poses[i].b, options.request);
     rss_us[i] = 1e6 * SecondsSince(start);
     if (!r.ok()) {
       results.errors.push_back(where + ": " + r.status().ToString());
@@ -370,11 +378,12 @@ void RunPoseSet(const Model& model, const ModelRow& model_row, const PoseSetSpec
     }
     d_rss[i] = r->distance;
     rss_tests += static_cast<double>(r->volume_tests);
+    rss_leaf_tests += static_cast<double>(r->sphere_tests);
   }
   for (std::size_t i = 0; i < n; ++i) {
     const auto start = Clock::now();
     absl::StatusOr<DistanceResult> r =
-        SeparationDistance(model.sphere, poses[i].a, model.sphere, poses[i].b);
+        SeparationDistance(model.sphere, poses[i].a, model.sphere, poses[i].b, options.request);
     sphere_us[i] = 1e6 * SecondsSince(start);
     if (!r.ok()) {
       results.errors.push_back(where + ": " + r.status().ToString());
@@ -382,6 +391,7 @@ void RunPoseSet(const Model& model, const ModelRow& model_row, const PoseSetSpec
     }
     d_sphere[i] = r->distance;
     sphere_tests += static_cast<double>(r->volume_tests);
+    sphere_leaf_tests += static_cast<double>(r->sphere_tests);
   }
   // Exact distance between the triangle sets. FCL 0.7 reports 0 for meshes that touch or
   // interpenetrate (the triangle-triangle distance of crossing triangles is 0; its "signed
@@ -404,7 +414,8 @@ void RunPoseSet(const Model& model, const ModelRow& model_row, const PoseSetSpec
   int separated = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const std::string at = absl::StrFormat("%s pose %d", where, i);
-    if (std::abs(d_sphere[i] - d_rss[i]) > kAgreement) {
+    if (std::abs(d_sphere[i] - d_rss[i]) >
+        std::max(Allowance(options.request, d_sphere[i]), Allowance(options.request, d_rss[i]))) {
       results.failed_checks.push_back(absl::StrFormat(
           "%s: sphere hierarchy %.17g, RSS hierarchy %.17g", at, d_sphere[i], d_rss[i]));
     }
@@ -426,11 +437,17 @@ void RunPoseSet(const Model& model, const ModelRow& model_row, const PoseSetSpec
     if (spot_check) {
       absl::StatusOr<DistanceResult> brute =
           BruteForceSeparationDistance(model.dilated, poses[i].a, model.dilated, poses[i].b);
-      if (!brute.ok() || std::abs(brute->distance - d_rss[i]) > kAgreement) {
-        results.failed_checks.push_back(absl::StrFormat(
-            "%s: brute force %s, RSS hierarchy %.17g", at,
-            brute.ok() ? absl::StrFormat("%.17g", brute->distance) : brute.status().ToString(),
-            d_rss[i]));
+      const auto off = [&](double d) {
+        return d < brute->distance - kAgreement ||
+               d - brute->distance > Allowance(options.request, d);
+      };
+      if (!brute.ok() || off(d_rss[i]) || off(d_sphere[i])) {
+        results.failed_checks.push_back(
+            absl::StrFormat(
+                "%s: brute force %s, RSS hierarchy %.17g", at,
+                brute.ok() ? absl::StrFormat("%.17g", brute->distance) : brute.status().ToString(),
+                d_rss[i]) +
+            absl::StrFormat(", sphere hierarchy %.17g", d_sphere[i]));
       }
     }
     if (touching) {
@@ -470,6 +487,8 @@ void RunPoseSet(const Model& model, const ModelRow& model_row, const PoseSetSpec
   row.fcl_us = Median(fcl_us);
   row.rss_volume_tests = rss_tests / static_cast<double>(n);
   row.sphere_volume_tests = sphere_tests / static_cast<double>(n);
+  row.rss_sphere_tests = rss_leaf_tests / static_cast<double>(n);
+  row.sphere_sphere_tests = sphere_leaf_tests / static_cast<double>(n);
   results.sets.push_back(row);
 }
 
@@ -513,23 +532,26 @@ void PrintPoseSets(const Options& options, const Results& results) {
       "mesh distance. signed = mean of d_sph - d_exact; overlaps = poses where the spheres "
       "overlap but the meshes do not touch; S_D err = the mean error of the spheres before "
       "dilation. Times: median microseconds of one query, each "
-      "timed alone on one thread; BV tests = mean bounding-volume pairs tested per query.\n\n",
-      options.poses, options.seed);
+      "timed alone on one thread; BV tests = mean bounding-volume pairs tested per query; sphere "
+      "pairs = mean sphere pairs "
+      "compared per query. Tolerances of the sphere queries: abs_err %g, rel_err %g.\n\n",
+      options.poses, options.seed, options.request.abs_err, options.request.rel_err);
   absl::PrintF(
       "| model | poses | spheres | touching | mean err | max err | signed | overlaps | S_D err | "
-      "RSSH us | SH us | FCL us | FCL/RSSH | BV tests RSSH / SH | mean <= %.2f | FCL/RSSH >= %.0f "
+      "RSSH us | SH us | FCL us | FCL/RSSH | BV tests RSSH / SH | sphere pairs RSSH / SH | mean <= "
+      "%.2f | FCL/RSSH >= %.0f "
       "|\n",
       kTargetMeanError, kTargetSpeedup);
-  absl::PrintF("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---|\n");
+  absl::PrintF(
+      "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---|\n");
   for (const PoseSetRow& r : results.sets) {
     absl::PrintF(
         "| %s | %s | %d | %.1f%% | %.4f | %.4f | %+.4f | %d | %.4f | %.1f | %.1f | %.1f | %.1f | "
-        "%.0f / "
-        "%.0f | %s | %s |\n",
+        "%.0f / %.0f | %.0f / %.0f | %s | %s |\n",
         r.model, r.set, r.spheres, 100.0 * r.touching / r.poses, r.mean_error, r.max_error,
         r.mean_signed_error, r.false_contacts, r.undilated_mean_error, r.rss_us, r.sphere_us,
-        r.fcl_us, r.speedup(), r.rss_volume_tests, r.sphere_volume_tests,
-        r.mean_error <= kTargetMeanError ? "pass" : "FAIL",
+        r.fcl_us, r.speedup(), r.rss_volume_tests, r.sphere_volume_tests, r.rss_sphere_tests,
+        r.sphere_sphere_tests, r.mean_error <= kTargetMeanError ? "pass" : "FAIL",
         r.speedup() >= kTargetSpeedup ? "pass" : "FAIL");
   }
   absl::PrintF(
@@ -570,6 +592,14 @@ int main(int argc, char** argv) {
   app.add_option("--growth", options.growth,
                  "DilationOptions::growth: fraction of the paper's growth (1 = the paper's rule)")
       ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  app.add_option("--abs-err", options.request.abs_err,
+                 "DistanceRequest::abs_err of the timed sphere queries (bbox-10 units)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--rel-err", options.request.rel_err,
+                 "DistanceRequest::rel_err of the timed sphere queries")
+      ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--seed", options.seed, "Seed of the pose sets ('far' uses seed + 1)")
       ->capture_default_str();

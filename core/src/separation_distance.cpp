@@ -23,49 +23,35 @@ Relative RelativePose(const RigidPose& pose_a, const RigidPose& pose_b) {
 }
 
 // A leaf sphere as a rectangle swept sphere: a point rectangle at its centre.
-Rss PointRss(const Sphere& s) {
+Rss PointRss(const SphereHierarchy::Slot& s) {
   Rss r;
   r.origin = s.center;
   r.radius = s.radius;
   return r;
 }
 
-// Reads one hierarchy's node or leaf volumes for the search.
-class Side {
- public:
-  explicit Side(const SphereHierarchy& h) : h_(h) {}
-  bool rss() const { return h_.volume() == HierarchyVolume::kRss; }
-  // The leaf's sphere, or the sphere around the node's volume.
-  const Sphere& sphere(HierarchyRef ref) const {
-    return IsLeaf(ref) ? h_.spheres()[static_cast<std::size_t>(LeafSphere(ref))]
-                       : h_.outer_sphere(ref);
-  }
-  // The volume as an RSS: the node's own, or a point RSS built in *scratch.
-  const Rss& AsRss(HierarchyRef ref, Rss* scratch) const {
-    if (!IsLeaf(ref) && rss()) return h_.rss(ref);
-    *scratch = PointRss(sphere(ref));
-    return *scratch;
-  }
-  // How big the volume is: the side to descend is the bigger one.
-  double Size(HierarchyRef ref) const { return sphere(ref).radius; }
-  const SphereHierarchy& hierarchy() const { return h_; }
+// Node pairs with at most this many sphere pairs below them are compared pair by pair: 64
+// beat 16, 32 and 128 in bench/separation_distance_bench (eight and knot1, both hierarchies).
+constexpr std::int64_t kAllPairs = 64;
 
- private:
-  const SphereHierarchy& h_;
-};
-
-// Node pairs with at most this many sphere pairs below them are compared pair by pair.
-constexpr std::int32_t kAllPairs = 32;
-
+// Branch and bound over the two hierarchies, depth first, nearer child pair first. Each step
+// reads one record per side (SphereHierarchy::Slot): the sphere around the node, its children
+// and its range of spheres; RSS volumes are read only when the spheres around two nodes do not
+// already prune them.
 class Search {
  public:
+  using Slot = SphereHierarchy::Slot;
+
   Search(const SphereHierarchy& a, const SphereHierarchy& b, const Relative& relative,
          const DistanceRequest& request)
       : a_(a),
         b_(b),
         rel_(relative),
         request_(request),
-        yes_no_(std::isfinite(request.closer_than)) {}
+        yes_no_(std::isfinite(request.closer_than)),
+        rss_a_(a.volume() == HierarchyVolume::kRss),
+        rss_b_(b.volume() == HierarchyVolume::kRss),
+        threshold_(request.closer_than) {}
 
   DistanceResult Run() {
     DistanceResult out;
@@ -76,44 +62,44 @@ class Search {
     // One stack per thread, kept between queries: no allocation per query.
     thread_local std::vector<Pair> stack;
     stack.clear();
-    const HierarchyRef ra = a_.hierarchy().root(), rb = b_.hierarchy().root();
-    stack.push_back({ra, rb, Bound(ra, rb, Threshold(), &out)});
+    const HierarchyRef ra = a_.root(), rb = b_.root();
+    const Slot& root_b = b_.slot(rb);
+    stack.push_back({ra, rb, Bound(ra, a_.slot(ra), rb, root_b, Move(root_b.center), &out)});
     while (!stack.empty()) {
       const Pair p = stack.back();
       stack.pop_back();
-      const double threshold = Threshold();
-      if (p.bound >= threshold) continue;
-      if (IsLeaf(p.a) && IsLeaf(p.b)) {
+      if (p.bound >= threshold_) continue;
+      const Slot& sa = a_.slot(p.a);
+      const Slot& sb = b_.slot(p.b);
+      if (sa.count == 1 && sb.count == 1) {
         // The bound of two leaves is their exact value.
-        best_ = p.bound;
-        best_a_ = LeafSphere(p.a);
-        best_b_ = LeafSphere(p.b);
+        Improve(p.bound, a_.leaf_order()[static_cast<std::size_t>(sa.first)],
+                b_.leaf_order()[static_cast<std::size_t>(sb.first)]);
         if (yes_no_ && best_ < request_.closer_than) break;
         continue;
       }
       // Few sphere pairs left below: compare them all rather than test more volumes.
-      const std::int32_t na = a_.hierarchy().count(p.a), nb = b_.hierarchy().count(p.b);
-      if (na * nb <= kAllPairs) {
-        CompareAll(p.a, p.b, &out);
+      if (std::int64_t{sa.count} * sb.count <= kAllPairs) {
+        CompareAll(sa, sb, &out);
         if (yes_no_ && best_ < request_.closer_than) break;
         continue;
       }
-      const bool split_a = !IsLeaf(p.a) && (IsLeaf(p.b) || a_.Size(p.a) >= b_.Size(p.b));
+      const bool split_a = sa.count > 1 && (sb.count == 1 || sa.radius >= sb.radius);
       Pair first, second;
       if (split_a) {
-        const HierarchyRef l = a_.hierarchy().left(p.a), r = a_.hierarchy().right(p.a);
-        first = {l, p.b, Bound(l, p.b, threshold, &out)};
-        second = {r, p.b, Bound(r, p.b, threshold, &out)};
+        const Vector3 cb = Move(sb.center);  // shared by both children's tests
+        first = {sa.left, p.b, Bound(sa.left, a_.slot(sa.left), p.b, sb, cb, &out)};
+        second = {sa.right, p.b, Bound(sa.right, a_.slot(sa.right), p.b, sb, cb, &out)};
       } else {
-        const HierarchyRef l = b_.hierarchy().left(p.b), r = b_.hierarchy().right(p.b);
-        first = {p.a, l, Bound(p.a, l, threshold, &out)};
-        second = {p.a, r, Bound(p.a, r, threshold, &out)};
+        const Slot& l = b_.slot(sb.left);
+        const Slot& r = b_.slot(sb.right);
+        first = {p.a, sb.left, Bound(p.a, sa, sb.left, l, Move(l.center), &out)};
+        second = {p.a, sb.right, Bound(p.a, sa, sb.right, r, Move(r.center), &out)};
       }
-      // The nearer pair is searched first (pushed last). The threshold has not moved since
-      // the pop: only leaf pairs move it.
+      // The nearer pair is searched first (pushed last).
       if (first.bound < second.bound) std::swap(first, second);
-      if (first.bound < threshold) stack.push_back(first);
-      if (second.bound < threshold) stack.push_back(second);
+      if (first.bound < threshold_) stack.push_back(first);
+      if (second.bound < threshold_) stack.push_back(second);
     }
     if (best_a_ >= 0) {
       out.distance = best_;
@@ -125,69 +111,75 @@ class Search {
   }
 
  private:
-  // Every sphere of a against every sphere of b, keeping pairs below the threshold.
-  void CompareAll(HierarchyRef a, HierarchyRef b, DistanceResult* out) {
-    const SphereHierarchy& ha = a_.hierarchy();
-    const SphereHierarchy& hb = b_.hierarchy();
-    const std::int32_t* ia = &ha.leaf_order()[static_cast<std::size_t>(ha.first(a))];
-    const std::int32_t* ib = &hb.leaf_order()[static_cast<std::size_t>(hb.first(b))];
-    const std::int32_t na = ha.count(a), nb = hb.count(b);
+  // b's point in a's frame.
+  Vector3 Move(const Vector3& p) const { return rel_.rotation * p + rel_.translation; }
+
+  // A new best pair; pairs bounded at or above the new threshold cannot improve the answer
+  // beyond the tolerance, or cannot answer a closer_than query yes.
+  void Improve(double d, std::int32_t sphere_a, std::int32_t sphere_b) {
+    best_ = d;
+    best_a_ = sphere_a;
+    best_b_ = sphere_b;
+    const double tolerance = std::max(request_.abs_err, request_.rel_err * std::abs(d));
+    threshold_ = std::min(d - tolerance, request_.closer_than);
+  }
+
+  // Every sphere below a against every sphere below b (at most kAllPairs pairs). A pair is
+  // rejected on squared distances first; the square root is taken only for a possible
+  // improvement, with the same expression as the brute force.
+  void CompareAll(const Slot& sa, const Slot& sb, DistanceResult* out) {
+    const Sphere* spheres_a = &a_.ordered_spheres()[static_cast<std::size_t>(sa.first)];
+    const Sphere* spheres_b = &b_.ordered_spheres()[static_cast<std::size_t>(sb.first)];
+    const std::int32_t na = sa.count, nb = sb.count;
     Vector3 moved[kAllPairs];
-    for (std::int32_t j = 0; j < nb; ++j) {
-      moved[j] =
-          rel_.rotation * hb.spheres()[static_cast<std::size_t>(ib[j])].center + rel_.translation;
-    }
-    out->sphere_tests += na * nb;
-    double threshold = Threshold();
+    for (std::int32_t j = 0; j < nb; ++j) moved[j] = Move(spheres_b[j].center);
+    out->sphere_tests += std::int64_t{na} * nb;
     for (std::int32_t i = 0; i < na; ++i) {
-      const Sphere& sa = ha.spheres()[static_cast<std::size_t>(ia[i])];
+      const Sphere& s = spheres_a[i];
       for (std::int32_t j = 0; j < nb; ++j) {
-        const double d = (sa.center - moved[j]).norm() - sa.radius -
-                         hb.spheres()[static_cast<std::size_t>(ib[j])].radius;
-        if (d < threshold) {
-          best_ = d;
-          best_a_ = ia[i];
-          best_b_ = ib[j];
-          threshold = Threshold();
+        const double reach = threshold_ + s.radius + spheres_b[j].radius;
+        const double squared = (s.center - moved[j]).squaredNorm();
+        // d < threshold needs |c_a - c_b| < reach: impossible when reach <= 0.
+        if (!(reach > 0.0) || squared >= reach * reach) continue;
+        const double d = (s.center - moved[j]).norm() - s.radius - spheres_b[j].radius;
+        if (d < threshold_) {
+          Improve(d, a_.leaf_order()[static_cast<std::size_t>(sa.first + i)],
+                  b_.leaf_order()[static_cast<std::size_t>(sb.first + j)]);
         }
       }
     }
   }
 
-  // Node pairs bounded at or above this cannot improve the answer beyond the tolerance, or
-  // cannot answer a closer_than query yes.
-  double Threshold() const {
-    if (!std::isfinite(best_)) return request_.closer_than;
-    const double tolerance = std::max(request_.abs_err, request_.rel_err * std::abs(best_));
-    return std::min(best_ - tolerance, request_.closer_than);
-  }
-
-  // A lower bound on |c_a - c_b| - r_a - r_b over the spheres below a and b; exact for two
-  // leaves. The spheres around the two volumes give a cheap bound first; the RSS test (several
-  // times dearer) runs only when that bound would not already prune the pair.
-  double Bound(HierarchyRef a, HierarchyRef b, double threshold, DistanceResult* out) const {
-    const Sphere& sa = a_.sphere(a);
-    const Sphere& sb = b_.sphere(b);
-    const double cheap =
-        (sa.center - (rel_.rotation * sb.center + rel_.translation)).norm() - sa.radius - sb.radius;
-    if (IsLeaf(a) && IsLeaf(b)) {
+  // A lower bound on |c_a - c_b| - r_a - r_b over the spheres below a and b, given b's centre
+  // already in a's frame; exact for two leaves. The spheres around the two volumes give a cheap
+  // bound first; the RSS test (several times dearer) runs only when that bound would not
+  // already prune the pair.
+  double Bound(HierarchyRef a, const Slot& sa, HierarchyRef b, const Slot& sb,
+               const Vector3& moved_b, DistanceResult* out) const {
+    const double cheap = (sa.center - moved_b).norm() - sa.radius - sb.radius;
+    const bool node_a = !IsLeaf(a), node_b = !IsLeaf(b);
+    if (!node_a && !node_b) {
       ++out->sphere_tests;
       return cheap;
     }
     ++out->volume_tests;
-    if ((!a_.rss() || IsLeaf(a)) && (!b_.rss() || IsLeaf(b))) return cheap;
-    if (cheap >= threshold) return cheap;
+    const bool rss_a = rss_a_ && node_a, rss_b = rss_b_ && node_b;
+    if ((!rss_a && !rss_b) || cheap >= threshold_) return cheap;
     ++out->rss_tests;
-    Rss scratch_a, scratch_b;
-    return std::max(cheap, RssDistance(a_.AsRss(a, &scratch_a), rel_.rotation, rel_.translation,
-                                       b_.AsRss(b, &scratch_b)));
+    const Rss point_a = rss_a ? Rss() : PointRss(sa);
+    const Rss point_b = rss_b ? Rss() : PointRss(sb);
+    return std::max(cheap, RssDistance(rss_a ? a_.rss(a) : point_a, rel_.rotation, rel_.translation,
+                                       rss_b ? b_.rss(b) : point_b));
   }
 
-  Side a_, b_;
+  const SphereHierarchy& a_;
+  const SphereHierarchy& b_;
   Relative rel_;
   const DistanceRequest& request_;
   const bool yes_no_;  // a closer_than query: stop at the first pair below it
+  const bool rss_a_, rss_b_;
   double best_ = std::numeric_limits<double>::infinity();
+  double threshold_;  // pairs bounded at or above this are pruned
   std::int32_t best_a_ = -1, best_b_ = -1;
 };
 

@@ -254,19 +254,35 @@ void SphereHierarchy::ComputeDerived() {
     stack.push_back({right_[node], false});
     stack.push_back({left_[node], false});
   }
+  ordered_spheres_.resize(spheres_.size());
+  for (std::size_t i = 0; i < spheres_.size(); ++i) {
+    ordered_spheres_[i] = spheres_[static_cast<std::size_t>(leaf_order_[i])];
+  }
   if (volume_ == HierarchyVolume::kSphere) {
     outer_spheres_ = bounding_spheres_;
-    return;
+  } else {
+    outer_spheres_.resize(rss_.size());
+    for (std::size_t i = 0; i < rss_.size(); ++i) {
+      const Rss& r = rss_[i];
+      const double half0 = 0.5 * r.length[0], half1 = 0.5 * r.length[1];
+      Sphere& s = outer_spheres_[i];
+      s.center = r.origin + half0 * r.axes.col(0) + half1 * r.axes.col(1);
+      // Padded: the corners' distance from the centre, computed, may round below the true one.
+      s.radius = (r.radius + std::sqrt(half0 * half0 + half1 * half1)) *
+                 (1.0 + 8.0 * std::numeric_limits<double>::epsilon());
+    }
   }
-  outer_spheres_.resize(rss_.size());
-  for (std::size_t i = 0; i < rss_.size(); ++i) {
-    const Rss& r = rss_[i];
-    const double half0 = 0.5 * r.length[0], half1 = 0.5 * r.length[1];
-    Sphere& s = outer_spheres_[i];
-    s.center = r.origin + half0 * r.axes.col(0) + half1 * r.axes.col(1);
-    // Padded: the corners' distance from the centre, computed, may round below the true one.
-    s.radius = (r.radius + std::sqrt(half0 * half0 + half1 * half1)) *
-               (1.0 + 8.0 * std::numeric_limits<double>::epsilon());
+  slots_.resize(nodes + spheres_.size());
+  for (std::size_t i = 0; i < nodes; ++i) {
+    slots_[i] = Slot{outer_spheres_[i].center,
+                     outer_spheres_[i].radius,
+                     first_[i],
+                     count_[i],
+                     left_[i],
+                     right_[i]};
+  }
+  for (std::size_t i = 0; i < spheres_.size(); ++i) {
+    slots_[nodes + i] = Slot{spheres_[i].center, spheres_[i].radius, leaf_position_[i], 1, 0, 0};
   }
 }
 

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 #include <string>
 #include <vector>
@@ -55,6 +56,35 @@ void ExpectNodesBoundTheirSpheres(const SphereHierarchy& h) {
                       << " sticks out by " << excess;
       }
     }
+    // The query's record of the node: the same children, the sphere around the volume holding
+    // every sphere below, and a range of ordered_spheres() holding exactly those spheres.
+    const SphereHierarchy::Slot& slot = h.slot(node);
+    EXPECT_EQ(slot.left, h.left(node));
+    EXPECT_EQ(slot.right, h.right(node));
+    ASSERT_EQ(slot.count, static_cast<std::int32_t>(below.size()));
+    std::vector<std::int32_t> in_range(h.leaf_order().begin() + slot.first,
+                                       h.leaf_order().begin() + slot.first + slot.count);
+    std::sort(in_range.begin(), in_range.end());
+    std::sort(below.begin(), below.end());
+    EXPECT_EQ(in_range, below) << "node " << node;
+    for (const std::int32_t i : below) {
+      const Sphere& s = h.spheres()[static_cast<std::size_t>(i)];
+      const double excess = (s.center - slot.center).norm() + s.radius - slot.radius;
+      if (excess > 1e-12 && failures++ < 5) {
+        ADD_FAILURE() << "slot of node " << node << ": sphere " << i << " sticks out by " << excess;
+      }
+    }
+  }
+  // Leaves: the sphere itself, found at its place in ordered_spheres().
+  for (std::size_t i = 0; i < h.spheres().size(); ++i) {
+    const SphereHierarchy::Slot& slot = h.slot(-1 - static_cast<std::int32_t>(i));
+    const Sphere& ordered = h.ordered_spheres()[static_cast<std::size_t>(slot.first)];
+    EXPECT_EQ(slot.count, 1);
+    EXPECT_EQ(h.leaf_order()[static_cast<std::size_t>(slot.first)], static_cast<std::int32_t>(i));
+    EXPECT_EQ(slot.center, h.spheres()[i].center);
+    EXPECT_EQ(slot.radius, h.spheres()[i].radius);
+    EXPECT_EQ(ordered.center, h.spheres()[i].center);
+    EXPECT_EQ(ordered.radius, h.spheres()[i].radius);
   }
   EXPECT_EQ(failures, 0);
 }
@@ -133,6 +163,7 @@ TEST(SphereHierarchy, SerialisationRoundTripsAndRefusesCorruption) {
     ASSERT_TRUE(back.ok()) << back.status();
     EXPECT_EQ(back->Serialize(), bytes);
     EXPECT_EQ(back->depth(), h->depth());
+    ExpectNodesBoundTheirSpheres(*back);  // the derived records are rebuilt too
 
     for (std::size_t n = 0; n < bytes.size(); n += (n < 64 ? 1 : 37)) {
       EXPECT_FALSE(SphereHierarchy::Deserialize(bytes.substr(0, n)).ok()) << n;

@@ -72,6 +72,25 @@ class SphereHierarchy {
   }
   // Sphere indices in the order the leaves are met depth-first.
   const std::vector<std::int32_t>& leaf_order() const { return leaf_order_; }
+  // The spheres in leaf_order(): a node's spheres are the contiguous range [first, first +
+  // count). Derived, not serialised.
+  const std::vector<Sphere>& ordered_spheres() const { return ordered_spheres_; }
+
+  // What the distance query reads at each step about one node or leaf, in one record: the
+  // sphere around it (outer_sphere(), or the leaf's own), its range in ordered_spheres(), and
+  // a node's children (0 for a leaf). Derived, not serialised.
+  struct Slot {
+    Vector3 center;
+    double radius;
+    std::int32_t first, count;
+    HierarchyRef left, right;
+  };
+  // Nodes first (slot = ref), then leaves (slot = num_nodes() + sphere).
+  std::size_t slot_index(HierarchyRef ref) const {
+    return ref >= 0 ? static_cast<std::size_t>(ref)
+                    : left_.size() + static_cast<std::size_t>(LeafSphere(ref));
+  }
+  const Slot& slot(HierarchyRef ref) const { return slots_[slot_index(ref)]; }
   // Longest path from the root to a leaf, in edges.
   int depth() const { return depth_; }
 
@@ -100,6 +119,8 @@ class SphereHierarchy {
   std::vector<Sphere> bounding_spheres_;
   std::vector<Sphere> outer_spheres_;
   std::vector<std::int32_t> leaf_order_, leaf_position_, first_, count_;
+  std::vector<Sphere> ordered_spheres_;
+  std::vector<Slot> slots_;
   int depth_ = 0;
 };
 

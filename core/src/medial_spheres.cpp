@@ -376,7 +376,9 @@ absl::StatusOr<MedialSphereResult> GenerateMedialSpheres(const BoundaryOracle& o
 
   if (Cancelled(control)) return absl::CancelledError("medial-sphere generation cancelled");
   std::int64_t queries = 0;
-  const std::vector<VisitedVoxel> voxels = internal::CullVoxels(oracle, *grid, queries);
+  const std::vector<VisitedVoxel> voxels =
+      internal::CullVoxels(oracle, *grid, queries, control.cancel);
+  if (Cancelled(control)) return absl::CancelledError("medial-sphere generation cancelled");
   result.stats.visited_voxels = static_cast<std::int64_t>(voxels.size());
   for (const VisitedVoxel& voxel : voxels) result.stats.boundary_voxels += voxel.boundary;
 
@@ -384,8 +386,9 @@ absl::StatusOr<MedialSphereResult> GenerateMedialSpheres(const BoundaryOracle& o
   // that the output order, and so the output, do not depend on scheduling.
   std::vector<char> screened_in;
   if (options.corner_screen) {
-    screened_in = internal::ScreenByCorners(oracle, *grid, voxels,
-                                            options.object_angle - kCornerScreenMargin, queries);
+    screened_in = internal::ScreenByCorners(
+        oracle, *grid, voxels, options.object_angle - kCornerScreenMargin, queries, control.cancel);
+    if (Cancelled(control)) return absl::CancelledError("medial-sphere generation cancelled");
   }
   for (char pass : screened_in) result.stats.screened_voxels += pass == 0;
   const int slots = options.subdivide_boundary ? 8 : 1;

@@ -59,7 +59,10 @@ absl::StatusOr<Grid> MakeGrid(const BoundingBox& box, double size, std::int64_t 
 // blocks of voxels: a block whose centre lies outside by more than the block's circumradius is
 // dropped whole; one inside by more than that is kept whole without further queries.
 std::vector<VisitedVoxel> CullVoxels(const BoundaryOracle& oracle, const Grid& grid,
-                                     std::int64_t& queries) {
+                                     std::int64_t& queries, const std::atomic<bool>* cancel) {
+  auto cancelled = [cancel] {
+    return cancel != nullptr && cancel->load(std::memory_order_relaxed);
+  };
   struct Block {
     std::array<std::int64_t, 3> start;
     std::int64_t size;  // power of two, in voxels
@@ -81,11 +84,12 @@ std::vector<VisitedVoxel> CullVoxels(const BoundaryOracle& oracle, const Grid& g
       }
     }
   };
-  while (!blocks.empty()) {
+  while (!blocks.empty() && !cancelled()) {
     std::vector<double> distances(blocks.size());
     std::vector<double> radii(blocks.size());
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks.size(), 64),
                       [&](const tbb::blocked_range<std::size_t>& range) {
+                        if (cancelled()) return;  // the result is discarded
                         for (std::size_t b = range.begin(); b != range.end(); ++b) {
                           const Block& block = blocks[b];
                           Vector3 lo = grid.corner(block.start[0], block.start[1], block.start[2]);
@@ -131,7 +135,7 @@ std::vector<VisitedVoxel> CullVoxels(const BoundaryOracle& oracle, const Grid& g
 // within (theta - margin) of each other is skipped. Returns one flag per visited voxel.
 std::vector<char> ScreenByCorners(const BoundaryOracle& oracle, const Grid& grid,
                                   const std::vector<VisitedVoxel>& voxels, double min_angle,
-                                  std::int64_t& queries) {
+                                  std::int64_t& queries, const std::atomic<bool>* cancel) {
   const std::int64_t vx = grid.dims[0] + 1;
   const std::int64_t vy = grid.dims[1] + 1;
   auto vertex_id = [&](std::int64_t i, std::int64_t j, std::int64_t k) {
@@ -152,6 +156,8 @@ std::vector<char> ScreenByCorners(const BoundaryOracle& oracle, const Grid& grid
   const Mesh& mesh = oracle.mesh();
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, vertices.size(), 256),
                     [&](const tbb::blocked_range<std::size_t>& range) {
+                      // Cancelled: stop; the caller discards the (incomplete) result.
+                      if (cancel != nullptr && cancel->load(std::memory_order_relaxed)) return;
                       for (std::size_t v = range.begin(); v != range.end(); ++v) {
                         const std::int64_t id = vertices[v];
                         const Vector3 x = grid.corner(id % vx, (id / vx) % vy, id / (vx * vy));

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <vector>
 
@@ -37,14 +38,16 @@ struct VisitedVoxel {
 absl::StatusOr<Grid> MakeGrid(const BoundingBox& box, double size, std::int64_t max_voxels);
 
 // Voxels inside the mesh or possibly crossed by its boundary, sorted by linear index. Adds the
-// closest-point queries it made to `queries`.
+// closest-point queries it made to `queries`. When `*cancel` becomes true the work stops early
+// and the result is incomplete: the caller must check the flag and discard it.
 std::vector<VisitedVoxel> CullVoxels(const BoundaryOracle& oracle, const Grid& grid,
-                                     std::int64_t& queries);
+                                     std::int64_t& queries,
+                                     const std::atomic<bool>* cancel = nullptr);
 
 // One flag per voxel: 1 when its 8 corners' inward directions at their nearest boundary
 // points differ by at least `min_angle` (radians) for some pair. Adds its queries to `queries`.
 std::vector<char> ScreenByCorners(const BoundaryOracle& oracle, const Grid& grid,
                                   const std::vector<VisitedVoxel>& voxels, double min_angle,
-                                  std::int64_t& queries);
+                                  std::int64_t& queries, const std::atomic<bool>* cancel = nullptr);
 
 }  // namespace inscribe::internal

@@ -1,5 +1,7 @@
 #include "inscribe/server/convert.h"
 
+#include <cmath>
+
 #include "absl/strings/str_cat.h"
 
 namespace inscribe::server {
@@ -167,6 +169,159 @@ absl::Status FromGrpcStatus(const grpc::Status& status) {
   return absl::Status(code > 0 && code <= kLastCanonicalCode ? static_cast<absl::StatusCode>(code)
                                                              : absl::StatusCode::kUnknown,
                       status.error_message());
+}
+
+void SphereSetToProto(const SphereSet& set, v1::SphereSet* out) {
+  out->Clear();
+  out->mutable_centers()->Reserve(static_cast<int>(3 * set.size()));
+  out->mutable_radii()->Reserve(static_cast<int>(set.size()));
+  for (const Sphere& s : set.spheres) {
+    for (int k = 0; k < kPerRow; ++k) out->add_centers(s.center[k]);
+    out->add_radii(s.radius);
+  }
+  for (const SurfaceContact& c : set.contacts) {
+    out->add_contact_triangles(c.triangle);
+    for (int k = 0; k < kPerRow; ++k) out->add_contact_barycentrics(c.barycentric[k]);
+  }
+}
+
+absl::StatusOr<SphereSet> SphereSetFromProto(const v1::SphereSet& set, absl::string_view field) {
+  const int n = set.radii_size();
+  if (set.centers_size() != kPerRow * n) {
+    return absl::InvalidArgumentError(absl::StrCat(field, ".centers has length ",
+                                                   set.centers_size(), "; expected 3 per radius (",
+                                                   n, " radii)"));
+  }
+  const bool contacts = set.contact_triangles_size() > 0 || set.contact_barycentrics_size() > 0;
+  if (contacts && (set.contact_triangles_size() != n || set.contact_barycentrics_size() != 3 * n)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        field, ": contacts need one triangle and 3 barycentrics per sphere (", n, " spheres), got ",
+        set.contact_triangles_size(), " and ", set.contact_barycentrics_size()));
+  }
+  SphereSet out;
+  out.spheres.resize(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    Sphere& s = out.spheres[static_cast<std::size_t>(i)];
+    s.center = Vector3(set.centers(3 * i), set.centers(3 * i + 1), set.centers(3 * i + 2));
+    s.radius = set.radii(i);
+    if (!s.center.allFinite()) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(field, ": sphere ", i, " has a non-finite centre"));
+    }
+    if (!std::isfinite(s.radius) || s.radius <= 0.0) {
+      return absl::InvalidArgumentError(absl::StrCat(field, ": sphere ", i, " has radius ",
+                                                     s.radius, "; radii must be finite and > 0"));
+    }
+  }
+  if (contacts) {
+    out.contacts.resize(static_cast<std::size_t>(n));
+    for (int i = 0; i < n; ++i) {
+      SurfaceContact& c = out.contacts[static_cast<std::size_t>(i)];
+      c.triangle = set.contact_triangles(i);
+      c.barycentric = Vector3(set.contact_barycentrics(3 * i), set.contact_barycentrics(3 * i + 1),
+                              set.contact_barycentrics(3 * i + 2));
+      if (!c.barycentric.allFinite()) {
+        return absl::InvalidArgumentError(
+            absl::StrCat(field, ": sphere ", i, " has non-finite contact barycentrics"));
+      }
+    }
+  }
+  return out;
+}
+
+void QualityReportToProto(const QualityReport& r, v1::QualityReport* out) {
+  out->set_spheres(r.spheres);
+  out->set_volume_mesh(r.volume_mesh);
+  out->set_volume_union(r.volume_union);
+  out->set_nerr(r.nerr);
+  out->set_nerr_is_exact(r.nerr_is_exact);
+  out->set_protrusion_max(r.protrusion_max);
+  out->set_protrusion_mean(r.protrusion_mean);
+  out->set_protrusion_p95(r.protrusion_p95);
+  out->set_protruding_spheres(r.protruding_spheres);
+  out->set_bbox_diagonal(r.bbox_diagonal);
+  out->set_surface_samples(r.surface_samples);
+  out->set_coverage(r.coverage);
+  out->set_coverage_tolerance(r.coverage_tolerance);
+  out->set_boundary_to_union_mean(r.boundary_to_union_mean);
+  out->set_boundary_to_union_hausdorff(r.boundary_to_union_hausdorff);
+  out->set_radius_min(r.radius_min);
+  out->set_radius_max(r.radius_max);
+  out->set_fat(r.fat);
+  out->set_voxel_size(r.voxel_size);
+  out->set_seconds(r.seconds);
+}
+
+void PoseToProto(const RigidPose& pose, v1::Pose* out) {
+  out->set_qw(pose.rotation.w());
+  out->set_qx(pose.rotation.x());
+  out->set_qy(pose.rotation.y());
+  out->set_qz(pose.rotation.z());
+  out->set_tx(pose.translation.x());
+  out->set_ty(pose.translation.y());
+  out->set_tz(pose.translation.z());
+}
+
+namespace {
+
+absl::StatusOr<RigidPose> MakePose(const double* v, absl::string_view what) {
+  RigidPose pose;
+  pose.rotation = Eigen::Quaterniond(v[0], v[1], v[2], v[3]);
+  pose.translation = Vector3(v[4], v[5], v[6]);
+  absl::StatusOr<RigidPose> normalized = NormalizedPose(pose);
+  if (!normalized.ok()) {
+    return absl::InvalidArgumentError(absl::StrCat(what, ": ", normalized.status().message()));
+  }
+  return normalized;
+}
+
+constexpr int kPoseNumbers = 7;  // qw, qx, qy, qz, tx, ty, tz
+
+}  // namespace
+
+absl::StatusOr<RigidPose> PoseFromProto(const v1::Pose& pose, absl::string_view field) {
+  const double v[kPoseNumbers] = {pose.qw(), pose.qx(), pose.qy(), pose.qz(),
+                                  pose.tx(), pose.ty(), pose.tz()};
+  return MakePose(v, field);
+}
+
+void PosesToProto(const std::vector<RigidPose>& poses, v1::PoseArray* out) {
+  out->Clear();
+  out->mutable_values()->Reserve(static_cast<int>(kPoseNumbers * poses.size()));
+  for (const RigidPose& p : poses) {
+    for (double v : {p.rotation.w(), p.rotation.x(), p.rotation.y(), p.rotation.z(),
+                     p.translation.x(), p.translation.y(), p.translation.z()}) {
+      out->add_values(v);
+    }
+  }
+}
+
+absl::StatusOr<std::vector<RigidPose>> PosesFromProto(const v1::PoseArray& poses,
+                                                      absl::string_view field) {
+  if (poses.values_size() % kPoseNumbers != 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(field, " has length ", poses.values_size(),
+                     "; expected a multiple of 7 (qw, qx, qy, qz, tx, ty, tz per pose)"));
+  }
+  std::vector<RigidPose> out(static_cast<std::size_t>(poses.values_size() / kPoseNumbers));
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    absl::StatusOr<RigidPose> pose =
+        MakePose(poses.values().data() + kPoseNumbers * i, absl::StrCat(field, " pose ", i));
+    if (!pose.ok()) return pose.status();
+    out[i] = *pose;
+  }
+  return out;
+}
+
+void AppendDistanceResults(const std::vector<DistanceResult>& results, v1::DistanceResults* out) {
+  for (const DistanceResult& r : results) {
+    out->add_distances(r.distance);
+    out->add_spheres_a(r.sphere_a);
+    out->add_spheres_b(r.sphere_b);
+    for (int k = 0; k < kPerRow; ++k) out->add_points_a(r.point_a[k]);
+    for (int k = 0; k < kPerRow; ++k) out->add_points_b(r.point_b[k]);
+    out->add_closer(r.closer);
+  }
 }
 
 }  // namespace inscribe::server

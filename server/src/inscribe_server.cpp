@@ -32,6 +32,10 @@ absl::Status CheckOptions(const ServerOptions& options) {
   if (options.limits.max_triangles < 1) {
     return absl::InvalidArgumentError("--max-triangles must be >= 1");
   }
+  if (options.limits.max_voxels < 1 || options.limits.max_spheres < 1 ||
+      options.limits.max_poses < 1) {
+    return absl::InvalidArgumentError("--max-voxels, --max-spheres and --max-poses must be >= 1");
+  }
   return absl::OkStatus();
 }
 
@@ -44,10 +48,14 @@ int ResolveJobs(int jobs) {
 
 // Declaration order is construction order: the gRPC server is destroyed first, the pool last.
 struct InscribeServer::Parts {
-  Parts(const JobPoolOptions& pool_options, const ServiceLimits& limits, CallObserver observer)
-      : pool(pool_options), service(&pool, limits, std::move(observer)) {}
+  Parts(const JobPoolOptions& pool_options, std::unique_ptr<ResultCache> result_cache,
+        const ServiceLimits& limits, CallObserver observer)
+      : pool(pool_options),
+        cache(std::move(result_cache)),
+        service(&pool, cache.get(), limits, std::move(observer)) {}
 
   JobPool pool;
+  std::unique_ptr<ResultCache> cache;
   InscribeService service;
   std::unique_ptr<grpc::Server> server;
 
@@ -61,8 +69,10 @@ absl::StatusOr<std::unique_ptr<InscribeServer>> InscribeServer::Start(
     const ServerOptions& options) {
   if (absl::Status s = CheckOptions(options); !s.ok()) return s;
   const int jobs = ResolveJobs(options.jobs);
-  auto parts = std::make_unique<Parts>(JobPoolOptions{jobs, options.max_queue}, options.limits,
-                                       options.on_call);
+  absl::StatusOr<std::unique_ptr<ResultCache>> cache = ResultCache::Open(options.cache);
+  if (!cache.ok()) return cache.status();
+  auto parts = std::make_unique<Parts>(JobPoolOptions{jobs, options.max_queue}, *std::move(cache),
+                                       options.limits, options.on_call);
 
   // Both are process-wide switches read by the builder; setting them again is harmless.
   grpc::EnableDefaultHealthCheckService(true);

@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <exception>
+#include <functional>
 #include <new>
 #include <utility>
 
@@ -9,6 +10,7 @@
 #include "inscribe/mesh_hash.h"
 #include "inscribe/mesh_validation.h"
 #include "inscribe/server/convert.h"
+#include "result_store.h"
 
 namespace inscribe::server {
 namespace {
@@ -45,16 +47,36 @@ absl::Status RunInspectMesh(const v1::InspectMeshRequest& request,
 
 }  // namespace
 
-InscribeService::InscribeService(JobPool* pool, const ServiceLimits& limits, CallObserver observer)
-    : pool_(pool), limits_(limits), observer_(std::move(observer)) {}
+InscribeService::InscribeService(JobPool* pool, ResultCache* cache, const ServiceLimits& limits,
+                                 CallObserver observer)
+    : pool_(pool),
+      store_(
+          std::make_unique<ResultStore>(cache, StoreLimits{limits.max_voxels, limits.max_spheres})),
+      limits_(limits),
+      observer_(std::move(observer)) {}
+
+InscribeService::~InscribeService() = default;
+
+void InscribeService::CallStarted() {
+  std::lock_guard<std::mutex> lock(calls_mutex_);
+  ++active_calls_;
+}
+
+void InscribeService::CallEnded() {
+  std::lock_guard<std::mutex> lock(calls_mutex_);
+  if (--active_calls_ == 0) calls_answered_.notify_all();
+}
+
+void InscribeService::Observe(const CallRecord& record) const {
+  if (observer_) observer_(record);
+}
 
 void InscribeService::Finish(grpc::ServerUnaryReactor* reactor, CallRecord& record,
                              const absl::Status& status) {
   record.status = status;
-  if (observer_) observer_(record);
+  Observe(record);
   reactor->Finish(ToGrpcStatus(status));
-  std::lock_guard<std::mutex> lock(calls_mutex_);
-  if (--active_calls_ == 0) calls_answered_.notify_all();
+  CallEnded();
 }
 
 void InscribeService::StartDraining() { draining_.store(true); }
@@ -64,40 +86,28 @@ bool InscribeService::WaitForCalls(std::chrono::system_clock::time_point deadlin
   return calls_answered_.wait_until(lock, deadline, [this] { return active_calls_ == 0; });
 }
 
-grpc::ServerUnaryReactor* InscribeService::InspectMesh(grpc::CallbackServerContext* context,
-                                                       const v1::InspectMeshRequest* request,
-                                                       v1::InspectMeshResponse* response) {
+grpc::ServerUnaryReactor* InscribeService::RunUnary(grpc::CallbackServerContext* context,
+                                                    const char* method, std::int64_t triangles,
+                                                    const absl::Status& precheck,
+                                                    std::function<absl::Status()> body) {
   grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
   const Clock::time_point arrived = Clock::now();
   CallRecord record;
-  record.method = "InspectMesh";
+  record.method = method;
   record.peer = context->peer();
-  record.triangles = TriangleCount(request->mesh());
-  {
-    std::lock_guard<std::mutex> lock(calls_mutex_);
-    ++active_calls_;
-  }
-
+  record.triangles = triangles;
+  CallStarted();
   if (draining_.load()) {
     Finish(reactor, record, absl::UnavailableError("server is shutting down; retry"));
     return reactor;
   }
-
   // O(1) checks stay on the gRPC thread, so bad or oversized requests never occupy the queue.
-  if (absl::Status shape = CheckMeshShape(request->mesh()); !shape.ok()) {
-    Finish(reactor, record, shape);
+  if (!precheck.ok()) {
+    Finish(reactor, record, precheck);
     return reactor;
   }
-  if (record.triangles > limits_.max_triangles) {
-    Finish(reactor, record,
-           absl::ResourceExhaustedError(absl::StrCat(
-               "mesh has ", record.triangles,
-               " triangles; this server's limit (--max-triangles) is ", limits_.max_triangles)));
-    return reactor;
-  }
-
-  const bool queued = pool_->TrySubmit([this, context, request, response, reactor, arrived,
-                                        record]() mutable {
+  const bool queued = pool_->TrySubmit([this, context, reactor, arrived, record,
+                                        body = std::move(body)]() mutable {
     record.queued_seconds = SecondsSince(arrived);
     // The caller may have given up (cancel, disconnect) while the job waited; a passed
     // deadline counts too, even before gRPC has noticed it and cancelled the call.
@@ -111,21 +121,40 @@ grpc::ServerUnaryReactor* InscribeService::InspectMesh(grpc::CallbackServerConte
     }
     const Clock::time_point started = Clock::now();
     absl::Status status;
-    // Jobs must not throw (JobPool); running out of memory on a huge mesh is the one exception
-    // worth expecting here, and is the caller's to act on.
+    // Jobs must not throw (JobPool); running out of memory on a huge request is the one
+    // exception worth expecting here, and is the caller's to act on.
     try {
-      status = RunInspectMesh(*request, response);
+      status = body();
     } catch (const std::bad_alloc&) {
-      status = absl::ResourceExhaustedError(
-          "server ran out of memory inspecting the mesh; send a smaller mesh or retry later");
+      status =
+          absl::ResourceExhaustedError(absl::StrCat("server ran out of memory in ", record.method,
+                                                    "; send a smaller request or retry later"));
     } catch (const std::exception& e) {
-      status = absl::InternalError(absl::StrCat("inspecting the mesh failed: ", e.what()));
+      status = absl::InternalError(absl::StrCat(record.method, " failed: ", e.what()));
     }
     record.run_seconds = SecondsSince(started);
     Finish(reactor, record, status);
   });
   if (!queued) Finish(reactor, record, QueueFullError(*pool_));
   return reactor;
+}
+
+absl::Status InscribeService::CheckMesh(const v1::Mesh& mesh) const {
+  if (absl::Status shape = CheckMeshShape(mesh); !shape.ok()) return shape;
+  if (TriangleCount(mesh) > limits_.max_triangles) {
+    return absl::ResourceExhaustedError(absl::StrCat(
+        "mesh has ", TriangleCount(mesh), " triangles; this server's limit (--max-triangles) is ",
+        limits_.max_triangles));
+  }
+  return absl::OkStatus();
+}
+
+grpc::ServerUnaryReactor* InscribeService::InspectMesh(grpc::CallbackServerContext* context,
+                                                       const v1::InspectMeshRequest* request,
+                                                       v1::InspectMeshResponse* response) {
+  return RunUnary(context, "InspectMesh", TriangleCount(request->mesh()),
+                  CheckMesh(request->mesh()),
+                  [request, response] { return RunInspectMesh(*request, response); });
 }
 
 }  // namespace inscribe::server

@@ -61,6 +61,22 @@ int main(int argc, char** argv) {
   app.add_option("--max-triangles", options.limits.max_triangles, "triangles in one mesh")
       ->check(CLI::Range(std::int64_t{1}, std::int64_t{INT_MAX}))
       ->capture_default_str();
+  app.add_option("--max-voxels", options.limits.max_voxels, "voxels in one generation grid")
+      ->check(CLI::Range(std::int64_t{1}, std::int64_t{1} << 40))
+      ->capture_default_str();
+  app.add_option("--max-spheres", options.limits.max_spheres, "sphere budget of one Generate call")
+      ->check(CLI::Range(std::int64_t{1}, std::int64_t{1} << 30))
+      ->capture_default_str();
+  app.add_option("--max-poses", options.limits.max_poses, "pose pairs in one Distance call")
+      ->check(CLI::Range(std::int64_t{1}, std::int64_t{1} << 30))
+      ->capture_default_str();
+  app.add_option("--cache-dir", options.cache.disk_dir,
+                 "directory of the on-disk result cache (created if missing); empty = memory only")
+      ->capture_default_str();
+  app.add_option("--cache-memory-bytes", options.cache.memory_bytes,
+                 "bytes of results kept in memory (least recently used dropped first)")
+      ->check(CLI::Range(std::int64_t{0}, std::int64_t{1} << 50))
+      ->capture_default_str();
   app.add_option("--shutdown-grace", shutdown_grace_seconds,
                  "seconds calls in progress get to finish after SIGTERM/SIGINT")
       ->check(CLI::Range(0.0, 3600.0))
@@ -84,9 +100,11 @@ int main(int argc, char** argv) {
     return 1;
   }
   spdlog::info(
-      "event=serving address={} jobs={} max_queue={} max_message_bytes={} max_triangles={}",
+      "event=serving address={} jobs={} max_queue={} max_message_bytes={} max_triangles={} "
+      "max_voxels={} max_spheres={} max_poses={} cache_dir=\"{}\" cache_memory_bytes={}",
       (*server)->address(), (*server)->jobs(), options.max_queue, options.max_message_bytes,
-      options.limits.max_triangles);
+      options.limits.max_triangles, options.limits.max_voxels, options.limits.max_spheres,
+      options.limits.max_poses, options.cache.disk_dir, options.cache.memory_bytes);
   std::fprintf(stderr, "inscribed listening on %s\n", (*server)->address().c_str());
   std::fflush(stderr);
 

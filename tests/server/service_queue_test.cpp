@@ -29,7 +29,8 @@ class ServiceQueueTest : public ::testing::Test {
  protected:
   void SetUp() override {
     pool_ = std::make_unique<JobPool>(JobPoolOptions{/*concurrency=*/1, /*max_jobs=*/2});
-    service_ = std::make_unique<InscribeService>(pool_.get(), ServiceLimits{},
+    cache_ = *ResultCache::Open(ResultCacheOptions{});
+    service_ = std::make_unique<InscribeService>(pool_.get(), cache_.get(), ServiceLimits{},
                                                  [this](const CallRecord& record) {
                                                    std::lock_guard<std::mutex> lock(records_mutex_);
                                                    records_.push_back(record);
@@ -88,6 +89,7 @@ class ServiceQueueTest : public ::testing::Test {
   std::promise<void> release_;
   bool released_ = false;
   std::unique_ptr<JobPool> pool_;
+  std::unique_ptr<ResultCache> cache_;
   std::unique_ptr<InscribeService> service_;
   std::unique_ptr<grpc::Server> server_;
   std::unique_ptr<v1::Inscribe::Stub> stub_;

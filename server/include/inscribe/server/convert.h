@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
@@ -12,7 +13,12 @@
 #include "grpcpp/support/status.h"
 #include "inscribe/mesh.h"
 #include "inscribe/mesh_validation.h"
+#include "inscribe/rigid_pose.h"
+#include "inscribe/separation_distance.h"
+#include "inscribe/sphere.h"
+#include "inscribe/sphere_quality.h"
 #include "inscribe/v1/mesh.pb.h"
+#include "inscribe/v1/spheres.pb.h"
 
 namespace inscribe::server {
 
@@ -41,6 +47,30 @@ void MeshReportToProto(const MeshReport& report, v1::MeshReport* out);
 // MeshReportToProto). An issue severity this build does not know (a newer server) becomes
 // kWarning. INVALID_ARGUMENT when bbox_min or bbox_max has a length other than 0 or 3.
 absl::StatusOr<MeshReport> MeshReportFromProto(const v1::MeshReport& report);
+
+// Spheres and contacts as packed arrays (contacts only when the set has them).
+void SphereSetToProto(const SphereSet& set, v1::SphereSet* out);
+
+// The inverse, checking shapes and numbers: INVALID_ARGUMENT naming the field (prefixed by
+// `field`) for centres not 3 per radius, contacts of the wrong length, a non-finite centre,
+// a radius that is not finite and > 0, or barycentrics that are not finite. O(#spheres).
+absl::StatusOr<SphereSet> SphereSetFromProto(const v1::SphereSet& set,
+                                             absl::string_view field = "spheres");
+
+void QualityReportToProto(const QualityReport& report, v1::QualityReport* out);
+
+void PoseToProto(const RigidPose& pose, v1::Pose* out);
+// The pose with its quaternion normalised (NormalizedPose); INVALID_ARGUMENT naming `field`.
+absl::StatusOr<RigidPose> PoseFromProto(const v1::Pose& pose, absl::string_view field = "pose");
+
+void PosesToProto(const std::vector<RigidPose>& poses, v1::PoseArray* out);
+// Every pose normalised; INVALID_ARGUMENT naming the field and the pose index for a length
+// that is not a multiple of 7 or a bad pose.
+absl::StatusOr<std::vector<RigidPose>> PosesFromProto(const v1::PoseArray& poses,
+                                                      absl::string_view field = "poses");
+
+// Appends one result per query (witness points in the world frame, as computed).
+void AppendDistanceResults(const std::vector<DistanceResult>& results, v1::DistanceResults* out);
 
 // absl and gRPC share the canonical status codes (same numbers, same meaning), so these map
 // code and message unchanged; error details are not carried.

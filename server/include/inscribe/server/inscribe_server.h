@@ -23,6 +23,8 @@ struct ServerOptions {
   // triangles with ~2.5M vertices). gRPC's own default, 4 MiB, is too small for meshes.
   int max_message_bytes = 256 * 1024 * 1024;
   ServiceLimits limits;
+  // --cache-memory-bytes and --cache-dir: the result cache's tiers.
+  ResultCacheOptions cache;
   // Told about every finished call; see CallObserver. May be empty.
   CallObserver on_call;
 };

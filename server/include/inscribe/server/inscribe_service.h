@@ -6,14 +6,18 @@
 #include <condition_variable>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <mutex>
 #include <string>
 
 #include "absl/status/status.h"
 #include "inscribe/server/job_pool.h"
+#include "inscribe/server/result_cache.h"
 #include "inscribe/v1/service.grpc.pb.h"
 
 namespace inscribe::server {
+
+class ResultStore;
 
 // Per-request limits. Each is a flag of `inscribed` with the same name; a breach is
 // RESOURCE_EXHAUSTED with a message naming the flag.
@@ -21,6 +25,12 @@ struct ServiceLimits {
   // --max-triangles: triangles in one mesh. Validation costs O(#T log #T) time and ~100 bytes
   // of memory per triangle on top of the request.
   std::int64_t max_triangles = 5'000'000;
+  // --max-voxels: voxels in one generation grid (a finer grid is INVALID_ARGUMENT up front).
+  std::int64_t max_voxels = 20'000'000;
+  // --max-spheres: a Generate sphere budget, and spheres in one inline sphere set.
+  std::int64_t max_spheres = 1'000'000;
+  // --max-poses: pose pairs in one Distance call, or object pairs in one stream frame.
+  std::int64_t max_poses = 1'000'000;
 };
 
 // What the service did with one call, for access logs and metrics. Times in seconds.
@@ -42,13 +52,35 @@ using CallObserver = std::function<void(const CallRecord&)>;
 // the service and be drained (JobPool::WaitIdle) before the service is destroyed.
 class InscribeService final : public v1::Inscribe::CallbackService {
  public:
-  InscribeService(JobPool* pool, const ServiceLimits& limits, CallObserver observer = nullptr);
+  // `cache` holds meshes and results; it must outlive the service.
+  InscribeService(JobPool* pool, ResultCache* cache, const ServiceLimits& limits,
+                  CallObserver observer = nullptr);
+  ~InscribeService() override;
 
   // Validates the mesh (core ValidateMesh, orientation fixed) and replies with the report and
   // the hash of the fixed mesh. Errors: see service.proto.
   grpc::ServerUnaryReactor* InspectMesh(grpc::CallbackServerContext* context,
                                         const v1::InspectMeshRequest* request,
                                         v1::InspectMeshResponse* response) override;
+
+  // The RPCs below: see service.proto for what each returns and its errors.
+  grpc::ServerUnaryReactor* PutMesh(grpc::CallbackServerContext* context,
+                                    const v1::PutMeshRequest* request,
+                                    v1::PutMeshResponse* response) override;
+  grpc::ServerWriteReactor<v1::GenerateResponse>* Generate(
+      grpc::CallbackServerContext* context, const v1::GenerateRequest* request) override;
+  grpc::ServerUnaryReactor* GetSphereSet(grpc::CallbackServerContext* context,
+                                         const v1::GetSphereSetRequest* request,
+                                         v1::GetSphereSetResponse* response) override;
+  grpc::ServerUnaryReactor* GetHierarchy(grpc::CallbackServerContext* context,
+                                         const v1::GetHierarchyRequest* request,
+                                         v1::GetHierarchyResponse* response) override;
+  grpc::ServerUnaryReactor* Distance(grpc::CallbackServerContext* context,
+                                     const v1::DistanceRequest* request,
+                                     v1::DistanceResponse* response) override;
+  grpc::ServerUnaryReactor* CacheStats(grpc::CallbackServerContext* context,
+                                       const v1::CacheStatsRequest* request,
+                                       v1::CacheStatsResponse* response) override;
 
   // Graceful shutdown, first half: from now on new calls get UNAVAILABLE ("server is shutting
   // down"), which clients retry, later or on another replica; calls already accepted go on.
@@ -65,7 +97,26 @@ class InscribeService final : public v1::Inscribe::CallbackService {
   // as active.
   void Finish(grpc::ServerUnaryReactor* reactor, CallRecord& record, const absl::Status& status);
 
+  // The shape of every unary call: counts it as active, refuses it while draining or when
+  // `precheck` (O(1) checks done on the gRPC thread) failed, else runs `body` on the pool
+  // (after checking the caller is still waiting and within its deadline) and replies with its
+  // status. `body` may throw std::bad_alloc (RESOURCE_EXHAUSTED) but nothing else escapes.
+  grpc::ServerUnaryReactor* RunUnary(grpc::CallbackServerContext* context, const char* method,
+                                     std::int64_t triangles, const absl::Status& precheck,
+                                     std::function<absl::Status()> body);
+
+  // Shape and --max-triangles of a request's mesh: INVALID_ARGUMENT or RESOURCE_EXHAUSTED.
+  absl::Status CheckMesh(const v1::Mesh& mesh) const;
+
+  // Active-call bookkeeping shared by unary and streaming calls.
+  void CallStarted();
+  void CallEnded();
+  // Tells the observer; for streaming calls, which finish through their own reactor.
+  void Observe(const CallRecord& record) const;
+  friend class GenerateReactor;
+
   JobPool* const pool_;
+  std::unique_ptr<ResultStore> store_;
   const ServiceLimits limits_;
   const CallObserver observer_;
 

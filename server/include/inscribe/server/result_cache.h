@@ -1,0 +1,127 @@
+// The server's cache of computed results (validated meshes, sphere sets, hierarchies), keyed by
+// content: two tiers, an in-memory LRU bounded in bytes and an optional on-disk
+// content-addressed directory, with single flight (concurrent requests for one key compute it
+// once).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
+
+namespace inscribe::server {
+
+struct ResultCacheOptions {
+  // --cache-memory-bytes: the in-memory tier holds entries up to this many bytes in all (each
+  // entry counts its key's length, its bytes and its object_bytes); the least recently used go
+  // first. An entry larger than the whole budget is returned but not kept in memory.
+  std::int64_t memory_bytes = std::int64_t{1} << 30;
+  // --cache-dir: directory of the on-disk tier, created if missing; empty = no disk tier.
+  // Entries survive restarts; a file that fails its checks on read is deleted and recomputed.
+  // Files are disk_dir/<first 2 hex digits>/<64 hex digits of SHA-256(key)>. One process per
+  // directory: Open removes the temporary files it finds, and the disk counters assume no
+  // other writer.
+  std::string disk_dir;
+};
+
+// One cached result: its serialised bytes (what the disk tier stores and what RPCs ship) and,
+// optionally, a decoded object the service queries directly (e.g. a SphereHierarchy), so a hit
+// costs no parsing. Immutable once cached; shared by every caller holding it.
+struct CachedValue {
+  std::string bytes;
+  std::shared_ptr<const void> object;  // may be null
+  std::int64_t object_bytes = 0;       // memory the object holds, for the LRU budget
+
+  template <typename T>
+  std::shared_ptr<const T> As() const {
+    return std::static_pointer_cast<const T>(object);
+  }
+};
+
+// Where a lookup's value came from.
+enum class CacheSource {
+  kMemory,    // the in-memory tier
+  kDisk,      // the on-disk tier (checksum verified), now also in memory
+  kComputed,  // this call computed it
+  kJoined,    // an identical call was computing it; this one waited for that result
+};
+const char* CacheSourceName(CacheSource source);  // "memory", "disk", "computed", "joined"
+
+struct CacheLookup {
+  std::shared_ptr<const CachedValue> value;
+  CacheSource source = CacheSource::kMemory;
+};
+
+// Counters since the cache was opened (disk_entries / disk_bytes: what the directory holds
+// now, counted at open and kept up to date by this process). Each lookup (GetOrCompute or Get
+// with a well-formed key) counts in exactly one of memory_hits, disk_hits, misses and joined.
+struct ResultCacheStats {
+  std::int64_t entries = 0;  // in memory
+  std::int64_t bytes = 0;    // in memory (key length + bytes + object_bytes, summed)
+  std::int64_t memory_hits = 0;
+  std::int64_t disk_hits = 0;
+  std::int64_t misses = 0;        // lookups found in neither tier (GetOrCompute or Get)
+  std::int64_t computations = 0;  // compute functions run (failed ones included)
+  std::int64_t joined = 0;        // lookups that waited for an identical computation
+  std::int64_t evictions = 0;     // entries dropped from memory for the byte budget
+  std::int64_t disk_entries = 0;
+  std::int64_t disk_bytes = 0;
+  std::int64_t disk_errors = 0;        // disk files dropped (bad checksum, truncated, wrong key)
+  std::int64_t disk_write_errors = 0;  // results that could not be written (disk full, ...)
+};
+
+// Thread-safe. Keys are printable: 1-200 characters from [A-Za-z0-9._:/-], e.g.
+// "spheres/v1/<64 hex>"; callers derive them from content hashes, so equal keys mean equal
+// results. Disk files are named by the SHA-256 of the key.
+class ResultCache {
+ public:
+  // Turns stored bytes back into a value (decoding its object), moving `bytes` into the
+  // value's own `bytes`; used on disk hits. A failure counts as a corrupt entry: the file is
+  // dropped and the result recomputed (GetOrCompute) or reported missing (Get).
+  using Decode = std::function<absl::StatusOr<CachedValue>(std::string bytes)>;
+  // Must not look up its own key (it would wait for itself).
+  using Compute = std::function<absl::StatusOr<CachedValue>()>;
+
+  // Creates disk_dir if needed and counts what it holds. INVALID_ARGUMENT for a negative
+  // memory budget; FAILED_PRECONDITION naming the directory when it cannot be created or
+  // written.
+  static absl::StatusOr<std::unique_ptr<ResultCache>> Open(const ResultCacheOptions& options);
+
+  // No call may be in progress.
+  ~ResultCache();
+  ResultCache(const ResultCache&) = delete;
+  ResultCache& operator=(const ResultCache&) = delete;
+
+  // The value under `key`: from memory, else from disk (decoded, then kept in memory), else
+  // computed by `compute` on the calling thread, then stored in both tiers (the disk write is
+  // atomic: a temporary file, fsync, rename). While one call computes a key, other calls for
+  // the same key wait and share its result (or its error; errors are not cached). INVALID_
+  // ARGUMENT for a malformed key; otherwise compute's error.
+  absl::StatusOr<CacheLookup> GetOrCompute(absl::string_view key, const Compute& compute,
+                                           const Decode& decode);
+
+  // The value under `key` from either tier, or NOT_FOUND ("no cached entry <key>"). Waits for
+  // an identical computation in progress (NOT_FOUND, with its error, if that one fails).
+  absl::StatusOr<CacheLookup> Get(absl::string_view key, const Decode& decode);
+
+  // Stores a value computed elsewhere (e.g. an uploaded mesh) in both tiers, replacing none: an
+  // existing entry under `key` is kept (equal keys mean equal content) and returned; an
+  // existing disk file is not rewritten. INVALID_ARGUMENT for a malformed key.
+  absl::StatusOr<std::shared_ptr<const CachedValue>> Put(absl::string_view key, CachedValue value);
+
+  ResultCacheStats stats() const;
+
+ private:
+  struct Impl;
+  explicit ResultCache(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+// OK for a well-formed key, else INVALID_ARGUMENT saying why.
+absl::Status CheckCacheKey(absl::string_view key);
+
+}  // namespace inscribe::server

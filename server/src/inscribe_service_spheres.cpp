@@ -1,0 +1,330 @@
+// The InscribeService RPCs over stored meshes and cached results: PutMesh, Generate,
+// GetSphereSet, GetHierarchy, Distance, CacheStats. Each validates on the gRPC thread what is
+// O(1), then hands the rest to the pool through ResultStore (the cache).
+#include <atomic>
+#include <chrono>
+#include <mutex>
+#include <new>
+#include <optional>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+#include "inscribe/medial_spheres.h"
+#include "inscribe/separation_distance.h"
+#include "inscribe/server/convert.h"
+#include "inscribe/server/inscribe_service.h"
+#include "result_store.h"
+
+namespace inscribe::server {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double SecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+HierarchyVolume VolumeFromProto(v1::HierarchyVolume volume) {
+  return volume == v1::RSS ? HierarchyVolume::kRss : HierarchyVolume::kSphere;
+}
+
+absl::Status CheckKey(const std::string& key, const char* field) {
+  if (key.empty()) return absl::InvalidArgumentError(absl::StrCat(field, " is required"));
+  if (absl::Status s = CheckCacheKey(key); !s.ok()) {
+    return absl::InvalidArgumentError(absl::StrCat(field, ": ", s.message()));
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<DistanceRequest> ToleranceFromProto(const v1::DistanceTolerance& t) {
+  DistanceRequest request;
+  request.abs_err = t.abs_err();
+  request.rel_err = t.rel_err();
+  if (t.has_closer_than()) request.closer_than = t.closer_than();
+  if (!(std::isfinite(request.abs_err) && request.abs_err >= 0.0 &&
+        std::isfinite(request.rel_err) && request.rel_err >= 0.0) ||
+      std::isnan(request.closer_than)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "tolerance: abs_err and rel_err must be finite and >= 0 and closer_than a number, got ",
+        request.abs_err, ", ", request.rel_err, ", ", request.closer_than));
+  }
+  return request;
+}
+
+}  // namespace
+
+grpc::ServerUnaryReactor* InscribeService::PutMesh(grpc::CallbackServerContext* context,
+                                                   const v1::PutMeshRequest* request,
+                                                   v1::PutMeshResponse* response) {
+  return RunUnary(context, "PutMesh", TriangleCount(request->mesh()), CheckMesh(request->mesh()),
+                  [this, request, response]() -> absl::Status {
+                    absl::StatusOr<Mesh> mesh = MeshFromProto(request->mesh());
+                    if (!mesh.ok()) return mesh.status();
+                    bool already = false;
+                    absl::StatusOr<std::shared_ptr<const StoredMeshEntry>> stored =
+                        store_->PutMesh(*std::move(mesh), request->fill_holes(), &already);
+                    if (!stored.ok()) return stored.status();
+                    response->set_mesh_sha256((*stored)->key);
+                    MeshReportToProto((*stored)->report, response->mutable_report());
+                    response->set_already_stored(already);
+                    return absl::OkStatus();
+                  });
+}
+
+// Generate: a server-streaming call. The job on the pool reports progress; at most one write is
+// in flight, so progress messages that arrive during a write are dropped (the next one carries
+// a later fraction). The result is the last message. Cancellation (the caller gave up, or its
+// deadline passed) sets the flag generation polls, so the worker stops promptly.
+class GenerateReactor final : public grpc::ServerWriteReactor<v1::GenerateResponse> {
+ public:
+  GenerateReactor(InscribeService* service, grpc::CallbackServerContext* context,
+                  const v1::GenerateRequest* request)
+      : service_(service), context_(context), request_(request) {
+    record_.method = "Generate";
+    record_.peer = context->peer();
+  }
+
+  void Start() {
+    service_->CallStarted();
+    absl::Status precheck = CheckKey(request_->mesh_sha256(), "mesh_sha256");
+    if (precheck.ok()) precheck = CanonicalParameters(request_->parameters()).status();
+    if (service_->draining_.load()) {
+      precheck = absl::UnavailableError("server is shutting down; retry");
+    }
+    if (!precheck.ok()) {
+      Complete(precheck, nullptr);
+      return;
+    }
+    const Clock::time_point arrived = Clock::now();
+    const bool queued = service_->pool_->TrySubmit([this, arrived] { Run(arrived); });
+    if (!queued) {
+      Complete(absl::ResourceExhaustedError(absl::StrCat(
+                   "server is busy: the job queue is full; this server's limit (--max-queue) "
+                   "is ",
+                   service_->pool_->options().max_jobs, " queued or running jobs; retry later")),
+               nullptr);
+    }
+  }
+
+  void OnCancel() override { cancel_.store(true); }
+
+  void OnWriteDone(bool /*ok*/) override {
+    bool finish = false;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      writing_ = false;
+      finish = done_;
+    }
+    if (finish) SendFinal();
+  }
+
+  void OnDone() override {
+    service_->CallEnded();
+    delete this;
+  }
+
+ private:
+  void Run(Clock::time_point arrived) {
+    record_.queued_seconds = SecondsSince(arrived);
+    const auto deadline = context_->deadline();
+    if (context_->IsCancelled() || cancel_.load()) {
+      Complete(absl::CancelledError("call was cancelled before work started"), nullptr);
+      return;
+    }
+    if (std::chrono::system_clock::now() >= deadline) {
+      Complete(absl::DeadlineExceededError("deadline passed before work started"), nullptr);
+      return;
+    }
+    const double interval =
+        request_->progress_interval() > 0.0 ? request_->progress_interval() : 0.5;
+    Clock::time_point last_progress = Clock::now();
+    GenerationControl control;
+    control.cancel = &cancel_;
+    control.on_progress = [&](double fraction) {
+      // Deadlines are checked here too: gRPC cancels the call at the deadline, but the flag
+      // is what stops the worker, and progress comes often.
+      if (std::chrono::system_clock::now() >= deadline) cancel_.store(true);
+      if (SecondsSince(last_progress) >= interval) {
+        last_progress = Clock::now();
+        Progress(fraction);
+      }
+    };
+    const Clock::time_point started = Clock::now();
+    absl::StatusOr<std::pair<std::shared_ptr<const SphereSetEntry>, CacheSource>> result;
+    try {
+      result = service_->store_->Generate(*request_, control);
+    } catch (const std::bad_alloc&) {
+      result = absl::ResourceExhaustedError("server ran out of memory generating spheres");
+    }
+    record_.run_seconds = SecondsSince(started);
+    if (!result.ok() && result.status().code() == absl::StatusCode::kCancelled &&
+        std::chrono::system_clock::now() >= deadline) {
+      result = absl::DeadlineExceededError(absl::StrCat(
+          "deadline passed while generating; stopped after ", record_.run_seconds, " s"));
+    }
+    if (!result.ok()) {
+      Complete(result.status(), nullptr);
+      return;
+    }
+    auto final_message = std::make_unique<v1::GenerateResponse>();
+    v1::GenerateResult* out = final_message->mutable_result();
+    *out = result->first->result;
+    out->set_cache(CacheSourceName(result->second));
+    Complete(absl::OkStatus(), std::move(final_message));
+  }
+
+  void Progress(double fraction) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (writing_ || done_) return;
+    progress_.mutable_progress()->set_fraction(fraction);
+    writing_ = true;
+    StartWrite(&progress_);
+  }
+
+  // The job's last touch of the reactor: after this, OnDone may delete it at any time.
+  void Complete(const absl::Status& status, std::unique_ptr<v1::GenerateResponse> final_message) {
+    record_.status = status;
+    service_->Observe(record_);
+    bool send_now = false;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      status_ = status;
+      final_ = std::move(final_message);
+      done_ = true;
+      send_now = !writing_;
+    }
+    if (send_now) SendFinal();
+  }
+
+  void SendFinal() {
+    if (status_.ok()) {
+      StartWriteAndFinish(final_.get(), grpc::WriteOptions(), grpc::Status::OK);
+    } else {
+      Finish(ToGrpcStatus(status_));
+    }
+  }
+
+  InscribeService* const service_;
+  grpc::CallbackServerContext* const context_;
+  const v1::GenerateRequest* const request_;
+  std::atomic<bool> cancel_{false};
+  CallRecord record_;
+  std::mutex mutex_;
+  bool writing_ = false;  // a progress write is in flight
+  bool done_ = false;     // the job has completed; status_ and final_ are set
+  v1::GenerateResponse progress_;
+  absl::Status status_;
+  std::unique_ptr<v1::GenerateResponse> final_;
+};
+
+grpc::ServerWriteReactor<v1::GenerateResponse>* InscribeService::Generate(
+    grpc::CallbackServerContext* context, const v1::GenerateRequest* request) {
+  auto* reactor = new GenerateReactor(this, context, request);
+  reactor->Start();
+  return reactor;
+}
+
+grpc::ServerUnaryReactor* InscribeService::GetSphereSet(grpc::CallbackServerContext* context,
+                                                        const v1::GetSphereSetRequest* request,
+                                                        v1::GetSphereSetResponse* response) {
+  return RunUnary(context, "GetSphereSet", 0, CheckKey(request->sphere_set_key(), "sphere_set_key"),
+                  [this, request, response]() -> absl::Status {
+                    absl::StatusOr<std::shared_ptr<const SphereSetEntry>> entry =
+                        store_->GetSphereSet(request->sphere_set_key());
+                    if (!entry.ok()) return entry.status();
+                    *response->mutable_spheres() = (*entry)->result.spheres();
+                    response->set_mesh_sha256((*entry)->result.mesh_sha256());
+                    return absl::OkStatus();
+                  });
+}
+
+grpc::ServerUnaryReactor* InscribeService::GetHierarchy(grpc::CallbackServerContext* context,
+                                                        const v1::GetHierarchyRequest* request,
+                                                        v1::GetHierarchyResponse* response) {
+  return RunUnary(context, "GetHierarchy", 0, CheckKey(request->sphere_set_key(), "sphere_set_key"),
+                  [this, request, response]() -> absl::Status {
+                    absl::StatusOr<std::shared_ptr<const SphereHierarchy>> h = store_->GetHierarchy(
+                        request->sphere_set_key(), VolumeFromProto(request->volume()));
+                    if (!h.ok()) return h.status();
+                    response->set_hierarchy((*h)->Serialize());
+                    return absl::OkStatus();
+                  });
+}
+
+grpc::ServerUnaryReactor* InscribeService::Distance(grpc::CallbackServerContext* context,
+                                                    const v1::DistanceRequest* request,
+                                                    v1::DistanceResponse* response) {
+  absl::Status precheck = CheckKey(request->sphere_set_a(), "sphere_set_a");
+  if (precheck.ok()) precheck = CheckKey(request->sphere_set_b(), "sphere_set_b");
+  const std::int64_t pairs = request->poses_b().values_size() / 7;
+  if (precheck.ok() && pairs > limits_.max_poses) {
+    precheck = absl::ResourceExhaustedError(
+        absl::StrCat(pairs, " pose pairs; this server's limit (--max-poses) is ", limits_.max_poses,
+                     " per call"));
+  }
+  return RunUnary(context, "Distance", 0, precheck, [this, request, response]() -> absl::Status {
+    absl::StatusOr<DistanceRequest> tolerance = ToleranceFromProto(request->tolerance());
+    if (!tolerance.ok()) return tolerance.status();
+    absl::StatusOr<std::vector<RigidPose>> poses_a = PosesFromProto(request->poses_a(), "poses_a");
+    if (!poses_a.ok()) return poses_a.status();
+    absl::StatusOr<std::vector<RigidPose>> poses_b = PosesFromProto(request->poses_b(), "poses_b");
+    if (!poses_b.ok()) return poses_b.status();
+    if (poses_a->size() != 1 && poses_a->size() != poses_b->size()) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("poses_a has ", poses_a->size(), " poses and poses_b ", poses_b->size(),
+                       "; poses_a must have one pose or as many as poses_b"));
+    }
+    const HierarchyVolume volume = VolumeFromProto(request->volume());
+    absl::StatusOr<std::shared_ptr<const SphereHierarchy>> a =
+        store_->GetHierarchy(request->sphere_set_a(), volume);
+    if (!a.ok()) return a.status();
+    absl::StatusOr<std::shared_ptr<const SphereHierarchy>> b =
+        store_->GetHierarchy(request->sphere_set_b(), volume);
+    if (!b.ok()) return b.status();
+    const Clock::time_point start = Clock::now();
+    // B's poses relative to A's, so that the batch call (one frame, A fixed) serves all.
+    std::vector<RigidPose> relative(poses_b->size());
+    for (std::size_t i = 0; i < relative.size(); ++i) {
+      const RigidPose& pa = (*poses_a)[poses_a->size() == 1 ? 0 : i];
+      relative[i] = pa.Inverse() * (*poses_b)[i];
+    }
+    absl::StatusOr<std::vector<DistanceResult>> results =
+        SeparationDistances(**a, **b, relative, *tolerance);
+    if (!results.ok()) return results.status();
+    // Witnesses back to the world frame.
+    for (std::size_t i = 0; i < results->size(); ++i) {
+      const RigidPose& pa = (*poses_a)[poses_a->size() == 1 ? 0 : i];
+      DistanceResult& r = (*results)[i];
+      r.point_a = pa * r.point_a;
+      r.point_b = pa * r.point_b;
+    }
+    AppendDistanceResults(*results, response->mutable_results());
+    response->set_seconds(SecondsSince(start));
+    return absl::OkStatus();
+  });
+}
+
+grpc::ServerUnaryReactor* InscribeService::CacheStats(grpc::CallbackServerContext* context,
+                                                      const v1::CacheStatsRequest* /*request*/,
+                                                      v1::CacheStatsResponse* response) {
+  // A snapshot of counters under the cache's lock: cheap enough for the gRPC thread, and it
+  // must answer even when the pool is saturated.
+  grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+  const ResultCacheStats s = store_->cache().stats();
+  response->set_entries(s.entries);
+  response->set_bytes(s.bytes);
+  response->set_memory_hits(s.memory_hits);
+  response->set_disk_hits(s.disk_hits);
+  response->set_hits(s.memory_hits + s.disk_hits);
+  response->set_misses(s.misses);
+  response->set_computations(s.computations);
+  response->set_joined(s.joined);
+  response->set_evictions(s.evictions);
+  response->set_disk_entries(s.disk_entries);
+  response->set_disk_bytes(s.disk_bytes);
+  response->set_disk_errors(s.disk_errors);
+  reactor->Finish(grpc::Status::OK);
+  return reactor;
+}
+
+}  // namespace inscribe::server

@@ -1,0 +1,78 @@
+// The service's typed view of its ResultCache: stored meshes, generated sphere sets and their
+// hierarchies, each under a content key, each decoded once and shared. Private to the server.
+#pragma once
+
+#include <atomic>
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "absl/status/statusor.h"
+#include "inscribe/boundary_oracle.h"
+#include "inscribe/medial_spheres.h"
+#include "inscribe/mesh.h"
+#include "inscribe/mesh_validation.h"
+#include "inscribe/server/result_cache.h"
+#include "inscribe/sphere.h"
+#include "inscribe/sphere_hierarchy.h"
+#include "inscribe/v1/service.pb.h"
+
+namespace inscribe::server {
+
+// A validated mesh ready for queries: the cache object under "sha256:<hex>".
+struct StoredMeshEntry {
+  std::string key;  // "sha256:<64 hex>"
+  Mesh mesh;        // orientation fixed, holes filled when asked
+  MeshReport report;
+  BoundaryOracle oracle;
+};
+
+// A generated sphere set: the cache object under "spheres/v1/<hex>". `result` is what Generate
+// returns (its `cache` field empty).
+struct SphereSetEntry {
+  v1::GenerateResult result;
+  SphereSet set;
+};
+
+// Limits the store enforces while computing (the service checks the cheap ones first).
+struct StoreLimits {
+  std::int64_t max_voxels = 20'000'000;
+  std::int64_t max_spheres = 1'000'000;
+};
+
+class ResultStore {
+ public:
+  ResultStore(ResultCache* cache, const StoreLimits& limits);
+
+  // Validates `mesh` and stores it under its hash. FAILED_PRECONDITION when it is unusable
+  // (naming the first error). *already_stored: the key was held before.
+  absl::StatusOr<std::shared_ptr<const StoredMeshEntry>> PutMesh(Mesh mesh, bool fill_holes,
+                                                                 bool* already_stored);
+  // NOT_FOUND for a key the cache does not hold (in memory or on disk).
+  absl::StatusOr<std::shared_ptr<const StoredMeshEntry>> GetMesh(const std::string& key);
+
+  // The sphere set for (mesh, parameters): cached, or generated with `control` (progress and
+  // cancellation). INVALID_ARGUMENT for bad parameters, NOT_FOUND for an unknown mesh.
+  absl::StatusOr<std::pair<std::shared_ptr<const SphereSetEntry>, CacheSource>> Generate(
+      const v1::GenerateRequest& request, const GenerationControl& control);
+  absl::StatusOr<std::shared_ptr<const SphereSetEntry>> GetSphereSet(const std::string& key);
+
+  // The hierarchy of a cached sphere set, built on first use.
+  absl::StatusOr<std::shared_ptr<const SphereHierarchy>> GetHierarchy(const std::string& key,
+                                                                      HierarchyVolume volume);
+
+  ResultCache& cache() { return *cache_; }
+
+ private:
+  ResultCache* const cache_;
+  const StoreLimits limits_;
+};
+
+// The canonical form of `parameters` (defaults filled in) or INVALID_ARGUMENT naming the bad
+// field; the sphere-set key hashes this with the mesh key and the algorithm version.
+absl::StatusOr<v1::GenerateParameters> CanonicalParameters(
+    const v1::GenerateParameters& parameters);
+std::string SphereSetKey(const std::string& mesh_key, const v1::GenerateParameters& canonical,
+                         bool with_quality);
+
+}  // namespace inscribe::server

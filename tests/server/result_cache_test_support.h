@@ -1,0 +1,85 @@
+// What the result cache tests share: a temporary directory per test, and values, compute and
+// decode functions that count their calls or fail the test when called.
+#pragma once
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <system_error>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+#include "inscribe/server/result_cache.h"
+
+namespace inscribe::server::cache_test {
+
+namespace fs = std::filesystem;
+
+// A fresh directory under the system's temporary directory, removed with its contents.
+class TempDir {
+ public:
+  TempDir() {
+    static std::atomic<int> count{0};
+    path_ = fs::temp_directory_path() /
+            absl::StrCat("inscribe_result_cache_test_", ::getpid(), "_", count++);
+    fs::remove_all(path_);
+    fs::create_directories(path_);
+  }
+  ~TempDir() {
+    std::error_code error;
+    fs::permissions(path_, fs::perms::owner_all, fs::perm_options::add, error);
+    fs::remove_all(path_, error);
+  }
+  const fs::path& path() const { return path_; }
+  // The cache's own directory: a subdirectory, so Open has to create it.
+  std::string cache() const { return (path_ / "cache").string(); }
+
+ private:
+  fs::path path_;
+};
+
+// Throws (failing the test with the status) when Open fails, so tests can use the cache
+// directly.
+inline std::unique_ptr<ResultCache> OpenCache(std::int64_t memory_bytes, std::string dir = "") {
+  absl::StatusOr<std::unique_ptr<ResultCache>> cache =
+      ResultCache::Open(ResultCacheOptions{memory_bytes, std::move(dir)});
+  if (!cache.ok()) throw std::runtime_error(cache.status().ToString());
+  return *std::move(cache);
+}
+
+inline CachedValue Value(std::string bytes, std::int64_t object_bytes = 0) {
+  CachedValue value;
+  value.bytes = std::move(bytes);
+  value.object_bytes = object_bytes;
+  return value;
+}
+
+inline ResultCache::Compute Returning(std::string bytes, int* calls,
+                                      std::int64_t object_bytes = 0) {
+  return [bytes = std::move(bytes), calls, object_bytes]() -> absl::StatusOr<CachedValue> {
+    ++*calls;
+    return Value(bytes, object_bytes);
+  };
+}
+
+inline ResultCache::Compute MustNotCompute() {
+  return []() -> absl::StatusOr<CachedValue> {
+    ADD_FAILURE() << "computed a cached entry";
+    return absl::InternalError("computed a cached entry");
+  };
+}
+
+inline ResultCache::Decode MustNotDecode() {
+  return [](std::string) -> absl::StatusOr<CachedValue> {
+    ADD_FAILURE() << "decoded with no disk entry";
+    return absl::InternalError("decoded with no disk entry");
+  };
+}
+
+}  // namespace inscribe::server::cache_test

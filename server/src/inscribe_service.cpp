@@ -21,12 +21,6 @@ double SecondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-absl::Status QueueFullError(const JobPool& pool) {
-  return absl::ResourceExhaustedError(
-      absl::StrCat("server is busy: the job queue is full; this server's limit (--max-queue) is ",
-                   pool.options().max_jobs, " queued or running jobs; retry later"));
-}
-
 // The body of InspectMesh, run on the pool. Only expected failures are returned; the mesh's
 // own problems are issues in the report, not errors.
 absl::Status RunInspectMesh(const v1::InspectMeshRequest& request,
@@ -77,6 +71,12 @@ void InscribeService::Finish(grpc::ServerUnaryReactor* reactor, CallRecord& reco
   Observe(record);
   reactor->Finish(ToGrpcStatus(status));
   CallEnded();
+}
+
+absl::Status InscribeService::QueueFullError() const {
+  return absl::ResourceExhaustedError(
+      absl::StrCat("server is busy: the job queue is full; this server's limit (--max-queue) is ",
+                   pool_->options().max_jobs, " queued or running jobs; retry later"));
 }
 
 void InscribeService::StartDraining() { draining_.store(true); }
@@ -135,7 +135,7 @@ grpc::ServerUnaryReactor* InscribeService::RunUnary(grpc::CallbackServerContext*
     record.run_seconds = SecondsSince(started);
     Finish(reactor, record, status);
   });
-  if (!queued) Finish(reactor, record, QueueFullError(*pool_));
+  if (!queued) Finish(reactor, record, QueueFullError());
   return reactor;
 }
 

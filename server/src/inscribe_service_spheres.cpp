@@ -97,13 +97,7 @@ class GenerateReactor final : public grpc::ServerWriteReactor<v1::GenerateRespon
     }
     const Clock::time_point arrived = Clock::now();
     const bool queued = service_->pool_->TrySubmit([this, arrived] { Run(arrived); });
-    if (!queued) {
-      Complete(absl::ResourceExhaustedError(absl::StrCat(
-                   "server is busy: the job queue is full; this server's limit (--max-queue) "
-                   "is ",
-                   service_->pool_->options().max_jobs, " queued or running jobs; retry later")),
-               nullptr);
-    }
+    if (!queued) Complete(service_->QueueFullError(), nullptr);
   }
 
   void OnCancel() override { cancel_.store(true); }

@@ -105,6 +105,9 @@ class InscribeService final : public v1::Inscribe::CallbackService {
                                      std::int64_t triangles, const absl::Status& precheck,
                                      std::function<absl::Status()> body);
 
+  // RESOURCE_EXHAUSTED naming --max-queue: the pool refused a job.
+  absl::Status QueueFullError() const;
+
   // Shape and --max-triangles of a request's mesh: INVALID_ARGUMENT or RESOURCE_EXHAUSTED.
   absl::Status CheckMesh(const v1::Mesh& mesh) const;
 

@@ -250,6 +250,37 @@ void QualityReportToProto(const QualityReport& r, v1::QualityReport* out) {
   out->set_fat(r.fat);
   out->set_voxel_size(r.voxel_size);
   out->set_seconds(r.seconds);
+  out->set_protrusion_tolerance(r.protrusion_tolerance);
+  out->set_fat_up_to_voxel_size(r.fat_up_to_voxel_size);
+  out->set_fraction_radius_over_sqrt3_sigma(r.fraction_radius_over_sqrt3_sigma);
+}
+
+QualityReport QualityReportFromProto(const v1::QualityReport& r) {
+  QualityReport out;
+  out.spheres = r.spheres();
+  out.volume_mesh = r.volume_mesh();
+  out.volume_union = r.volume_union();
+  out.nerr = r.nerr();
+  out.nerr_is_exact = r.nerr_is_exact();
+  out.protrusion_max = r.protrusion_max();
+  out.protrusion_mean = r.protrusion_mean();
+  out.protrusion_p95 = r.protrusion_p95();
+  out.protruding_spheres = r.protruding_spheres();
+  out.protrusion_tolerance = r.protrusion_tolerance();
+  out.bbox_diagonal = r.bbox_diagonal();
+  out.surface_samples = r.surface_samples();
+  out.coverage = r.coverage();
+  out.coverage_tolerance = r.coverage_tolerance();
+  out.boundary_to_union_mean = r.boundary_to_union_mean();
+  out.boundary_to_union_hausdorff = r.boundary_to_union_hausdorff();
+  out.radius_min = r.radius_min();
+  out.radius_max = r.radius_max();
+  out.fat_up_to_voxel_size = r.fat_up_to_voxel_size();
+  out.voxel_size = r.voxel_size();
+  out.fat = r.fat();
+  out.fraction_radius_over_sqrt3_sigma = r.fraction_radius_over_sqrt3_sigma();
+  out.seconds = r.seconds();
+  return out;
 }
 
 void PoseToProto(const RigidPose& pose, v1::Pose* out) {
@@ -322,6 +353,29 @@ void AppendDistanceResults(const std::vector<DistanceResult>& results, v1::Dista
     for (int k = 0; k < kPerRow; ++k) out->add_points_b(r.point_b[k]);
     out->add_closer(r.closer);
   }
+}
+
+absl::StatusOr<std::vector<DistanceResult>> DistanceResultsFromProto(
+    const v1::DistanceResults& in) {
+  const int n = in.distances_size();
+  if (in.spheres_a_size() != n || in.spheres_b_size() != n || in.points_a_size() != kPerRow * n ||
+      in.points_b_size() != kPerRow * n || in.closer_size() != n) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "distance results: ", n, " distances but ", in.spheres_a_size(), " spheres_a, ",
+        in.spheres_b_size(), " spheres_b, ", in.points_a_size(), " points_a numbers, ",
+        in.points_b_size(), " points_b numbers and ", in.closer_size(), " closer flags"));
+  }
+  std::vector<DistanceResult> out(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    DistanceResult& r = out[static_cast<std::size_t>(i)];
+    r.distance = in.distances(i);
+    r.sphere_a = in.spheres_a(i);
+    r.sphere_b = in.spheres_b(i);
+    r.point_a = Vector3(in.points_a(3 * i), in.points_a(3 * i + 1), in.points_a(3 * i + 2));
+    r.point_b = Vector3(in.points_b(3 * i), in.points_b(3 * i + 1), in.points_b(3 * i + 2));
+    r.closer = in.closer(i);
+  }
+  return out;
 }
 
 }  // namespace inscribe::server

@@ -79,8 +79,6 @@ absl::Status InscribeService::QueueFullError() const {
                    pool_->options().max_jobs, " queued or running jobs; retry later"));
 }
 
-void InscribeService::StartDraining() { draining_.store(true); }
-
 bool InscribeService::WaitForCalls(std::chrono::system_clock::time_point deadline) {
   std::unique_lock<std::mutex> lock(calls_mutex_);
   return calls_answered_.wait_until(lock, deadline, [this] { return active_calls_ == 0; });

@@ -14,44 +14,9 @@
 #include "inscribe/server/convert.h"
 #include "inscribe/server/inscribe_service.h"
 #include "result_store.h"
+#include "service_checks.h"
 
 namespace inscribe::server {
-namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double SecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-HierarchyVolume VolumeFromProto(v1::HierarchyVolume volume) {
-  return volume == v1::RSS ? HierarchyVolume::kRss : HierarchyVolume::kSphere;
-}
-
-absl::Status CheckKey(const std::string& key, const char* field) {
-  if (key.empty()) return absl::InvalidArgumentError(absl::StrCat(field, " is required"));
-  if (absl::Status s = CheckCacheKey(key); !s.ok()) {
-    return absl::InvalidArgumentError(absl::StrCat(field, ": ", s.message()));
-  }
-  return absl::OkStatus();
-}
-
-absl::StatusOr<DistanceRequest> ToleranceFromProto(const v1::DistanceTolerance& t) {
-  DistanceRequest request;
-  request.abs_err = t.abs_err();
-  request.rel_err = t.rel_err();
-  if (t.has_closer_than()) request.closer_than = t.closer_than();
-  if (!(std::isfinite(request.abs_err) && request.abs_err >= 0.0 &&
-        std::isfinite(request.rel_err) && request.rel_err >= 0.0) ||
-      std::isnan(request.closer_than)) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "tolerance: abs_err and rel_err must be finite and >= 0 and closer_than a number, got ",
-        request.abs_err, ", ", request.rel_err, ", ", request.closer_than));
-  }
-  return request;
-}
-
-}  // namespace
 
 grpc::ServerUnaryReactor* InscribeService::PutMesh(grpc::CallbackServerContext* context,
                                                    const v1::PutMeshRequest* request,
@@ -95,7 +60,7 @@ class GenerateReactor final : public grpc::ServerWriteReactor<v1::GenerateRespon
       Complete(precheck, nullptr);
       return;
     }
-    const Clock::time_point arrived = Clock::now();
+    const ServiceClock::time_point arrived = ServiceClock::now();
     const bool queued = service_->pool_->TrySubmit([this, arrived] { Run(arrived); });
     if (!queued) Complete(service_->QueueFullError(), nullptr);
   }
@@ -118,7 +83,7 @@ class GenerateReactor final : public grpc::ServerWriteReactor<v1::GenerateRespon
   }
 
  private:
-  void Run(Clock::time_point arrived) {
+  void Run(ServiceClock::time_point arrived) {
     record_.queued_seconds = SecondsSince(arrived);
     const auto deadline = context_->deadline();
     if (context_->IsCancelled() || cancel_.load()) {
@@ -131,7 +96,7 @@ class GenerateReactor final : public grpc::ServerWriteReactor<v1::GenerateRespon
     }
     const double interval =
         request_->progress_interval() > 0.0 ? request_->progress_interval() : 0.5;
-    Clock::time_point last_progress = Clock::now();
+    ServiceClock::time_point last_progress = ServiceClock::now();
     GenerationControl control;
     control.cancel = &cancel_;
     control.on_progress = [&](double fraction) {
@@ -139,11 +104,11 @@ class GenerateReactor final : public grpc::ServerWriteReactor<v1::GenerateRespon
       // is what stops the worker, and progress comes often.
       if (std::chrono::system_clock::now() >= deadline) cancel_.store(true);
       if (SecondsSince(last_progress) >= interval) {
-        last_progress = Clock::now();
+        last_progress = ServiceClock::now();
         Progress(fraction);
       }
     };
-    const Clock::time_point started = Clock::now();
+    const ServiceClock::time_point started = ServiceClock::now();
     absl::StatusOr<std::pair<std::shared_ptr<const SphereSetEntry>, CacheSource>> result;
     try {
       result = service_->store_->Generate(*request_, control);
@@ -275,7 +240,7 @@ grpc::ServerUnaryReactor* InscribeService::Distance(grpc::CallbackServerContext*
     absl::StatusOr<std::shared_ptr<const SphereHierarchy>> b =
         store_->GetHierarchy(request->sphere_set_b(), volume);
     if (!b.ok()) return b.status();
-    const Clock::time_point start = Clock::now();
+    const ServiceClock::time_point start = ServiceClock::now();
     // B's poses relative to A's, so that the batch call (one frame, A fixed) serves all.
     std::vector<RigidPose> relative(poses_b->size());
     for (std::size_t i = 0; i < relative.size(); ++i) {

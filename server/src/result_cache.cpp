@@ -463,6 +463,11 @@ absl::StatusOr<CacheLookup> ResultCache::Impl::Lookup(absl::string_view key, con
     std::shared_ptr<const CachedValue> value = flight->value;
     wait.unlock();
     if (absent && compute != nullptr) continue;  // a Get found nothing: compute it ourselves
+    // The leader's caller gave up; that says nothing about this caller, which takes over.
+    if (compute != nullptr && (status.code() == absl::StatusCode::kCancelled ||
+                               status.code() == absl::StatusCode::kDeadlineExceeded)) {
+      continue;
+    }
 
     std::lock_guard<std::mutex> lock(mutex);
     if (absent) {
@@ -537,7 +542,7 @@ absl::StatusOr<CacheLookup> ResultCache::Impl::Lead(absl::string_view key,
   // Waiters go on while the file is written. The flight stays registered until the file
   // exists, so a value too large for memory is joined rather than computed again meanwhile.
   Publish(*flight, /*absent=*/false, absl::OkStatus(), value);
-  if (!dir.empty()) WriteDisk(key, value->bytes);
+  if (!dir.empty() && value->persist) WriteDisk(key, value->bytes);
   {
     std::lock_guard<std::mutex> lock(mutex);
     EraseFlightLocked(key, flight);
@@ -582,7 +587,7 @@ absl::StatusOr<std::shared_ptr<const CachedValue>> ResultCache::Put(absl::string
     if (kept != nullptr) return kept;
     kept = impl_->InsertLocked(key, std::move(fresh), evicted);
   }
-  if (!impl_->dir.empty()) impl_->WriteDisk(key, kept->bytes);
+  if (!impl_->dir.empty() && kept->persist) impl_->WriteDisk(key, kept->bytes);
   return kept;
 }
 

@@ -21,6 +21,9 @@ namespace {
 // input, so that old cache entries (memory or disk) are never served for new code.
 constexpr char kSphereAlgorithmVersion[] = "inscribe-spheres-1";
 constexpr char kHierarchyVersion[] = "v1";
+// Hashed with an uploaded set's numbers: uploaded keys never collide with generated ones.
+constexpr char kUploadedSetVersion[] = "inscribe-uploaded-spheres-1";
+constexpr char kDeformerVersion[] = "inscribe-deformer-1";
 constexpr double kDefaultObjectAngle = 0.6;
 constexpr int kDefaultSamples = 32;
 constexpr int kMaxSamples = 4096;
@@ -305,6 +308,82 @@ absl::StatusOr<std::shared_ptr<const SphereHierarchy>> ResultStore::GetHierarchy
       DecodeHierarchy);
   if (!found.ok()) return found.status();
   return found->value->As<SphereHierarchy>();
+}
+
+absl::StatusOr<std::shared_ptr<const SphereSetEntry>> ResultStore::PutSphereSet(
+    SphereSet set, const std::string& mesh_key, bool* already_stored) {
+  if (!mesh_key.empty()) {
+    absl::StatusOr<std::shared_ptr<const StoredMeshEntry>> mesh = GetMesh(mesh_key);
+    if (!mesh.ok()) return mesh.status();
+    const std::int64_t triangles = (*mesh)->mesh.num_triangles();
+    for (std::size_t i = 0; i < set.contacts.size(); ++i) {
+      const std::int32_t t = set.contacts[i].triangle;
+      if (t < 0 || t >= triangles) {
+        return absl::InvalidArgumentError(absl::StrCat("spheres: sphere ", i, " touches triangle ",
+                                                       t, "; mesh ", mesh_key, " has ", triangles,
+                                                       " triangles (0-based)"));
+      }
+    }
+  }
+  v1::GenerateResult result;
+  SphereSetToProto(set, result.mutable_spheres());
+  // The packed arrays of one message serialise the same way for the same numbers.
+  const std::string key =
+      "spheres/v1/" + Sha256Hex(absl::StrCat(kUploadedSetVersion, "\n", mesh_key, "\n",
+                                             result.spheres().SerializeAsString()));
+  result.set_sphere_set_key(key);
+  result.set_mesh_sha256(mesh_key);
+  absl::StatusOr<CacheLookup> found = cache_->GetOrCompute(
+      key, [&]() { return DecodeSphereSet(result.SerializeAsString()); }, DecodeSphereSet);
+  if (!found.ok()) return found.status();
+  if (already_stored != nullptr) {
+    *already_stored = found->source == CacheSource::kMemory || found->source == CacheSource::kDisk;
+  }
+  return found->value->As<SphereSetEntry>();
+}
+
+absl::StatusOr<std::shared_ptr<const DeformerEntry>> ResultStore::GetDeformer(
+    const std::string& mesh_key, const std::string& set_key, const DeformationOptions& options) {
+  const std::string canonical = absl::StrFormat(
+      "%s\n%s\n%s\nxi=%.17g\nstrict=%d\ndirection=%d\ninside=%d\n", kDeformerVersion, mesh_key,
+      set_key, options.xi, options.strict, static_cast<int>(options.direction),
+      static_cast<int>(options.oracle.inside_test));
+  const std::string key = "deformer/v1/" + Sha256Hex(canonical);
+  absl::StatusOr<CacheLookup> found = cache_->GetOrCompute(
+      key,
+      [&]() -> absl::StatusOr<CachedValue> {
+        absl::StatusOr<std::shared_ptr<const SphereSetEntry>> set = GetSphereSet(set_key);
+        if (!set.ok()) return set.status();
+        if (!(*set)->set.has_contacts()) {
+          return absl::FailedPreconditionError(absl::StrCat(
+              "sphere set ", set_key,
+              " has no contacts; deformation needs a set generated without dilation, or "
+              "uploaded with its contacts"));
+        }
+        absl::StatusOr<std::shared_ptr<const StoredMeshEntry>> mesh = GetMesh(mesh_key);
+        if (!mesh.ok()) return mesh.status();
+        absl::StatusOr<SphereDeformer> deformer =
+            SphereDeformer::Create((*mesh)->mesh, (*set)->set, options);
+        if (!deformer.ok()) {
+          return absl::FailedPreconditionError(absl::StrCat("sphere set ", set_key,
+                                                            " does not fit mesh ", mesh_key, ": ",
+                                                            deformer.status().message()));
+        }
+        auto entry = std::make_shared<const DeformerEntry>(mesh_key, (*mesh)->mesh.triangles,
+                                                           *std::move(deformer));
+        CachedValue value;
+        value.persist = false;
+        // The reference mesh, its oracle and the per-sphere frames.
+        value.object_bytes =
+            MeshObjectBytes((*mesh)->mesh) + 96 * static_cast<std::int64_t>((*set)->set.size());
+        value.object = std::move(entry);
+        return value;
+      },
+      [](std::string) -> absl::StatusOr<CachedValue> {
+        return absl::DataLossError("deformers are never stored on disk");
+      });
+  if (!found.ok()) return found.status();
+  return found->value->As<DeformerEntry>();
 }
 
 }  // namespace inscribe::server

@@ -5,7 +5,9 @@
 #include <atomic>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <string>
+#include <utility>
 
 #include "absl/status/statusor.h"
 #include "inscribe/boundary_oracle.h"
@@ -14,6 +16,7 @@
 #include "inscribe/mesh_validation.h"
 #include "inscribe/server/result_cache.h"
 #include "inscribe/sphere.h"
+#include "inscribe/sphere_deformation.h"
 #include "inscribe/sphere_hierarchy.h"
 #include "inscribe/v1/service.pb.h"
 
@@ -32,6 +35,22 @@ struct StoredMeshEntry {
 struct SphereSetEntry {
   v1::GenerateResult result;
   SphereSet set;
+};
+
+// A SphereDeformer kept between UpdateDeformation calls on one (mesh, set, options): the
+// cache object under "deformer/v1/<hex>", in memory only (it holds a refit oracle). Update
+// mutates the deformer, so callers take `mutex` for the update and every read of `deformer`
+// that follows it (its oracle is the last frame's).
+struct DeformerEntry {
+  DeformerEntry(std::string mesh, Triangles mesh_triangles, SphereDeformer made)
+      : mesh_key(std::move(mesh)),
+        triangles(std::move(mesh_triangles)),
+        deformer(std::move(made)) {}
+
+  const std::string mesh_key;
+  const Triangles triangles;  // the stored mesh's, for hashing deformed frames
+  mutable std::mutex mutex;
+  mutable SphereDeformer deformer;  // guarded by mutex
 };
 
 // Limits the store enforces while computing (the service checks the cheap ones first).
@@ -56,6 +75,18 @@ class ResultStore {
   absl::StatusOr<std::pair<std::shared_ptr<const SphereSetEntry>, CacheSource>> Generate(
       const v1::GenerateRequest& request, const GenerationControl& control);
   absl::StatusOr<std::shared_ptr<const SphereSetEntry>> GetSphereSet(const std::string& key);
+
+  // Stores an uploaded set under "spheres/v1/<SHA-256 of mesh key and numbers>". `mesh_key`
+  // may be empty; when given the mesh must be stored (NOT_FOUND) and contacts must name its
+  // triangles (INVALID_ARGUMENT). *already_stored: the key was held before.
+  absl::StatusOr<std::shared_ptr<const SphereSetEntry>> PutSphereSet(SphereSet set,
+                                                                     const std::string& mesh_key,
+                                                                     bool* already_stored);
+
+  // The deformer of (mesh, set, options), created on first use (an oracle build). FAILED_
+  // PRECONDITION for a set without contacts or whose contacts do not fit the mesh.
+  absl::StatusOr<std::shared_ptr<const DeformerEntry>> GetDeformer(
+      const std::string& mesh_key, const std::string& set_key, const DeformationOptions& options);
 
   // The hierarchy of a cached sphere set, built on first use.
   absl::StatusOr<std::shared_ptr<const SphereHierarchy>> GetHierarchy(const std::string& key,

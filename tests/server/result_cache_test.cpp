@@ -207,6 +207,72 @@ TEST(ResultCacheSingleFlight, FailureIsSharedWithWaitersAndNotCached) {
   EXPECT_EQ(stats.disk_entries, 1);
 }
 
+// A leader whose caller gave up (CANCELLED, DEADLINE_EXCEEDED) does not fail the waiters: the
+// first of them computes the key itself and the rest join that computation.
+TEST(ResultCacheSingleFlight, WaitersTakeOverFromCancelledLeader) {
+  for (const absl::StatusCode code :
+       {absl::StatusCode::kCancelled, absl::StatusCode::kDeadlineExceeded}) {
+    SCOPED_TRACE(absl::StatusCodeToString(code));
+    auto cache = OpenCache(1 << 20);
+    std::atomic<int> started{0};
+    std::atomic<int> release{0};
+    std::atomic<int> taken_over{0};
+    const ResultCache::Compute cancelled = [&]() -> absl::StatusOr<CachedValue> {
+      ++started;
+      WaitForCount(release, 1);
+      return absl::Status(code, "caller gave up");
+    };
+    const ResultCache::Compute completes = [&]() -> absl::StatusOr<CachedValue> {
+      ++taken_over;
+      return Value("computed by a waiter");
+    };
+    absl::StatusOr<CacheLookup> led;
+    std::vector<absl::StatusOr<CacheLookup>> waited(3);
+    std::thread leader([&] { led = cache->GetOrCompute("k/taken", cancelled, MustNotDecode()); });
+    WaitForCount(started, 1);
+    std::vector<std::thread> waiters;
+    for (auto& result : waited) {
+      waiters.emplace_back(
+          [&] { result = cache->GetOrCompute("k/taken", completes, MustNotDecode()); });
+    }
+    std::this_thread::sleep_for(200ms);  // lets the waiters reach their wait
+    ++release;
+    leader.join();
+    for (std::thread& waiter : waiters) waiter.join();
+
+    EXPECT_EQ(led.status().code(), code);
+    EXPECT_EQ(taken_over.load(), 1);
+    int computed = 0;
+    for (const auto& result : waited) {
+      ASSERT_TRUE(result.ok()) << result.status();
+      EXPECT_EQ(result->value->bytes, "computed by a waiter");
+      computed += result->source == CacheSource::kComputed;
+    }
+    EXPECT_EQ(computed, 1);
+    EXPECT_EQ(cache->stats().computations, 2);
+  }
+}
+
+// persist = false keeps a value in memory only.
+TEST(ResultCache, ValuesNotPersistedStayOffDisk) {
+  TempDir dir;
+  auto cache = OpenCache(1 << 20, dir.cache());
+  const ResultCache::Compute compute = []() -> absl::StatusOr<CachedValue> {
+    CachedValue value = Value("process-local");
+    value.persist = false;
+    return value;
+  };
+  ASSERT_TRUE(cache->GetOrCompute("k/local", compute, MustNotDecode()).ok());
+  CachedValue put = Value("also local");
+  put.persist = false;
+  ASSERT_TRUE(cache->Put("k/local2", std::move(put)).ok());
+  int calls = 0;
+  ASSERT_TRUE(cache->GetOrCompute("k/kept", Returning("on disk", &calls), MustNotDecode()).ok());
+  const ResultCacheStats stats = cache->stats();
+  EXPECT_EQ(stats.entries, 3);
+  EXPECT_EQ(stats.disk_entries, 1);
+}
+
 // Get waits for a computation in progress and shares its value, or reports its failure.
 
 TEST(ResultCacheSingleFlight, GetWaitsForComputationInProgress) {

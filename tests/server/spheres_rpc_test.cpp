@@ -22,90 +22,13 @@
 #include "inscribe/server/inscribe_server.h"
 #include "inscribe/sphere_hierarchy.h"
 #include "inscribe/v1/service.grpc.pb.h"
+#include "spheres_rpc_fixture.h"
 #include "support/synthetic_meshes.h"
 
 namespace inscribe::server {
 namespace {
 
 using ::testing::HasSubstr;
-
-class SpheresRpcTest : public ::testing::Test {
- protected:
-  void SetUp() override {
-    cache_dir_ = std::filesystem::temp_directory_path() /
-                 ("inscribe-rpc-" + std::to_string(std::random_device{}()));
-    Restart();
-  }
-  void TearDown() override {
-    server_.reset();
-    std::filesystem::remove_all(cache_dir_);
-  }
-
-  // A fresh server process state (new memory tier) on the same cache directory.
-  void Restart() {
-    server_.reset();
-    ServerOptions options;
-    options.listen = "127.0.0.1:0";
-    options.jobs = 2;
-    options.max_queue = 64;
-    options.cache.disk_dir = cache_dir_.string();
-    options.limits.max_poses = 5000;
-    absl::StatusOr<std::unique_ptr<InscribeServer>> started = InscribeServer::Start(options);
-    ASSERT_TRUE(started.ok()) << started.status();
-    server_ = *std::move(started);
-    stub_ = v1::Inscribe::NewStub(
-        grpc::CreateChannel(server_->address(), grpc::InsecureChannelCredentials()));
-  }
-
-  std::unique_ptr<grpc::ClientContext> Context(double seconds = 60.0) {
-    auto context = std::make_unique<grpc::ClientContext>();
-    context->set_deadline(std::chrono::system_clock::now() +
-                          std::chrono::milliseconds(static_cast<int>(1000 * seconds)));
-    return context;
-  }
-
-  std::string PutMesh(const Mesh& mesh) {
-    v1::PutMeshRequest request;
-    MeshToProto(mesh, request.mutable_mesh());
-    v1::PutMeshResponse response;
-    const grpc::Status status = stub_->PutMesh(Context().get(), request, &response);
-    EXPECT_TRUE(status.ok()) << status.error_message();
-    return response.mesh_sha256();
-  }
-
-  // Runs Generate to its end; the last message's result, progress messages counted.
-  grpc::Status Generate(const v1::GenerateRequest& request, v1::GenerateResult* result,
-                        int* progress_messages = nullptr, double seconds = 60.0) {
-    auto context = Context(seconds);
-    std::unique_ptr<grpc::ClientReader<v1::GenerateResponse>> reader =
-        stub_->Generate(context.get(), request);
-    v1::GenerateResponse message;
-    int progress = 0;
-    while (reader->Read(&message)) {
-      if (message.has_progress()) ++progress;
-      if (message.has_result()) *result = message.result();
-    }
-    if (progress_messages != nullptr) *progress_messages = progress;
-    return reader->Finish();
-  }
-
-  v1::GenerateRequest SphereRequest(const std::string& mesh_key, double voxel_size) {
-    v1::GenerateRequest request;
-    request.set_mesh_sha256(mesh_key);
-    request.mutable_parameters()->set_voxel_size(voxel_size);
-    return request;
-  }
-
-  v1::CacheStatsResponse Stats() {
-    v1::CacheStatsResponse response;
-    EXPECT_TRUE(stub_->CacheStats(Context().get(), v1::CacheStatsRequest(), &response).ok());
-    return response;
-  }
-
-  std::filesystem::path cache_dir_;
-  std::unique_ptr<InscribeServer> server_;
-  std::unique_ptr<v1::Inscribe::Stub> stub_;
-};
 
 TEST_F(SpheresRpcTest, PutMeshKeysByContentAndRefusesUnusableMeshes) {
   const Mesh cube = testing::UnitCube();

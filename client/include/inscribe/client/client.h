@@ -2,14 +2,22 @@
 #pragma once
 
 #include <chrono>
+#include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "absl/status/statusor.h"
 #include "inscribe/client/connection.h"
 #include "inscribe/mesh.h"
 #include "inscribe/mesh_validation.h"
+#include "inscribe/rigid_pose.h"
+#include "inscribe/separation_distance.h"
+#include "inscribe/sphere.h"
+#include "inscribe/sphere_hierarchy.h"
+#include "inscribe/sphere_quality.h"
 
 namespace inscribe::client {
 
@@ -49,6 +57,171 @@ struct InspectMeshResult {
   MeshReport report;
 };
 
+// Options every call takes: overrides ClientOptions::default_timeout for this call.
+struct CallOptions {
+  std::optional<std::chrono::milliseconds> timeout;
+};
+
+struct PutMeshResult {
+  std::string mesh_sha256;  // "sha256:<64 hex>": the key later calls name the mesh by
+  MeshReport report;
+  bool already_stored = false;
+};
+
+// What to generate (paper Sections III-IV; see GenerateParameters in spheres.proto, which
+// this mirrors field by field: 0 means the server's default where that says so). Exactly one
+// of voxel_size and max_spheres must be > 0.
+struct GenerateSettings {
+  double voxel_size = 0.0;
+  std::int64_t max_spheres = 0;
+  double object_angle = 0.0;
+  double epsilon = 0.0;
+  int samples = 0;
+  bool subdivide_boundary = false;
+  bool dilate = false;
+  double dilation_growth = 0.0;
+  bool fill_holes = false;
+  // Skip the quality report (exact union volume, surface sampling).
+  bool skip_quality = false;
+};
+
+struct GenerateOptions : CallOptions {
+  // Called on the calling thread with the fraction done, at most every progress_interval.
+  std::function<void(double fraction)> on_progress;
+  double progress_interval = 0.0;  // seconds; 0 = the server's 0.5 s
+};
+
+struct GenerateResult {
+  std::string sphere_set_key;  // "spheres/v1/<64 hex>"
+  std::string mesh_sha256;
+  SphereSet spheres;
+  double voxel_size = 0.0;
+  double seconds = 0.0;  // the computation's wall time (the original run's when cached)
+  std::optional<QualityReport> quality;  // absent when skip_quality
+  std::string cache;                     // "memory", "disk", "computed" or "joined"
+};
+
+struct PutSphereSetResult {
+  std::string sphere_set_key;
+  bool already_stored = false;
+};
+
+struct StoredSphereSet {
+  SphereSet spheres;
+  std::string mesh_sha256;  // empty when uploaded without a mesh
+};
+
+struct DeformationSettings {
+  double xi = 0.0;  // mesh units; 0 = 0.25% of the largest bounding-box extent
+  bool strict = false;
+  bool interpolated_normal = false;
+  bool ray_parity = false;
+  bool bounds = false;  // also compute nerr bounds (exact union volumes)
+  bool store = false;   // also cache the moved set and return its key
+};
+
+struct DeformationResult {
+  SphereSet spheres;  // with contacts: can serve as a later reference
+  std::vector<std::int32_t> reference_index;
+  double xi = 0.0;
+  double max_protrusion = 0.0;
+  std::int64_t shrunk = 0;
+  std::int64_t dropped = 0;
+  std::int64_t closest_point_queries = 0;
+  int max_shrink_steps = 0;
+  double seconds = 0.0;  // server time of the update
+  std::int64_t reference_spheres = 0;
+  std::string deformed_mesh_sha256;
+  std::string sphere_set_key;  // when settings.store
+  // When settings.bounds:
+  struct Bounds {
+    double nerr_lower = 0.0;
+    double nerr_upper = 0.0;
+    bool nerr_is_exact = false;
+    double volume_mesh = 0.0;
+    double volume_union = 0.0;
+    std::optional<double> nerr_upper_uniform_xi;  // absent when Lemma 2's premise fails
+    double seconds = 0.0;
+  };
+  std::optional<Bounds> bounds;
+};
+
+struct DistanceOptions : CallOptions {
+  HierarchyVolume volume = HierarchyVolume::kSphere;
+  DistanceRequest tolerance;  // abs_err, rel_err, closer_than
+};
+
+struct DistanceBatchResult {
+  std::vector<DistanceResult> results;  // entry i answers pose pair i; witnesses in world frame
+  double server_seconds = 0.0;          // the server's time on the queries
+};
+
+struct EvaluateSettings {
+  std::int64_t samples = 0;         // boundary samples; 0 = 100,000; negative = none
+  double voxel_size = 0.0;          // for the fatness test; 0 = unknown
+  double coverage_tolerance = 0.0;  // mesh units; 0 = 1e-3 of the bbox diagonal
+};
+
+// CacheStats as the server reports it (see CacheStatsResponse in service.proto).
+struct ServerCacheStats {
+  std::int64_t entries = 0;
+  std::int64_t bytes = 0;
+  std::int64_t memory_hits = 0;
+  std::int64_t disk_hits = 0;
+  std::int64_t hits = 0;
+  std::int64_t misses = 0;
+  std::int64_t computations = 0;
+  std::int64_t joined = 0;
+  std::int64_t evictions = 0;
+  std::int64_t disk_entries = 0;
+  std::int64_t disk_bytes = 0;
+  std::int64_t disk_errors = 0;
+};
+
+// One object pair of a simulator frame: two cached sets and their world poses.
+struct PosePair {
+  std::string sphere_set_a;
+  std::string sphere_set_b;
+  RigidPose pose_a;
+  RigidPose pose_b;
+};
+
+struct DistanceSessionOptions {
+  HierarchyVolume volume = HierarchyVolume::kSphere;
+  DistanceRequest tolerance;
+  // Time allowed for each frame's round trip; a late frame ends the session with
+  // DEADLINE_EXCEEDED.
+  std::chrono::milliseconds frame_timeout{10'000};
+  // Time the whole session may stay open; nullopt = no limit.
+  std::optional<std::chrono::milliseconds> session_timeout;
+};
+
+// A long-lived DistanceStream call for a simulator loop: one Query per frame, answered in
+// order over one HTTP/2 stream (no per-call setup). Not thread-safe; movable, not copyable.
+// Any error ends the session: later Query calls return the same error. Destroying an open
+// session cancels the call.
+class DistanceSession {
+ public:
+  DistanceSession(std::unique_ptr<DistanceStreamConnection> stream,
+                  const DistanceSessionOptions& options);
+  DistanceSession(DistanceSession&&) noexcept;
+  DistanceSession& operator=(DistanceSession&&) noexcept;
+  ~DistanceSession();
+
+  // Distances for every pair of one frame (entry i answers pairs[i]; witnesses in world
+  // frame). Frames are numbered 0, 1, ... and the reply's number is checked.
+  absl::StatusOr<std::vector<DistanceResult>> Query(const std::vector<PosePair>& pairs);
+
+  // Ends the stream cleanly; the server's final status.
+  absl::Status Close();
+
+ private:
+  std::unique_ptr<DistanceStreamConnection> stream_;
+  DistanceSessionOptions options_;
+  std::int64_t next_frame_ = 0;
+  absl::Status broken_;  // the error that ended the session, once one has
+};
+
 // Calls the service through a Connection, adding a deadline to every call and retrying
 // idempotent calls on UNAVAILABLE with exponential backoff. Thread-safe; cheap to copy (shares
 // the connection).
@@ -62,6 +235,62 @@ class Client {
   // see result.report.usable().
   absl::StatusOr<InspectMeshResult> InspectMesh(const Mesh& mesh,
                                                 const InspectMeshOptions& options = {}) const;
+
+  // Every call below is idempotent, so UNAVAILABLE is retried (see RetryPolicy); server errors
+  // come back unchanged (codes and messages as service.proto documents them).
+
+  // Validates and stores `mesh` on the server. FAILED_PRECONDITION for an unusable mesh.
+  absl::StatusOr<PutMeshResult> PutMesh(const Mesh& mesh, bool fill_holes = false,
+                                        const CallOptions& options = {}) const;
+
+  // Spheres for a stored mesh (cached on the server by content).
+  absl::StatusOr<GenerateResult> Generate(const std::string& mesh_sha256,
+                                          const GenerateSettings& settings,
+                                          const GenerateOptions& options = {}) const;
+  // Uploads `mesh` (PutMesh, with settings.fill_holes) and generates; if the server lost the
+  // mesh in between (NOT_FOUND: evicted), uploads it once more.
+  absl::StatusOr<GenerateResult> Generate(const Mesh& mesh, const GenerateSettings& settings,
+                                          const GenerateOptions& options = {}) const;
+
+  absl::StatusOr<PutSphereSetResult> PutSphereSet(const SphereSet& spheres,
+                                                  const std::string& mesh_sha256 = "",
+                                                  const CallOptions& options = {}) const;
+  absl::StatusOr<StoredSphereSet> GetSphereSet(const std::string& sphere_set_key,
+                                               const CallOptions& options = {}) const;
+  // The server's hierarchy, deserialised (SphereHierarchy::Deserialize checks it).
+  absl::StatusOr<SphereHierarchy> GetHierarchy(const std::string& sphere_set_key,
+                                               HierarchyVolume volume,
+                                               const CallOptions& options = {}) const;
+
+  // Moves the cached set `sphere_set_key` onto `deformed_vertices` (#V x 3, the stored mesh's
+  // vertex order). `mesh_sha256` empty = the mesh the set names.
+  absl::StatusOr<DeformationResult> UpdateDeformation(const std::string& mesh_sha256,
+                                                      const std::string& sphere_set_key,
+                                                      const Vertices& deformed_vertices,
+                                                      const DeformationSettings& settings = {},
+                                                      const CallOptions& options = {}) const;
+
+  // One batch: poses_a holds one pose (for all queries) or one per entry of poses_b.
+  absl::StatusOr<DistanceBatchResult> Distance(const std::string& sphere_set_a,
+                                               const std::string& sphere_set_b,
+                                               const std::vector<RigidPose>& poses_a,
+                                               const std::vector<RigidPose>& poses_b,
+                                               const DistanceOptions& options = {}) const;
+
+  // Quality of a cached set, or of `spheres` sent inline, against a stored mesh.
+  absl::StatusOr<QualityReport> Evaluate(const std::string& mesh_sha256,
+                                         const std::string& sphere_set_key,
+                                         const EvaluateSettings& settings = {},
+                                         const CallOptions& options = {}) const;
+  absl::StatusOr<QualityReport> Evaluate(const std::string& mesh_sha256, const SphereSet& spheres,
+                                         const EvaluateSettings& settings = {},
+                                         const CallOptions& options = {}) const;
+
+  absl::StatusOr<ServerCacheStats> CacheStats(const CallOptions& options = {}) const;
+
+  // Opens a DistanceStream session (not retried: a stream is not idempotent as a whole).
+  absl::StatusOr<DistanceSession> OpenDistanceSession(
+      const DistanceSessionOptions& options = {}) const;
 
   const ClientOptions& options() const { return options_; }
 

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <chrono>
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -17,6 +18,23 @@ namespace inscribe::client {
 // Absolute time by which a call must be answered (the clock gRPC deadlines use).
 using Deadline = std::chrono::system_clock::time_point;
 
+// One open DistanceStream call. Frames go out and come back one at a time, in order.
+// Not thread-safe: one simulator loop drives one stream.
+class DistanceStreamConnection {
+ public:
+  // Ends the call (cancelling it if Finish was not reached).
+  virtual ~DistanceStreamConnection() = default;
+
+  // Sends `frame` and waits for its result until `deadline`. An error ends the stream: the
+  // server's status (NOT_FOUND, INVALID_ARGUMENT, ...), UNAVAILABLE when the connection broke,
+  // DEADLINE_EXCEEDED when the result did not come in time (the call is then cancelled).
+  virtual absl::StatusOr<v1::DistanceFrameResult> RoundTrip(const v1::DistanceFrame& frame,
+                                                            Deadline deadline) = 0;
+
+  // Half-closes the stream and returns the server's final status (OK after a clean end).
+  virtual absl::Status Finish() = 0;
+};
+
 // One method per RPC of inscribe.v1.Inscribe. Each call is a single attempt with the given
 // deadline: retries, backoff and default deadlines belong to Client. Errors carry the gRPC code
 // unchanged (UNAVAILABLE when the server cannot be reached, DEADLINE_EXCEEDED, the server's
@@ -29,6 +47,32 @@ class Connection {
 
   virtual absl::StatusOr<v1::InspectMeshResponse> InspectMesh(const v1::InspectMeshRequest& request,
                                                               Deadline deadline) = 0;
+  virtual absl::StatusOr<v1::PutMeshResponse> PutMesh(const v1::PutMeshRequest& request,
+                                                      Deadline deadline) = 0;
+  // Reads the whole Generate stream: `on_progress` (may be null) gets each progress fraction
+  // as it arrives, on the calling thread; the result is the stream's last message. INTERNAL
+  // when the stream ends OK without a result.
+  virtual absl::StatusOr<v1::GenerateResult> Generate(
+      const v1::GenerateRequest& request, Deadline deadline,
+      const std::function<void(double fraction)>& on_progress) = 0;
+  virtual absl::StatusOr<v1::PutSphereSetResponse> PutSphereSet(
+      const v1::PutSphereSetRequest& request, Deadline deadline) = 0;
+  virtual absl::StatusOr<v1::GetSphereSetResponse> GetSphereSet(
+      const v1::GetSphereSetRequest& request, Deadline deadline) = 0;
+  virtual absl::StatusOr<v1::GetHierarchyResponse> GetHierarchy(
+      const v1::GetHierarchyRequest& request, Deadline deadline) = 0;
+  virtual absl::StatusOr<v1::UpdateDeformationResponse> UpdateDeformation(
+      const v1::UpdateDeformationRequest& request, Deadline deadline) = 0;
+  virtual absl::StatusOr<v1::DistanceResponse> Distance(const v1::DistanceRequest& request,
+                                                        Deadline deadline) = 0;
+  virtual absl::StatusOr<v1::EvaluateResponse> Evaluate(const v1::EvaluateRequest& request,
+                                                        Deadline deadline) = 0;
+  virtual absl::StatusOr<v1::CacheStatsResponse> CacheStats(const v1::CacheStatsRequest& request,
+                                                            Deadline deadline) = 0;
+  // Opens a DistanceStream call that must end by `deadline` (Deadline::max() for none). Never
+  // fails for an unreachable server: the first RoundTrip reports UNAVAILABLE.
+  virtual absl::StatusOr<std::unique_ptr<DistanceStreamConnection>> OpenDistanceStream(
+      Deadline deadline) = 0;
 };
 
 struct ConnectionOptions {

@@ -58,6 +58,8 @@ absl::StatusOr<SphereSet> SphereSetFromProto(const v1::SphereSet& set,
                                              absl::string_view field = "spheres");
 
 void QualityReportToProto(const QualityReport& report, v1::QualityReport* out);
+// The inverse: every field, unchecked (a report is numbers only).
+QualityReport QualityReportFromProto(const v1::QualityReport& report);
 
 void PoseToProto(const RigidPose& pose, v1::Pose* out);
 // The pose with its quaternion normalised (NormalizedPose); INVALID_ARGUMENT naming `field`.
@@ -71,6 +73,9 @@ absl::StatusOr<std::vector<RigidPose>> PosesFromProto(const v1::PoseArray& poses
 
 // Appends one result per query (witness points in the world frame, as computed).
 void AppendDistanceResults(const std::vector<DistanceResult>& results, v1::DistanceResults* out);
+// The inverse, all queries of `results`; INVALID_ARGUMENT when the arrays' lengths disagree.
+absl::StatusOr<std::vector<DistanceResult>> DistanceResultsFromProto(
+    const v1::DistanceResults& results);
 
 // absl and gRPC share the canonical status codes (same numbers, same meaning), so these map
 // code and message unchanged; error details are not carried.

@@ -8,6 +8,7 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <set>
 #include <string>
 
 #include "absl/status/status.h"
@@ -18,6 +19,7 @@
 namespace inscribe::server {
 
 class ResultStore;
+class DistanceStreamReactor;
 
 // Per-request limits. Each is a flag of `inscribed` with the same name; a breach is
 // RESOURCE_EXHAUSTED with a message naming the flag.
@@ -69,6 +71,9 @@ class InscribeService final : public v1::Inscribe::CallbackService {
                                     v1::PutMeshResponse* response) override;
   grpc::ServerWriteReactor<v1::GenerateResponse>* Generate(
       grpc::CallbackServerContext* context, const v1::GenerateRequest* request) override;
+  grpc::ServerUnaryReactor* PutSphereSet(grpc::CallbackServerContext* context,
+                                         const v1::PutSphereSetRequest* request,
+                                         v1::PutSphereSetResponse* response) override;
   grpc::ServerUnaryReactor* GetSphereSet(grpc::CallbackServerContext* context,
                                          const v1::GetSphereSetRequest* request,
                                          v1::GetSphereSetResponse* response) override;
@@ -78,12 +83,22 @@ class InscribeService final : public v1::Inscribe::CallbackService {
   grpc::ServerUnaryReactor* Distance(grpc::CallbackServerContext* context,
                                      const v1::DistanceRequest* request,
                                      v1::DistanceResponse* response) override;
+  grpc::ServerUnaryReactor* UpdateDeformation(grpc::CallbackServerContext* context,
+                                              const v1::UpdateDeformationRequest* request,
+                                              v1::UpdateDeformationResponse* response) override;
+  grpc::ServerBidiReactor<v1::DistanceFrame, v1::DistanceFrameResult>* DistanceStream(
+      grpc::CallbackServerContext* context) override;
+  grpc::ServerUnaryReactor* Evaluate(grpc::CallbackServerContext* context,
+                                     const v1::EvaluateRequest* request,
+                                     v1::EvaluateResponse* response) override;
   grpc::ServerUnaryReactor* CacheStats(grpc::CallbackServerContext* context,
                                        const v1::CacheStatsRequest* request,
                                        v1::CacheStatsResponse* response) override;
 
   // Graceful shutdown, first half: from now on new calls get UNAVAILABLE ("server is shutting
   // down"), which clients retry, later or on another replica; calls already accepted go on.
+  // Open DistanceStreams end with UNAVAILABLE after the frame they are on (at once when
+  // waiting for one), so that long-lived simulator sessions do not hold the drain up.
   void StartDraining();
 
   // Blocks until every accepted call has been answered or `deadline` passes; true when all
@@ -117,6 +132,7 @@ class InscribeService final : public v1::Inscribe::CallbackService {
   // Tells the observer; for streaming calls, which finish through their own reactor.
   void Observe(const CallRecord& record) const;
   friend class GenerateReactor;
+  friend class DistanceStreamReactor;
 
   JobPool* const pool_;
   std::unique_ptr<ResultStore> store_;
@@ -127,6 +143,8 @@ class InscribeService final : public v1::Inscribe::CallbackService {
   std::mutex calls_mutex_;
   std::condition_variable calls_answered_;
   std::int64_t active_calls_ = 0;  // guarded by calls_mutex_
+  // Open DistanceStreams, told when draining starts; guarded by calls_mutex_.
+  std::set<DistanceStreamReactor*> streams_;
 };
 
 }  // namespace inscribe::server

@@ -35,6 +35,9 @@ struct CachedValue {
   std::string bytes;
   std::shared_ptr<const void> object;  // may be null
   std::int64_t object_bytes = 0;       // memory the object holds, for the LRU budget
+  // False for values that only make sense in this process (e.g. a deformer holding a refit
+  // oracle): kept in memory only, never written to the disk tier.
+  bool persist = true;
 
   template <typename T>
   std::shared_ptr<const T> As() const {
@@ -99,8 +102,10 @@ class ResultCache {
   // The value under `key`: from memory, else from disk (decoded, then kept in memory), else
   // computed by `compute` on the calling thread, then stored in both tiers (the disk write is
   // atomic: a temporary file, fsync, rename). While one call computes a key, other calls for
-  // the same key wait and share its result (or its error; errors are not cached). INVALID_
-  // ARGUMENT for a malformed key; otherwise compute's error.
+  // the same key wait and share its result (or its error; errors are not cached), except that
+  // when the computing call was cancelled or ran out of time (CANCELLED, DEADLINE_EXCEEDED:
+  // its caller's own business) a waiter computes the key itself. INVALID_ARGUMENT for a
+  // malformed key; otherwise compute's error.
   absl::StatusOr<CacheLookup> GetOrCompute(absl::string_view key, const Compute& compute,
                                            const Decode& decode);
 

@@ -1,0 +1,278 @@
+// DistanceStream: one request per simulator frame, one response per frame, in order, over one
+// long-lived bidirectional call. One frame is in the reactor at a time (read, compute on the
+// pool, write, read the next), so frames can never be reordered and a slow client slows only
+// itself. The hierarchies a stream names are resolved once and held for the stream's life.
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <atomic>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "inscribe/separation_distance.h"
+#include "inscribe/server/convert.h"
+#include "inscribe/server/inscribe_service.h"
+#include "result_store.h"
+#include "service_checks.h"
+
+namespace inscribe::server {
+namespace {
+
+// Distinct (set, volume) pairs one stream may hold: each pins a hierarchy in memory even after
+// the cache has evicted it, so a stream cannot pin an unbounded amount.
+constexpr std::size_t kMaxStreamSets = 1024;
+// Pairs per parallel chunk; cancellation is checked between chunks (~1 ms of work).
+constexpr std::size_t kChunk = 64;
+
+}  // namespace
+
+// States: kReading (a read is pending; nothing else), kBusy (a frame is being computed or its
+// result written), kFinished (Finish was called). Transitions happen under mutex_, and Finish
+// and StartRead are called under it, so a drain can never finish a stream between a state
+// change and the read it announces.
+class DistanceStreamReactor final
+    : public grpc::ServerBidiReactor<v1::DistanceFrame, v1::DistanceFrameResult> {
+ public:
+  DistanceStreamReactor(InscribeService* service, grpc::CallbackServerContext* context)
+      : service_(service) {
+    record_.method = "DistanceStream";
+    record_.peer = context->peer();
+  }
+
+  void Start() {
+    service_->CallStarted();
+    {
+      std::lock_guard<std::mutex> lock(service_->calls_mutex_);
+      service_->streams_.insert(this);
+    }
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (service_->draining_.load()) {
+      FinishLocked(absl::UnavailableError("server is shutting down; retry"));
+      return;
+    }
+    state_ = State::kReading;
+    StartRead(&frame_);
+  }
+
+  // The service is draining: end now when waiting for a frame, else after the current one.
+  void Drain() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    draining_ = true;
+    if (state_ == State::kReading) {
+      FinishLocked(absl::UnavailableError("server is shutting down; reconnect to another"));
+    }
+  }
+
+  // Keeps the reactor alive across a Drain call made outside the service's lock.
+  void Ref() { refs_.fetch_add(1); }
+  void Unref() {
+    if (refs_.fetch_sub(1) == 1) delete this;
+  }
+
+  void OnReadDone(bool ok) override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (state_ == State::kFinished) return;
+    if (!ok) {
+      // The client half-closed (done sending) or the call was cancelled; either way every
+      // frame read has been answered.
+      FinishLocked(absl::OkStatus());
+      return;
+    }
+    if (frame_.pairs_size() > service_->limits_.max_poses) {
+      FinishLocked(absl::ResourceExhaustedError(
+          absl::StrCat("frame ", frame_.frame(), " has ", frame_.pairs_size(),
+                       " pairs; this server's limit (--max-poses) is ", service_->limits_.max_poses,
+                       " per frame")));
+      return;
+    }
+    state_ = State::kBusy;
+    const ServiceClock::time_point arrived = ServiceClock::now();
+    if (!service_->pool_->TrySubmit([this, arrived] { RunFrame(arrived); })) {
+      FinishLocked(service_->QueueFullError());
+    }
+  }
+
+  void OnWriteDone(bool ok) override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (state_ == State::kFinished) return;
+    if (!ok) {
+      FinishLocked(absl::CancelledError("client went away"));
+      return;
+    }
+    if (draining_) {
+      FinishLocked(absl::UnavailableError("server is shutting down; reconnect to another"));
+      return;
+    }
+    state_ = State::kReading;
+    StartRead(&frame_);
+  }
+
+  void OnCancel() override { cancelled_.store(true); }
+
+  void OnDone() override {
+    {
+      std::lock_guard<std::mutex> lock(service_->calls_mutex_);
+      service_->streams_.erase(this);
+    }
+    record_.status = final_status_;
+    service_->Observe(record_);
+    service_->CallEnded();
+    Unref();
+  }
+
+ private:
+  enum class State { kStarting, kReading, kBusy, kFinished };
+
+  void FinishLocked(const absl::Status& status) {
+    state_ = State::kFinished;
+    final_status_ = status;
+    Finish(ToGrpcStatus(status));
+  }
+
+  // On the pool: answers frame_ into result_, then writes it (or ends the stream).
+  void RunFrame(ServiceClock::time_point arrived) {
+    record_.queued_seconds += SecondsSince(arrived);
+    const ServiceClock::time_point started = ServiceClock::now();
+    absl::Status status;
+    try {
+      status = ComputeFrame();
+    } catch (const std::bad_alloc&) {
+      status = absl::ResourceExhaustedError("server ran out of memory in DistanceStream");
+    }
+    if (status.ok() && cancelled_.load()) status = absl::CancelledError("client went away");
+    record_.run_seconds += SecondsSince(started);
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!status.ok()) {
+      FinishLocked(status);
+      return;
+    }
+    StartWrite(&result_);
+  }
+
+  absl::Status ComputeFrame() {
+    result_.Clear();
+    result_.set_frame(frame_.frame());
+    absl::StatusOr<DistanceRequest> tolerance = ToleranceFromProto(frame_.tolerance());
+    if (!tolerance.ok()) return tolerance.status();
+    const HierarchyVolume volume = VolumeFromProto(frame_.volume());
+    const std::size_t n = static_cast<std::size_t>(frame_.pairs_size());
+    struct Query {
+      const SphereHierarchy* a;
+      const SphereHierarchy* b;
+      RigidPose pose_a, pose_b;
+    };
+    std::vector<Query> queries(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const v1::DistancePair& pair = frame_.pairs(static_cast<int>(i));
+      const std::string where = absl::StrCat("frame ", frame_.frame(), " pairs[", i, "]");
+      absl::StatusOr<const SphereHierarchy*> a =
+          Hierarchy(pair.sphere_set_a(), volume, where + ".sphere_set_a");
+      if (!a.ok()) return a.status();
+      absl::StatusOr<const SphereHierarchy*> b =
+          Hierarchy(pair.sphere_set_b(), volume, where + ".sphere_set_b");
+      if (!b.ok()) return b.status();
+      absl::StatusOr<RigidPose> pose_a = PoseFromProto(pair.pose_a(), where + ".pose_a");
+      if (!pose_a.ok()) return pose_a.status();
+      absl::StatusOr<RigidPose> pose_b = PoseFromProto(pair.pose_b(), where + ".pose_b");
+      if (!pose_b.ok()) return pose_b.status();
+      queries[i] = Query{*a, *b, *pose_a, *pose_b};
+    }
+    std::vector<DistanceResult> results(n);
+    std::vector<absl::Status> errors(n);
+    auto run = [&](std::size_t begin, std::size_t end) {
+      if (cancelled_.load()) return;
+      for (std::size_t i = begin; i < end; ++i) {
+        const Query& q = queries[i];
+        absl::StatusOr<DistanceResult> r =
+            SeparationDistance(*q.a, q.pose_a, *q.b, q.pose_b, *tolerance);
+        if (r.ok()) {
+          results[i] = *r;
+        } else {
+          errors[i] = r.status();
+        }
+      }
+    };
+    // A few pairs (the usual frame) cost microseconds: forking would cost more than it saves.
+    if (n <= kChunk) {
+      run(0, n);
+    } else {
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kChunk),
+                        [&](const tbb::blocked_range<std::size_t>& r) { run(r.begin(), r.end()); });
+    }
+    if (cancelled_.load()) return absl::CancelledError("client went away mid-frame");
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!errors[i].ok()) {
+        return absl::Status(errors[i].code(), absl::StrCat("frame ", frame_.frame(), " pairs[", i,
+                                                           "]: ", errors[i].message()));
+      }
+    }
+    AppendDistanceResults(results, result_.mutable_results());
+    return absl::OkStatus();
+  }
+
+  // The hierarchy of `key` for this stream, from the stream's own table or the store.
+  absl::StatusOr<const SphereHierarchy*> Hierarchy(const std::string& key, HierarchyVolume volume,
+                                                   const std::string& field) {
+    const std::string slot = absl::StrCat(HierarchyVolumeName(volume), "/", key);
+    if (auto it = held_.find(slot); it != held_.end()) return it->second.get();
+    if (absl::Status s = CheckKey(key, field.c_str()); !s.ok()) return s;
+    if (held_.size() >= kMaxStreamSets) {
+      return absl::ResourceExhaustedError(
+          absl::StrCat(field, ": a stream may name at most ", kMaxStreamSets,
+                       " distinct sphere sets (per hierarchy volume); open another stream"));
+    }
+    absl::StatusOr<std::shared_ptr<const SphereHierarchy>> h =
+        service_->store_->GetHierarchy(key, volume);
+    if (!h.ok()) {
+      return absl::Status(h.status().code(), absl::StrCat(field, ": ", h.status().message()));
+    }
+    const SphereHierarchy* raw = h->get();
+    held_.emplace(slot, *std::move(h));
+    return raw;
+  }
+
+  InscribeService* const service_;
+  std::atomic<bool> cancelled_{false};
+  std::atomic<int> refs_{1};  // gRPC's (released in OnDone) plus each drain in progress
+
+  std::mutex mutex_;
+  State state_ = State::kStarting;  // guarded by mutex_
+  bool draining_ = false;           // guarded by mutex_
+  absl::Status final_status_;       // set once, by FinishLocked
+
+  // Touched by one thread at a time: gRPC callbacks and the frame's job never overlap.
+  v1::DistanceFrame frame_;
+  v1::DistanceFrameResult result_;
+  std::unordered_map<std::string, std::shared_ptr<const SphereHierarchy>> held_;
+  CallRecord record_;
+};
+
+grpc::ServerBidiReactor<v1::DistanceFrame, v1::DistanceFrameResult>*
+InscribeService::DistanceStream(grpc::CallbackServerContext* context) {
+  auto* reactor = new DistanceStreamReactor(this, context);
+  reactor->Start();
+  return reactor;
+}
+
+void InscribeService::StartDraining() {
+  draining_.store(true);
+  std::vector<DistanceStreamReactor*> streams;
+  {
+    std::lock_guard<std::mutex> lock(calls_mutex_);
+    for (DistanceStreamReactor* stream : streams_) {
+      stream->Ref();
+      streams.push_back(stream);
+    }
+  }
+  for (DistanceStreamReactor* stream : streams) {
+    stream->Drain();
+    stream->Unref();
+  }
+}
+
+}  // namespace inscribe::server

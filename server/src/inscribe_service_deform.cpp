@@ -1,0 +1,251 @@
+// The InscribeService RPCs on sphere sets made elsewhere or moved: PutSphereSet,
+// UpdateDeformation (paper Section V) and Evaluate (Section IV-B measures). O(1) checks on
+// the gRPC thread, the rest on the pool through ResultStore.
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+#include "inscribe/mesh_hash.h"
+#include "inscribe/server/convert.h"
+#include "inscribe/server/inscribe_service.h"
+#include "inscribe/sphere_deformation.h"
+#include "inscribe/sphere_quality.h"
+#include "result_store.h"
+#include "service_checks.h"
+
+namespace inscribe::server {
+namespace {
+
+// Boundary samples Evaluate takes at most: ~100 ms per million samples and 1,000 spheres on
+// one core, so this bounds a call to seconds, not hours.
+constexpr std::int64_t kMaxEvaluateSamples = 10'000'000;
+constexpr std::int64_t kDefaultEvaluateSamples = 100'000;
+
+// The mesh a call is about: the request's, else the one the set names. INVALID_ARGUMENT when
+// neither names one, or when they differ (contacts index one mesh's triangles).
+absl::StatusOr<std::string> MeshKeyFor(const std::string& requested, const SphereSetEntry& set,
+                                       const std::string& set_key) {
+  const std::string& own = set.result.mesh_sha256();
+  if (requested.empty()) {
+    if (own.empty()) {
+      return absl::InvalidArgumentError(absl::StrCat("mesh_sha256 is required: sphere set ",
+                                                     set_key, " was uploaded without a mesh"));
+    }
+    return own;
+  }
+  if (absl::Status s = CheckKey(requested, "mesh_sha256"); !s.ok()) return s;
+  if (!own.empty() && own != requested) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("sphere set ", set_key, " was made for mesh ", own, ", not ", requested));
+  }
+  return requested;
+}
+
+// Copies packed xyz triples into #V x 3 vertices. INVALID_ARGUMENT for a length that is not
+// 3 * expected (naming both) or a non-finite coordinate (naming the vertex).
+absl::StatusOr<Vertices> DeformedVertices(const v1::UpdateDeformationRequest& request,
+                                          std::int64_t expected) {
+  const int n = request.vertices_size();
+  if (n != 3 * expected) {
+    return absl::InvalidArgumentError(absl::StrCat("vertices has ", n, " numbers; the mesh has ",
+                                                   expected, " vertices, so 3 x ", expected, " = ",
+                                                   3 * expected, " are needed"));
+  }
+  Vertices vertices(expected, 3);
+  for (int i = 0; i < n; ++i) {
+    const double x = request.vertices(i);
+    if (!std::isfinite(x)) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("vertices: vertex ", i / 3, " has a non-finite coordinate"));
+    }
+    vertices(i / 3, i % 3) = x;
+  }
+  return vertices;
+}
+
+}  // namespace
+
+grpc::ServerUnaryReactor* InscribeService::PutSphereSet(grpc::CallbackServerContext* context,
+                                                        const v1::PutSphereSetRequest* request,
+                                                        v1::PutSphereSetResponse* response) {
+  absl::Status precheck;
+  if (request->spheres().radii_size() > limits_.max_spheres) {
+    precheck = absl::ResourceExhaustedError(
+        absl::StrCat("spheres has ", request->spheres().radii_size(),
+                     " spheres; this server's limit (--max-spheres) is ", limits_.max_spheres));
+  } else if (!request->mesh_sha256().empty()) {
+    precheck = CheckKey(request->mesh_sha256(), "mesh_sha256");
+  }
+  return RunUnary(context, "PutSphereSet", 0, precheck,
+                  [this, request, response]() -> absl::Status {
+                    absl::StatusOr<SphereSet> set = SphereSetFromProto(request->spheres());
+                    if (!set.ok()) return set.status();
+                    bool already = false;
+                    absl::StatusOr<std::shared_ptr<const SphereSetEntry>> entry =
+                        store_->PutSphereSet(*std::move(set), request->mesh_sha256(), &already);
+                    if (!entry.ok()) return entry.status();
+                    response->set_sphere_set_key((*entry)->result.sphere_set_key());
+                    response->set_already_stored(already);
+                    return absl::OkStatus();
+                  });
+}
+
+grpc::ServerUnaryReactor* InscribeService::UpdateDeformation(
+    grpc::CallbackServerContext* context, const v1::UpdateDeformationRequest* request,
+    v1::UpdateDeformationResponse* response) {
+  absl::Status precheck = CheckKey(request->sphere_set_key(), "sphere_set_key");
+  if (precheck.ok() && request->vertices_size() / 3 > 3 * limits_.max_triangles) {
+    // A closed mesh has about half as many vertices as triangles; 3x leaves room.
+    precheck = absl::ResourceExhaustedError(
+        absl::StrCat("vertices has ", request->vertices_size() / 3,
+                     " vertices; no stored mesh has more than 3 x --max-triangles = ",
+                     3 * limits_.max_triangles));
+  }
+  if (precheck.ok() && !(std::isfinite(request->xi()) && request->xi() >= 0.0)) {
+    precheck = absl::InvalidArgumentError(
+        absl::StrCat("xi must be finite and >= 0 (0 = the default), got ", request->xi()));
+  }
+  return RunUnary(
+      context, "UpdateDeformation", 0, precheck, [this, request, response]() -> absl::Status {
+        absl::StatusOr<std::shared_ptr<const SphereSetEntry>> set =
+            store_->GetSphereSet(request->sphere_set_key());
+        if (!set.ok()) return set.status();
+        absl::StatusOr<std::string> mesh_key =
+            MeshKeyFor(request->mesh_sha256(), **set, request->sphere_set_key());
+        if (!mesh_key.ok()) return mesh_key.status();
+        absl::StatusOr<std::shared_ptr<const StoredMeshEntry>> mesh = store_->GetMesh(*mesh_key);
+        if (!mesh.ok()) return mesh.status();
+        absl::StatusOr<Vertices> vertices =
+            DeformedVertices(*request, (*mesh)->mesh.num_vertices());
+        if (!vertices.ok()) return vertices.status();
+
+        DeformationOptions options;
+        options.xi = request->xi();
+        options.strict = request->strict();
+        options.direction = request->interpolated_normal() ? ContactDirection::kInterpolatedNormal
+                                                           : ContactDirection::kCarriedFrame;
+        // As the stored mesh's own oracle: the pseudonormal sign fails near buried sheets.
+        if (request->ray_parity() || (*mesh)->report.self_intersecting_pairs > 0) {
+          options.oracle.inside_test = InsideTest::kRayParity;
+        }
+        absl::StatusOr<std::shared_ptr<const DeformerEntry>> entry =
+            store_->GetDeformer(*mesh_key, request->sphere_set_key(), options);
+        if (!entry.ok()) return entry.status();
+
+        absl::StatusOr<DeformedSpheres> moved;
+        absl::StatusOr<DeformationErrorBounds> bounds;
+        {
+          // One update at a time per deformer: Update refits its oracle in place, and the
+          // bounds read that oracle.
+          std::lock_guard<std::mutex> lock((*entry)->mutex);
+          moved = (*entry)->deformer.Update(*vertices);
+          if (!moved.ok()) return moved.status();
+          if (request->bounds()) {
+            bounds =
+                BoundDeformationError((*entry)->deformer.oracle(), moved->set.spheres, moved->xi);
+            if (!bounds.ok()) return bounds.status();
+          }
+          response->set_reference_spheres(
+              static_cast<std::int64_t>((*entry)->deformer.reference_spheres().size()));
+        }
+        SphereSetToProto(moved->set, response->mutable_spheres());
+        response->set_xi(moved->xi);
+        response->set_max_protrusion(moved->max_protrusion);
+        response->set_shrunk(moved->shrunk);
+        response->set_dropped(moved->dropped);
+        response->set_seconds(moved->seconds);
+        response->set_closest_point_queries(moved->closest_point_queries);
+        response->set_max_shrink_steps(moved->max_shrink_steps);
+        for (const std::int32_t i : moved->reference_index) response->add_reference_index(i);
+        const std::string deformed_key =
+            FormatSha256(MeshSha256(Mesh{*std::move(vertices), (*entry)->triangles}));
+        response->set_deformed_mesh_sha256(deformed_key);
+        if (request->bounds()) {
+          response->set_nerr_lower(bounds->nerr_lower);
+          response->set_nerr_upper(bounds->nerr_upper);
+          response->set_nerr_is_exact(bounds->exact);
+          response->set_bounds_seconds(bounds->seconds);
+          response->set_volume_mesh(bounds->volume_mesh);
+          response->set_volume_union(bounds->volume_union);
+          if (bounds->uniform_xi_holds) {
+            response->set_nerr_upper_uniform_xi(bounds->nerr_upper_uniform_xi);
+          }
+        }
+        if (request->store()) {
+          // Keyed by the deformed mesh's hash, which names no stored mesh unless the caller
+          // uploads the deformed mesh too; the key is what Distance needs.
+          absl::StatusOr<std::shared_ptr<const SphereSetEntry>> stored =
+              store_->PutSphereSet(std::move(moved->set), "", nullptr);
+          if (!stored.ok()) return stored.status();
+          response->set_sphere_set_key((*stored)->result.sphere_set_key());
+        }
+        return absl::OkStatus();
+      });
+}
+
+grpc::ServerUnaryReactor* InscribeService::Evaluate(grpc::CallbackServerContext* context,
+                                                    const v1::EvaluateRequest* request,
+                                                    v1::EvaluateResponse* response) {
+  absl::Status precheck;
+  if (request->has_sphere_set()) {
+    if (request->sphere_set().radii_size() > limits_.max_spheres) {
+      precheck = absl::ResourceExhaustedError(
+          absl::StrCat("sphere_set has ", request->sphere_set().radii_size(),
+                       " spheres; this server's limit (--max-spheres) is ", limits_.max_spheres));
+    } else {
+      precheck = CheckKey(request->mesh_sha256(), "mesh_sha256");
+    }
+  } else {
+    precheck = CheckKey(request->sphere_set_key(), "sphere_set_key (or an inline sphere_set)");
+  }
+  if (precheck.ok() && request->samples() > kMaxEvaluateSamples) {
+    precheck = absl::InvalidArgumentError(absl::StrCat(
+        "samples is ", request->samples(), "; at most ", kMaxEvaluateSamples, " are taken"));
+  }
+  if (precheck.ok() &&
+      !(std::isfinite(request->voxel_size()) && request->voxel_size() >= 0.0 &&
+        std::isfinite(request->coverage_tolerance()) && request->coverage_tolerance() >= 0.0)) {
+    precheck = absl::InvalidArgumentError(
+        absl::StrCat("voxel_size and coverage_tolerance must be finite and >= 0, got ",
+                     request->voxel_size(), " and ", request->coverage_tolerance()));
+  }
+  return RunUnary(context, "Evaluate", 0, precheck, [this, request, response]() -> absl::Status {
+    std::string mesh_key = request->mesh_sha256();
+    std::shared_ptr<const SphereSetEntry> cached;
+    SphereSet inline_set;
+    if (request->has_sphere_set()) {
+      absl::StatusOr<SphereSet> set = SphereSetFromProto(request->sphere_set(), "sphere_set");
+      if (!set.ok()) return set.status();
+      inline_set = *std::move(set);
+    } else {
+      absl::StatusOr<std::shared_ptr<const SphereSetEntry>> set =
+          store_->GetSphereSet(request->sphere_set_key());
+      if (!set.ok()) return set.status();
+      cached = *std::move(set);
+      absl::StatusOr<std::string> key =
+          MeshKeyFor(request->mesh_sha256(), *cached, request->sphere_set_key());
+      if (!key.ok()) return key.status();
+      mesh_key = *std::move(key);
+    }
+    absl::StatusOr<std::shared_ptr<const StoredMeshEntry>> mesh = store_->GetMesh(mesh_key);
+    if (!mesh.ok()) return mesh.status();
+    QualityOptions options;
+    options.surface_samples = request->samples() == 0  ? kDefaultEvaluateSamples
+                              : request->samples() < 0 ? 0
+                                                       : request->samples();
+    options.voxel_size = request->voxel_size();
+    if (request->coverage_tolerance() > 0.0) {
+      options.coverage_tolerance = request->coverage_tolerance();
+    }
+    const std::vector<Sphere>& spheres = cached ? cached->set.spheres : inline_set.spheres;
+    absl::StatusOr<QualityReport> report = EvaluateSpheres((*mesh)->oracle, spheres, options);
+    if (!report.ok()) return report.status();
+    QualityReportToProto(*report, response->mutable_quality());
+    return absl::OkStatus();
+  });
+}
+
+}  // namespace inscribe::server

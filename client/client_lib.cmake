@@ -4,6 +4,8 @@
 # from anywhere.
 add_library(inscribe_client STATIC
   ${CMAKE_CURRENT_LIST_DIR}/src/client/client.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/src/client/distance_query_proto.h
+  ${CMAKE_CURRENT_LIST_DIR}/src/client/distance_session.cpp
   ${CMAKE_CURRENT_LIST_DIR}/src/client/grpc_connection.cpp)
 add_library(inscribe::client ALIAS inscribe_client)
 target_include_directories(inscribe_client

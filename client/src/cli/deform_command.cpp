@@ -14,6 +14,7 @@
 #include "inscribe/sphere_deformation.h"
 #include "inscribe/sphere_io.h"
 #include "nlohmann/json.hpp"
+#include "remote_options.h"
 #include "sphere_output.h"
 
 namespace inscribe::cli {
@@ -30,6 +31,7 @@ struct DeformCliOptions {
   std::string output_path;
   std::string format;
   bool json = false;
+  RemoteOptions remote;
 };
 
 // The deformed file must be the reference file with its vertices moved: same vertex count,
@@ -54,49 +56,46 @@ std::string DescribeTopologyDifference(const Mesh& reference, const Mesh& deform
   return "";
 }
 
-void PrintText(const DeformCliOptions& options, const DeformedSpheres& result,
-               const DeformationErrorBounds& bounds) {
-  auto line = [](const char* key, const std::string& value) {
-    std::cout << absl::StrFormat("%-26s %s\n", key, value);
-  };
-  line("reference", options.reference_path);
-  line("deformed", options.deformed_path);
-  line("spheres", absl::StrFormat("%d (%d shrunk, %d dropped)", result.set.size(), result.shrunk,
-                                  result.dropped));
-  line("xi", absl::StrFormat("%.6g", result.xi));
-  line("max protrusion", absl::StrFormat("%.6g", result.max_protrusion));
-  line(bounds.exact ? "nerr (exact)" : "nerr bounds (Lemmas 1, 2)",
-       bounds.exact ? absl::StrFormat("%.6f", bounds.nerr_lower)
-                    : absl::StrFormat("%.6f .. %.6f", bounds.nerr_lower, bounds.nerr_upper));
-  line("update", absl::StrFormat("%.4f s (%d closest-point queries)", result.seconds,
-                                 result.closest_point_queries));
-  line("bounds", absl::StrFormat("%.4f s", bounds.seconds));
-}
+// The local half of deform, the same in both modes: the three files read and checked against
+// each other, the reference validated and hashed, the deformed solid checked.
+struct DeformInputs {
+  SphereFile file;
+  Mesh reference_file;      // as read: what remote mode uploads (the server validates it itself)
+  ValidatedMesh reference;  // orientation fixed, holes filled when asked
+  std::string reference_sha256;
+  Mesh deformed;  // the validated reference's triangles on the moved vertices
+  std::string deformed_sha256;
+  std::int64_t deformed_self_intersecting_pairs = 0;
+  // Ray parity when either pose self-intersects: the pseudonormal sign fails near buried
+  // sheets.
+  bool ray_parity = false;
+};
 
-int RunDeform(const DeformCliOptions& options) {
-  const auto load_start = std::chrono::steady_clock::now();
+// Prints why and sets *exit_code when it returns nothing.
+std::optional<DeformInputs> ReadInputs(const DeformCliOptions& options, int* exit_code) {
+  *exit_code = kExitBadInput;
   SphereFileReadOptions read;
   if (!options.format.empty()) read.format = *ParseSphereFileFormat(options.format);
   absl::StatusOr<SphereFile> file = ReadSphereFile(options.spheres_path, read);
   if (!file.ok()) {
     std::cerr << "inscribe: " << file.status().message() << "\n";
-    return kExitBadInput;
+    return std::nullopt;
   }
   if (!file->set.has_contacts()) {
     std::cerr << "inscribe: " << options.spheres_path
               << ": no contact points; deform needs the JSON sphere file inscribe generate "
                  "writes (contacts are where each sphere touches the reference mesh)\n";
-    return kExitBadInput;
+    return std::nullopt;
   }
   absl::StatusOr<Mesh> reference = ReadMesh(options.reference_path);
   if (!reference.ok()) {
     std::cerr << "inscribe: " << reference.status().message() << "\n";
-    return kExitBadInput;
+    return std::nullopt;
   }
   absl::StatusOr<Mesh> deformed_file = ReadMesh(options.deformed_path);
   if (!deformed_file.ok()) {
     std::cerr << "inscribe: " << deformed_file.status().message() << "\n";
-    return kExitBadInput;
+    return std::nullopt;
   }
   if (const std::string why = DescribeTopologyDifference(*reference, *deformed_file);
       !why.empty()) {
@@ -104,117 +103,250 @@ int RunDeform(const DeformCliOptions& options) {
               << options.reference_path << ": " << why
               << " (a deformed mesh keeps the reference's vertices and triangles, in order, "
                  "and only moves the vertices)\n";
-    return kExitBadInput;
+    return std::nullopt;
   }
+  DeformInputs in;
+  in.reference_file = *reference;
   ValidateOptions validate;
   validate.fill_holes = options.fill_holes;
   absl::StatusOr<ValidatedMesh> solid = PrepareMesh(*std::move(reference), validate);
   if (!solid.ok()) {
     std::cerr << "inscribe: " << options.reference_path << ": " << solid.status().message() << "\n";
-    return kExitUnusableMesh;
+    *exit_code = kExitUnusableMesh;
+    return std::nullopt;
   }
-  const std::string reference_sha256 = FormatSha256(MeshSha256(solid->mesh));
-  if (!file->mesh_sha256.empty() && file->mesh_sha256 != reference_sha256) {
+  in.reference_sha256 = FormatSha256(MeshSha256(solid->mesh));
+  if (!file->mesh_sha256.empty() && file->mesh_sha256 != in.reference_sha256) {
     std::cerr << "inscribe: " << options.spheres_path << " was made for mesh " << file->mesh_sha256
-              << ", but " << options.reference_path << " is " << reference_sha256
+              << ", but " << options.reference_path << " is " << in.reference_sha256
               << (options.fill_holes ? ""
                                      : " (if the spheres were made with --fill-holes, "
                                        "pass it here too)")
               << "\n";
-    return kExitBadInput;
+    return std::nullopt;
   }
-  // The reference's triangles as validated (orientation fixed, holes filled) on the moved
-  // vertices: the deformed solid is that of the reference, deformed.
-  Mesh deformed{deformed_file->vertices, solid->mesh.triangles};
+  // The deformed solid is that of the reference, deformed.
+  in.deformed = Mesh{deformed_file->vertices, solid->mesh.triangles};
   ValidateOptions check;
   check.fix_orientation = false;
-  const ValidatedMesh deformed_check = ValidateMesh(deformed, check);
-  const std::string deformed_sha256 = FormatSha256(MeshSha256(deformed));
+  in.deformed_self_intersecting_pairs =
+      ValidateMesh(in.deformed, check).report.self_intersecting_pairs;
+  in.deformed_sha256 = FormatSha256(MeshSha256(in.deformed));
+  in.ray_parity =
+      solid->report.self_intersecting_pairs > 0 || in.deformed_self_intersecting_pairs > 0;
+  in.file = *std::move(file);
+  in.reference = *std::move(solid);
+  *exit_code = kExitOk;
+  return in;
+}
 
+// Embedded mode: the core's deformer and bounds, in the client library's result type (which
+// both modes print from). Prints why and sets *exit_code on failure.
+std::optional<client::DeformationResult> DeformHere(const DeformCliOptions& options,
+                                                    DeformInputs in, int* exit_code) {
   DeformationOptions deform;
   deform.xi = options.xi;
   deform.strict = options.strict;
   deform.direction = options.interpolated_normal ? ContactDirection::kInterpolatedNormal
                                                  : ContactDirection::kCarriedFrame;
-  // Ray parity when either pose self-intersects: the pseudonormal sign fails near buried
-  // sheets.
-  if (solid->report.self_intersecting_pairs > 0 ||
-      deformed_check.report.self_intersecting_pairs > 0) {
-    deform.oracle.inside_test = InsideTest::kRayParity;
-  }
+  if (in.ray_parity) deform.oracle.inside_test = InsideTest::kRayParity;
   absl::StatusOr<SphereDeformer> deformer =
-      SphereDeformer::Create(std::move(solid->mesh), std::move(file->set), deform);
+      SphereDeformer::Create(std::move(in.reference.mesh), std::move(in.file.set), deform);
   if (!deformer.ok()) {
     std::cerr << "inscribe: " << options.spheres_path << ": " << deformer.status().message()
               << "\n";
-    return kExitBadInput;
+    *exit_code = kExitBadInput;
+    return std::nullopt;
   }
-  const double load_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - load_start).count();
-  absl::StatusOr<DeformedSpheres> result = deformer->Update(deformed.vertices);
-  if (!result.ok()) {
-    std::cerr << "inscribe: " << options.deformed_path << ": " << result.status().message() << "\n";
-    return kExitUnusableMesh;
+  absl::StatusOr<DeformedSpheres> moved = deformer->Update(in.deformed.vertices);
+  if (!moved.ok()) {
+    std::cerr << "inscribe: " << options.deformed_path << ": " << moved.status().message() << "\n";
+    *exit_code = kExitUnusableMesh;
+    return std::nullopt;
   }
   absl::StatusOr<DeformationErrorBounds> bounds =
-      BoundDeformationError(deformer->oracle(), result->set.spheres, result->xi);
+      BoundDeformationError(deformer->oracle(), moved->set.spheres, moved->xi);
   if (!bounds.ok()) {
     std::cerr << "inscribe: bounding the error: " << bounds.status().message() << "\n";
-    return kExitUnusableMesh;
+    *exit_code = kExitUnusableMesh;
+    return std::nullopt;
   }
+  client::DeformationResult r;
+  r.spheres = std::move(moved->set);
+  r.reference_index = std::move(moved->reference_index);
+  r.xi = moved->xi;
+  r.max_protrusion = moved->max_protrusion;
+  r.shrunk = moved->shrunk;
+  r.dropped = moved->dropped;
+  r.closest_point_queries = moved->closest_point_queries;
+  r.max_shrink_steps = moved->max_shrink_steps;
+  r.seconds = moved->seconds;
+  r.reference_spheres = static_cast<std::int64_t>(deformer->reference_spheres().size());
+  r.deformed_mesh_sha256 = in.deformed_sha256;
+  client::DeformationResult::Bounds b;
+  b.nerr_lower = bounds->nerr_lower;
+  b.nerr_upper = bounds->nerr_upper;
+  b.nerr_is_exact = bounds->exact;
+  b.volume_mesh = bounds->volume_mesh;
+  b.volume_union = bounds->volume_union;
+  if (bounds->uniform_xi_holds) b.nerr_upper_uniform_xi = bounds->nerr_upper_uniform_xi;
+  b.seconds = bounds->seconds;
+  r.bounds = b;
+  return r;
+}
+
+// Remote mode: the reference and the spheres are stored on the server, which keeps a deformer
+// for them; the moved vertices go in one UpdateDeformation call.
+std::optional<client::DeformationResult> DeformRemotely(const DeformCliOptions& options,
+                                                        const DeformInputs& in, int* exit_code) {
+  const client::Client client = MakeClient(options.remote);
+  absl::StatusOr<client::PutMeshResult> mesh =
+      client.PutMesh(in.reference_file, options.fill_holes);
+  if (!mesh.ok()) {
+    *exit_code = ReportRemoteError(mesh.status(), options.remote);
+    return std::nullopt;
+  }
+  if (mesh->mesh_sha256 != in.reference_sha256) {
+    std::cerr << "inscribe: the server stored " << options.reference_path << " as "
+              << mesh->mesh_sha256 << ", not " << in.reference_sha256 << " (server "
+              << options.remote.server << ")\n";
+    *exit_code = kExitInternal;
+    return std::nullopt;
+  }
+  absl::StatusOr<client::PutSphereSetResult> set =
+      client.PutSphereSet(in.file.set, mesh->mesh_sha256);
+  if (!set.ok()) {
+    *exit_code = ReportRemoteError(set.status(), options.remote);
+    return std::nullopt;
+  }
+  client::DeformationSettings settings;
+  settings.xi = options.xi;
+  settings.strict = options.strict;
+  settings.interpolated_normal = options.interpolated_normal;
+  settings.ray_parity = in.ray_parity;
+  settings.bounds = true;
+  absl::StatusOr<client::DeformationResult> result = client.UpdateDeformation(
+      mesh->mesh_sha256, set->sphere_set_key, in.deformed.vertices, settings);
+  if (!result.ok()) {
+    *exit_code = ReportRemoteError(result.status(), options.remote);
+    // As in embedded mode: contacts that do not fit are the sphere file's fault, a degenerate
+    // deformed solid (the vertex count was checked here) is the deformed mesh's.
+    if (result.status().code() == absl::StatusCode::kFailedPrecondition) *exit_code = kExitBadInput;
+    if (result.status().code() == absl::StatusCode::kInvalidArgument) {
+      *exit_code = kExitUnusableMesh;
+    }
+    return std::nullopt;
+  }
+  if (!result->bounds) {
+    std::cerr << "inscribe: the server sent no error bounds (server " << options.remote.server
+              << ")\n";
+    *exit_code = kExitInternal;
+    return std::nullopt;
+  }
+  return *std::move(result);
+}
+
+void PrintText(const DeformCliOptions& options, const client::DeformationResult& result) {
+  auto line = [](const char* key, const std::string& value) {
+    std::cout << absl::StrFormat("%-26s %s\n", key, value);
+  };
+  const client::DeformationResult::Bounds& bounds = *result.bounds;
+  line("reference", options.reference_path);
+  line("deformed", options.deformed_path);
+  line("spheres", absl::StrFormat("%d (%d shrunk, %d dropped)", result.spheres.size(),
+                                  result.shrunk, result.dropped));
+  line("xi", absl::StrFormat("%.6g", result.xi));
+  line("max protrusion", absl::StrFormat("%.6g", result.max_protrusion));
+  line(bounds.nerr_is_exact ? "nerr (exact)" : "nerr bounds (Lemmas 1, 2)",
+       bounds.nerr_is_exact
+           ? absl::StrFormat("%.6f", bounds.nerr_lower)
+           : absl::StrFormat("%.6f .. %.6f", bounds.nerr_lower, bounds.nerr_upper));
+  line("update", absl::StrFormat("%.4f s (%d closest-point queries)", result.seconds,
+                                 result.closest_point_queries));
+  line("bounds", absl::StrFormat("%.4f s", bounds.seconds));
+}
+
+void PrintSummary(const DeformCliOptions& options, const DeformInputs& in,
+                  const client::DeformationResult& result, double load_seconds) {
+  const client::DeformationResult::Bounds& bounds = *result.bounds;
+  nlohmann::json summary;
+  summary["reference_mesh"] = options.reference_path;
+  summary["reference_mesh_sha256"] = in.reference_sha256;
+  summary["deformed_mesh"] = options.deformed_path;
+  summary["mesh_sha256"] = in.deformed_sha256;
+  summary["spheres"] = result.spheres.size();
+  summary["reference_spheres"] = result.reference_spheres;
+  summary["shrunk"] = result.shrunk;
+  summary["dropped"] = result.dropped;
+  summary["xi"] = result.xi;
+  summary["strict"] = options.strict;
+  summary["max_protrusion"] = result.max_protrusion;
+  summary["max_shrink_steps"] = result.max_shrink_steps;
+  summary["closest_point_queries"] = result.closest_point_queries;
+  summary["seconds"] = result.seconds;
+  summary["bounds_seconds"] = bounds.seconds;
+  summary["load_seconds"] = load_seconds;
+  summary["volume_mesh"] = bounds.volume_mesh;
+  summary["volume_union"] = bounds.volume_union;
+  summary["nerr_lower"] = bounds.nerr_lower;
+  summary["nerr_upper"] = bounds.nerr_upper;
+  // JSON has no infinity: null when Lemma 2's uniform-xi premise fails.
+  summary["nerr_upper_uniform_xi"] = bounds.nerr_upper_uniform_xi
+                                         ? nlohmann::json(*bounds.nerr_upper_uniform_xi)
+                                         : nlohmann::json(nullptr);
+  summary["nerr_is_exact"] = bounds.nerr_is_exact;
+  summary["self_intersecting_pairs"] = in.deformed_self_intersecting_pairs;
+  if (options.remote.enabled()) summary["server"] = options.remote.server;
+  if (!options.output_path.empty()) summary["output"] = options.output_path;
+  std::cout << summary.dump() << "\n";
+}
+
+int RunDeform(const DeformCliOptions& options) {
+  const auto load_start = std::chrono::steady_clock::now();
+  int exit_code = kExitOk;
+  std::optional<DeformInputs> in = ReadInputs(options, &exit_code);
+  if (!in) return exit_code;
+  const double load_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - load_start).count();
+  std::optional<client::DeformationResult> result;
+  if (options.remote.enabled()) {
+    result = DeformRemotely(options, *in, &exit_code);
+  } else {
+    result = DeformHere(options, *in, &exit_code);
+  }
+  if (!result) return exit_code;
+  const client::DeformationResult::Bounds& bounds = *result->bounds;
 
   SphereFile out;
-  out.set = result->set;
-  out.mesh_sha256 = deformed_sha256;
+  out.set = result->spheres;
+  out.mesh_sha256 = in->deformed_sha256;
   out.params = {
-      {"reference_mesh_sha256", reference_sha256},
+      {"reference_mesh_sha256", in->reference_sha256},
       {"xi", result->xi},
       {"strict", options.strict},
       {"direction",
        std::string(options.interpolated_normal ? "interpolated_normal" : "carried_frame")},
   };
   out.stats = {
-      {"seconds", result->seconds},         {"bounds_seconds", bounds->seconds},
-      {"volume_mesh", bounds->volume_mesh}, {"volume_union", bounds->volume_union},
-      {"nerr_lower", bounds->nerr_lower},   {"nerr_upper", bounds->nerr_upper},
-      {"nerr_is_exact", bounds->exact},     {"max_protrusion", result->max_protrusion},
-      {"shrunk", result->shrunk},           {"dropped", result->dropped},
+      {"seconds", result->seconds},
+      {"bounds_seconds", bounds.seconds},
+      {"volume_mesh", bounds.volume_mesh},
+      {"volume_union", bounds.volume_union},
+      {"nerr_lower", bounds.nerr_lower},
+      {"nerr_upper", bounds.nerr_upper},
+      {"nerr_is_exact", bounds.nerr_is_exact},
+      {"max_protrusion", result->max_protrusion},
+      {"shrunk", result->shrunk},
+      {"dropped", result->dropped},
   };
   if (const int code = EmitSphereFile(out, options.output_path, options.format, options.json);
       code != kExitOk) {
     return code;
   }
   if (options.json) {
-    nlohmann::json summary;
-    summary["reference_mesh"] = options.reference_path;
-    summary["reference_mesh_sha256"] = reference_sha256;
-    summary["deformed_mesh"] = options.deformed_path;
-    summary["mesh_sha256"] = deformed_sha256;
-    summary["spheres"] = result->set.size();
-    summary["reference_spheres"] = deformer->reference_spheres().size();
-    summary["shrunk"] = result->shrunk;
-    summary["dropped"] = result->dropped;
-    summary["xi"] = result->xi;
-    summary["strict"] = options.strict;
-    summary["max_protrusion"] = result->max_protrusion;
-    summary["max_shrink_steps"] = result->max_shrink_steps;
-    summary["closest_point_queries"] = result->closest_point_queries;
-    summary["seconds"] = result->seconds;
-    summary["bounds_seconds"] = bounds->seconds;
-    summary["load_seconds"] = load_seconds;
-    summary["volume_mesh"] = bounds->volume_mesh;
-    summary["volume_union"] = bounds->volume_union;
-    summary["nerr_lower"] = bounds->nerr_lower;
-    summary["nerr_upper"] = bounds->nerr_upper;
-    // JSON has no infinity: null when Lemma 2's uniform-xi premise fails.
-    summary["nerr_upper_uniform_xi"] =
-        bounds->uniform_xi_holds ? nlohmann::json(bounds->nerr_upper_uniform_xi) : nullptr;
-    summary["nerr_is_exact"] = bounds->exact;
-    summary["self_intersecting_pairs"] = deformed_check.report.self_intersecting_pairs;
-    if (!options.output_path.empty()) summary["output"] = options.output_path;
-    std::cout << summary.dump() << "\n";
+    PrintSummary(options, *in, *result, load_seconds);
   } else if (!options.output_path.empty()) {
-    PrintText(options, *result, *bounds);
+    PrintText(options, *result);
   }
   return kExitOk;
 }
@@ -256,6 +388,7 @@ void AddDeformCommand(CLI::App& app, int* exit_code) {
   cmd->add_flag("--json", options->json,
                 "Print one JSON summary on stdout (spheres, seconds, nerr_lower, nerr_upper, "
                 "max_protrusion, ...)");
+  AddRemoteOptions(cmd, &options->remote, 60.0);
   cmd->callback([options, exit_code] { *exit_code = RunDeform(*options); });
 }
 

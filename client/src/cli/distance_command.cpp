@@ -2,11 +2,14 @@
 
 #include <tbb/info.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -18,6 +21,7 @@
 #include "inscribe/sphere_io.h"
 #include "nlohmann/json.hpp"
 #include "pose_file.h"
+#include "remote_options.h"
 
 namespace inscribe::cli {
 namespace {
@@ -28,6 +32,7 @@ struct DistanceCliOptions {
   std::string output_path;
   DistanceRequest request;
   bool json = false;
+  RemoteOptions remote;
 };
 
 using Clock = std::chrono::steady_clock;
@@ -48,7 +53,147 @@ std::string FormatCsv(const std::vector<DistanceResult>& results) {
   return out.str();
 }
 
+// Poses per Distance call in remote mode: 100,000 poses are a 5.6 MB request and a 6.5 MB
+// answer, far below gRPC's and the server's message limits (--max-message-bytes, --max-poses),
+// and large enough that the round trips cost nothing next to the queries.
+constexpr std::size_t kPosesPerCall = 100'000;
+
+// What distance reports, computed here or by the server. The server sends neither the work
+// counts nor its hierarchy build time and thread count: those stay empty in remote mode.
+struct Distances {
+  std::vector<DistanceResult> results;  // entry i answers pose i
+  double seconds = 0.0;                 // the queries (remote: the server's time on them)
+  std::optional<double> build_seconds;  // both hierarchies
+  std::optional<int> threads;
+  bool work_counted = false;  // volume_tests and sphere_tests are filled in
+};
+
+// Embedded mode. Prints why and returns nothing on failure (kExitBadInput).
+std::optional<Distances> DistancesHere(const DistanceCliOptions& options, const SphereSet& a,
+                                       const SphereSet& b, const std::vector<RigidPose>& poses) {
+  Distances d;
+  d.results.resize(poses.size());
+  d.work_counted = true;
+  const auto start = Clock::now();
+  if (options.hierarchy == "none") {
+    const RigidPose identity;
+    for (std::size_t i = 0; i < poses.size(); ++i) {
+      absl::StatusOr<DistanceResult> r =
+          BruteForceSeparationDistance(a.spheres, identity, b.spheres, poses[i], options.request);
+      if (!r.ok()) {
+        std::cerr << "inscribe: pose " << i << ": " << r.status().message() << "\n";
+        return std::nullopt;
+      }
+      d.results[i] = *r;
+    }
+    d.build_seconds = 0.0;
+    d.threads = 1;
+  } else {
+    const HierarchyVolume volume =
+        options.hierarchy == "sphere" ? HierarchyVolume::kSphere : HierarchyVolume::kRss;
+    absl::StatusOr<SphereHierarchy> ha = SphereHierarchy::Build(a.spheres, volume);
+    absl::StatusOr<SphereHierarchy> hb = SphereHierarchy::Build(b.spheres, volume);
+    if (!ha.ok() || !hb.ok()) {
+      std::cerr << "inscribe: " << (ha.ok() ? hb.status() : ha.status()).message() << "\n";
+      return std::nullopt;
+    }
+    d.build_seconds = SecondsSince(start);
+    absl::StatusOr<std::vector<DistanceResult>> batch =
+        SeparationDistances(*ha, *hb, poses, options.request);
+    if (!batch.ok()) {
+      std::cerr << "inscribe: " << batch.status().message() << "\n";
+      return std::nullopt;
+    }
+    d.results = *std::move(batch);
+    d.threads = tbb::info::default_concurrency();
+  }
+  d.seconds = SecondsSince(start) - d.build_seconds.value_or(0.0);
+  return d;
+}
+
+// Remote mode: both sets stored on the server (PutSphereSet), then the poses in batches of
+// kPosesPerCall, A at the origin. Prints why and sets *exit_code on failure.
+std::optional<Distances> DistancesRemotely(const DistanceCliOptions& options, const SphereSet& a,
+                                           const SphereSet& b, const std::vector<RigidPose>& poses,
+                                           int* exit_code) {
+  const client::Client client = MakeClient(options.remote);
+  std::string keys[2];
+  for (int k = 0; k < 2; ++k) {
+    absl::StatusOr<client::PutSphereSetResult> stored = client.PutSphereSet(k == 0 ? a : b);
+    if (!stored.ok()) {
+      *exit_code = ReportRemoteError(stored.status(), options.remote);
+      return std::nullopt;
+    }
+    keys[k] = stored->sphere_set_key;
+  }
+  client::DistanceOptions call;
+  call.volume = options.hierarchy == "sphere" ? HierarchyVolume::kSphere : HierarchyVolume::kRss;
+  call.tolerance = options.request;
+  const std::vector<RigidPose> origin = {RigidPose()};
+  Distances d;
+  d.results.reserve(poses.size());
+  for (std::size_t first = 0; first < poses.size(); first += kPosesPerCall) {
+    const std::vector<RigidPose> batch(
+        poses.begin() + static_cast<std::ptrdiff_t>(first),
+        poses.begin() + static_cast<std::ptrdiff_t>(std::min(poses.size(), first + kPosesPerCall)));
+    absl::StatusOr<client::DistanceBatchResult> answer =
+        client.Distance(keys[0], keys[1], origin, batch, call);
+    if (!answer.ok()) {
+      *exit_code = ReportRemoteError(answer.status(), options.remote);
+      return std::nullopt;
+    }
+    d.seconds += answer->server_seconds;
+    for (DistanceResult& r : answer->results) d.results.push_back(std::move(r));
+  }
+  return d;
+}
+
+void PrintSummary(const DistanceCliOptions& options, const SphereSet& a, const SphereSet& b,
+                  const Distances& d) {
+  double min_distance = std::numeric_limits<double>::infinity();
+  std::int64_t touching = 0, closer = 0, volume_tests = 0, sphere_tests = 0;
+  for (const DistanceResult& r : d.results) {
+    min_distance = std::min(min_distance, r.distance);
+    touching += r.distance <= 0.0;
+    closer += r.closer;
+    volume_tests += r.volume_tests;
+    sphere_tests += r.sphere_tests;
+  }
+  const auto n = static_cast<double>(d.results.size());
+  nlohmann::json j;
+  j["a"] = options.a_path;
+  j["b"] = options.b_path;
+  j["spheres_a"] = a.size();
+  j["spheres_b"] = b.size();
+  j["hierarchy"] = options.hierarchy;
+  j["queries"] = d.results.size();
+  j["seconds"] = d.seconds;
+  j["us_per_query"] = 1e6 * d.seconds / n;
+  if (d.threads) j["threads"] = *d.threads;
+  if (d.build_seconds) j["build_seconds"] = *d.build_seconds;
+  j["min_distance"] = min_distance;
+  j["touching"] = touching;
+  if (std::isfinite(options.request.closer_than)) {
+    j["closer_than"] = options.request.closer_than;
+    j["closer"] = closer;
+  }
+  j["abs_err"] = options.request.abs_err;
+  j["rel_err"] = options.request.rel_err;
+  if (d.work_counted) {
+    j["mean_volume_tests"] = static_cast<double>(volume_tests) / n;
+    j["mean_sphere_tests"] = static_cast<double>(sphere_tests) / n;
+  }
+  if (options.remote.enabled()) j["server"] = options.remote.server;
+  if (!options.output_path.empty()) j["output"] = options.output_path;
+  std::cout << j.dump() << "\n";
+}
+
 int RunDistance(const DistanceCliOptions& options) {
+  if (options.remote.enabled() && options.hierarchy == "none") {
+    std::cerr << "inscribe: --hierarchy none (every sphere pair, in this process) cannot be "
+                 "used with --server; the server answers with --hierarchy sphere or rss\n";
+    return kExitUsage;
+  }
   absl::StatusOr<SphereFile> a = ReadSphereFile(options.a_path);
   if (!a.ok()) {
     std::cerr << "inscribe: " << a.status().message() << "\n";
@@ -72,88 +217,23 @@ int RunDistance(const DistanceCliOptions& options) {
     return kExitBadInput;
   }
 
-  std::vector<DistanceResult> results(poses->size());
-  double build_seconds = 0.0;
-  const auto start = Clock::now();
-  if (options.hierarchy == "none") {
-    const RigidPose identity;
-    for (std::size_t i = 0; i < poses->size(); ++i) {
-      absl::StatusOr<DistanceResult> r = BruteForceSeparationDistance(
-          a->set.spheres, identity, b->set.spheres, (*poses)[i], options.request);
-      if (!r.ok()) {
-        std::cerr << "inscribe: pose " << i << ": " << r.status().message() << "\n";
-        return kExitBadInput;
-      }
-      results[i] = *r;
-    }
-  } else {
-    const HierarchyVolume volume =
-        options.hierarchy == "sphere" ? HierarchyVolume::kSphere : HierarchyVolume::kRss;
-    const auto build_start = Clock::now();
-    absl::StatusOr<SphereHierarchy> ha = SphereHierarchy::Build(a->set.spheres, volume);
-    absl::StatusOr<SphereHierarchy> hb = SphereHierarchy::Build(b->set.spheres, volume);
-    if (!ha.ok() || !hb.ok()) {
-      std::cerr << "inscribe: " << (ha.ok() ? hb.status() : ha.status()).message() << "\n";
-      return kExitBadInput;
-    }
-    build_seconds = SecondsSince(build_start);
-    const auto query_start = Clock::now();
-    absl::StatusOr<std::vector<DistanceResult>> batch =
-        SeparationDistances(*ha, *hb, *poses, options.request);
-    if (!batch.ok()) {
-      std::cerr << "inscribe: " << batch.status().message() << "\n";
-      return kExitBadInput;
-    }
-    results = *std::move(batch);
-    (void)query_start;
-  }
-  const double seconds = SecondsSince(start) - build_seconds;
+  int exit_code = kExitBadInput;
+  const std::optional<Distances> d =
+      options.remote.enabled() ? DistancesRemotely(options, a->set, b->set, *poses, &exit_code)
+                               : DistancesHere(options, a->set, b->set, *poses);
+  if (!d) return exit_code;
 
   if (!options.output_path.empty()) {
     std::ofstream out(options.output_path, std::ios::binary | std::ios::trunc);
-    out << FormatCsv(results);
+    out << FormatCsv(d->results);
     if (!out.flush()) {
       std::cerr << "inscribe: " << options.output_path << ": cannot write\n";
       return kExitBadInput;
     }
   } else if (!options.json) {
-    std::cout << FormatCsv(results);
+    std::cout << FormatCsv(d->results);
   }
-  if (options.json) {
-    double min_distance = std::numeric_limits<double>::infinity();
-    std::int64_t touching = 0, closer = 0, volume_tests = 0, sphere_tests = 0;
-    for (const DistanceResult& r : results) {
-      min_distance = std::min(min_distance, r.distance);
-      touching += r.distance <= 0.0;
-      closer += r.closer;
-      volume_tests += r.volume_tests;
-      sphere_tests += r.sphere_tests;
-    }
-    const auto n = static_cast<double>(results.size());
-    nlohmann::json j;
-    j["a"] = options.a_path;
-    j["b"] = options.b_path;
-    j["spheres_a"] = a->set.size();
-    j["spheres_b"] = b->set.size();
-    j["hierarchy"] = options.hierarchy;
-    j["queries"] = results.size();
-    j["seconds"] = seconds;
-    j["us_per_query"] = 1e6 * seconds / n;
-    j["threads"] = options.hierarchy == "none" ? 1 : tbb::info::default_concurrency();
-    j["build_seconds"] = build_seconds;
-    j["min_distance"] = min_distance;
-    j["touching"] = touching;
-    if (std::isfinite(options.request.closer_than)) {
-      j["closer_than"] = options.request.closer_than;
-      j["closer"] = closer;
-    }
-    j["abs_err"] = options.request.abs_err;
-    j["rel_err"] = options.request.rel_err;
-    j["mean_volume_tests"] = static_cast<double>(volume_tests) / n;
-    j["mean_sphere_tests"] = static_cast<double>(sphere_tests) / n;
-    if (!options.output_path.empty()) j["output"] = options.output_path;
-    std::cout << j.dump() << "\n";
-  }
+  if (options.json) PrintSummary(options, a->set, b->set, *d);
   return kExitOk;
 }
 
@@ -172,7 +252,7 @@ void AddDistanceCommand(CLI::App& app, int* exit_code) {
       ->required();
   cmd->add_option("--hierarchy", options->hierarchy,
                   "Bounding volumes: sphere (default: the fastest on the Table II benchmark), "
-                  "rss (the paper's), or none (every sphere pair)")
+                  "rss (the paper's), or none (every sphere pair; not with --server)")
       ->check(CLI::IsMember({"rss", "sphere", "none"}));
   cmd->add_option("--abs-err", options->request.abs_err,
                   "Answers may exceed the true distance by this much (mesh units)")
@@ -186,6 +266,7 @@ void AddDistanceCommand(CLI::App& app, int* exit_code) {
                   "Write the CSV here: pose,distance,sphere_a,sphere_b,ax,ay,az,bx,by,bz");
   cmd->add_flag("--json", options->json,
                 "Print one JSON summary (queries, seconds, us_per_query, ...) on stdout");
+  AddRemoteOptions(cmd, &options->remote, 60.0);
   cmd->callback([options, exit_code] { *exit_code = RunDistance(*options); });
 }
 

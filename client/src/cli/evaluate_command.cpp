@@ -1,14 +1,17 @@
 #include "evaluate_command.h"
 
+#include <algorithm>
 #include <iostream>
 #include <memory>
 #include <optional>
 #include <string>
+#include <variant>
 
 #include "absl/strings/str_format.h"
 #include "exit_codes.h"
 #include "inscribe/sphere_io.h"
 #include "inscribe/sphere_quality.h"
+#include "remote_options.h"
 #include "report_json.h"
 #include "solid_loading.h"
 
@@ -23,6 +26,13 @@ struct EvaluateCliOptions {
   QualityOptions quality;
   bool json = false;
   bool fill_holes = false;
+  RemoteOptions remote;
+};
+
+// The mesh's key and the report, from this process or from the server.
+struct Evaluated {
+  std::string mesh_sha256;
+  QualityReport report;
 };
 
 void PrintText(const EvaluateCliOptions& options, const QualityReport& r) {
@@ -57,7 +67,48 @@ void PrintText(const EvaluateCliOptions& options, const QualityReport& r) {
   line("evaluated in", absl::StrFormat("%.3f s", r.seconds));
 }
 
+// Embedded mode. Prints why and sets *exit_code on failure.
+std::optional<Evaluated> EvaluateHere(const EvaluateCliOptions& options, const SphereFile& file,
+                                      const QualityOptions& quality, int* exit_code) {
+  std::optional<LoadedSolid> solid =
+      LoadSolid(options.mesh_path, exit_code, LoadSolidOptions{options.fill_holes});
+  if (!solid) return std::nullopt;
+  absl::StatusOr<QualityReport> report = EvaluateSpheres(solid->oracle, file.set.spheres, quality);
+  if (!report.ok()) {
+    std::cerr << "inscribe: " << report.status().message() << "\n";
+    *exit_code = report.status().code() == absl::StatusCode::kInvalidArgument ? kExitBadInput
+                                                                              : kExitUnusableMesh;
+    return std::nullopt;
+  }
+  return Evaluated{solid->sha256, *std::move(report)};
+}
+
+// Remote mode: PutMesh, then Evaluate with the spheres sent inline.
+std::optional<Evaluated> EvaluateRemotely(const EvaluateCliOptions& options, const SphereFile& file,
+                                          const QualityOptions& quality, int* exit_code) {
+  const client::Client client = MakeClient(options.remote);
+  std::optional<UploadedSolid> solid =
+      UploadSolid(client, options.remote, options.mesh_path, exit_code, {options.fill_holes});
+  if (!solid) return std::nullopt;
+  client::EvaluateSettings settings;
+  // The wire's 0 means the default; "no samples" is negative there.
+  settings.samples = quality.surface_samples > 0 ? quality.surface_samples : -1;
+  settings.voxel_size = quality.voxel_size;
+  settings.coverage_tolerance = std::max(quality.coverage_tolerance, 0.0);
+  absl::StatusOr<QualityReport> report = client.Evaluate(solid->sha256, file.set, settings);
+  if (!report.ok()) {
+    *exit_code = ReportRemoteError(report.status(), options.remote);
+    return std::nullopt;
+  }
+  return Evaluated{solid->sha256, *std::move(report)};
+}
+
 int RunEvaluate(const EvaluateCliOptions& options) {
+  if (options.remote.enabled() && options.quality.coverage_tolerance == 0.0) {
+    // On the wire 0 asks for the default (1e-3 of the diagonal), not for exact coverage.
+    std::cerr << "inscribe: --coverage-tolerance 0 cannot be used with --server\n";
+    return kExitUsage;
+  }
   int exit_code = kExitOk;
   SphereFileReadOptions read;
   if (!options.format.empty()) read.format = *ParseSphereFileFormat(options.format);
@@ -67,13 +118,6 @@ int RunEvaluate(const EvaluateCliOptions& options) {
     std::cerr << "inscribe: " << file.status().message() << "\n";
     return kExitBadInput;
   }
-  std::optional<LoadedSolid> solid =
-      LoadSolid(options.mesh_path, &exit_code, LoadSolidOptions{options.fill_holes});
-  if (!solid) return exit_code;
-  if (!file->mesh_sha256.empty() && file->mesh_sha256 != solid->sha256) {
-    std::cerr << "inscribe: warning: " << options.spheres_path << " was made for mesh "
-              << file->mesh_sha256 << ", not " << solid->sha256 << "\n";
-  }
   QualityOptions quality = options.quality;
   if (quality.voxel_size == 0.0) {
     for (const auto& [key, value] : file->params) {
@@ -82,20 +126,23 @@ int RunEvaluate(const EvaluateCliOptions& options) {
       }
     }
   }
-  absl::StatusOr<QualityReport> report = EvaluateSpheres(solid->oracle, file->set.spheres, quality);
-  if (!report.ok()) {
-    std::cerr << "inscribe: " << report.status().message() << "\n";
-    return report.status().code() == absl::StatusCode::kInvalidArgument ? kExitBadInput
-                                                                        : kExitUnusableMesh;
+  const std::optional<Evaluated> evaluated =
+      options.remote.enabled() ? EvaluateRemotely(options, *file, quality, &exit_code)
+                               : EvaluateHere(options, *file, quality, &exit_code);
+  if (!evaluated) return exit_code;
+  if (!file->mesh_sha256.empty() && file->mesh_sha256 != evaluated->mesh_sha256) {
+    std::cerr << "inscribe: warning: " << options.spheres_path << " was made for mesh "
+              << file->mesh_sha256 << ", not " << evaluated->mesh_sha256 << "\n";
   }
   if (options.json) {
-    nlohmann::json j = QualityReportJson(*report);
+    nlohmann::json j = QualityReportJson(evaluated->report);
     j["mesh"] = options.mesh_path;
-    j["mesh_sha256"] = solid->sha256;
+    j["mesh_sha256"] = evaluated->mesh_sha256;
     j["spheres_path"] = options.spheres_path;
+    if (options.remote.enabled()) j["server"] = options.remote.server;
     std::cout << j.dump() << "\n";
   } else {
-    PrintText(options, *report);
+    PrintText(options, evaluated->report);
   }
   return kExitOk;
 }
@@ -126,6 +173,7 @@ void AddEvaluateCommand(CLI::App& app, int* exit_code) {
   cmd->add_flag("--fill-holes", options->fill_holes,
                 "Close the mesh's holes first (see inscribe info --fill-holes)");
   cmd->add_flag("--json", options->json, "Print one JSON object on stdout");
+  AddRemoteOptions(cmd, &options->remote, 60.0);
   cmd->callback([options, exit_code] { *exit_code = RunEvaluate(*options); });
 }
 

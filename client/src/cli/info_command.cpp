@@ -11,6 +11,7 @@
 #include "inscribe/mesh_hash.h"
 #include "inscribe/mesh_io.h"
 #include "inscribe/mesh_validation.h"
+#include "remote_options.h"
 #include "report_json.h"
 
 namespace inscribe::cli {
@@ -21,10 +22,35 @@ struct InfoOptions {
   bool json = false;
   bool skip_self_intersections = false;
   bool fill_holes = false;
+  RemoteOptions remote;
 };
 
-void PrintText(const std::string& path, const MeshReport& report, const std::string& sha256,
-               const ReadMeshInfo& read, double seconds) {
+// What info prints, from this process's validation or the server's.
+struct InfoResult {
+  MeshReport report;
+  std::string sha256;  // "" when the mesh's indices or coordinates cannot be trusted
+  ReadMeshInfo read;   // always local: the file is parsed here
+  double seconds = 0.0;
+};
+
+InfoResult ValidateHere(Mesh mesh, const InfoOptions& options) {
+  ValidateOptions validate;
+  validate.check_self_intersections = !options.skip_self_intersections;
+  validate.fill_holes = options.fill_holes;
+  ValidatedMesh validated = ValidateMesh(std::move(mesh), validate);
+  InfoResult result;
+  // The hash is only meaningful for a mesh whose indices and coordinates can be trusted.
+  if (validated.report.non_finite_vertices == 0 && validated.report.out_of_range_indices == 0) {
+    result.sha256 = FormatSha256(MeshSha256(validated.mesh));
+  }
+  result.report = std::move(validated.report);
+  return result;
+}
+
+void PrintText(const std::string& path, const InfoResult& result) {
+  const MeshReport& report = result.report;
+  const std::string& sha256 = result.sha256;
+  const ReadMeshInfo& read = result.read;
   auto line = [](const char* key, const std::string& value) {
     std::cout << absl::StrFormat("%-20s %s\n", key, value);
   };
@@ -53,7 +79,7 @@ void PrintText(const std::string& path, const MeshReport& report, const std::str
                   ? std::string("none")
                   : absl::StrFormat("%d pairs", report.self_intersecting_pairs))
            : std::string("not checked"));
-  line("checked in", absl::StrFormat("%.3f s", seconds));
+  line("checked in", absl::StrFormat("%.3f s", result.seconds));
   if (report.issues.empty()) {
     line("issues", "none");
   } else {
@@ -73,19 +99,25 @@ int RunInfo(const InfoOptions& options) {
     std::cerr << "inscribe: " << mesh.status().message() << "\n";
     return kExitBadInput;
   }
-  ValidateOptions validate;
-  validate.check_self_intersections = !options.skip_self_intersections;
-  validate.fill_holes = options.fill_holes;
-  ValidatedMesh validated = ValidateMesh(*std::move(mesh), validate);
-  const MeshReport& report = validated.report;
-  // The hash is only meaningful for a mesh whose indices and coordinates can be trusted.
-  const std::string sha256 = report.non_finite_vertices == 0 && report.out_of_range_indices == 0
-                                 ? FormatSha256(MeshSha256(validated.mesh))
-                                 : std::string();
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  InfoResult result;
+  // The server's InspectMesh does not fill holes, so --fill-holes validates here even with
+  // --server (its output is then exactly the embedded one).
+  if (options.remote.enabled() && !options.fill_holes) {
+    client::InspectMeshOptions inspect;
+    inspect.skip_self_intersections = options.skip_self_intersections;
+    absl::StatusOr<client::InspectMeshResult> inspected =
+        MakeClient(options.remote).InspectMesh(*mesh, inspect);
+    if (!inspected.ok()) return ReportRemoteError(inspected.status(), options.remote);
+    result.report = std::move(inspected->report);
+    result.sha256 = std::move(inspected->mesh_sha256);
+  } else {
+    result = ValidateHere(*std::move(mesh), options);
+  }
+  result.read = read;
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const MeshReport& report = result.report;
   if (options.json) {
-    nlohmann::json j = MeshReportJson(report, sha256);
+    nlohmann::json j = MeshReportJson(report, result.sha256);
     j["path"] = options.path;
     j["polygons_triangulated"] = read.polygons_triangulated;
     // With --fill-holes the hash, volume and self-intersections describe the repaired mesh;
@@ -94,10 +126,11 @@ int RunInfo(const InfoOptions& options) {
       j["holes_filled"] = report.holes_filled;
       j["hole_triangles_added"] = report.hole_triangles_added;
     }
-    j["seconds"] = seconds;
+    j["seconds"] = result.seconds;
+    if (options.remote.enabled() && !options.fill_holes) j["server"] = options.remote.server;
     std::cout << j.dump() << "\n";
   } else {
-    PrintText(options.path, report, sha256, read, seconds);
+    PrintText(options.path, result);
   }
   if (!report.usable()) {
     std::cerr << "inscribe: " << options.path << ": " << report.first_error() << "\n";
@@ -118,7 +151,9 @@ void AddInfoCommand(CLI::App& app, int* exit_code) {
                 "Skip the exact self-intersection test (faster on huge meshes)");
   cmd->add_flag("--fill-holes", options->fill_holes,
                 "Close every hole (border loop) with triangles between its border vertices, "
-                "then validate, hash and describe the repaired mesh");
+                "then validate, hash and describe the repaired mesh (done in this process even "
+                "with --server: the server's InspectMesh does not fill holes)");
+  AddRemoteOptions(cmd, &options->remote, 60.0);
   cmd->callback([options, exit_code] { *exit_code = RunInfo(*options); });
 }
 

@@ -8,6 +8,18 @@
 #include "inscribe/mesh_io.h"
 
 namespace inscribe::cli {
+namespace {
+
+// The solid is no longer the file's: say so, since hashes and results now differ from it.
+void NoteRepairs(const std::string& path, const MeshReport& report) {
+  for (const MeshIssue& issue : report.issues) {
+    if (issue.code == "holes_filled") {
+      std::cerr << "inscribe: " << path << ": " << issue.message << "\n";
+    }
+  }
+}
+
+}  // namespace
 
 std::optional<LoadedSolid> LoadSolid(const std::string& path, int* exit_code,
                                      const LoadSolidOptions& options) {
@@ -26,12 +38,7 @@ std::optional<LoadedSolid> LoadSolid(const std::string& path, int* exit_code,
     *exit_code = kExitUnusableMesh;
     return std::nullopt;
   }
-  // The solid is no longer the file's: say so, since hashes and results now differ from it.
-  for (const MeshIssue& issue : validated->report.issues) {
-    if (issue.code == "holes_filled") {
-      std::cerr << "inscribe: " << path << ": " << issue.message << "\n";
-    }
-  }
+  NoteRepairs(path, validated->report);
   BoundaryOracleOptions oracle_options;
   // The pseudonormal sign is wrong near sheets buried inside a self-intersecting solid.
   if (validated->report.self_intersecting_pairs > 0) {
@@ -47,6 +54,27 @@ std::optional<LoadedSolid> LoadSolid(const std::string& path, int* exit_code,
   }
   return LoadedSolid{
       std::move(validated->report), sha256, *std::move(oracle),
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()};
+}
+
+std::optional<UploadedSolid> UploadSolid(const client::Client& client, const RemoteOptions& remote,
+                                         const std::string& path, int* exit_code,
+                                         const LoadSolidOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  absl::StatusOr<Mesh> mesh = ReadMesh(path, nullptr);
+  if (!mesh.ok()) {
+    std::cerr << "inscribe: " << mesh.status().message() << "\n";
+    *exit_code = kExitBadInput;
+    return std::nullopt;
+  }
+  absl::StatusOr<client::PutMeshResult> stored = client.PutMesh(*mesh, options.fill_holes);
+  if (!stored.ok()) {
+    *exit_code = ReportRemoteError(stored.status(), remote);
+    return std::nullopt;
+  }
+  NoteRepairs(path, stored->report);
+  return UploadedSolid{
+      *std::move(mesh), std::move(stored->report), std::move(stored->mesh_sha256),
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()};
 }
 

@@ -7,6 +7,8 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/string_view.h"
+#include "distance_query_proto.h"
 #include "inscribe/server/convert.h"
 
 namespace inscribe::client {
@@ -41,6 +43,95 @@ absl::Status RetryIdempotent(const RetryPolicy& policy, Deadline deadline,
   }
 }
 
+// RetryIdempotent for an attempt that returns a response: the last attempt's response, or the
+// final error (with RetryIdempotent's "gave up" note).
+template <typename Attempt>
+auto Retried(const RetryPolicy& policy, Deadline deadline, const Attempt& attempt)
+    -> decltype(attempt(deadline)) {
+  decltype(attempt(deadline)) response = absl::UnknownError("never attempted");
+  const absl::Status status = RetryIdempotent(policy, deadline, [&](Deadline d) {
+    response = attempt(d);
+    return response.status();
+  });
+  if (!status.ok()) return status;
+  return response;
+}
+
+Deadline DeadlineAfter(const std::optional<std::chrono::milliseconds>& timeout,
+                       const ClientOptions& options) {
+  return std::chrono::system_clock::now() + timeout.value_or(options.default_timeout);
+}
+
+// A response the server should never send (a bug or a version mismatch, not the caller's
+// fault): INTERNAL, naming the RPC and what is wrong with it.
+absl::Status Malformed(absl::string_view rpc, absl::string_view problem) {
+  return absl::InternalError(absl::StrCat("malformed ", rpc, " response: ", problem));
+}
+
+absl::StatusOr<PutMeshResult> PutMeshUntil(Connection& connection, const RetryPolicy& retry,
+                                           const v1::PutMeshRequest& request, Deadline deadline) {
+  absl::StatusOr<v1::PutMeshResponse> response =
+      Retried(retry, deadline, [&](Deadline d) { return connection.PutMesh(request, d); });
+  if (!response.ok()) return response.status();
+  absl::StatusOr<MeshReport> report = server::MeshReportFromProto(response->report());
+  if (!report.ok()) return Malformed("PutMesh", report.status().message());
+  return PutMeshResult{std::move(*response->mutable_mesh_sha256()), *std::move(report),
+                       response->already_stored()};
+}
+
+v1::GenerateRequest GenerateRequestFor(const std::string& mesh_sha256,
+                                       const GenerateSettings& settings,
+                                       const GenerateOptions& options) {
+  v1::GenerateRequest request;
+  request.set_mesh_sha256(mesh_sha256);
+  v1::GenerateParameters* p = request.mutable_parameters();
+  p->set_voxel_size(settings.voxel_size);
+  p->set_max_spheres(settings.max_spheres);
+  p->set_object_angle(settings.object_angle);
+  p->set_epsilon(settings.epsilon);
+  p->set_samples(settings.samples);
+  p->set_subdivide_boundary(settings.subdivide_boundary);
+  p->set_dilate(settings.dilate);
+  p->set_dilation_growth(settings.dilation_growth);
+  p->set_fill_holes(settings.fill_holes);
+  request.set_skip_quality(settings.skip_quality);
+  request.set_progress_interval(options.progress_interval);
+  return request;
+}
+
+absl::StatusOr<GenerateResult> GenerateUntil(Connection& connection, const RetryPolicy& retry,
+                                             const v1::GenerateRequest& request,
+                                             const std::function<void(double)>& on_progress,
+                                             Deadline deadline) {
+  absl::StatusOr<v1::GenerateResult> response = Retried(
+      retry, deadline, [&](Deadline d) { return connection.Generate(request, d, on_progress); });
+  if (!response.ok()) return response.status();
+  absl::StatusOr<SphereSet> spheres = server::SphereSetFromProto(response->spheres());
+  if (!spheres.ok()) return Malformed("Generate", spheres.status().message());
+  GenerateResult result;
+  result.sphere_set_key = std::move(*response->mutable_sphere_set_key());
+  result.mesh_sha256 = std::move(*response->mutable_mesh_sha256());
+  result.spheres = *std::move(spheres);
+  result.voxel_size = response->voxel_size();
+  result.seconds = response->seconds();
+  if (response->has_quality()) result.quality = server::QualityReportFromProto(response->quality());
+  result.cache = std::move(*response->mutable_cache());
+  return result;
+}
+
+absl::StatusOr<QualityReport> EvaluateUntil(Connection& connection, const RetryPolicy& retry,
+                                            v1::EvaluateRequest& request,
+                                            const EvaluateSettings& settings, Deadline deadline) {
+  request.set_samples(settings.samples);
+  request.set_voxel_size(settings.voxel_size);
+  request.set_coverage_tolerance(settings.coverage_tolerance);
+  absl::StatusOr<v1::EvaluateResponse> response =
+      Retried(retry, deadline, [&](Deadline d) { return connection.Evaluate(request, d); });
+  if (!response.ok()) return response.status();
+  if (!response->has_quality()) return Malformed("Evaluate", "no quality report");
+  return server::QualityReportFromProto(response->quality());
+}
+
 }  // namespace
 
 Client::Client(std::shared_ptr<Connection> connection, ClientOptions options)
@@ -51,22 +142,240 @@ absl::StatusOr<InspectMeshResult> Client::InspectMesh(const Mesh& mesh,
   v1::InspectMeshRequest request;
   server::MeshToProto(mesh, request.mutable_mesh());
   request.set_skip_self_intersections(options.skip_self_intersections);
-
-  const Deadline deadline =
-      std::chrono::system_clock::now() + options.timeout.value_or(options_.default_timeout);
-  absl::StatusOr<v1::InspectMeshResponse> response;
-  const absl::Status status = RetryIdempotent(options_.retry, deadline, [&](Deadline d) {
-    response = connection_->InspectMesh(request, d);
-    return response.status();
-  });
-  if (!status.ok()) return status;
-
+  absl::StatusOr<v1::InspectMeshResponse> response =
+      Retried(options_.retry, DeadlineAfter(options.timeout, options_),
+              [&](Deadline d) { return connection_->InspectMesh(request, d); });
+  if (!response.ok()) return response.status();
   absl::StatusOr<MeshReport> report = server::MeshReportFromProto(response->report());
-  if (!report.ok()) {
-    return absl::InternalError(
-        absl::StrCat("malformed InspectMesh response: ", report.status().message()));
-  }
+  if (!report.ok()) return Malformed("InspectMesh", report.status().message());
   return InspectMeshResult{std::move(*response->mutable_mesh_sha256()), *std::move(report)};
+}
+
+absl::StatusOr<PutMeshResult> Client::PutMesh(const Mesh& mesh, bool fill_holes,
+                                              const CallOptions& options) const {
+  v1::PutMeshRequest request;
+  server::MeshToProto(mesh, request.mutable_mesh());
+  request.set_fill_holes(fill_holes);
+  return PutMeshUntil(*connection_, options_.retry, request,
+                      DeadlineAfter(options.timeout, options_));
+}
+
+absl::StatusOr<GenerateResult> Client::Generate(const std::string& mesh_sha256,
+                                                const GenerateSettings& settings,
+                                                const GenerateOptions& options) const {
+  return GenerateUntil(*connection_, options_.retry,
+                       GenerateRequestFor(mesh_sha256, settings, options), options.on_progress,
+                       DeadlineAfter(options.timeout, options_));
+}
+
+absl::StatusOr<GenerateResult> Client::Generate(const Mesh& mesh, const GenerateSettings& settings,
+                                                const GenerateOptions& options) const {
+  // One deadline for the uploads and generations together; the mesh is converted once.
+  const Deadline deadline = DeadlineAfter(options.timeout, options_);
+  v1::PutMeshRequest put;
+  server::MeshToProto(mesh, put.mutable_mesh());
+  put.set_fill_holes(settings.fill_holes);
+  absl::StatusOr<PutMeshResult> stored = PutMeshUntil(*connection_, options_.retry, put, deadline);
+  if (!stored.ok()) return stored.status();
+  v1::GenerateRequest request = GenerateRequestFor(stored->mesh_sha256, settings, options);
+  absl::StatusOr<GenerateResult> generated =
+      GenerateUntil(*connection_, options_.retry, request, options.on_progress, deadline);
+  if (generated.status().code() != absl::StatusCode::kNotFound) return generated;
+  // The server dropped the mesh between the calls (evicted, or restarted without its disk
+  // tier): upload it again, once; a second NOT_FOUND is the server's answer.
+  stored = PutMeshUntil(*connection_, options_.retry, put, deadline);
+  if (!stored.ok()) return stored.status();
+  request.set_mesh_sha256(stored->mesh_sha256);
+  return GenerateUntil(*connection_, options_.retry, request, options.on_progress, deadline);
+}
+
+absl::StatusOr<PutSphereSetResult> Client::PutSphereSet(const SphereSet& spheres,
+                                                        const std::string& mesh_sha256,
+                                                        const CallOptions& options) const {
+  v1::PutSphereSetRequest request;
+  server::SphereSetToProto(spheres, request.mutable_spheres());
+  request.set_mesh_sha256(mesh_sha256);
+  absl::StatusOr<v1::PutSphereSetResponse> response =
+      Retried(options_.retry, DeadlineAfter(options.timeout, options_),
+              [&](Deadline d) { return connection_->PutSphereSet(request, d); });
+  if (!response.ok()) return response.status();
+  return PutSphereSetResult{std::move(*response->mutable_sphere_set_key()),
+                            response->already_stored()};
+}
+
+absl::StatusOr<StoredSphereSet> Client::GetSphereSet(const std::string& sphere_set_key,
+                                                     const CallOptions& options) const {
+  v1::GetSphereSetRequest request;
+  request.set_sphere_set_key(sphere_set_key);
+  absl::StatusOr<v1::GetSphereSetResponse> response =
+      Retried(options_.retry, DeadlineAfter(options.timeout, options_),
+              [&](Deadline d) { return connection_->GetSphereSet(request, d); });
+  if (!response.ok()) return response.status();
+  absl::StatusOr<SphereSet> spheres = server::SphereSetFromProto(response->spheres());
+  if (!spheres.ok()) return Malformed("GetSphereSet", spheres.status().message());
+  return StoredSphereSet{*std::move(spheres), std::move(*response->mutable_mesh_sha256())};
+}
+
+absl::StatusOr<SphereHierarchy> Client::GetHierarchy(const std::string& sphere_set_key,
+                                                     HierarchyVolume volume,
+                                                     const CallOptions& options) const {
+  v1::GetHierarchyRequest request;
+  request.set_sphere_set_key(sphere_set_key);
+  request.set_volume(VolumeToProto(volume));
+  absl::StatusOr<v1::GetHierarchyResponse> response =
+      Retried(options_.retry, DeadlineAfter(options.timeout, options_),
+              [&](Deadline d) { return connection_->GetHierarchy(request, d); });
+  if (!response.ok()) return response.status();
+  absl::StatusOr<SphereHierarchy> hierarchy = SphereHierarchy::Deserialize(response->hierarchy());
+  if (!hierarchy.ok()) {
+    return Malformed("GetHierarchy", absl::StrCat("hierarchy: ", hierarchy.status().message()));
+  }
+  if (hierarchy->volume() != volume) {
+    return Malformed("GetHierarchy",
+                     absl::StrCat("hierarchy: asked for ", HierarchyVolumeName(volume), ", got ",
+                                  HierarchyVolumeName(hierarchy->volume())));
+  }
+  return hierarchy;
+}
+
+absl::StatusOr<DeformationResult> Client::UpdateDeformation(const std::string& mesh_sha256,
+                                                            const std::string& sphere_set_key,
+                                                            const Vertices& deformed_vertices,
+                                                            const DeformationSettings& settings,
+                                                            const CallOptions& options) const {
+  v1::UpdateDeformationRequest request;
+  request.set_mesh_sha256(mesh_sha256);
+  request.set_sphere_set_key(sphere_set_key);
+  // Row-major #V x 3: the storage is already the wire's x0, y0, z0, x1, ...
+  request.mutable_vertices()->Add(deformed_vertices.data(),
+                                  deformed_vertices.data() + deformed_vertices.size());
+  request.set_xi(settings.xi);
+  request.set_strict(settings.strict);
+  request.set_interpolated_normal(settings.interpolated_normal);
+  request.set_ray_parity(settings.ray_parity);
+  request.set_bounds(settings.bounds);
+  request.set_store(settings.store);
+  absl::StatusOr<v1::UpdateDeformationResponse> response =
+      Retried(options_.retry, DeadlineAfter(options.timeout, options_),
+              [&](Deadline d) { return connection_->UpdateDeformation(request, d); });
+  if (!response.ok()) return response.status();
+
+  absl::StatusOr<SphereSet> spheres = server::SphereSetFromProto(response->spheres());
+  if (!spheres.ok()) return Malformed("UpdateDeformation", spheres.status().message());
+  if (static_cast<std::size_t>(response->reference_index_size()) != spheres->size()) {
+    return Malformed("UpdateDeformation",
+                     absl::StrCat("reference_index has ", response->reference_index_size(),
+                                  " entries for ", spheres->size(), " spheres"));
+  }
+  DeformationResult result;
+  result.spheres = *std::move(spheres);
+  result.reference_index.assign(response->reference_index().begin(),
+                                response->reference_index().end());
+  result.xi = response->xi();
+  result.max_protrusion = response->max_protrusion();
+  result.shrunk = response->shrunk();
+  result.dropped = response->dropped();
+  result.closest_point_queries = response->closest_point_queries();
+  result.max_shrink_steps = response->max_shrink_steps();
+  result.seconds = response->seconds();
+  result.reference_spheres = response->reference_spheres();
+  result.deformed_mesh_sha256 = std::move(*response->mutable_deformed_mesh_sha256());
+  result.sphere_set_key = std::move(*response->mutable_sphere_set_key());
+  // The wire has no presence bit for the bounds: they are there when they were asked for.
+  if (settings.bounds) {
+    DeformationResult::Bounds& bounds = result.bounds.emplace();
+    bounds.nerr_lower = response->nerr_lower();
+    bounds.nerr_upper = response->nerr_upper();
+    bounds.nerr_is_exact = response->nerr_is_exact();
+    bounds.volume_mesh = response->volume_mesh();
+    bounds.volume_union = response->volume_union();
+    if (response->has_nerr_upper_uniform_xi()) {
+      bounds.nerr_upper_uniform_xi = response->nerr_upper_uniform_xi();
+    }
+    bounds.seconds = response->bounds_seconds();
+  }
+  return result;
+}
+
+absl::StatusOr<DistanceBatchResult> Client::Distance(const std::string& sphere_set_a,
+                                                     const std::string& sphere_set_b,
+                                                     const std::vector<RigidPose>& poses_a,
+                                                     const std::vector<RigidPose>& poses_b,
+                                                     const DistanceOptions& options) const {
+  v1::DistanceRequest request;
+  request.set_sphere_set_a(sphere_set_a);
+  request.set_sphere_set_b(sphere_set_b);
+  request.set_volume(VolumeToProto(options.volume));
+  server::PosesToProto(poses_a, request.mutable_poses_a());
+  server::PosesToProto(poses_b, request.mutable_poses_b());
+  ToleranceToProto(options.tolerance, request.mutable_tolerance());
+  absl::StatusOr<v1::DistanceResponse> response =
+      Retried(options_.retry, DeadlineAfter(options.timeout, options_),
+              [&](Deadline d) { return connection_->Distance(request, d); });
+  if (!response.ok()) return response.status();
+  absl::StatusOr<std::vector<DistanceResult>> results =
+      server::DistanceResultsFromProto(response->results());
+  if (!results.ok()) return Malformed("Distance", results.status().message());
+  if (results->size() != poses_b.size()) {
+    return Malformed("Distance", absl::StrCat("results has ", results->size(), " entries for ",
+                                              poses_b.size(), " pose pairs"));
+  }
+  return DistanceBatchResult{*std::move(results), response->seconds()};
+}
+
+absl::StatusOr<QualityReport> Client::Evaluate(const std::string& mesh_sha256,
+                                               const std::string& sphere_set_key,
+                                               const EvaluateSettings& settings,
+                                               const CallOptions& options) const {
+  v1::EvaluateRequest request;
+  request.set_mesh_sha256(mesh_sha256);
+  request.set_sphere_set_key(sphere_set_key);
+  return EvaluateUntil(*connection_, options_.retry, request, settings,
+                       DeadlineAfter(options.timeout, options_));
+}
+
+absl::StatusOr<QualityReport> Client::Evaluate(const std::string& mesh_sha256,
+                                               const SphereSet& spheres,
+                                               const EvaluateSettings& settings,
+                                               const CallOptions& options) const {
+  v1::EvaluateRequest request;
+  request.set_mesh_sha256(mesh_sha256);
+  server::SphereSetToProto(spheres, request.mutable_sphere_set());
+  return EvaluateUntil(*connection_, options_.retry, request, settings,
+                       DeadlineAfter(options.timeout, options_));
+}
+
+absl::StatusOr<ServerCacheStats> Client::CacheStats(const CallOptions& options) const {
+  const v1::CacheStatsRequest request;
+  absl::StatusOr<v1::CacheStatsResponse> response =
+      Retried(options_.retry, DeadlineAfter(options.timeout, options_),
+              [&](Deadline d) { return connection_->CacheStats(request, d); });
+  if (!response.ok()) return response.status();
+  ServerCacheStats stats;
+  stats.entries = response->entries();
+  stats.bytes = response->bytes();
+  stats.memory_hits = response->memory_hits();
+  stats.disk_hits = response->disk_hits();
+  stats.hits = response->hits();
+  stats.misses = response->misses();
+  stats.computations = response->computations();
+  stats.joined = response->joined();
+  stats.evictions = response->evictions();
+  stats.disk_entries = response->disk_entries();
+  stats.disk_bytes = response->disk_bytes();
+  stats.disk_errors = response->disk_errors();
+  return stats;
+}
+
+absl::StatusOr<DistanceSession> Client::OpenDistanceSession(
+    const DistanceSessionOptions& options) const {
+  const Deadline deadline = options.session_timeout
+                                ? std::chrono::system_clock::now() + *options.session_timeout
+                                : Deadline::max();
+  absl::StatusOr<std::unique_ptr<DistanceStreamConnection>> stream =
+      connection_->OpenDistanceStream(deadline);
+  if (!stream.ok()) return stream.status();
+  return DistanceSession(*std::move(stream), options);
 }
 
 }  // namespace inscribe::client

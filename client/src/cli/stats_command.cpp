@@ -1,0 +1,69 @@
+#include "stats_command.h"
+
+#include <cstdint>
+#include <iostream>
+#include <memory>
+#include <utility>
+#include <vector>
+
+#include "absl/strings/str_format.h"
+#include "exit_codes.h"
+#include "nlohmann/json.hpp"
+#include "remote_options.h"
+
+namespace inscribe::cli {
+namespace {
+
+struct StatsCliOptions {
+  bool json = false;
+  RemoteOptions remote;
+};
+
+// Every counter of CacheStatsResponse, in its order, with its JSON name and what it counts.
+std::vector<std::pair<const char*, std::int64_t>> Counters(const client::ServerCacheStats& s) {
+  return {{"entries", s.entries},
+          {"bytes", s.bytes},
+          {"memory_hits", s.memory_hits},
+          {"disk_hits", s.disk_hits},
+          {"hits", s.hits},
+          {"misses", s.misses},
+          {"computations", s.computations},
+          {"joined", s.joined},
+          {"evictions", s.evictions},
+          {"disk_entries", s.disk_entries},
+          {"disk_bytes", s.disk_bytes},
+          {"disk_errors", s.disk_errors}};
+}
+
+int RunStats(const StatsCliOptions& options) {
+  absl::StatusOr<client::ServerCacheStats> stats = MakeClient(options.remote).CacheStats();
+  if (!stats.ok()) return ReportRemoteError(stats.status(), options.remote);
+  if (options.json) {
+    nlohmann::json j;
+    j["server"] = options.remote.server;
+    for (const auto& [name, value] : Counters(*stats)) j[name] = value;
+    std::cout << j.dump() << "\n";
+    return kExitOk;
+  }
+  std::cout << absl::StrFormat("%-14s %s\n", "server", options.remote.server);
+  for (const auto& [name, value] : Counters(*stats)) {
+    std::cout << absl::StrFormat("%-14s %d\n", name, value);
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+void AddStatsCommand(CLI::App& app, int* exit_code) {
+  auto options = std::make_shared<StatsCliOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "stats",
+      "The server's result-cache counters: entries and bytes in memory and on disk, hits "
+      "(memory, disk), misses, computations, joined (waited for an identical request), "
+      "evictions, disk errors");
+  cmd->add_flag("--json", options->json, "Print one JSON object on stdout");
+  AddRemoteOptions(cmd, &options->remote, 60.0, /*server_required=*/true);
+  cmd->callback([options, exit_code] { *exit_code = RunStats(*options); });
+}
+
+}  // namespace inscribe::cli

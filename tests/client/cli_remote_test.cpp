@@ -4,10 +4,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <netinet/in.h>
-#include <signal.h>
-#include <spawn.h>
 #include <sys/socket.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -27,9 +24,8 @@
 #include "deformation_sequences.h"
 #include "inscribe/mesh_io.h"
 #include "inscribe/sphere_io.h"
+#include "support/inscribed_process.h"
 #include "support/test_meshes.h"
-
-extern char** environ;
 
 namespace inscribe {
 namespace {
@@ -38,59 +34,23 @@ using ::testing::HasSubstr;
 namespace fs = std::filesystem;
 using Keys = std::set<std::string>;
 
-// inscribed as a child process on a free loopback port, with its own disk cache. Its stderr
-// (one log line per call) is drained by a thread so that the server never blocks on it.
-class InscribedProcess {
+// inscribed on a free loopback port with its own disk cache, its log drained in the
+// background for as long as it runs.
+class LoopbackServer {
  public:
-  explicit InscribedProcess(const fs::path& cache_dir) {
-    int fds[2];
-    if (pipe(fds) != 0) return;
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_adddup2(&actions, fds[1], STDERR_FILENO);
-    posix_spawn_file_actions_addclose(&actions, fds[0]);
-    std::vector<std::string> args = {INSCRIBED, "--listen",    "127.0.0.1:0",     "--jobs",
-                                     "2",       "--cache-dir", cache_dir.string()};
-    std::vector<char*> argv;
-    for (std::string& arg : args) argv.push_back(arg.data());
-    argv.push_back(nullptr);
-    if (posix_spawn(&pid_, INSCRIBED, &actions, nullptr, argv.data(), environ) != 0) pid_ = -1;
-    posix_spawn_file_actions_destroy(&actions);
-    close(fds[1]);
-    FILE* err = fdopen(fds[0], "r");
-    if (pid_ <= 0 || err == nullptr) return;
-    constexpr char kReady[] = "inscribed listening on ";
-    char line[4096];
-    while (address_.empty() && fgets(line, sizeof line, err) != nullptr) {
-      std::string text(line);
-      if (const std::size_t at = text.find(kReady); at != std::string::npos) {
-        address_ = text.substr(at + sizeof kReady - 1);
-        while (!address_.empty() && std::isspace(static_cast<unsigned char>(address_.back()))) {
-          address_.pop_back();
-        }
-      }
-    }
-    drain_ = std::thread([err] {
-      char rest[4096];
-      while (fgets(rest, sizeof rest, err) != nullptr) {
-      }
-      fclose(err);
-    });
-  }
-  ~InscribedProcess() {
-    if (pid_ > 0) {
-      kill(pid_, SIGKILL);
-      waitpid(pid_, nullptr, 0);
-    }
-    if (drain_.joinable()) drain_.join();  // EOF once the process is gone
+  explicit LoopbackServer(const fs::path& cache_dir)
+      : process_(INSCRIBED,
+                 {"--listen", "127.0.0.1:0", "--jobs", "2", "--cache-dir", cache_dir.string()}) {
+    if (!process_.started()) return;
+    address_ = process_.WaitUntilListening();
+    process_.DrainLogInBackground();
   }
   // "127.0.0.1:PORT", or "" when the server did not start.
   const std::string& address() const { return address_; }
 
  private:
-  pid_t pid_ = -1;
+  testing::InscribedProcess process_;
   std::string address_;
-  std::thread drain_;
 };
 
 // A loopback port nothing listens on: bound to learn a free number, then released.
@@ -181,7 +141,7 @@ class CliRemote : public ::testing::Test {
   static void SetUpTestSuite() {
     dir_ = fs::temp_directory_path() / ("inscribe_cli_remote_" + std::to_string(::getpid()));
     fs::create_directories(dir_ / "cache");
-    server_ = new InscribedProcess(dir_ / "cache");
+    server_ = new LoopbackServer(dir_ / "cache");
   }
   static void TearDownTestSuite() {
     delete server_;
@@ -220,7 +180,7 @@ class CliRemote : public ::testing::Test {
   }
 
   static inline fs::path dir_;
-  static inline InscribedProcess* server_ = nullptr;
+  static inline LoopbackServer* server_ = nullptr;
 };
 
 // What the server does not send (see generate_command.cpp) and what it adds.
@@ -395,7 +355,7 @@ TEST(CliRemoteStats, CountsComputationsAndHits) {
       fs::temp_directory_path() / ("inscribe_cli_stats_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   {
-    InscribedProcess server(dir);
+    LoopbackServer server(dir);
     ASSERT_FALSE(server.address().empty());
     const std::string remote = " --server " + server.address();
     auto stats = [&remote] {

@@ -1,0 +1,52 @@
+// The inscribed executable as a child process, for tests that run it as an operator would:
+// start it with flags, learn its address from the ready line on stderr, stop it by signal.
+#pragma once
+
+#include <sys/types.h>
+
+#include <chrono>
+#include <cstdio>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace inscribe::testing {
+
+class InscribedProcess {
+ public:
+  // Spawns `binary` with `args`, its stderr piped to this object. started() says whether the
+  // spawn worked.
+  InscribedProcess(const std::string& binary, std::vector<std::string> args);
+  // SIGKILL if still running, then reaps it.
+  ~InscribedProcess();
+  InscribedProcess(const InscribedProcess&) = delete;
+  InscribedProcess& operator=(const InscribedProcess&) = delete;
+
+  bool started() const { return pid_ > 0 && stderr_ != nullptr; }
+
+  // Reads stderr up to the line "inscribed listening on HOST:PORT" and returns HOST:PORT, or
+  // "" when the process ended first.
+  std::string WaitUntilListening();
+
+  // For a server that runs for the whole test: reads (and keeps) the rest of its stderr on a
+  // thread, so that its log lines never fill the pipe and block it.
+  void DrainLogInBackground();
+
+  // Sends `signal` (0: none, just wait), then reads the rest of stderr and reaps the process.
+  // The wait status, or -1 if it did not exit within `timeout`.
+  int StopWith(int signal, std::chrono::seconds timeout);
+
+  // Everything read from stderr so far.
+  std::string log() const;
+
+ private:
+  pid_t pid_ = -1;
+  FILE* stderr_ = nullptr;
+  bool exited_ = false;
+  mutable std::mutex log_mutex_;
+  std::string log_;  // guarded by log_mutex_
+  std::thread drain_;
+};
+
+}  // namespace inscribe::testing

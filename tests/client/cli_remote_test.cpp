@@ -3,8 +3,6 @@
 // aside), and remote failures must say which server and exit with their own codes.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <netinet/in.h>
-#include <sys/socket.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -52,19 +50,6 @@ class LoopbackServer {
   testing::InscribedProcess process_;
   std::string address_;
 };
-
-// A loopback port nothing listens on: bound to learn a free number, then released.
-int ClosedPort() {
-  const int fd = socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in addr{};
-  addr.sin_family = AF_INET;
-  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  socklen_t length = sizeof addr;
-  bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr);
-  getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &length);
-  close(fd);
-  return ntohs(addr.sin_port);
-}
 
 bool Close(double a, double b) {
   return std::abs(a - b) <= 1e-9 * std::max({1.0, std::abs(a), std::abs(b)});
@@ -336,7 +321,7 @@ TEST_F(CliRemote, ServerRefusalsSayWhichServerAndMapToExitCodes) {
 
 TEST(CliRemoteUnreachable, EveryCommandExits69NamingTheAddress) {
   INSCRIBE_REQUIRE_MESH("eight.off");
-  const std::string address = "127.0.0.1:" + std::to_string(ClosedPort());
+  const std::string address = "127.0.0.1:" + std::to_string(testing::UnusedLoopbackPort());
   const std::string eight = Quote(testing::TestMeshPath("eight.off"));
   for (const std::string& command : std::vector<std::string>{
            "info " + eight, "generate --voxel-size 0.2 " + eight, "stats", "stats --json"}) {

@@ -2,18 +2,15 @@
 // against a mock Connection; the gRPC Connection against a closed port.
 #include "inscribe/client/client.h"
 
-#include <arpa/inet.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <netinet/in.h>
-#include <sys/socket.h>
-#include <unistd.h>
 
 #include <atomic>
 #include <deque>
 #include <thread>
 
 #include "client_test_support.h"
+#include "support/inscribed_process.h"
 
 namespace inscribe::client {
 namespace {
@@ -361,22 +358,9 @@ TEST(Client, ConcurrentCallsRetryIndependently) {
   EXPECT_EQ(attempts.load(), 2 * kThreads * kCalls);
 }
 
-// A loopback port that was free a moment ago: bound by the kernel's choice, then released.
-int UnusedLoopbackPort() {
-  const int fd = socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in address{};
-  address.sin_family = AF_INET;
-  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  socklen_t length = sizeof address;
-  bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof address);
-  getsockname(fd, reinterpret_cast<sockaddr*>(&address), &length);
-  close(fd);
-  return ntohs(address.sin_port);
-}
-
 TEST(GrpcConnection, UnreachableServerIsUnavailable) {
   // Nothing listens there, so every attempt is refused at once.
-  Client client(MakeGrpcConnection("127.0.0.1:" + std::to_string(UnusedLoopbackPort())),
+  Client client(MakeGrpcConnection("127.0.0.1:" + std::to_string(testing::UnusedLoopbackPort())),
                 FastRetries());
   absl::StatusOr<InspectMeshResult> result = client.InspectMesh(testing::UnitCube());
   EXPECT_EQ(result.status().code(), absl::StatusCode::kUnavailable) << result.status();

@@ -49,4 +49,8 @@ class InscribedProcess {
   std::thread drain_;
 };
 
+// A loopback port that was free a moment ago (bound by the kernel's choice, then released):
+// a server address nothing listens on, for unreachable-server tests.
+int UnusedLoopbackPort();
+
 }  // namespace inscribe::testing

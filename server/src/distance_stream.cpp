@@ -169,17 +169,21 @@ class DistanceStreamReactor final
     std::vector<Query> queries(n);
     for (std::size_t i = 0; i < n; ++i) {
       const v1::DistancePair& pair = frame_.pairs(static_cast<int>(i));
-      const std::string where = absl::StrCat("frame ", frame_.frame(), " pairs[", i, "]");
+      // Field names are built only for an error: this loop is on every frame's path.
+      auto in_pair = [&](const absl::Status& s) {
+        return absl::Status(
+            s.code(), absl::StrCat("frame ", frame_.frame(), " pairs[", i, "].", s.message()));
+      };
       absl::StatusOr<const SphereHierarchy*> a =
-          Hierarchy(pair.sphere_set_a(), volume, where + ".sphere_set_a");
-      if (!a.ok()) return a.status();
+          Hierarchy(pair.sphere_set_a(), volume, "sphere_set_a");
+      if (!a.ok()) return in_pair(a.status());
       absl::StatusOr<const SphereHierarchy*> b =
-          Hierarchy(pair.sphere_set_b(), volume, where + ".sphere_set_b");
-      if (!b.ok()) return b.status();
-      absl::StatusOr<RigidPose> pose_a = PoseFromProto(pair.pose_a(), where + ".pose_a");
-      if (!pose_a.ok()) return pose_a.status();
-      absl::StatusOr<RigidPose> pose_b = PoseFromProto(pair.pose_b(), where + ".pose_b");
-      if (!pose_b.ok()) return pose_b.status();
+          Hierarchy(pair.sphere_set_b(), volume, "sphere_set_b");
+      if (!b.ok()) return in_pair(b.status());
+      absl::StatusOr<RigidPose> pose_a = PoseFromProto(pair.pose_a(), "pose_a");
+      if (!pose_a.ok()) return in_pair(pose_a.status());
+      absl::StatusOr<RigidPose> pose_b = PoseFromProto(pair.pose_b(), "pose_b");
+      if (!pose_b.ok()) return in_pair(pose_b.status());
       queries[i] = Query{*a, *b, *pose_a, *pose_b};
     }
     std::vector<DistanceResult> results(n);
@@ -217,10 +221,10 @@ class DistanceStreamReactor final
 
   // The hierarchy of `key` for this stream, from the stream's own table or the store.
   absl::StatusOr<const SphereHierarchy*> Hierarchy(const std::string& key, HierarchyVolume volume,
-                                                   const std::string& field) {
+                                                   const char* field) {
     const std::string slot = absl::StrCat(HierarchyVolumeName(volume), "/", key);
     if (auto it = held_.find(slot); it != held_.end()) return it->second.get();
-    if (absl::Status s = CheckKey(key, field.c_str()); !s.ok()) return s;
+    if (absl::Status s = CheckKey(key, field); !s.ok()) return s;
     if (held_.size() >= kMaxStreamSets) {
       return absl::ResourceExhaustedError(
           absl::StrCat(field, ": a stream may name at most ", kMaxStreamSets,

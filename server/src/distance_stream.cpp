@@ -44,13 +44,18 @@ class DistanceStreamReactor final
     record_.peer = context->peer();
   }
 
-  void Start() {
+  // `admitted`: the service's Authenticate verdict; a refused stream ends before any read.
+  void Start(const absl::Status& admitted) {
     service_->CallStarted();
     {
       std::lock_guard<std::mutex> lock(service_->calls_mutex_);
       service_->streams_.insert(this);
     }
     std::lock_guard<std::mutex> lock(mutex_);
+    if (!admitted.ok()) {
+      FinishLocked(admitted);
+      return;
+    }
     if (service_->draining_.load()) {
       FinishLocked(absl::UnavailableError("server is shutting down; retry"));
       return;
@@ -259,7 +264,7 @@ class DistanceStreamReactor final
 grpc::ServerBidiReactor<v1::DistanceFrame, v1::DistanceFrameResult>*
 InscribeService::DistanceStream(grpc::CallbackServerContext* context) {
   auto* reactor = new DistanceStreamReactor(this, context);
-  reactor->Start();
+  reactor->Start(Authenticate(*context));
   return reactor;
 }
 

@@ -42,12 +42,13 @@ absl::Status RunInspectMesh(const v1::InspectMeshRequest& request,
 }  // namespace
 
 InscribeService::InscribeService(JobPool* pool, ResultCache* cache, const ServiceLimits& limits,
-                                 CallObserver observer)
+                                 CallObserver observer, CallAuthenticator authenticate)
     : pool_(pool),
       store_(
           std::make_unique<ResultStore>(cache, StoreLimits{limits.max_voxels, limits.max_spheres})),
       limits_(limits),
-      observer_(std::move(observer)) {}
+      observer_(std::move(observer)),
+      authenticate_(std::move(authenticate)) {}
 
 InscribeService::~InscribeService() = default;
 
@@ -63,6 +64,10 @@ void InscribeService::CallEnded() {
 
 void InscribeService::Observe(const CallRecord& record) const {
   if (observer_) observer_(record);
+}
+
+absl::Status InscribeService::Authenticate(const grpc::CallbackServerContext& context) const {
+  return authenticate_ ? authenticate_(context) : absl::OkStatus();
 }
 
 void InscribeService::Finish(grpc::ServerUnaryReactor* reactor, CallRecord& record,
@@ -95,6 +100,12 @@ grpc::ServerUnaryReactor* InscribeService::RunUnary(grpc::CallbackServerContext*
   record.peer = context->peer();
   record.triangles = triangles;
   CallStarted();
+  // Refused callers learn nothing else: not whether the server drains, nor what their
+  // request's problems are.
+  if (absl::Status admitted = Authenticate(*context); !admitted.ok()) {
+    Finish(reactor, record, admitted);
+    return reactor;
+  }
   if (draining_.load()) {
     Finish(reactor, record, absl::UnavailableError("server is shutting down; retry"));
     return reactor;

@@ -175,10 +175,10 @@ grpc::ServerUnaryReactor* InscribeService::UpdateDeformation(
           }
         }
         if (request->store()) {
-          // Keyed by the deformed mesh's hash, which names no stored mesh unless the caller
-          // uploads the deformed mesh too; the key is what Distance needs.
+          // Named by no mesh (the deformed one is not stored); its key routes like the
+          // reference set's, so a routing client's Distance on it finds it here.
           absl::StatusOr<std::shared_ptr<const SphereSetEntry>> stored =
-              store_->PutSphereSet(std::move(moved->set), "", nullptr);
+              store_->PutSphereSet(std::move(moved->set), "", nullptr, request->sphere_set_key());
           if (!stored.ok()) return stored.status();
           response->set_sphere_set_key((*stored)->result.sphere_set_key());
         }

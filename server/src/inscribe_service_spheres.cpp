@@ -51,11 +51,12 @@ class GenerateReactor final : public grpc::ServerWriteReactor<v1::GenerateRespon
 
   void Start() {
     service_->CallStarted();
-    absl::Status precheck = CheckKey(request_->mesh_sha256(), "mesh_sha256");
-    if (precheck.ok()) precheck = CanonicalParameters(request_->parameters()).status();
-    if (service_->draining_.load()) {
+    absl::Status precheck = service_->Authenticate(*context_);
+    if (precheck.ok() && service_->draining_.load()) {
       precheck = absl::UnavailableError("server is shutting down; retry");
     }
+    if (precheck.ok()) precheck = CheckKey(request_->mesh_sha256(), "mesh_sha256");
+    if (precheck.ok()) precheck = CanonicalParameters(request_->parameters()).status();
     if (!precheck.ok()) {
       Complete(precheck, nullptr);
       return;
@@ -269,6 +270,14 @@ grpc::ServerUnaryReactor* InscribeService::CacheStats(grpc::CallbackServerContex
   // A snapshot of counters under the cache's lock: cheap enough for the gRPC thread, and it
   // must answer even when the pool is saturated.
   grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+  if (absl::Status admitted = Authenticate(*context); !admitted.ok()) {
+    CallRecord record;
+    record.method = "CacheStats";
+    record.peer = context->peer();
+    CallStarted();
+    Finish(reactor, record, admitted);  // observed, so refusals are logged and counted
+    return reactor;
+  }
   const ResultCacheStats s = store_->cache().stats();
   response->set_entries(s.entries);
   response->set_bytes(s.bytes);
@@ -282,6 +291,14 @@ grpc::ServerUnaryReactor* InscribeService::CacheStats(grpc::CallbackServerContex
   response->set_disk_entries(s.disk_entries);
   response->set_disk_bytes(s.disk_bytes);
   response->set_disk_errors(s.disk_errors);
+  response->set_shared_hits(s.shared_hits);
+  response->set_shared_misses(s.shared_misses);
+  response->set_shared_errors(s.shared_errors);
+  response->set_shared_writes(s.shared_writes);
+  response->set_shared_write_errors(s.shared_write_errors);
+  response->set_shared_skipped(s.shared_skipped);
+  response->set_shared_corrupt(s.shared_corrupt);
+  response->set_shared_available(s.shared_available);
   reactor->Finish(grpc::Status::OK);
   return reactor;
 }

@@ -31,6 +31,27 @@ void LogCall(const CallRecord& call) {
               std::string(call.status.message()));
 }
 
+// The shared Redis tier going down (lookups then skip it and compute or use the local tiers)
+// or coming back; the cache retries on its own.
+void LogSharedTier(const inscribe::server::SharedTierEvent& event) {
+  if (event.available) {
+    spdlog::info("event=redis_up");
+  } else {
+    spdlog::warn("event=redis_down error=\"{}\" retry_ms={}", std::string(event.error.message()),
+                 event.retry_after.count());
+  }
+}
+
+// Whether HOST of --listen HOST:PORT is a loopback address, where plaintext cannot be sniffed
+// from another machine. 0.0.0.0 and [::] listen on every interface: not loopback.
+bool IsLoopbackListen(const std::string& listen) {
+  std::string host = listen.substr(0, listen.rfind(':'));
+  if (host.size() >= 2 && host.front() == '[' && host.back() == ']') {
+    host = host.substr(1, host.size() - 2);
+  }
+  return host == "localhost" || host == "::1" || host.rfind("127.", 0) == 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -45,7 +66,7 @@ int main(int argc, char** argv) {
   ServerOptions options;
   double shutdown_grace_seconds = 10.0;
   std::string log_level = "info";
-  CLI::App app{"inscribed: serves inscribe.v1.Inscribe over gRPC (plaintext)"};
+  CLI::App app{"inscribed: serves inscribe.v1.Inscribe over gRPC"};
   app.add_option("--listen", options.listen, "HOST:PORT to bind; port 0 picks a free port")
       ->capture_default_str();
   app.add_option("--jobs", options.jobs, "requests computed at once; 0 = one per hardware thread")
@@ -77,6 +98,32 @@ int main(int argc, char** argv) {
                  "bytes of results kept in memory (least recently used dropped first)")
       ->check(CLI::Range(std::int64_t{0}, std::int64_t{1} << 50))
       ->capture_default_str();
+  app.add_option("--redis", options.cache.redis_url,
+                 "Redis shared by replicas as a third cache tier, "
+                 "redis://[:PASSWORD@]HOST[:PORT][/DB]; empty = none")
+      ->capture_default_str();
+  app.add_option("--redis-timeout-ms", options.cache.redis_timeout_ms,
+                 "longest wait for one Redis connect, read or write; Redis slower than this is "
+                 "skipped and retried later")
+      ->check(CLI::Range(1, 60'000))
+      ->capture_default_str();
+  app.add_option("--tls-cert", options.tls.cert_file,
+                 "PEM certificate chain of the server; with --tls-key serves TLS instead of "
+                 "plaintext")
+      ->check(CLI::ExistingFile);
+  app.add_option("--tls-key", options.tls.key_file, "PEM private key of --tls-cert")
+      ->check(CLI::ExistingFile);
+  app.add_option("--tls-client-ca", options.tls.client_ca_file,
+                 "PEM CA certificates: clients must present a certificate signed by one "
+                 "(mutual TLS)")
+      ->check(CLI::ExistingFile);
+  app.add_option("--auth-tokens", options.auth_tokens_file,
+                 "file of accepted bearer tokens, one per line; calls without one get "
+                 "UNAUTHENTICATED")
+      ->check(CLI::ExistingFile);
+  app.add_option("--metrics-listen", options.metrics_listen,
+                 "HOST:PORT of the Prometheus endpoint (/metrics); empty = none")
+      ->capture_default_str();
   app.add_option("--shutdown-grace", shutdown_grace_seconds,
                  "seconds calls in progress get to finish after SIGTERM/SIGINT")
       ->check(CLI::Range(0.0, 3600.0))
@@ -92,6 +139,7 @@ int main(int argc, char** argv) {
   logger->flush_on(spdlog::level::info);
   spdlog::set_default_logger(logger);
   options.on_call = LogCall;
+  options.cache.on_shared_tier_event = LogSharedTier;
 
   absl::StatusOr<std::unique_ptr<InscribeServer>> server = InscribeServer::Start(options);
   if (!server.ok()) {
@@ -101,10 +149,21 @@ int main(int argc, char** argv) {
   }
   spdlog::info(
       "event=serving address={} jobs={} max_queue={} max_message_bytes={} max_triangles={} "
-      "max_voxels={} max_spheres={} max_poses={} cache_dir=\"{}\" cache_memory_bytes={}",
+      "max_voxels={} max_spheres={} max_poses={} cache_dir=\"{}\" cache_memory_bytes={} "
+      "redis=\"{}\" tls={} auth={} metrics_port={}",
       (*server)->address(), (*server)->jobs(), options.max_queue, options.max_message_bytes,
       options.limits.max_triangles, options.limits.max_voxels, options.limits.max_spheres,
-      options.limits.max_poses, options.cache.disk_dir, options.cache.memory_bytes);
+      options.limits.max_poses, options.cache.disk_dir, options.cache.memory_bytes,
+      inscribe::server::RedactRedisUrl(options.cache.redis_url), options.tls.enabled(),
+      !options.auth_tokens_file.empty(), (*server)->metrics_port());
+  if (!options.auth_tokens_file.empty() && !options.tls.enabled() &&
+      !IsLoopbackListen(options.listen)) {
+    spdlog::warn(
+        "event=plaintext_tokens listen={} message=\"bearer tokens are checked on a plaintext "
+        "port that is not loopback: anyone on the path can read and reuse them; add --tls-cert "
+        "and --tls-key\"",
+        options.listen);
+  }
   std::fprintf(stderr, "inscribed listening on %s\n", (*server)->address().c_str());
   std::fflush(stderr);
 

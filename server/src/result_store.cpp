@@ -6,8 +6,10 @@
 #include <cmath>
 #include <utility>
 
+#include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "absl/strings/strip.h"
 #include "inscribe/medial_spheres.h"
 #include "inscribe/mesh_hash.h"
 #include "inscribe/server/convert.h"
@@ -35,6 +37,33 @@ std::string Sha256Hex(const std::string& bytes) {
   std::string hex;
   for (unsigned int i = 0; i < length; ++i) absl::StrAppendFormat(&hex, "%02x", digest[i]);
   return hex;
+}
+
+// Hex digits of a key that route it (inscribe::client::RouteKey): a mesh and every key derived
+// from it share their first 16, so a routing client sends all of them to one replica.
+constexpr std::size_t kRouteDigits = 16;
+
+// The first kRouteDigits hex digits of a mesh key ("sha256:<hex>") or of a key derived from
+// one ("spheres/v1/<hex>"), or "" for any other key (an uploaded set's is then a full hash).
+std::string RoutePrefix(const std::string& key) {
+  absl::string_view hex = key;
+  if (!absl::ConsumePrefix(&hex, "sha256:") && !absl::ConsumePrefix(&hex, "spheres/v1/")) {
+    return "";
+  }
+  if (hex.size() < kRouteDigits) return "";
+  for (char c : hex.substr(0, kRouteDigits)) {
+    if (!absl::ascii_isxdigit(c) || absl::ascii_isupper(c)) return "";
+  }
+  return std::string(hex.substr(0, kRouteDigits));
+}
+
+// `prefix` (a RoutePrefix, or "") then the SHA-256 of `canonical`, 64 hex digits in all: the
+// prefix takes the place of the digest's last 16 digits. The 192 bits left keep collisions out
+// of reach (about 2^96 keys of one mesh before the first).
+std::string DerivedKeyHex(const std::string& prefix, const std::string& canonical) {
+  const std::string digest = Sha256Hex(canonical);
+  if (prefix.empty()) return digest;
+  return prefix + digest.substr(0, digest.size() - prefix.size());
 }
 
 // Memory a stored mesh holds beyond its bytes: the mesh arrays and the oracle's BVH and
@@ -160,7 +189,7 @@ std::string SphereSetKey(const std::string& mesh_key, const v1::GenerateParamete
       kSphereAlgorithmVersion, mesh_key, p.voxel_size(), p.max_spheres(), p.object_angle(),
       p.epsilon(), p.samples(), p.subdivide_boundary(), p.dilate(), p.dilation_growth(),
       p.fill_holes(), with_quality);
-  return "spheres/v1/" + Sha256Hex(canonical);
+  return "spheres/v1/" + DerivedKeyHex(RoutePrefix(mesh_key), canonical);
 }
 
 ResultStore::ResultStore(ResultCache* cache, const StoreLimits& limits)
@@ -311,7 +340,8 @@ absl::StatusOr<std::shared_ptr<const SphereHierarchy>> ResultStore::GetHierarchy
 }
 
 absl::StatusOr<std::shared_ptr<const SphereSetEntry>> ResultStore::PutSphereSet(
-    SphereSet set, const std::string& mesh_key, bool* already_stored) {
+    SphereSet set, const std::string& mesh_key, bool* already_stored,
+    const std::string& derived_from) {
   if (!mesh_key.empty()) {
     absl::StatusOr<std::shared_ptr<const StoredMeshEntry>> mesh = GetMesh(mesh_key);
     if (!mesh.ok()) return mesh.status();
@@ -327,10 +357,12 @@ absl::StatusOr<std::shared_ptr<const SphereSetEntry>> ResultStore::PutSphereSet(
   }
   v1::GenerateResult result;
   SphereSetToProto(set, result.mutable_spheres());
-  // The packed arrays of one message serialise the same way for the same numbers.
+  // The packed arrays of one message serialise the same way for the same numbers. The route
+  // prefix is the mesh's, else the set's it was derived from, else none (a full SHA-256).
+  const std::string prefix = RoutePrefix(mesh_key.empty() ? derived_from : mesh_key);
   const std::string key =
-      "spheres/v1/" + Sha256Hex(absl::StrCat(kUploadedSetVersion, "\n", mesh_key, "\n",
-                                             result.spheres().SerializeAsString()));
+      "spheres/v1/" + DerivedKeyHex(prefix, absl::StrCat(kUploadedSetVersion, "\n", mesh_key, "\n",
+                                                         result.spheres().SerializeAsString()));
   result.set_sphere_set_key(key);
   result.set_mesh_sha256(mesh_key);
   absl::StatusOr<CacheLookup> found = cache_->GetOrCompute(
@@ -348,7 +380,7 @@ absl::StatusOr<std::shared_ptr<const DeformerEntry>> ResultStore::GetDeformer(
       "%s\n%s\n%s\nxi=%.17g\nstrict=%d\ndirection=%d\ninside=%d\n", kDeformerVersion, mesh_key,
       set_key, options.xi, options.strict, static_cast<int>(options.direction),
       static_cast<int>(options.oracle.inside_test));
-  const std::string key = "deformer/v1/" + Sha256Hex(canonical);
+  const std::string key = "deformer/v1/" + DerivedKeyHex(RoutePrefix(mesh_key), canonical);
   absl::StatusOr<CacheLookup> found = cache_->GetOrCompute(
       key,
       [&]() -> absl::StatusOr<CachedValue> {

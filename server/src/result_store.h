@@ -76,12 +76,15 @@ class ResultStore {
       const v1::GenerateRequest& request, const GenerationControl& control);
   absl::StatusOr<std::shared_ptr<const SphereSetEntry>> GetSphereSet(const std::string& key);
 
-  // Stores an uploaded set under "spheres/v1/<SHA-256 of mesh key and numbers>". `mesh_key`
-  // may be empty; when given the mesh must be stored (NOT_FOUND) and contacts must name its
-  // triangles (INVALID_ARGUMENT). *already_stored: the key was held before.
-  absl::StatusOr<std::shared_ptr<const SphereSetEntry>> PutSphereSet(SphereSet set,
-                                                                     const std::string& mesh_key,
-                                                                     bool* already_stored);
+  // Stores an uploaded set under "spheres/v1/<64 hex>": the first 16 hex digits of the mesh
+  // key (else of `derived_from`, the key of the set this one was computed from, so that a
+  // routing client finds it on the replica that made it), then the SHA-256 of mesh key and
+  // numbers; a full SHA-256 when neither names a mesh. `mesh_key` may be empty; when given the
+  // mesh must be stored (NOT_FOUND) and contacts must name its triangles (INVALID_ARGUMENT).
+  // *already_stored: the key was held before.
+  absl::StatusOr<std::shared_ptr<const SphereSetEntry>> PutSphereSet(
+      SphereSet set, const std::string& mesh_key, bool* already_stored,
+      const std::string& derived_from = "");
 
   // The deformer of (mesh, set, options), created on first use (an oracle build). FAILED_
   // PRECONDITION for a set without contacts or whose contacts do not fit the mesh.
@@ -100,7 +103,8 @@ class ResultStore {
 };
 
 // The canonical form of `parameters` (defaults filled in) or INVALID_ARGUMENT naming the bad
-// field; the sphere-set key hashes this with the mesh key and the algorithm version.
+// field; the sphere-set key hashes this with the mesh key and the algorithm version:
+// "spheres/v1/" + the mesh key's first 16 hex digits + the first 48 of that SHA-256.
 absl::StatusOr<v1::GenerateParameters> CanonicalParameters(
     const v1::GenerateParameters& parameters);
 std::string SphereSetKey(const std::string& mesh_key, const v1::GenerateParameters& canonical,

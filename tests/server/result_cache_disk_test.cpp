@@ -241,13 +241,13 @@ TEST(ResultCacheDisk, DecodeFailureCountsAsCorruptAndRecomputes) {
 }
 
 TEST(ResultCacheOpen, RejectsNegativeBudgetAndUnusableDirectory) {
-  EXPECT_EQ(ResultCache::Open(ResultCacheOptions{-1, ""}).status().code(),
+  EXPECT_EQ(ResultCache::Open(cache_test::Options(-1, "")).status().code(),
             absl::StatusCode::kInvalidArgument);
   TempDir dir;
   const fs::path file = dir.path() / "file";
   WriteFile(file, "x");
   for (const fs::path& bad : {file / "cache", file}) {
-    auto cache = ResultCache::Open(ResultCacheOptions{1 << 20, bad.string()});
+    auto cache = ResultCache::Open(cache_test::Options(1 << 20, bad.string()));
     EXPECT_EQ(cache.status().code(), absl::StatusCode::kFailedPrecondition) << bad;
     EXPECT_THAT(cache.status().message(), HasSubstr(bad.string()));
   }
@@ -257,7 +257,7 @@ TEST(ResultCacheOpen, ReadOnlyDirectoryIsFailedPrecondition) {
   if (::geteuid() == 0) GTEST_SKIP() << "root writes to read-only directories";
   TempDir dir;
   fs::permissions(dir.path(), fs::perms::owner_read | fs::perms::owner_exec);
-  auto cache = ResultCache::Open(ResultCacheOptions{1 << 20, dir.path().string()});
+  auto cache = ResultCache::Open(cache_test::Options(1 << 20, dir.path().string()));
   EXPECT_EQ(cache.status().code(), absl::StatusCode::kFailedPrecondition);
   EXPECT_THAT(cache.status().message(), HasSubstr(dir.path().string()));
 }

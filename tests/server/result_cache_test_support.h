@@ -44,11 +44,18 @@ class TempDir {
   fs::path path_;
 };
 
+inline ResultCacheOptions Options(std::int64_t memory_bytes, std::string dir) {
+  ResultCacheOptions options;
+  options.memory_bytes = memory_bytes;
+  options.disk_dir = std::move(dir);
+  return options;
+}
+
 // Throws (failing the test with the status) when Open fails, so tests can use the cache
 // directly.
 inline std::unique_ptr<ResultCache> OpenCache(std::int64_t memory_bytes, std::string dir = "") {
   absl::StatusOr<std::unique_ptr<ResultCache>> cache =
-      ResultCache::Open(ResultCacheOptions{memory_bytes, std::move(dir)});
+      ResultCache::Open(Options(memory_bytes, std::move(dir)));
   if (!cache.ok()) throw std::runtime_error(cache.status().ToString());
   return *std::move(cache);
 }

@@ -116,7 +116,12 @@ std::optional<Distances> DistancesHere(const DistanceCliOptions& options, const 
 std::optional<Distances> DistancesRemotely(const DistanceCliOptions& options, const SphereSet& a,
                                            const SphereSet& b, const std::vector<RigidPose>& poses,
                                            int* exit_code) {
-  const client::Client client = MakeClient(options.remote);
+  absl::StatusOr<client::Client> made = MakeClient(options.remote);
+  if (!made.ok()) {
+    *exit_code = ReportRemoteError(made.status(), options.remote);
+    return std::nullopt;
+  }
+  const client::Client& client = *made;
   std::string keys[2];
   for (int k = 0; k < 2; ++k) {
     absl::StatusOr<client::PutSphereSetResult> stored = client.PutSphereSet(k == 0 ? a : b);

@@ -11,6 +11,10 @@ inline constexpr int kExitUsage = 64;        // bad command line (CLI11 prints w
 // not answer within --timeout (DEADLINE_EXCEEDED). Worth retrying later; nothing is wrong
 // with the input. sysexits' EX_UNAVAILABLE.
 inline constexpr int kExitServerUnavailable = 69;
+// --server refused the caller: no or a wrong bearer token (UNAUTHENTICATED; --token-file), or
+// not allowed (PERMISSION_DENIED). Retrying will not help until the credentials change.
+// sysexits' EX_NOPERM.
+inline constexpr int kExitNotAuthorized = 77;
 // A bug, here or in the server (an unexpected exception, INTERNAL, UNIMPLEMENTED, ...).
 inline constexpr int kExitInternal = 70;
 

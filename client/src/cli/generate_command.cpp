@@ -208,7 +208,12 @@ std::string OptionTheServerCannotTake(const GenerateCliOptions& options) {
 
 // Remote mode: PutMesh, then Generate with the progress bar fed by the server's messages.
 std::optional<Generated> GenerateRemotely(const GenerateCliOptions& options, int* exit_code) {
-  const client::Client client = MakeClient(options.remote);
+  absl::StatusOr<client::Client> made = MakeClient(options.remote);
+  if (!made.ok()) {
+    *exit_code = ReportRemoteError(made.status(), options.remote);
+    return std::nullopt;
+  }
+  const client::Client& client = *made;
   std::optional<UploadedSolid> solid =
       UploadSolid(client, options.remote, options.mesh_path, exit_code, {options.fill_holes});
   if (!solid) return std::nullopt;

@@ -105,8 +105,9 @@ int RunInfo(const InfoOptions& options) {
   if (options.remote.enabled() && !options.fill_holes) {
     client::InspectMeshOptions inspect;
     inspect.skip_self_intersections = options.skip_self_intersections;
-    absl::StatusOr<client::InspectMeshResult> inspected =
-        MakeClient(options.remote).InspectMesh(*mesh, inspect);
+    absl::StatusOr<client::Client> client = MakeClient(options.remote);
+    if (!client.ok()) return ReportRemoteError(client.status(), options.remote);
+    absl::StatusOr<client::InspectMeshResult> inspected = client->InspectMesh(*mesh, inspect);
     if (!inspected.ok()) return ReportRemoteError(inspected.status(), options.remote);
     result.report = std::move(inspected->report);
     result.sha256 = std::move(inspected->mesh_sha256);

@@ -9,6 +9,7 @@
 #include "evaluate_command.h"
 #include "exit_codes.h"
 #include "generate_command.h"
+#include "health_command.h"
 #include "info_command.h"
 #include "stats_command.h"
 
@@ -19,7 +20,8 @@ int main(int argc, char** argv) {
   app.footer(
       "Exit status: 0 done; 1 the mesh cannot be used; 2 missing, unreadable or malformed "
       "input; 64 bad command line; 69 the --server could not be reached or did not answer "
-      "within --timeout; 70 internal error.");
+      "within --timeout; 70 internal error; 77 the --server refused the call (missing or wrong "
+      "--token-file, UNAUTHENTICATED or PERMISSION_DENIED).");
   int exit_code = inscribe::cli::kExitOk;
   inscribe::cli::AddInfoCommand(app, &exit_code);
   inscribe::cli::AddGenerateCommand(app, &exit_code);
@@ -27,6 +29,7 @@ int main(int argc, char** argv) {
   inscribe::cli::AddDeformCommand(app, &exit_code);
   inscribe::cli::AddDistanceCommand(app, &exit_code);
   inscribe::cli::AddStatsCommand(app, &exit_code);
+  inscribe::cli::AddHealthCommand(app, &exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

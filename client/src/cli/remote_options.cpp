@@ -4,9 +4,12 @@
 #include <cmath>
 #include <iostream>
 
+#include "absl/strings/ascii.h"
 #include "absl/strings/str_format.h"
+#include "absl/strings/str_split.h"
 #include "exit_codes.h"
 #include "inscribe/client/connection.h"
+#include "inscribe/client/routing.h"
 
 namespace inscribe::cli {
 
@@ -15,21 +18,75 @@ void AddRemoteOptions(CLI::App* cmd, RemoteOptions* options, double default_time
   options->timeout_seconds = default_timeout_seconds;
   CLI::Option* server = cmd->add_option(
       "--server", options->server,
-      "Run on the inscribed server at HOST:PORT (plaintext gRPC) instead of in this process; "
-      "the output is the same");
+      "Run on the inscribed server at HOST:PORT instead of in this process (the output is the "
+      "same); several replicas separated by commas: each mesh's calls go to one of them, "
+      "failing over to the next when it is down");
   if (server_required) server->required();
   cmd->add_option("--timeout", options->timeout_seconds,
                   "With --server: seconds a call may take, retries included (exit 69 when "
                   "exceeded or the server cannot be reached)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  cmd->add_flag("--tls", options->tls,
+                "With --server: TLS, verifying the server against the system's CA certificates");
+  cmd->add_option("--tls-ca", options->tls_files.ca_file,
+                  "With --server: TLS, verifying the server against these PEM CA certificates")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--tls-cert", options->tls_files.cert_file,
+                  "With --server: TLS client certificate (PEM) for servers that verify clients")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--tls-key", options->tls_files.key_file, "Private key (PEM) of --tls-cert")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--token-file", options->token_file,
+                  "With --server: file whose first line is the bearer token to send")
+      ->check(CLI::ExistingFile);
 }
 
-client::Client MakeClient(const RemoteOptions& options) {
+std::vector<std::string> RemoteOptions::servers() const {
+  std::vector<std::string> out;
+  for (absl::string_view part : absl::StrSplit(server, ',', absl::SkipWhitespace())) {
+    out.emplace_back(absl::StripAsciiWhitespace(part));
+  }
+  return out;
+}
+
+absl::StatusOr<client::ConnectionOptions> ConnectionOptionsFor(const RemoteOptions& options) {
+  client::ConnectionOptions connection_options;
+  if (options.tls_enabled()) {
+    absl::StatusOr<std::shared_ptr<grpc::ChannelCredentials>> credentials =
+        client::MakeTlsCredentials(options.tls_files);
+    if (!credentials.ok()) return credentials.status();
+    connection_options.credentials = *std::move(credentials);
+  }
+  if (!options.token_file.empty()) {
+    absl::StatusOr<std::string> token = client::ReadBearerToken(options.token_file);
+    if (!token.ok()) return token.status();
+    connection_options.bearer_token = *std::move(token);
+  }
+  return connection_options;
+}
+
+absl::StatusOr<client::Client> MakeClient(const RemoteOptions& options) {
+  absl::StatusOr<client::ConnectionOptions> made = ConnectionOptionsFor(options);
+  if (!made.ok()) return made.status();
+  const client::ConnectionOptions& connection_options = *made;
   client::ClientOptions client_options;
   client_options.default_timeout = std::chrono::duration_cast<std::chrono::milliseconds>(
       std::chrono::duration<double>(options.timeout_seconds));
-  return client::Client(client::MakeGrpcConnection(options.server), client_options);
+
+  const std::vector<std::string> targets = options.servers();
+  if (targets.size() == 1) {
+    return client::Client(client::MakeGrpcConnection(targets[0], connection_options),
+                          client_options);
+  }
+  std::vector<client::Endpoint> endpoints;
+  for (const std::string& target : targets) {
+    endpoints.push_back({target, client::MakeGrpcConnection(target, connection_options)});
+  }
+  absl::StatusOr<std::shared_ptr<client::Connection>> routed =
+      client::MakeRoutedConnection(std::move(endpoints));
+  if (!routed.ok()) return routed.status();
+  return client::Client(*std::move(routed), client_options);
 }
 
 int RemoteExitCode(absl::StatusCode code) {
@@ -44,6 +101,9 @@ int RemoteExitCode(absl::StatusCode code) {
       return kExitBadInput;
     case absl::StatusCode::kFailedPrecondition:
       return kExitUnusableMesh;
+    case absl::StatusCode::kUnauthenticated:
+    case absl::StatusCode::kPermissionDenied:
+      return kExitNotAuthorized;
     default:
       return kExitInternal;
   }

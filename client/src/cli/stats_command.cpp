@@ -32,11 +32,21 @@ std::vector<std::pair<const char*, std::int64_t>> Counters(const client::ServerC
           {"evictions", s.evictions},
           {"disk_entries", s.disk_entries},
           {"disk_bytes", s.disk_bytes},
-          {"disk_errors", s.disk_errors}};
+          {"disk_errors", s.disk_errors},
+          {"shared_hits", s.shared_hits},
+          {"shared_misses", s.shared_misses},
+          {"shared_errors", s.shared_errors},
+          {"shared_writes", s.shared_writes},
+          {"shared_write_errors", s.shared_write_errors},
+          {"shared_skipped", s.shared_skipped},
+          {"shared_corrupt", s.shared_corrupt},
+          {"shared_available", s.shared_available}};
 }
 
 int RunStats(const StatsCliOptions& options) {
-  absl::StatusOr<client::ServerCacheStats> stats = MakeClient(options.remote).CacheStats();
+  absl::StatusOr<client::Client> client = MakeClient(options.remote);
+  if (!client.ok()) return ReportRemoteError(client.status(), options.remote);
+  absl::StatusOr<client::ServerCacheStats> stats = client->CacheStats();
   if (!stats.ok()) return ReportRemoteError(stats.status(), options.remote);
   if (options.json) {
     nlohmann::json j;
@@ -45,9 +55,9 @@ int RunStats(const StatsCliOptions& options) {
     std::cout << j.dump() << "\n";
     return kExitOk;
   }
-  std::cout << absl::StrFormat("%-14s %s\n", "server", options.remote.server);
+  std::cout << absl::StrFormat("%-20s %s\n", "server", options.remote.server);
   for (const auto& [name, value] : Counters(*stats)) {
-    std::cout << absl::StrFormat("%-14s %d\n", name, value);
+    std::cout << absl::StrFormat("%-20s %d\n", name, value);
   }
   return kExitOk;
 }
@@ -60,7 +70,8 @@ void AddStatsCommand(CLI::App& app, int* exit_code) {
       "stats",
       "The server's result-cache counters: entries and bytes in memory and on disk, hits "
       "(memory, disk), misses, computations, joined (waited for an identical request), "
-      "evictions, disk errors");
+      "evictions, disk errors, and the shared Redis tier's hits, misses, errors, writes, "
+      "skips (while it is down), corrupt values and availability");
   cmd->add_flag("--json", options->json, "Print one JSON object on stdout");
   AddRemoteOptions(cmd, &options->remote, 60.0, /*server_required=*/true);
   cmd->callback([options, exit_code] { *exit_code = RunStats(*options); });

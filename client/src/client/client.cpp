@@ -364,6 +364,14 @@ absl::StatusOr<ServerCacheStats> Client::CacheStats(const CallOptions& options) 
   stats.disk_entries = response->disk_entries();
   stats.disk_bytes = response->disk_bytes();
   stats.disk_errors = response->disk_errors();
+  stats.shared_hits = response->shared_hits();
+  stats.shared_misses = response->shared_misses();
+  stats.shared_errors = response->shared_errors();
+  stats.shared_writes = response->shared_writes();
+  stats.shared_write_errors = response->shared_write_errors();
+  stats.shared_skipped = response->shared_skipped();
+  stats.shared_corrupt = response->shared_corrupt();
+  stats.shared_available = response->shared_available();
   return stats;
 }
 

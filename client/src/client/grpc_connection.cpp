@@ -1,13 +1,18 @@
 // The gRPC implementation of Connection: a channel and the generated stub.
 #include <chrono>
 #include <condition_variable>
+#include <fstream>
 #include <memory>
 #include <mutex>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <utility>
 
+#include "absl/strings/ascii.h"
+#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_split.h"
 #include "grpcpp/channel.h"
 #include "grpcpp/client_context.h"
 #include "grpcpp/create_channel.h"
@@ -23,14 +28,20 @@ namespace {
 
 using Stub = v1::Inscribe::Stub;
 
+// Sets what every call carries: its deadline and, when configured, the bearer token.
+void PrepareContext(grpc::ClientContext& context, const std::string& token, Deadline deadline) {
+  if (deadline != Deadline::max()) context.set_deadline(deadline);
+  if (!token.empty()) context.AddMetadata("authorization", absl::StrCat("Bearer ", token));
+}
+
 // One attempt of a unary RPC through the generated (blocking) stub method `method`.
 template <typename Request, typename Response>
-absl::StatusOr<Response> CallUnary(Stub& stub,
+absl::StatusOr<Response> CallUnary(Stub& stub, const std::string& token,
                                    grpc::Status (Stub::*method)(grpc::ClientContext*,
                                                                 const Request&, Response*),
                                    const Request& request, Deadline deadline) {
   grpc::ClientContext context;
-  context.set_deadline(deadline);
+  PrepareContext(context, token, deadline);
   Response response;
   const grpc::Status status = (stub.*method)(&context, request, &response);
   if (!status.ok()) return server::FromGrpcStatus(status);
@@ -114,8 +125,8 @@ class StreamWatchdog {
 
 class GrpcDistanceStream final : public DistanceStreamConnection {
  public:
-  GrpcDistanceStream(Stub& stub, Deadline deadline) {
-    if (deadline != Deadline::max()) context_.set_deadline(deadline);
+  GrpcDistanceStream(Stub& stub, const std::string& token, Deadline deadline) {
+    PrepareContext(context_, token, deadline);
     stream_ = stub.DistanceStream(&context_);
     watchdog_ = std::make_unique<StreamWatchdog>(&context_);
   }
@@ -187,24 +198,24 @@ class GrpcDistanceStream final : public DistanceStreamConnection {
 
 class GrpcConnection final : public Connection {
  public:
-  explicit GrpcConnection(std::shared_ptr<grpc::Channel> channel)
-      : stub_(v1::Inscribe::NewStub(std::move(channel))) {}
+  GrpcConnection(std::shared_ptr<grpc::Channel> channel, std::string token)
+      : stub_(v1::Inscribe::NewStub(std::move(channel))), token_(std::move(token)) {}
 
   absl::StatusOr<v1::InspectMeshResponse> InspectMesh(const v1::InspectMeshRequest& request,
                                                       Deadline deadline) override {
-    return CallUnary(*stub_, &Stub::InspectMesh, request, deadline);
+    return CallUnary(*stub_, token_, &Stub::InspectMesh, request, deadline);
   }
 
   absl::StatusOr<v1::PutMeshResponse> PutMesh(const v1::PutMeshRequest& request,
                                               Deadline deadline) override {
-    return CallUnary(*stub_, &Stub::PutMesh, request, deadline);
+    return CallUnary(*stub_, token_, &Stub::PutMesh, request, deadline);
   }
 
   absl::StatusOr<v1::GenerateResult> Generate(
       const v1::GenerateRequest& request, Deadline deadline,
       const std::function<void(double fraction)>& on_progress) override {
     grpc::ClientContext context;
-    context.set_deadline(deadline);
+    PrepareContext(context, token_, deadline);
     std::unique_ptr<grpc::ClientReader<v1::GenerateResponse>> reader =
         stub_->Generate(&context, request);
     v1::GenerateResponse message;
@@ -226,48 +237,90 @@ class GrpcConnection final : public Connection {
 
   absl::StatusOr<v1::PutSphereSetResponse> PutSphereSet(const v1::PutSphereSetRequest& request,
                                                         Deadline deadline) override {
-    return CallUnary(*stub_, &Stub::PutSphereSet, request, deadline);
+    return CallUnary(*stub_, token_, &Stub::PutSphereSet, request, deadline);
   }
 
   absl::StatusOr<v1::GetSphereSetResponse> GetSphereSet(const v1::GetSphereSetRequest& request,
                                                         Deadline deadline) override {
-    return CallUnary(*stub_, &Stub::GetSphereSet, request, deadline);
+    return CallUnary(*stub_, token_, &Stub::GetSphereSet, request, deadline);
   }
 
   absl::StatusOr<v1::GetHierarchyResponse> GetHierarchy(const v1::GetHierarchyRequest& request,
                                                         Deadline deadline) override {
-    return CallUnary(*stub_, &Stub::GetHierarchy, request, deadline);
+    return CallUnary(*stub_, token_, &Stub::GetHierarchy, request, deadline);
   }
 
   absl::StatusOr<v1::UpdateDeformationResponse> UpdateDeformation(
       const v1::UpdateDeformationRequest& request, Deadline deadline) override {
-    return CallUnary(*stub_, &Stub::UpdateDeformation, request, deadline);
+    return CallUnary(*stub_, token_, &Stub::UpdateDeformation, request, deadline);
   }
 
   absl::StatusOr<v1::DistanceResponse> Distance(const v1::DistanceRequest& request,
                                                 Deadline deadline) override {
-    return CallUnary(*stub_, &Stub::Distance, request, deadline);
+    return CallUnary(*stub_, token_, &Stub::Distance, request, deadline);
   }
 
   absl::StatusOr<v1::EvaluateResponse> Evaluate(const v1::EvaluateRequest& request,
                                                 Deadline deadline) override {
-    return CallUnary(*stub_, &Stub::Evaluate, request, deadline);
+    return CallUnary(*stub_, token_, &Stub::Evaluate, request, deadline);
   }
 
   absl::StatusOr<v1::CacheStatsResponse> CacheStats(const v1::CacheStatsRequest& request,
                                                     Deadline deadline) override {
-    return CallUnary(*stub_, &Stub::CacheStats, request, deadline);
+    return CallUnary(*stub_, token_, &Stub::CacheStats, request, deadline);
   }
 
   absl::StatusOr<std::unique_ptr<DistanceStreamConnection>> OpenDistanceStream(
       Deadline deadline) override {
-    return std::make_unique<GrpcDistanceStream>(*stub_, deadline);
+    return std::make_unique<GrpcDistanceStream>(*stub_, token_, deadline);
   }
 
  private:
   // Generated stubs are thread-safe; one serves every caller.
   const std::unique_ptr<v1::Inscribe::Stub> stub_;
+  const std::string token_;  // empty: no authorization header
 };
+
+// The whole of a small text file, or INVALID_ARGUMENT naming it.
+absl::StatusOr<std::string> ReadSmallFile(const std::string& path, absl::string_view what) {
+  std::ifstream in(path, std::ios::binary);
+  std::string text;
+  if (in) {
+    std::ostringstream buffer;
+    buffer << in.rdbuf();
+    text = buffer.str();
+  }
+  if (!in && !in.eof()) {
+    return absl::InvalidArgumentError(absl::StrCat("cannot read ", what, " ", path));
+  }
+  if (text.size() > (std::size_t{1} << 20)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(what, " ", path, " is ", text.size(), " bytes; at most 1 MiB"));
+  }
+  return text;
+}
+
+// A PEM file's text, or INVALID_ARGUMENT when it cannot be read or holds no PEM block labelled
+// `label` ("CERTIFICATE", "PRIVATE KEY"). gRPC parses the PEM itself, but only in the first
+// handshake, where a mix-up (a certificate given as the key, a key as the CA) would surface as
+// an UNAVAILABLE that the client retries until its deadline; checking the label up front names
+// the file instead.
+absl::StatusOr<std::string> ReadPem(const std::string& path, absl::string_view what,
+                                    absl::string_view label) {
+  absl::StatusOr<std::string> text = ReadSmallFile(path, what);
+  if (!text.ok()) return text.status();
+  // The label may have a prefix ("RSA PRIVATE KEY", "EC PRIVATE KEY").
+  if (!absl::StrContains(*text, "-----BEGIN ") ||
+      !absl::StrContains(*text, absl::StrCat(label, "-----"))) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(what, " ", path, " is not a PEM file holding a ", label));
+  }
+  if (absl::StrContains(*text, "-----BEGIN ENCRYPTED PRIVATE KEY-----")) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(what, " ", path, " is encrypted; gRPC needs an unencrypted key"));
+  }
+  return text;
+}
 
 }  // namespace
 
@@ -278,8 +331,50 @@ std::shared_ptr<Connection> MakeGrpcConnection(const std::string& target,
   arguments.SetMaxSendMessageSize(options.max_message_bytes);
   std::shared_ptr<grpc::ChannelCredentials> credentials =
       options.credentials ? options.credentials : grpc::InsecureChannelCredentials();
-  return std::make_shared<GrpcConnection>(
-      grpc::CreateCustomChannel(target, credentials, arguments));
+  return std::make_shared<GrpcConnection>(grpc::CreateCustomChannel(target, credentials, arguments),
+                                          options.bearer_token);
+}
+
+absl::StatusOr<std::shared_ptr<grpc::ChannelCredentials>> MakeTlsCredentials(
+    const TlsFiles& files) {
+  if (files.cert_file.empty() != files.key_file.empty()) {
+    return absl::InvalidArgumentError(
+        "a TLS client certificate needs both its certificate and its key file");
+  }
+  grpc::SslCredentialsOptions ssl;
+  if (!files.ca_file.empty()) {
+    absl::StatusOr<std::string> roots = ReadPem(files.ca_file, "TLS CA file", "CERTIFICATE");
+    if (!roots.ok()) return roots.status();
+    ssl.pem_root_certs = *std::move(roots);
+  }
+  if (!files.cert_file.empty()) {
+    absl::StatusOr<std::string> chain =
+        ReadPem(files.cert_file, "TLS certificate file", "CERTIFICATE");
+    if (!chain.ok()) return chain.status();
+    absl::StatusOr<std::string> key = ReadPem(files.key_file, "TLS key file", "PRIVATE KEY");
+    if (!key.ok()) return key.status();
+    ssl.pem_cert_chain = *std::move(chain);
+    ssl.pem_private_key = *std::move(key);
+  }
+  return grpc::SslCredentials(ssl);
+}
+
+absl::StatusOr<std::string> ReadBearerToken(const std::string& path) {
+  absl::StatusOr<std::string> text = ReadSmallFile(path, "token file");
+  if (!text.ok()) return text.status();
+  for (absl::string_view line : absl::StrSplit(*text, '\n')) {
+    line = absl::StripAsciiWhitespace(line);
+    if (line.empty() || absl::StartsWith(line, "#")) continue;
+    for (char c : line) {
+      // What an HTTP/2 header value may hold, less spaces (RFC 6750's token68 is narrower).
+      if (c < 0x21 || c > 0x7e) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            "token file ", path, ": the token holds a space or a non-printable character"));
+      }
+    }
+    return std::string(line);
+  }
+  return absl::InvalidArgumentError(absl::StrCat("token file ", path, " holds no token"));
 }
 
 }  // namespace inscribe::client

@@ -98,7 +98,7 @@ struct GenerateResult {
   double voxel_size = 0.0;
   double seconds = 0.0;  // the computation's wall time (the original run's when cached)
   std::optional<QualityReport> quality;  // absent when skip_quality
-  std::string cache;                     // "memory", "disk", "computed" or "joined"
+  std::string cache;  // "memory", "disk", "redis" (the replicas' shared tier), "computed", "joined"
 };
 
 struct PutSphereSetResult {
@@ -176,6 +176,15 @@ struct ServerCacheStats {
   std::int64_t disk_entries = 0;
   std::int64_t disk_bytes = 0;
   std::int64_t disk_errors = 0;
+  // The replicas' shared Redis tier (all 0 without one); see CacheStatsResponse.
+  std::int64_t shared_hits = 0;
+  std::int64_t shared_misses = 0;
+  std::int64_t shared_errors = 0;
+  std::int64_t shared_writes = 0;
+  std::int64_t shared_write_errors = 0;
+  std::int64_t shared_skipped = 0;
+  std::int64_t shared_corrupt = 0;
+  std::int64_t shared_available = 0;  // 1 while the server's Redis is up
 };
 
 // One object pair of a simulator frame: two cached sets and their world poses.

@@ -77,12 +77,35 @@ class Connection {
 
 struct ConnectionOptions {
   // Channel credentials; nullptr means plaintext (grpc::InsecureChannelCredentials), which is
-  // what inscribed serves by default on loopback.
+  // what inscribed serves by default on loopback. MakeTlsCredentials builds TLS ones.
   std::shared_ptr<grpc::ChannelCredentials> credentials;
+  // Sent on every call as "authorization: Bearer <token>" (inscribed --auth-tokens); empty =
+  // none; printable ASCII without spaces (ReadBearerToken checks). Over plaintext the token
+  // travels in the clear: use TLS beyond loopback.
+  std::string bearer_token;
   // Largest message sent or received, in bytes. Matches inscribed's --max-message-bytes
   // default (256 MiB); gRPC's own 4 MiB receive default is too small for meshes.
   int max_message_bytes = 256 * 1024 * 1024;
 };
+
+// PEM files for a TLS channel (inscribed --tls-cert/--tls-key/--tls-client-ca).
+struct TlsFiles {
+  // CA certificates the server's certificate must chain to; empty = the system's roots.
+  std::string ca_file;
+  // The client's certificate chain and key, for servers that verify clients (mutual TLS).
+  // Both or neither.
+  std::string cert_file;
+  std::string key_file;
+};
+
+// TLS channel credentials from PEM files. INVALID_ARGUMENT naming a file that cannot be read
+// or is not PEM, or when only one of cert_file and key_file is given.
+absl::StatusOr<std::shared_ptr<grpc::ChannelCredentials>> MakeTlsCredentials(const TlsFiles& files);
+
+// The token of a token file: its first line that is neither blank nor a '#' comment, without
+// surrounding whitespace. INVALID_ARGUMENT naming the file when it cannot be read, holds no
+// token, or the token has a character outside printable ASCII (or a space).
+absl::StatusOr<std::string> ReadBearerToken(const std::string& path);
 
 // A Connection over one gRPC channel to `target` ("HOST:PORT", or any gRPC target URI such as
 // "dns:///host:port"). The channel connects lazily on the first call, so this never fails; an

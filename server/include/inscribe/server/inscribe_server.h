@@ -11,9 +11,22 @@
 
 namespace inscribe::server {
 
+// TLS on the listening port. PEM files, read once at start.
+struct ServerTlsOptions {
+  // --tls-cert and --tls-key: the server's certificate chain and private key. Both or neither;
+  // with neither the port is plaintext.
+  std::string cert_file;
+  std::string key_file;
+  // --tls-client-ca: CA certificates; when given, every client must present a certificate
+  // signed by one of them (mutual TLS) or the handshake fails.
+  std::string client_ca_file;
+
+  bool enabled() const { return !cert_file.empty() || !key_file.empty(); }
+};
+
 struct ServerOptions {
-  // --listen: HOST:PORT to bind, plaintext. Loopback by default; port 0 picks a free port
-  // (read it back from InscribeServer::port()).
+  // --listen: HOST:PORT to bind (plaintext unless `tls` is enabled). Loopback by default; port
+  // 0 picks a free port (read it back from InscribeServer::port()).
   std::string listen = "127.0.0.1:50051";
   // --jobs: requests computed at the same time. 0 = one per hardware thread.
   int jobs = 0;
@@ -23,8 +36,17 @@ struct ServerOptions {
   // triangles with ~2.5M vertices). gRPC's own default, 4 MiB, is too small for meshes.
   int max_message_bytes = 256 * 1024 * 1024;
   ServiceLimits limits;
-  // --cache-memory-bytes and --cache-dir: the result cache's tiers.
+  // --cache-memory-bytes, --cache-dir, --redis: the result cache's tiers.
   ResultCacheOptions cache;
+  // --tls-cert, --tls-key, --tls-client-ca.
+  ServerTlsOptions tls;
+  // --auth-tokens: file of accepted bearer tokens, one per line (blank lines and lines
+  // starting with '#' ignored); empty = no authentication. When set, every inscribe.v1 call
+  // must carry "authorization: Bearer <token>" with one of them, else UNAUTHENTICATED. The
+  // health service stays open (probes carry no token).
+  std::string auth_tokens_file;
+  // --metrics-listen: HOST:PORT of the Prometheus endpoint (GET /metrics); empty = none.
+  std::string metrics_listen;
   // Told about every finished call; see CallObserver. May be empty.
   CallObserver on_call;
 };
@@ -35,7 +57,9 @@ struct ServerOptions {
 class InscribeServer {
  public:
   // Binds and starts serving. UNAVAILABLE when the address cannot be bound, INVALID_ARGUMENT
-  // for options out of range.
+  // for options out of range; for the TLS and token files, FAILED_PRECONDITION naming one that
+  // cannot be read and INVALID_ARGUMENT naming one that holds the wrong thing (no PEM
+  // certificate, a key not matching the certificate, a malformed token or none).
   static absl::StatusOr<std::unique_ptr<InscribeServer>> Start(const ServerOptions& options);
 
   // Shutdown(now) if not done yet, then waits for running jobs.
@@ -47,6 +71,8 @@ class InscribeServer {
   int port() const { return port_; }
   // HOST:PORT with the bound port, e.g. "127.0.0.1:50051"; suitable as a client target.
   const std::string& address() const { return address_; }
+  // The port of the Prometheus endpoint (--metrics-listen), 0 when there is none.
+  int metrics_port() const;
   // Jobs (requests) used by the pool after resolving jobs = 0.
   int jobs() const { return jobs_; }
 

@@ -49,14 +49,21 @@ struct CallRecord {
 // thread-safe and fast. Libraries do not log: the `inscribed` binary passes a logger here.
 using CallObserver = std::function<void(const CallRecord&)>;
 
+// Admits or refuses a call from its metadata before any work is done: OK, or the status the
+// caller gets (UNAUTHENTICATED, PERMISSION_DENIED); the observer still sees refused calls.
+// Called on the gRPC thread for every inscribe.v1 call (not health or reflection), so it must
+// be thread-safe and take microseconds. InscribeServer builds one from --auth-tokens.
+using CallAuthenticator = std::function<absl::Status(const grpc::CallbackServerContext& context)>;
+
 // Handlers check what is O(1) to check (array shapes, limits, cancellation) on the gRPC thread
 // and hand everything else to `pool`; they never compute on gRPC threads. `pool` must outlive
 // the service and be drained (JobPool::WaitIdle) before the service is destroyed.
 class InscribeService final : public v1::Inscribe::CallbackService {
  public:
   // `cache` holds meshes and results; it must outlive the service.
+  // `authenticate` may be empty: every call is admitted.
   InscribeService(JobPool* pool, ResultCache* cache, const ServiceLimits& limits,
-                  CallObserver observer = nullptr);
+                  CallObserver observer = nullptr, CallAuthenticator authenticate = nullptr);
   ~InscribeService() override;
 
   // Validates the mesh (core ValidateMesh, orientation fixed) and replies with the report and
@@ -131,6 +138,8 @@ class InscribeService final : public v1::Inscribe::CallbackService {
   void CallEnded();
   // Tells the observer; for streaming calls, which finish through their own reactor.
   void Observe(const CallRecord& record) const;
+  // authenticate_'s verdict on the call; OK when there is none.
+  absl::Status Authenticate(const grpc::CallbackServerContext& context) const;
   friend class GenerateReactor;
   friend class DistanceStreamReactor;
 
@@ -138,6 +147,7 @@ class InscribeService final : public v1::Inscribe::CallbackService {
   std::unique_ptr<ResultStore> store_;
   const ServiceLimits limits_;
   const CallObserver observer_;
+  const CallAuthenticator authenticate_;
 
   std::atomic<bool> draining_{false};
   std::mutex calls_mutex_;

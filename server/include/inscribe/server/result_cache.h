@@ -1,9 +1,10 @@
 // The server's cache of computed results (validated meshes, sphere sets, hierarchies), keyed by
-// content: two tiers, an in-memory LRU bounded in bytes and an optional on-disk
-// content-addressed directory, with single flight (concurrent requests for one key compute it
-// once).
+// content: an in-memory LRU bounded in bytes, an optional on-disk content-addressed directory
+// and an optional Redis server shared by replicas, with single flight (concurrent requests for
+// one key compute it, or read it from disk or Redis, once).
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -14,6 +15,19 @@
 #include "absl/strings/string_view.h"
 
 namespace inscribe::server {
+
+// A change in the shared (Redis) tier's health, for the binary to log.
+struct SharedTierEvent {
+  // true: Redis answers (at open, or again after being down); false: it failed and is now
+  // skipped until retry_after has passed.
+  bool available = false;
+  // Why it went down (UNAVAILABLE; the message names host:port and what failed, never the
+  // password). OK when available.
+  absl::Status error;
+  // When down: time until one lookup tries Redis again (1 s, doubling per failed retry, at most
+  // 30 s).
+  std::chrono::milliseconds retry_after{0};
+};
 
 struct ResultCacheOptions {
   // --cache-memory-bytes: the in-memory tier holds entries up to this many bytes in all (each
@@ -26,7 +40,21 @@ struct ResultCacheOptions {
   // directory: Open removes the temporary files it finds, and the disk counters assume no
   // other writer.
   std::string disk_dir;
+  // --redis: URL of the Redis server replicas share as a third tier,
+  // "redis://[:PASSWORD@]HOST[:PORT][/DB]"; empty = none. Results are written through to it;
+  // a lookup missing memory and disk reads it before computing. Redis down or slow never fails
+  // a lookup: the tier is skipped (logged and counted) and retried later.
+  std::string redis_url;
+  // --redis-timeout-ms: longest wait for one Redis connect, read or write.
+  int redis_timeout_ms = 250;
+  // Called (on a lookup's thread, with no lock of the cache held; must be cheap and
+  // thread-safe) when the Redis tier goes down or comes back, and once at Open with its first
+  // state. May be empty. The cache itself never logs.
+  std::function<void(const SharedTierEvent&)> on_shared_tier_event;
 };
+
+// `url` with its password replaced by "***" ("redis://:***@host:6379/0"), for logs.
+std::string RedactRedisUrl(absl::string_view url);
 
 // One cached result: its serialised bytes (what the disk tier stores and what RPCs ship) and,
 // optionally, a decoded object the service queries directly (e.g. a SphereHierarchy), so a hit
@@ -36,7 +64,7 @@ struct CachedValue {
   std::shared_ptr<const void> object;  // may be null
   std::int64_t object_bytes = 0;       // memory the object holds, for the LRU budget
   // False for values that only make sense in this process (e.g. a deformer holding a refit
-  // oracle): kept in memory only, never written to the disk tier.
+  // oracle): kept in memory only, never written to the disk or Redis tier.
   bool persist = true;
 
   template <typename T>
@@ -51,8 +79,10 @@ enum class CacheSource {
   kDisk,      // the on-disk tier (checksum verified), now also in memory
   kComputed,  // this call computed it
   kJoined,    // an identical call was computing it; this one waited for that result
+  kShared,    // the shared Redis tier (checksum verified), now also in memory and on disk
 };
-const char* CacheSourceName(CacheSource source);  // "memory", "disk", "computed", "joined"
+// "memory", "disk", "computed", "joined", "redis"
+const char* CacheSourceName(CacheSource source);
 
 struct CacheLookup {
   std::shared_ptr<const CachedValue> value;
@@ -61,13 +91,14 @@ struct CacheLookup {
 
 // Counters since the cache was opened (disk_entries / disk_bytes: what the directory holds
 // now, counted at open and kept up to date by this process). Each lookup (GetOrCompute or Get
-// with a well-formed key) counts in exactly one of memory_hits, disk_hits, misses and joined.
+// with a well-formed key) counts in exactly one of memory_hits, disk_hits, shared_hits, misses
+// and joined.
 struct ResultCacheStats {
   std::int64_t entries = 0;  // in memory
   std::int64_t bytes = 0;    // in memory (key length + bytes + object_bytes, summed)
   std::int64_t memory_hits = 0;
   std::int64_t disk_hits = 0;
-  std::int64_t misses = 0;        // lookups found in neither tier (GetOrCompute or Get)
+  std::int64_t misses = 0;        // lookups found in no tier (GetOrCompute or Get)
   std::int64_t computations = 0;  // compute functions run (failed ones included)
   std::int64_t joined = 0;        // lookups that waited for an identical computation
   std::int64_t evictions = 0;     // entries dropped from memory for the byte budget
@@ -75,6 +106,16 @@ struct ResultCacheStats {
   std::int64_t disk_bytes = 0;
   std::int64_t disk_errors = 0;        // disk files dropped (bad checksum, truncated, wrong key)
   std::int64_t disk_write_errors = 0;  // results that could not be written (disk full, ...)
+  // The shared Redis tier; all 0 without one.
+  std::int64_t shared_hits = 0;    // lookups served from Redis
+  std::int64_t shared_misses = 0;  // Redis reads that found nothing
+  std::int64_t shared_errors =
+      0;  // Redis reads that failed (went on as a miss), or the check at Open
+  std::int64_t shared_writes = 0;  // entries written through to Redis
+  std::int64_t shared_write_errors = 0;
+  std::int64_t shared_skipped = 0;    // reads and writes not tried while Redis was marked down
+  std::int64_t shared_corrupt = 0;    // Redis values that failed their checks (deleted)
+  std::int64_t shared_available = 0;  // 1 while Redis is configured and not marked down
 };
 
 // Thread-safe. Keys are printable: 1-200 characters from [A-Za-z0-9._:/-], e.g.
@@ -89,9 +130,11 @@ class ResultCache {
   // Must not look up its own key (it would wait for itself).
   using Compute = std::function<absl::StatusOr<CachedValue>()>;
 
-  // Creates disk_dir if needed and counts what it holds. INVALID_ARGUMENT for a negative
-  // memory budget; FAILED_PRECONDITION naming the directory when it cannot be created or
-  // written.
+  // Creates disk_dir if needed and counts what it holds; connects to Redis once (unreachable
+  // is not an error: the tier starts marked down, reported through on_shared_tier_event).
+  // INVALID_ARGUMENT for a negative memory budget or a malformed redis_url (naming the wrong
+  // part, never showing the password); FAILED_PRECONDITION naming the directory when it cannot
+  // be created or written.
   static absl::StatusOr<std::unique_ptr<ResultCache>> Open(const ResultCacheOptions& options);
 
   // No call may be in progress.
@@ -100,8 +143,11 @@ class ResultCache {
   ResultCache& operator=(const ResultCache&) = delete;
 
   // The value under `key`: from memory, else from disk (decoded, then kept in memory), else
-  // computed by `compute` on the calling thread, then stored in both tiers (the disk write is
-  // atomic: a temporary file, fsync, rename). While one call computes a key, other calls for
+  // from Redis (verified, decoded, then kept in memory and written to disk), else computed by
+  // `compute` on the calling thread, then stored in every tier (the disk write is atomic: a
+  // temporary file, fsync, rename; the Redis write overwrites). A Redis that fails or times
+  // out counts as a miss: the lookup goes on, costing at most a few redis_timeout_ms, and
+  // Redis is skipped for a backoff. While one call computes a key, other calls for
   // the same key wait and share its result (or its error; errors are not cached), except that
   // when the computing call was cancelled or ran out of time (CANCELLED, DEADLINE_EXCEEDED:
   // its caller's own business) a waiter computes the key itself. INVALID_ARGUMENT for a
@@ -109,13 +155,13 @@ class ResultCache {
   absl::StatusOr<CacheLookup> GetOrCompute(absl::string_view key, const Compute& compute,
                                            const Decode& decode);
 
-  // The value under `key` from either tier, or NOT_FOUND ("no cached entry <key>"). Waits for
+  // The value under `key` from any tier, or NOT_FOUND ("no cached entry <key>"). Waits for
   // an identical computation in progress (NOT_FOUND, with its error, if that one fails).
   absl::StatusOr<CacheLookup> Get(absl::string_view key, const Decode& decode);
 
-  // Stores a value computed elsewhere (e.g. an uploaded mesh) in both tiers, replacing none: an
+  // Stores a value computed elsewhere (e.g. an uploaded mesh) in every tier, replacing none: an
   // existing entry under `key` is kept (equal keys mean equal content) and returned; an
-  // existing disk file is not rewritten. INVALID_ARGUMENT for a malformed key.
+  // existing disk file is not rewritten (the Redis value is). INVALID_ARGUMENT for a malformed key.
   absl::StatusOr<std::shared_ptr<const CachedValue>> Put(absl::string_view key, CachedValue value);
 
   ResultCacheStats stats() const;

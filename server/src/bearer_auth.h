@@ -1,0 +1,67 @@
+// Bearer-token authentication of inscribe.v1 calls (inscribed --auth-tokens). Private to the
+// server: InscribeServer::Start loads the file and hands the service a CallAuthenticator that
+// calls Check.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
+
+namespace grpc {
+class ServerContextBase;
+}  // namespace grpc
+
+namespace inscribe::server {
+
+// Tokens shorter than this are refused when the file is loaded: 16 printable characters are at
+// least ~90 bits when random (e.g. `openssl rand -hex 16` gives 32), which online guessing
+// cannot reach; shorter ones are typos or placeholders.
+inline constexpr std::size_t kMinBearerTokenLength = 16;
+// Longer ones are refused too: a header line that long is a mistake (gRPC's default limit for
+// all metadata of a call is 8 KiB).
+inline constexpr std::size_t kMaxBearerTokenLength = 4096;
+
+// The accepted tokens, kept only as SHA-256 digests. Immutable after loading; Check is
+// thread-safe and costs one SHA-256 of the presented token plus one 32-byte comparison per
+// accepted token (microseconds for a handful of tokens), on the calling gRPC thread.
+class BearerAuthenticator {
+ public:
+  // Reads `path`: one token per line; surrounding whitespace (and a CR) is dropped, blank lines
+  // and lines starting with '#' are ignored. Each token is printable ASCII without spaces
+  // (0x21-0x7E), kMinBearerTokenLength to kMaxBearerTokenLength characters. Errors name the
+  // file (and the line), never a token: FAILED_PRECONDITION when the file cannot be read,
+  // INVALID_ARGUMENT when it is over 1 MiB, a token is malformed, or it holds no token.
+  static absl::StatusOr<BearerAuthenticator> FromFile(const std::string& path);
+
+  // The same rules on the text of a token file; `source` names it in errors.
+  static absl::StatusOr<BearerAuthenticator> FromText(absl::string_view text,
+                                                      absl::string_view source);
+
+  // OK when the call's "authorization" metadata is "Bearer <token>" (the scheme in any case,
+  // then spaces) with an accepted token; else UNAUTHENTICATED, "missing bearer token" (no
+  // header, several, or another scheme) or "invalid bearer token". Messages never include what
+  // the caller sent. Every accepted digest is compared (CRYPTO_memcmp, no early exit), so the
+  // time taken does not depend on which token, or how much of one, matched.
+  absl::Status Check(const grpc::ServerContextBase& context) const;
+
+  // Check on the header's value; nullopt = no header.
+  absl::Status CheckHeader(std::optional<absl::string_view> authorization) const;
+
+  std::size_t token_count() const { return digests_.size(); }
+
+ private:
+  using Digest = std::array<unsigned char, 32>;
+  explicit BearerAuthenticator(std::vector<Digest> digests) : digests_(std::move(digests)) {}
+
+  static Digest Sha256(absl::string_view text);
+
+  std::vector<Digest> digests_;
+};
+
+}  // namespace inscribe::server

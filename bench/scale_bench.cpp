@@ -40,7 +40,7 @@ using Clock = std::chrono::steady_clock;
 struct Options {
   std::string inscribed = INSCRIBED;
   std::string data_dir = INSCRIBE_SOURCE_DIR "/data";
-  std::vector<std::string> models = {"eight", "knot1", "cow", "pig", "fandisk", "elephant"};
+  std::vector<std::string> models = {"eight", "knot1", "cow", "fandisk", "elephant", "bunny00"};
   int clients = 4;
   int jobs = 2;                // each replica's --jobs
   int generate_requests = 36;  // distinct requests per configuration

@@ -20,7 +20,9 @@
 
 #include "absl/container/flat_hash_map.h"
 #include "absl/container/node_hash_map.h"
+#include "absl/strings/ascii.h"
 #include "absl/strings/match.h"
+#include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
 #include "prometheus/counter.h"
@@ -232,6 +234,12 @@ absl::StatusOr<std::unique_ptr<MetricsEndpoint>> MetricsEndpoint::Listen(const s
     host = host.substr(1, host.size() - 2);  // [::1]:9464
   }
   const std::string service = listen.substr(colon + 1);
+  int port_number = -1;
+  if (!absl::SimpleAtoi(service, &port_number) || port_number < 0 || port_number > 65535 ||
+      !absl::ascii_isdigit(service.front())) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--metrics-listen ", listen, ": the port must be a number in 0-65535"));
+  }
   addrinfo hints{};
   hints.ai_family = AF_UNSPEC;
   hints.ai_socktype = SOCK_STREAM;

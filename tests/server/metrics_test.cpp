@@ -247,6 +247,14 @@ TEST(MetricsStartTest, BadAddressesAreClearErrors) {
   EXPECT_EQ(bad.status().code(), absl::StatusCode::kInvalidArgument);
   EXPECT_THAT(bad.status().message(), HasSubstr("--metrics-listen"));
 
+  for (const char* port : {"99999", "-1", "http", "+80"}) {
+    options.metrics_listen = absl::StrCat("127.0.0.1:", port);
+    bad = InscribeServer::Start(options);
+    ASSERT_FALSE(bad.ok()) << port;
+    EXPECT_EQ(bad.status().code(), absl::StatusCode::kInvalidArgument) << port;
+    EXPECT_THAT(bad.status().message(), HasSubstr("0-65535")) << port;
+  }
+
   options.metrics_listen = "127.0.0.1:0";
   absl::StatusOr<std::unique_ptr<InscribeServer>> first = InscribeServer::Start(options);
   ASSERT_TRUE(first.ok()) << first.status();

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "absl/strings/ascii.h"
+#include "absl/strings/escaping.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
 #include "absl/strings/strip.h"
@@ -43,14 +44,9 @@ Digest Sha256(absl::string_view bytes) {
 }
 
 std::string Hex(const Digest& digest, std::size_t digits) {
-  static constexpr char kDigits[] = "0123456789abcdef";
-  std::string hex;
-  for (std::size_t i = 0; hex.size() < digits; ++i) {
-    hex += kDigits[digest[i] >> 4];
-    hex += kDigits[digest[i] & 15];
-  }
-  hex.resize(digits);
-  return hex;
+  return absl::BytesToHexString(
+             absl::string_view(reinterpret_cast<const char*>(digest.data()), (digits + 1) / 2))
+      .substr(0, digits);
 }
 
 // The route key of a mesh as sent: the hash the server stores it under unless it fixes the

@@ -199,11 +199,8 @@ std::optional<client::DeformationResult> DeformHere(const DeformCliOptions& opti
 // for them; the moved vertices go in one UpdateDeformation call.
 std::optional<client::DeformationResult> DeformRemotely(const DeformCliOptions& options,
                                                         const DeformInputs& in, int* exit_code) {
-  absl::StatusOr<client::Client> made = MakeClient(options.remote);
-  if (!made.ok()) {
-    *exit_code = ReportRemoteError(made.status(), options.remote);
-    return std::nullopt;
-  }
+  const std::optional<client::Client> made = MakeClientOrReport(options.remote, exit_code);
+  if (!made) return std::nullopt;
   const client::Client& client = *made;
   absl::StatusOr<client::PutMeshResult> mesh =
       client.PutMesh(in.reference_file, options.fill_holes);

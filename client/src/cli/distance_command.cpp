@@ -116,11 +116,8 @@ std::optional<Distances> DistancesHere(const DistanceCliOptions& options, const 
 std::optional<Distances> DistancesRemotely(const DistanceCliOptions& options, const SphereSet& a,
                                            const SphereSet& b, const std::vector<RigidPose>& poses,
                                            int* exit_code) {
-  absl::StatusOr<client::Client> made = MakeClient(options.remote);
-  if (!made.ok()) {
-    *exit_code = ReportRemoteError(made.status(), options.remote);
-    return std::nullopt;
-  }
+  const std::optional<client::Client> made = MakeClientOrReport(options.remote, exit_code);
+  if (!made) return std::nullopt;
   const client::Client& client = *made;
   std::string keys[2];
   for (int k = 0; k < 2; ++k) {

@@ -86,11 +86,8 @@ std::optional<Evaluated> EvaluateHere(const EvaluateCliOptions& options, const S
 // Remote mode: PutMesh, then Evaluate with the spheres sent inline.
 std::optional<Evaluated> EvaluateRemotely(const EvaluateCliOptions& options, const SphereFile& file,
                                           const QualityOptions& quality, int* exit_code) {
-  absl::StatusOr<client::Client> made = MakeClient(options.remote);
-  if (!made.ok()) {
-    *exit_code = ReportRemoteError(made.status(), options.remote);
-    return std::nullopt;
-  }
+  const std::optional<client::Client> made = MakeClientOrReport(options.remote, exit_code);
+  if (!made) return std::nullopt;
   const client::Client& client = *made;
   std::optional<UploadedSolid> solid =
       UploadSolid(client, options.remote, options.mesh_path, exit_code, {options.fill_holes});

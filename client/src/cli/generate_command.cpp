@@ -208,11 +208,8 @@ std::string OptionTheServerCannotTake(const GenerateCliOptions& options) {
 
 // Remote mode: PutMesh, then Generate with the progress bar fed by the server's messages.
 std::optional<Generated> GenerateRemotely(const GenerateCliOptions& options, int* exit_code) {
-  absl::StatusOr<client::Client> made = MakeClient(options.remote);
-  if (!made.ok()) {
-    *exit_code = ReportRemoteError(made.status(), options.remote);
-    return std::nullopt;
-  }
+  const std::optional<client::Client> made = MakeClientOrReport(options.remote, exit_code);
+  if (!made) return std::nullopt;
   const client::Client& client = *made;
   std::optional<UploadedSolid> solid =
       UploadSolid(client, options.remote, options.mesh_path, exit_code, {options.fill_holes});

@@ -89,6 +89,15 @@ absl::StatusOr<client::Client> MakeClient(const RemoteOptions& options) {
   return client::Client(*std::move(routed), client_options);
 }
 
+std::optional<client::Client> MakeClientOrReport(const RemoteOptions& options, int* exit_code) {
+  absl::StatusOr<client::Client> made = MakeClient(options);
+  if (!made.ok()) {
+    *exit_code = ReportRemoteError(made.status(), options);
+    return std::nullopt;
+  }
+  return *std::move(made);
+}
+
 int RemoteExitCode(absl::StatusCode code) {
   switch (code) {
     case absl::StatusCode::kUnavailable:

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -51,6 +52,9 @@ absl::StatusOr<client::ConnectionOptions> ConnectionOptionsFor(const RemoteOptio
 // unreachable server shows up as UNAVAILABLE there; this fails only for unreadable TLS or
 // token files (INVALID_ARGUMENT naming the file).
 absl::StatusOr<client::Client> MakeClient(const RemoteOptions& options);
+// MakeClient for a subcommand: on failure, reports it (ReportRemoteError), sets *exit_code and
+// returns nullopt.
+std::optional<client::Client> MakeClientOrReport(const RemoteOptions& options, int* exit_code);
 
 int RemoteExitCode(absl::StatusCode code);
 

@@ -7,8 +7,10 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <exception>
 #include <iterator>
+#include <utility>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
@@ -125,6 +127,42 @@ double LoopDiagonal(const Mesh& mesh, const Loop& loop) {
   return (hi - lo).norm();
 }
 
+// False when two of the loop's vertices (nearly) coincide once projected along the average
+// normal CGAL 5.5's plane-polygon filling computes (triangulate_hole_polyline_with_cdt: the
+// fan triangles' normals, each turned to the positive side, averaged). Its simplicity test
+// misses such a pair and its constrained triangulation then crashes (found by fuzz_mesh on a
+// hole of 4 edges), so such a loop skips that method. Conservative: a tolerance of 1e-9 of
+// the loop's diagonal. Cost O(n log n).
+bool ProjectsWithoutCoincidences(const Mesh& mesh, const Loop& loop) {
+  // CGAL walks the hole from the target of the halfedge loop[0] -> loop[1].
+  const auto point = [&](std::size_t i) -> Vector3 {
+    return mesh.vertices.row(loop[(i + 1) % loop.size()]).transpose();
+  };
+  Vector3 normal = Vector3::Zero();
+  for (std::size_t i = 1; i + 1 < loop.size(); ++i) {
+    Vector3 n = (point(i) - point(0)).cross(point(i + 1) - point(0));
+    if (n.x() < 0 || (n.x() == 0 && (n.y() < 0 || (n.y() == 0 && n.z() < 0)))) n = -n;
+    normal += n;
+  }
+  if (!(normal.norm() > 0.0)) return true;  // CGAL gives up on this method by itself
+  normal.normalize();
+  const Vector3 u = normal.unitOrthogonal();
+  const Vector3 v = normal.cross(u);
+  std::vector<std::pair<double, double>> projected(loop.size());
+  for (std::size_t i = 0; i < loop.size(); ++i) {
+    projected[i] = {u.dot(point(i)), v.dot(point(i))};
+  }
+  std::sort(projected.begin(), projected.end());
+  const double tolerance = 1e-9 * LoopDiagonal(mesh, loop);
+  for (std::size_t i = 0; i < projected.size(); ++i) {
+    for (std::size_t j = i + 1;
+         j < projected.size() && projected[j].first - projected[i].first <= tolerance; ++j) {
+      if (std::abs(projected[j].second - projected[i].second) <= tolerance) return false;
+    }
+  }
+  return true;
+}
+
 std::string DescribeLoop(const Loop& loop) {
   return absl::StrCat("the loop of ", loop.size(), " border edges through vertex ", loop.front());
 }
@@ -183,11 +221,13 @@ HoleFilling FillHoles(const Mesh& mesh, const HoleFillingLimits& limits) {
       // First as a plane polygon: CGAL fits a plane to the loop and, when the loop's RMS
       // distance to it is within the tolerance and its projection is a simple polygon, fills
       // that polygon's constrained Delaunay triangulation. No other method is tried here.
-      PMP::triangulate_hole(surface, h, std::back_inserter(faces),
-                            CGAL::parameters::use_2d_constrained_delaunay_triangulation(true)
-                                .threshold_distance(kPlanarTolerance * LoopDiagonal(mesh, loop))
-                                .use_delaunay_triangulation(false)
-                                .do_not_use_cubic_algorithm(true));
+      if (ProjectsWithoutCoincidences(mesh, loop)) {
+        PMP::triangulate_hole(surface, h, std::back_inserter(faces),
+                              CGAL::parameters::use_2d_constrained_delaunay_triangulation(true)
+                                  .threshold_distance(kPlanarTolerance * LoopDiagonal(mesh, loop))
+                                  .use_delaunay_triangulation(false)
+                                  .do_not_use_cubic_algorithm(true));
+      }
       if (faces.empty()) {
         if (n > limits.max_spatial_hole_edges) {
           fail(absl::StrCat("is not near planar and is longer than ", limits.max_spatial_hole_edges,

@@ -1,12 +1,16 @@
 #include "mesh_file_diagnosis.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <sstream>
 #include <vector>
 
 #include "absl/strings/ascii.h"
+#include "absl/strings/match.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
@@ -163,63 +167,172 @@ std::string DiagnoseObj(const std::vector<Line>& lines) {
 
 }  // namespace
 
-std::string CheckOffCounts(const std::string& bytes) {
-  // Walks the file a line at a time, as CGAL's scanner does: header keyword, counts, one line
-  // per vertex, one per face. Nothing is stored.
-  std::size_t pos = 0;
-  int number = 0;
-  std::vector<absl::string_view> tokens;
-  auto next_line = [&]() -> bool {  // next non-blank line's tokens, comments removed
-    while (pos < bytes.size()) {
-      std::size_t end = bytes.find('\n', pos);
-      if (end == std::string::npos) end = bytes.size();
-      absl::string_view line(bytes.data() + pos, end - pos);
-      pos = end + 1;
-      ++number;
-      const std::size_t hash = line.find('#');
-      if (hash != absl::string_view::npos) line = line.substr(0, hash);
-      tokens = absl::StrSplit(line, absl::ByAnyChar(" \t\r\f\v"), absl::SkipEmpty());
-      if (!tokens.empty()) return true;
+namespace {
+
+// Reads ASCII OFF the way CGAL 5.5's File_header_OFF and File_scanner_OFF do, character for
+// character, so that the counts checked are the counts CGAL allocates from: the header's
+// integers are read with `>>` across line breaks (after the keyword, comment lines first), and
+// every vertex and face is the rest of a line after blanks and comment lines, whatever the
+// line structure; a count line may thus continue with the first vertex.
+class OffScanner {
+ public:
+  explicit OffScanner(const std::string& bytes) : bytes_(bytes) {}
+
+  bool at_end() const { return pos_ >= bytes_.size(); }
+  std::size_t pos() const { return pos_; }
+  // 1-based line number of the current position.
+  std::int64_t line() const {
+    return 1 +
+           std::count(bytes_.begin(),
+                      bytes_.begin() + static_cast<std::ptrdiff_t>(std::min(pos_, bytes_.size())),
+                      '\n');
+  }
+
+  // skip_comment_OFF: blanks, and lines whose first non-blank is '#'.
+  void SkipComments() {
+    while (!at_end()) {
+      if (std::isspace(static_cast<unsigned char>(bytes_[pos_]))) {
+        ++pos_;
+      } else if (bytes_[pos_] == '#') {
+        const std::size_t eol = bytes_.find('\n', pos_);
+        pos_ = eol == std::string::npos ? bytes_.size() : eol + 1;
+      } else {
+        break;
+      }
     }
-    return false;
-  };
-  if (!next_line()) return "";
-  for (absl::string_view token : tokens) {
-    if (token == "BINARY") return "binary OFF is not supported; use ASCII OFF, PLY or STL";
   }
-  std::size_t first = 1;  // counts may follow the keyword on its own line
-  if (tokens.size() < 3) {
-    if (!next_line()) return "";
-    first = 0;
+
+  // The header keyword: a first character, then letters and digits; like CGAL, the character
+  // that ends it is consumed too.
+  absl::string_view Keyword() {
+    const std::size_t begin = pos_;
+    if (!at_end()) ++pos_;
+    while (!at_end() && std::isalnum(static_cast<unsigned char>(bytes_[pos_]))) ++pos_;
+    const absl::string_view keyword(bytes_.data() + begin, pos_ - begin);
+    if (!at_end()) ++pos_;
+    return keyword;
   }
-  std::int64_t vertices = 0, faces = 0;
-  if (tokens.size() < first + 2 || !absl::SimpleAtoi(tokens[first], &vertices) ||
-      !absl::SimpleAtoi(tokens[first + 1], &faces)) {
-    return "";  // not counts: CGAL's reader refuses the file and the diagnosis says why
+
+  // `in >> int`: blanks, an optional sign, digits. False when there are none or the value
+  // does not fit an int (the stream fails then, and CGAL gives up before allocating).
+  bool Int(std::int64_t* value) {
+    while (!at_end() && std::isspace(static_cast<unsigned char>(bytes_[pos_]))) ++pos_;
+    std::size_t end = pos_;
+    const bool negative = end < bytes_.size() && bytes_[end] == '-';
+    if (end < bytes_.size() && (bytes_[end] == '-' || bytes_[end] == '+')) ++end;
+    const std::size_t digits = end;
+    while (end < bytes_.size() && bytes_[end] == '0') ++end;  // "0008" is 8
+    const std::size_t significant = end;
+    while (end < bytes_.size() && std::isdigit(static_cast<unsigned char>(bytes_[end]))) ++end;
+    if (end == digits || end - significant > 10) return false;
+    std::int64_t magnitude = 0;
+    if (end > significant &&
+        !absl::SimpleAtoi(absl::string_view(bytes_.data() + significant, end - significant),
+                          &magnitude)) {
+      return false;
+    }
+    pos_ = end;
+    *value = negative ? -magnitude : magnitude;
+    return *value >= std::numeric_limits<int>::min() && *value <= std::numeric_limits<int>::max();
+  }
+
+  // One vertex or face: comments skipped, then the rest of the line up to any '#'.
+  absl::string_view Record() {
+    SkipComments();
+    std::size_t eol = bytes_.find('\n', pos_);
+    if (eol == std::string::npos) eol = bytes_.size();
+    absl::string_view record(bytes_.data() + pos_, eol - pos_);
+    pos_ = eol + 1;
+    if (const std::size_t hash = record.find('#'); hash != absl::string_view::npos) {
+      record = record.substr(0, hash);
+    }
+    return record;
+  }
+
+ private:
+  const std::string& bytes_;
+  std::size_t pos_ = 0;
+};
+
+// The numbers CGAL's scanner takes from a record: `>> double` in a loop (IO::iformat<double>
+// is plain `>>` outside MSVC), up to the first that fails; "3-1" is 3 then -1.
+std::vector<double> CgalRecordNumbers(absl::string_view record) {
+  std::vector<double> numbers;
+  std::istringstream in{std::string(record)};
+  double value = 0;
+  while (in >> value) numbers.push_back(value);
+  return numbers;
+}
+
+}  // namespace
+
+std::string CheckOffCounts(const std::string& bytes) {
+  // Nothing is stored; cost O(file).
+  OffScanner scan(bytes);
+  scan.SkipComments();
+  if (scan.at_end()) return "";
+  const absl::string_view keyword = scan.Keyword();
+  const bool off = absl::EndsWith(keyword, "OFF");
+  if (!off && !absl::EndsWith(keyword, "SKEL")) return "";  // CGAL refuses the file
+  // nOFF / nSKEL: the dimension comes first, then the counts.
+  const bool dimensional =
+      keyword.size() >= (off ? 4u : 5u) && keyword[keyword.size() - (off ? 4 : 5)] == 'n';
+  scan.SkipComments();
+  if (absl::StartsWith(absl::string_view(bytes).substr(scan.pos()), "BINARY")) {
+    return "binary OFF is not supported; use ASCII OFF, PLY or STL";
+  }
+  const std::int64_t header_line = scan.line();
+  std::int64_t dimension = 0, vertices = 0, faces = 0, edges = 0;
+  if ((dimensional && !scan.Int(&dimension)) || !scan.Int(&vertices) || !scan.Int(&faces) ||
+      (off && !scan.Int(&edges))) {
+    if (vertices < 0 || faces < 0) {
+      // CGAL refuses these, but the count says more than its "wrong format".
+    } else {
+      return "";  // not counts: CGAL's reader refuses the file and the diagnosis says why
+    }
   }
   if (vertices < 0 || faces < 0) {
-    return absl::StrCat("line ", number, ": header announces ", vertices, " vertices and ", faces,
-                        " faces; counts cannot be negative");
+    return absl::StrCat("line ", header_line, ": header announces ", vertices, " vertices and ",
+                        faces, " faces; counts cannot be negative");
   }
   // CGAL sizes its arrays from these counts before reading: bound them by the file. The
   // shortest text a vertex can take is "0 0 0\n" (6 bytes), a face "3 0 1 2\n" (8).
-  const std::int64_t rest = static_cast<std::int64_t>(bytes.size() - std::min(pos, bytes.size()));
-  constexpr std::int64_t kLimit = std::int64_t{1} << 40;
-  if (vertices > kLimit || faces > kLimit || 6 * vertices + 8 * faces - 1 > rest) {
+  const std::int64_t rest =
+      static_cast<std::int64_t>(bytes.size() - std::min(scan.pos(), bytes.size()));
+  if (6 * vertices + 8 * faces - 1 > rest) {
     return absl::StrCat("header announces ", vertices, " vertices and ", faces,
                         " faces, more than the remaining ", rest, " bytes can hold (truncated?)");
   }
   for (std::int64_t v = 0; v < vertices; ++v) {
-    if (!next_line()) return "";  // truncated: the reader and the diagnosis handle it
+    scan.SkipComments();
+    if (scan.at_end()) return "";  // truncated: the reader and the diagnosis handle it
+    scan.Record();
   }
-  // CGAL also sizes each face from its corner count before reading the corners.
+  // CGAL also sizes each face from its corner count (the record's first number, cast to
+  // size_t) before reading the corners, which must follow in the same record.
   for (std::int64_t f = 0; f < faces; ++f) {
-    if (!next_line()) return "";
-    std::int64_t corners = 0;
-    if (!absl::SimpleAtoi(tokens[0], &corners)) return "";
-    if (corners < 0 || corners > static_cast<std::int64_t>(tokens.size()) - 1) {
-      return absl::StrCat("line ", number, ": face ", f, " announces ", corners,
-                          " corners but lists ", tokens.size() - 1);
+    scan.SkipComments();
+    if (scan.at_end()) return "";
+    const std::int64_t line = scan.line();
+    const std::vector<double> numbers = CgalRecordNumbers(scan.Record());
+    if (numbers.empty()) return "";  // CGAL stops on a face without numbers
+    const double corners = numbers[0];
+    const auto listed = static_cast<std::int64_t>(numbers.size()) - 1;
+    if (!(corners >= 0.0 && corners < static_cast<double>(numbers.size()))) {
+      const std::string announced = std::abs(corners) < 1e18 && corners == std::floor(corners)
+                                        ? absl::StrCat(static_cast<std::int64_t>(corners))
+                                        : absl::StrCat(corners);
+      return absl::StrCat("line ", line, ": face ", f, " announces ", announced,
+                          " corners but lists ", listed);
+    }
+    // CGAL casts each corner to size_t: undefined for a negative or huge number (UBSan's
+    // finding under fuzz_mesh). Indices past the vertices are reported after reading.
+    const auto count = static_cast<std::size_t>(corners);
+    for (std::size_t k = 1; k <= count; ++k) {
+      if (!(numbers[k] >= 0.0 && numbers[k] < 9.2e18)) {
+        return absl::StrCat("line ", line, ": face ", f, " refers to vertex ", numbers[k],
+                            ", but the file has ", vertices, " vertices (indices are 0-based)");
+      }
     }
   }
   return "";
@@ -353,6 +466,14 @@ std::string CheckPlyHeader(const std::string& bytes) {
       PlyProperty property;
       if (tokens.size() == 3) {
         property.size = PlyTypeSize(tokens[1]);
+        // CGAL 5.5 reads a vertex coordinate as double or float and calls through a null
+        // pointer for any other type (UBSan under fuzz_mesh).
+        const bool coordinate = tokens[2] == "x" || tokens[2] == "y" || tokens[2] == "z";
+        if (coordinate && elements.back().name == "vertex" && tokens[1] != "float" &&
+            tokens[1] != "double" && tokens[1] != "float32" && tokens[1] != "float64") {
+          return bad(absl::StrCat("vertex coordinate ", tokens[2], " has type ", tokens[1],
+                                  "; expected float or double"));
+        }
       } else if (tokens.size() == 5 && tokens[1] == "list") {
         property.count_size = PlyTypeSize(tokens[2]);
         property.count_signed = tokens[2][0] != 'u';

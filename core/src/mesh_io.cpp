@@ -23,6 +23,7 @@
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "atomic_file.h"
+#include "inscribe/mesh_validation.h"
 #include "mesh_file_diagnosis.h"
 
 namespace inscribe {
@@ -65,7 +66,14 @@ bool IsFinite(const Point& p) {
 void Triangulate(const Polygon& polygon, const std::vector<Point>& points,
                  std::vector<std::array<std::int64_t, 3>>& out) {
   bool usable = true;
-  for (std::size_t v : polygon) usable = usable && v < points.size() && IsFinite(points[v]);
+  // Beyond kMaxMeshCoordinate CGAL's projections overflow (GMP aborts on the infinity);
+  // validation refuses such meshes anyway.
+  for (std::size_t v : polygon) {
+    usable = usable && v < points.size() && IsFinite(points[v]) &&
+             std::abs(points[v].x()) <= kMaxMeshCoordinate &&
+             std::abs(points[v].y()) <= kMaxMeshCoordinate &&
+             std::abs(points[v].z()) <= kMaxMeshCoordinate;
+  }
   if (usable) {
     std::vector<Point> ring;
     ring.reserve(polygon.size());

@@ -584,6 +584,21 @@ ValidatedMesh ValidateMesh(Mesh mesh, const ValidateOptions& options) {
     return ValidatedMesh{std::move(mesh), std::move(report)};
   }
   report.bbox = ComputeBoundingBox(mesh.vertices);
+  // Found by fuzz_mesh: a vertex at 1.8e308 made hole filling's projected triangulation
+  // overflow to infinity and GMP abort the process inside CGAL, and one at -1e308 gave an
+  // infinite volume on a usable mesh. Below the bound, volumes and CGAL's constructions stay
+  // finite; nothing else runs on a mesh beyond it.
+  if (const std::int64_t huge =
+          (mesh.vertices.array().abs() > kMaxMeshCoordinate).rowwise().any().count();
+      huge > 0) {
+    AddIssue(report, Severity::kError, "coordinates_too_large",
+             absl::StrFormat("%s a coordinate beyond +-%g (largest magnitude %g); scale the "
+                             "mesh down",
+                             Plural(huge, "vertex has", "vertices have"), kMaxMeshCoordinate,
+                             mesh.vertices.cwiseAbs().maxCoeff()),
+             huge);
+    return ValidatedMesh{std::move(mesh), std::move(report)};
+  }
   CheckDegenerateAndDuplicate(mesh, report);
   const std::vector<EdgeUse> uses = internal::SortedEdgeUses(mesh);
   const EdgeGroups groups = GroupEdges(uses);

@@ -325,8 +325,11 @@ class Builder {
   }
 
   static int Bin(double c, double lo, double scale) {
-    const int b = static_cast<int>((c - lo) * scale);
-    return std::min(std::max(b, 0), kBins - 1);
+    // Clamped as a double: with a subnormal extent `scale` overflows and the product is NaN or
+    // infinite, whose cast to int is undefined (UBSan under fuzz_requests).
+    const double b = (c - lo) * scale;
+    if (!(b > 0.0)) return 0;
+    return b >= kBins - 1 ? kBins - 1 : static_cast<int>(b);
   }
 
   // Halves the range at the median centroid along `axis`, ties broken by triangle index.

@@ -4,7 +4,9 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
+#include <optional>
 #include <system_error>
 #include <utility>
 
@@ -21,6 +23,27 @@ namespace {
 // Temporary files are "<entry name>.tmp-<pid>-<n>" in the entry's directory, so that rename is
 // atomic (same file system) and Open can recognise and remove those a crash left behind.
 constexpr absl::string_view kTempMarker = ".tmp-";
+
+// Writes stop for this long after a failure of the file system, doubled per failed retry.
+constexpr std::chrono::milliseconds kFirstBackoff{1000};
+constexpr std::chrono::milliseconds kLongestBackoff{60'000};
+
+// Errors of the file system as a whole (full, read-only, over quota, forbidden, failing) rather
+// than of one entry: every further write would fail alike, so writes stop for a backoff.
+bool StopsWrites(int error) {
+  switch (error) {
+    case ENOSPC:
+    case EROFS:
+    case EACCES:
+    case EPERM:
+    case EDQUOT:
+    case EFBIG:
+    case EIO:
+      return true;
+    default:
+      return false;
+  }
+}
 
 bool IsLowerHex(absl::string_view name, std::size_t length) {
   if (name.size() != length) return false;
@@ -43,14 +66,17 @@ struct FileDescriptor {
   int fd;
 };
 
-bool WriteAll(int fd, absl::string_view data) {
+// 0, or the errno of the write that failed. A short write is followed by one that reports
+// why (ENOSPC, EFBIG past RLIMIT_FSIZE with SIGXFSZ ignored, ...).
+int WriteAll(int fd, absl::string_view data) {
   while (!data.empty()) {
     const ssize_t written = ::write(fd, data.data(), data.size());
     if (written < 0 && errno == EINTR) continue;
-    if (written <= 0) return false;
+    if (written < 0) return errno;
+    if (written == 0) return EIO;  // no progress and no reason: treat the device as failing
     data.remove_prefix(static_cast<std::size_t>(written));
   }
-  return true;
+  return 0;
 }
 
 // False on an error or end of file before `size` bytes.
@@ -67,8 +93,9 @@ bool ReadAll(int fd, char* out, std::size_t size) {
 
 }  // namespace
 
-absl::StatusOr<std::unique_ptr<DiskTier>> DiskTier::Open(const std::string& dir) {
-  std::unique_ptr<DiskTier> tier(new DiskTier(dir));
+absl::StatusOr<std::unique_ptr<DiskTier>> DiskTier::Open(
+    const std::string& dir, std::function<void(const DiskTierEvent&)> on_event) {
+  std::unique_ptr<DiskTier> tier(new DiskTier(dir, std::move(on_event)));
   if (absl::Status status = tier->Scan(); !status.ok()) return status;
   return tier;
 }
@@ -178,39 +205,97 @@ void DiskTier::Write(absl::string_view key, absl::string_view payload) {
   const fs::path path = EntryPath(key);
   std::error_code error;
   if (fs::exists(path, error)) return;  // kept: equal keys mean equal content
-  const auto count_error = [this] {
-    std::lock_guard<std::mutex> lock(mutex_);
-    ++counts_.write_errors;
-  };
-  fs::create_directories(path.parent_path(), error);
-  if (error) return count_error();
+  const Attempt attempt = BeginWrite();
+  if (!attempt.allowed) return;
+  std::string failed_step;
+  const int failure = WriteEntry(path, key, payload, &failed_step);
+  EndWrite(attempt, failure, failed_step);
+}
 
+int DiskTier::WriteEntry(const fs::path& path, absl::string_view key, absl::string_view payload,
+                         std::string* failed_step) {
+  std::error_code error;
+  fs::create_directories(path.parent_path(), error);
+  if (error) {
+    *failed_step = absl::StrCat("create ", path.parent_path().string());
+    return error.value();
+  }
   const fs::path temp = path.parent_path() / absl::StrCat(path.filename().string(), kTempMarker,
                                                           ::getpid(), "-", temp_files_++);
   const std::string header = EntryHeader(key, payload);
   const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
-  if (fd < 0) return count_error();
+  if (fd < 0) {
+    *failed_step = absl::StrCat("create ", temp.string());
+    return errno;
+  }
   // fsync before rename: after a crash the name refers to the whole payload or to nothing.
-  bool written = WriteAll(fd, header) && WriteAll(fd, payload) && ::fsync(fd) == 0;
-  if (::close(fd) != 0) written = false;
-  if (!written) {
+  int failure = WriteAll(fd, header);
+  if (failure == 0) failure = WriteAll(fd, payload);
+  if (failure == 0 && ::fsync(fd) != 0) failure = errno;
+  if (::close(fd) != 0 && failure == 0) failure = errno;
+  if (failure != 0) {
+    *failed_step = absl::StrCat("write ", temp.string());
     fs::remove(temp, error);
-    return count_error();
+    return failure;
   }
 
   std::lock_guard<std::mutex> lock(mutex_);
   if (fs::exists(path, error)) {  // written meanwhile (by a Put): keep that one
     fs::remove(temp, error);
-    return;
+    return 0;
   }
   fs::rename(temp, path, error);
   if (error) {
+    *failed_step = absl::StrCat("rename ", temp.string());
+    failure = error.value();
     fs::remove(temp, error);
-    ++counts_.write_errors;
-    return;
+    return failure;
   }
   ++counts_.entries;
   counts_.bytes += static_cast<std::int64_t>(header.size() + payload.size());
+  return 0;
+}
+
+DiskTier::Attempt DiskTier::BeginWrite() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (counts_.available) return Attempt{true, false};
+  if (!probing_ && std::chrono::steady_clock::now() >= stopped_until_) {
+    probing_ = true;
+    return Attempt{true, true};
+  }
+  ++counts_.writes_skipped;
+  return Attempt{false, false};
+}
+
+void DiskTier::EndWrite(const Attempt& attempt, int failure, const std::string& failed_step) {
+  std::optional<DiskTierEvent> event;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (failure == 0) {
+      if (attempt.probe) {
+        probing_ = false;
+        counts_.available = true;
+        backoff_ = std::chrono::milliseconds(0);
+        event = DiskTierEvent{DiskTierEvent::Kind::kRestored, dir_.string(), absl::OkStatus(), {}};
+      }
+    } else {
+      ++counts_.write_errors;
+      const bool stops = StopsWrites(failure);
+      if (counts_.available && stops) {
+        counts_.available = false;
+        backoff_ = kFirstBackoff;
+        stopped_until_ = std::chrono::steady_clock::now() + backoff_;
+        event = DiskTierEvent{DiskTierEvent::Kind::kDegraded, dir_.string(),
+                              absl::ErrnoToStatus(failure, failed_step), backoff_};
+      } else if (attempt.probe) {
+        // Any failure of the retry (even one of this entry alone) keeps writes stopped.
+        probing_ = false;
+        backoff_ = std::min(2 * backoff_, kLongestBackoff);
+        stopped_until_ = std::chrono::steady_clock::now() + backoff_;
+      }
+    }
+  }
+  if (event.has_value() && on_event_) on_event_(*event);
 }
 
 DiskTier::Counts DiskTier::counts() const {

@@ -5,6 +5,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <atomic>
 #include <memory>
 #include <mutex>
@@ -17,6 +18,7 @@
 #include "inscribe/separation_distance.h"
 #include "inscribe/server/convert.h"
 #include "inscribe/server/inscribe_service.h"
+#include "memory_budget.h"
 #include "result_store.h"
 #include "service_checks.h"
 
@@ -95,9 +97,22 @@ class DistanceStreamReactor final
                        " per frame")));
       return;
     }
+    // Held from here until the frame's reply has been written (or the stream ends).
+    absl::StatusOr<MemoryBudget::Reservation> reserved =
+        service_->memory_->Reserve(frame_.pairs_size() * MemoryCosts::kPerFramePair,
+                                   absl::StrCat("DistanceStream frame ", frame_.frame(), " of ",
+                                                frame_.pairs_size(), " pairs"));
+    if (!reserved.ok()) {
+      FinishLocked(reserved.status());
+      return;
+    }
+    frame_reservation_ = *std::move(reserved);
+    record_.memory_bytes = std::max(record_.memory_bytes, frame_reservation_.bytes());
     state_ = State::kBusy;
     const ServiceClock::time_point arrived = ServiceClock::now();
-    if (!service_->pool_->TrySubmit([this, arrived] { RunFrame(arrived); })) {
+    const JobSize size =
+        frame_reservation_.bytes() <= MemoryCosts::kSmallJob ? JobSize::kSmall : JobSize::kLarge;
+    if (!service_->pool_->TrySubmit([this, arrived] { RunFrame(arrived); }, size)) {
       FinishLocked(service_->QueueFullError());
     }
   }
@@ -109,6 +124,7 @@ class DistanceStreamReactor final
       FinishLocked(absl::CancelledError("client went away"));
       return;
     }
+    frame_reservation_.Release();
     if (draining_) {
       FinishLocked(absl::UnavailableError("server is shutting down; reconnect to another"));
       return;
@@ -134,6 +150,7 @@ class DistanceStreamReactor final
   enum class State { kStarting, kReading, kBusy, kFinished };
 
   void FinishLocked(const absl::Status& status) {
+    frame_reservation_.Release();
     state_ = State::kFinished;
     final_status_ = status;
     Finish(ToGrpcStatus(status));
@@ -257,6 +274,7 @@ class DistanceStreamReactor final
   // Touched by one thread at a time: gRPC callbacks and the frame's job never overlap.
   v1::DistanceFrame frame_;
   v1::DistanceFrameResult result_;
+  MemoryBudget::Reservation frame_reservation_;  // the current frame's estimate
   std::unordered_map<std::string, std::shared_ptr<const SphereHierarchy>> held_;
   CallRecord record_;
 };

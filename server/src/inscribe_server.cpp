@@ -260,6 +260,8 @@ void InscribeServer::Shutdown(std::chrono::system_clock::time_point deadline) {
 
 int InscribeServer::metrics_port() const { return parts_->metrics_port; }
 
+std::int64_t InscribeServer::jobs_in_flight() const { return parts_->pool.jobs_in_flight(); }
+
 void InscribeServer::Wait() {
   std::unique_lock<std::mutex> lock(parts_->mutex);
   parts_->stopped.wait(lock, [this] { return parts_->shutdown_done; });

@@ -10,16 +10,13 @@
 #include "inscribe/mesh_hash.h"
 #include "inscribe/mesh_validation.h"
 #include "inscribe/server/convert.h"
+#include "memory_budget.h"
+#include "mesh_sizes.h"
 #include "result_store.h"
+#include "service_checks.h"
 
 namespace inscribe::server {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double SecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 // The body of InspectMesh, run on the pool. Only expected failures are returned; the mesh's
 // own problems are issues in the report, not errors.
@@ -46,6 +43,8 @@ InscribeService::InscribeService(JobPool* pool, ResultCache* cache, const Servic
     : pool_(pool),
       store_(
           std::make_unique<ResultStore>(cache, StoreLimits{limits.max_voxels, limits.max_spheres})),
+      memory_(std::make_unique<MemoryBudget>(limits.memory_budget_bytes)),
+      mesh_sizes_(std::make_unique<MeshSizes>()),
       limits_(limits),
       observer_(std::move(observer)),
       authenticate_(std::move(authenticate)) {}
@@ -92,9 +91,10 @@ bool InscribeService::WaitForCalls(std::chrono::system_clock::time_point deadlin
 grpc::ServerUnaryReactor* InscribeService::RunUnary(grpc::CallbackServerContext* context,
                                                     const char* method, std::int64_t triangles,
                                                     const absl::Status& precheck,
+                                                    std::int64_t memory_bytes, std::string what,
                                                     std::function<absl::Status()> body) {
   grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
-  const Clock::time_point arrived = Clock::now();
+  const ServiceClock::time_point arrived = ServiceClock::now();
   CallRecord record;
   record.method = method;
   record.peer = context->peer();
@@ -115,35 +115,49 @@ grpc::ServerUnaryReactor* InscribeService::RunUnary(grpc::CallbackServerContext*
     Finish(reactor, record, precheck);
     return reactor;
   }
-  const bool queued = pool_->TrySubmit([this, context, reactor, arrived, record,
-                                        body = std::move(body)]() mutable {
-    record.queued_seconds = SecondsSince(arrived);
-    // The caller may have given up (cancel, disconnect) while the job waited; a passed
-    // deadline counts too, even before gRPC has noticed it and cancelled the call.
-    if (context->IsCancelled()) {
-      Finish(reactor, record, absl::CancelledError("call was cancelled before work started"));
-      return;
-    }
-    if (std::chrono::system_clock::now() >= context->deadline()) {
-      Finish(reactor, record, absl::DeadlineExceededError("deadline passed before work started"));
-      return;
-    }
-    const Clock::time_point started = Clock::now();
-    absl::Status status;
-    // Jobs must not throw (JobPool); running out of memory on a huge request is the one
-    // exception worth expecting here, and is the caller's to act on.
-    try {
-      status = body();
-    } catch (const std::bad_alloc&) {
-      status =
-          absl::ResourceExhaustedError(absl::StrCat("server ran out of memory in ", record.method,
-                                                    "; send a smaller request or retry later"));
-    } catch (const std::exception& e) {
-      status = absl::InternalError(absl::StrCat(record.method, " failed: ", e.what()));
-    }
-    record.run_seconds = SecondsSince(started);
-    Finish(reactor, record, status);
-  });
+  // Reserved before queueing, so that queued calls count too; held by the job (shared: a
+  // std::function must be copyable) and given back when the job ends, whichever way it ends,
+  // or at once when the pool refuses it.
+  absl::StatusOr<MemoryBudget::Reservation> reserved = memory_->Reserve(memory_bytes, what);
+  if (!reserved.ok()) {
+    Finish(reactor, record, reserved.status());
+    return reactor;
+  }
+  record.memory_bytes = reserved->bytes();
+  auto reservation = std::make_shared<MemoryBudget::Reservation>(*std::move(reserved));
+  const JobSize size = memory_bytes <= MemoryCosts::kSmallJob ? JobSize::kSmall : JobSize::kLarge;
+  const bool queued = pool_->TrySubmit(
+      [this, context, reactor, arrived, record, reservation, body = std::move(body)]() mutable {
+        record.queued_seconds = SecondsSince(arrived);
+        // The caller may have given up (cancel, disconnect) while the job waited; a passed
+        // deadline counts too, even before gRPC has noticed it and cancelled the call.
+        if (context->IsCancelled()) {
+          Finish(reactor, record, absl::CancelledError("call was cancelled before work started"));
+          return;
+        }
+        if (std::chrono::system_clock::now() >= context->deadline()) {
+          Finish(reactor, record,
+                 absl::DeadlineExceededError("deadline passed before work started"));
+          return;
+        }
+        const ServiceClock::time_point started = ServiceClock::now();
+        absl::Status status;
+        // Jobs must not throw (JobPool); running out of memory on a huge request is the one
+        // exception worth expecting here, and is the caller's to act on.
+        try {
+          status = body();
+        } catch (const std::bad_alloc&) {
+          status = absl::ResourceExhaustedError(
+              absl::StrCat("server ran out of memory in ", record.method,
+                           "; send a smaller request or retry later"));
+        } catch (const std::exception& e) {
+          status = absl::InternalError(absl::StrCat(record.method, " failed: ", e.what()));
+        }
+        record.run_seconds = SecondsSince(started);
+        reservation->Release();
+        Finish(reactor, record, status);
+      },
+      size);
   if (!queued) Finish(reactor, record, QueueFullError());
   return reactor;
 }
@@ -162,7 +176,8 @@ grpc::ServerUnaryReactor* InscribeService::InspectMesh(grpc::CallbackServerConte
                                                        const v1::InspectMeshRequest* request,
                                                        v1::InspectMeshResponse* response) {
   return RunUnary(context, "InspectMesh", TriangleCount(request->mesh()),
-                  CheckMesh(request->mesh()),
+                  CheckMesh(request->mesh()), MeshWorkBytes(request->mesh()),
+                  absl::StrCat("InspectMesh of ", TriangleCount(request->mesh()), " triangles"),
                   [request, response] { return RunInspectMesh(*request, response); });
 }
 

@@ -1,6 +1,7 @@
 // The InscribeService RPCs on sphere sets made elsewhere or moved: PutSphereSet,
 // UpdateDeformation (paper Section V) and Evaluate (Section IV-B measures). O(1) checks on
 // the gRPC thread, the rest on the pool through ResultStore.
+#include <algorithm>
 #include <cstdint>
 #include <memory>
 #include <mutex>
@@ -13,6 +14,7 @@
 #include "inscribe/server/inscribe_service.h"
 #include "inscribe/sphere_deformation.h"
 #include "inscribe/sphere_quality.h"
+#include "memory_budget.h"
 #include "result_store.h"
 #include "service_checks.h"
 
@@ -79,7 +81,10 @@ grpc::ServerUnaryReactor* InscribeService::PutSphereSet(grpc::CallbackServerCont
   } else if (!request->mesh_sha256().empty()) {
     precheck = CheckKey(request->mesh_sha256(), "mesh_sha256");
   }
-  return RunUnary(context, "PutSphereSet", 0, precheck,
+  // No union volume here: the core set and its stored copy, a quarter of kPerSphere.
+  const std::int64_t spheres = request->spheres().radii_size();
+  return RunUnary(context, "PutSphereSet", 0, precheck, spheres * MemoryCosts::kPerSphere / 4,
+                  absl::StrCat("PutSphereSet of ", spheres, " spheres"),
                   [this, request, response]() -> absl::Status {
                     absl::StatusOr<SphereSet> set = SphereSetFromProto(request->spheres());
                     if (!set.ok()) return set.status();
@@ -108,11 +113,21 @@ grpc::ServerUnaryReactor* InscribeService::UpdateDeformation(
     precheck = absl::InvalidArgumentError(
         absl::StrCat("xi must be finite and >= 0 (0 = the default), got ", request->xi()));
   }
+  const std::int64_t vertex_count = request->vertices_size() / 3;
   return RunUnary(
-      context, "UpdateDeformation", 0, precheck, [this, request, response]() -> absl::Status {
+      context, "UpdateDeformation", 0, precheck,
+      vertex_count * MemoryCosts::kPerDeformVertex + MemoryCosts::kSmallCall,
+      absl::StrCat("UpdateDeformation of ", vertex_count, " vertices"),
+      [this, request, response]() -> absl::Status {
         absl::StatusOr<std::shared_ptr<const SphereSetEntry>> set =
             store_->GetSphereSet(request->sphere_set_key());
         if (!set.ok()) return set.status();
+        // The set's size is known only now: its moved copy, and the union volume for bounds.
+        const std::int64_t spheres = static_cast<std::int64_t>((*set)->set.spheres.size());
+        absl::StatusOr<MemoryBudget::Reservation> more = memory_->Reserve(
+            spheres * (request->bounds() ? MemoryCosts::kPerSphere : MemoryCosts::kPerSphere / 4),
+            absl::StrCat("UpdateDeformation of ", spheres, " spheres"));
+        if (!more.ok()) return more.status();
         absl::StatusOr<std::string> mesh_key =
             MeshKeyFor(request->mesh_sha256(), **set, request->sphere_set_key());
         if (!mesh_key.ok()) return mesh_key.status();
@@ -212,40 +227,56 @@ grpc::ServerUnaryReactor* InscribeService::Evaluate(grpc::CallbackServerContext*
         absl::StrCat("voxel_size and coverage_tolerance must be finite and >= 0, got ",
                      request->voxel_size(), " and ", request->coverage_tolerance()));
   }
-  return RunUnary(context, "Evaluate", 0, precheck, [this, request, response]() -> absl::Status {
-    std::string mesh_key = request->mesh_sha256();
-    std::shared_ptr<const SphereSetEntry> cached;
-    SphereSet inline_set;
-    if (request->has_sphere_set()) {
-      absl::StatusOr<SphereSet> set = SphereSetFromProto(request->sphere_set(), "sphere_set");
-      if (!set.ok()) return set.status();
-      inline_set = *std::move(set);
-    } else {
-      absl::StatusOr<std::shared_ptr<const SphereSetEntry>> set =
-          store_->GetSphereSet(request->sphere_set_key());
-      if (!set.ok()) return set.status();
-      cached = *std::move(set);
-      absl::StatusOr<std::string> key =
-          MeshKeyFor(request->mesh_sha256(), *cached, request->sphere_set_key());
-      if (!key.ok()) return key.status();
-      mesh_key = *std::move(key);
-    }
-    absl::StatusOr<std::shared_ptr<const StoredMeshEntry>> mesh = store_->GetMesh(mesh_key);
-    if (!mesh.ok()) return mesh.status();
-    QualityOptions options;
-    options.surface_samples = request->samples() == 0  ? kDefaultEvaluateSamples
-                              : request->samples() < 0 ? 0
-                                                       : request->samples();
-    options.voxel_size = request->voxel_size();
-    if (request->coverage_tolerance() > 0.0) {
-      options.coverage_tolerance = request->coverage_tolerance();
-    }
-    const std::vector<Sphere>& spheres = cached ? cached->set.spheres : inline_set.spheres;
-    absl::StatusOr<QualityReport> report = EvaluateSpheres((*mesh)->oracle, spheres, options);
-    if (!report.ok()) return report.status();
-    QualityReportToProto(*report, response->mutable_quality());
-    return absl::OkStatus();
-  });
+  // Samples and an inline set are in the request; a cached set's size is reserved on the pool.
+  const std::int64_t samples = request->samples() == 0
+                                   ? kDefaultEvaluateSamples
+                                   : std::max<std::int64_t>(request->samples(), 0);
+  const std::int64_t inline_spheres = request->sphere_set().radii_size();
+  return RunUnary(
+      context, "Evaluate", 0, precheck,
+      std::min(samples, kMaxEvaluateSamples) * MemoryCosts::kPerSample +
+          inline_spheres * MemoryCosts::kPerSphere + MemoryCosts::kSmallCall,
+      absl::StrCat("Evaluate with ", samples, " samples and ", inline_spheres, " inline spheres"),
+      [this, request, response]() -> absl::Status {
+        std::string mesh_key = request->mesh_sha256();
+        std::shared_ptr<const SphereSetEntry> cached;
+        MemoryBudget::Reservation cached_reservation;  // held until the report is made
+        SphereSet inline_set;
+        if (request->has_sphere_set()) {
+          absl::StatusOr<SphereSet> set = SphereSetFromProto(request->sphere_set(), "sphere_set");
+          if (!set.ok()) return set.status();
+          inline_set = *std::move(set);
+        } else {
+          absl::StatusOr<std::shared_ptr<const SphereSetEntry>> set =
+              store_->GetSphereSet(request->sphere_set_key());
+          if (!set.ok()) return set.status();
+          cached = *std::move(set);
+          absl::StatusOr<MemoryBudget::Reservation> more = memory_->Reserve(
+              static_cast<std::int64_t>(cached->set.spheres.size()) * MemoryCosts::kPerSphere,
+              absl::StrCat("Evaluate of ", cached->set.spheres.size(), " cached spheres"));
+          if (!more.ok()) return more.status();
+          cached_reservation = *std::move(more);
+          absl::StatusOr<std::string> key =
+              MeshKeyFor(request->mesh_sha256(), *cached, request->sphere_set_key());
+          if (!key.ok()) return key.status();
+          mesh_key = *std::move(key);
+        }
+        absl::StatusOr<std::shared_ptr<const StoredMeshEntry>> mesh = store_->GetMesh(mesh_key);
+        if (!mesh.ok()) return mesh.status();
+        QualityOptions options;
+        options.surface_samples = request->samples() == 0  ? kDefaultEvaluateSamples
+                                  : request->samples() < 0 ? 0
+                                                           : request->samples();
+        options.voxel_size = request->voxel_size();
+        if (request->coverage_tolerance() > 0.0) {
+          options.coverage_tolerance = request->coverage_tolerance();
+        }
+        const std::vector<Sphere>& spheres = cached ? cached->set.spheres : inline_set.spheres;
+        absl::StatusOr<QualityReport> report = EvaluateSpheres((*mesh)->oracle, spheres, options);
+        if (!report.ok()) return report.status();
+        QualityReportToProto(*report, response->mutable_quality());
+        return absl::OkStatus();
+      });
 }
 
 }  // namespace inscribe::server

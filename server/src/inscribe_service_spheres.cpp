@@ -1,18 +1,23 @@
 // The InscribeService RPCs over stored meshes and cached results: PutMesh, Generate,
 // GetSphereSet, GetHierarchy, Distance, CacheStats. Each validates on the gRPC thread what is
 // O(1), then hands the rest to the pool through ResultStore (the cache).
+#include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <mutex>
 #include <new>
 #include <optional>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
 #include "inscribe/medial_spheres.h"
 #include "inscribe/separation_distance.h"
 #include "inscribe/server/convert.h"
 #include "inscribe/server/inscribe_service.h"
+#include "memory_budget.h"
+#include "mesh_sizes.h"
 #include "result_store.h"
 #include "service_checks.h"
 
@@ -22,6 +27,8 @@ grpc::ServerUnaryReactor* InscribeService::PutMesh(grpc::CallbackServerContext* 
                                                    const v1::PutMeshRequest* request,
                                                    v1::PutMeshResponse* response) {
   return RunUnary(context, "PutMesh", TriangleCount(request->mesh()), CheckMesh(request->mesh()),
+                  MeshWorkBytes(request->mesh()),
+                  absl::StrCat("PutMesh of ", TriangleCount(request->mesh()), " triangles"),
                   [this, request, response]() -> absl::Status {
                     absl::StatusOr<Mesh> mesh = MeshFromProto(request->mesh());
                     if (!mesh.ok()) return mesh.status();
@@ -29,6 +36,7 @@ grpc::ServerUnaryReactor* InscribeService::PutMesh(grpc::CallbackServerContext* 
                     absl::StatusOr<std::shared_ptr<const StoredMeshEntry>> stored =
                         store_->PutMesh(*std::move(mesh), request->fill_holes(), &already);
                     if (!stored.ok()) return stored.status();
+                    RecordMeshSize(**stored);
                     response->set_mesh_sha256((*stored)->key);
                     MeshReportToProto((*stored)->report, response->mutable_report());
                     response->set_already_stored(already);
@@ -56,7 +64,29 @@ class GenerateReactor final : public grpc::ServerWriteReactor<v1::GenerateRespon
       precheck = absl::UnavailableError("server is shutting down; retry");
     }
     if (precheck.ok()) precheck = CheckKey(request_->mesh_sha256(), "mesh_sha256");
-    if (precheck.ok()) precheck = CanonicalParameters(request_->parameters()).status();
+    std::int64_t bytes = 0;
+    if (precheck.ok()) {
+      absl::StatusOr<v1::GenerateParameters> canonical =
+          CanonicalParameters(request_->parameters());
+      if (!canonical.ok()) {
+        precheck = canonical.status();
+      } else {
+        absl::StatusOr<std::int64_t> estimate =
+            service_->GenerateWorkBytes(request_->mesh_sha256(), *canonical);
+        precheck = estimate.status();
+        if (estimate.ok()) bytes = *estimate;
+      }
+    }
+    if (precheck.ok()) {
+      absl::StatusOr<MemoryBudget::Reservation> reserved = service_->memory_->Reserve(
+          bytes, absl::StrCat("Generate on mesh ", request_->mesh_sha256()));
+      if (reserved.ok()) {
+        reservation_ = *std::move(reserved);
+        record_.memory_bytes = reservation_.bytes();
+      } else {
+        precheck = reserved.status();
+      }
+    }
     if (!precheck.ok()) {
       Complete(precheck, nullptr);
       return;
@@ -143,6 +173,7 @@ class GenerateReactor final : public grpc::ServerWriteReactor<v1::GenerateRespon
 
   // The job's last touch of the reactor: after this, OnDone may delete it at any time.
   void Complete(const absl::Status& status, std::unique_ptr<v1::GenerateResponse> final_message) {
+    reservation_.Release();
     record_.status = status;
     service_->Observe(record_);
     bool send_now = false;
@@ -168,6 +199,7 @@ class GenerateReactor final : public grpc::ServerWriteReactor<v1::GenerateRespon
   grpc::CallbackServerContext* const context_;
   const v1::GenerateRequest* const request_;
   std::atomic<bool> cancel_{false};
+  MemoryBudget::Reservation reservation_;  // set in Start, released in Complete
   CallRecord record_;
   std::mutex mutex_;
   bool writing_ = false;  // a progress write is in flight
@@ -176,6 +208,48 @@ class GenerateReactor final : public grpc::ServerWriteReactor<v1::GenerateRespon
   absl::Status status_;
   std::unique_ptr<v1::GenerateResponse> final_;
 };
+
+void InscribeService::RecordMeshSize(const StoredMeshEntry& entry) {
+  MeshSize size;
+  size.vertices = entry.mesh.num_vertices();
+  size.triangles = entry.mesh.num_triangles();
+  size.extent = ComputeBoundingBox(entry.mesh.vertices).extent();
+  mesh_sizes_->Record(entry.key, size);
+}
+
+absl::StatusOr<std::int64_t> InscribeService::GenerateWorkBytes(
+    const std::string& mesh_key, const v1::GenerateParameters& canonical) const {
+  const std::optional<MeshSize> size = mesh_sizes_->Find(mesh_key);
+  const double max_voxels = static_cast<double>(limits_.max_voxels);
+  double voxels = max_voxels;  // unknown mesh (stored by another process): the worst case
+  if (size && canonical.voxel_size() > 0.0) {
+    voxels = size->GridVoxels(canonical.voxel_size());
+    if (voxels > max_voxels) {
+      // Refused here, before the call is queued; core would refuse it too (MakeGrid), but
+      // only after a pool thread and a cache lookup.
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "parameters.voxel_size %g gives a grid of %.3g voxels over the mesh's bounding box "
+          "(%g x %g x %g); this server's limit (--max-voxels) is %d voxels; use a larger voxel "
+          "size",
+          canonical.voxel_size(), voxels, size->extent.x(), size->extent.y(), size->extent.z(),
+          limits_.max_voxels));
+    }
+  } else if (size) {
+    // A sphere budget N: the search starts at voxels of side ~diagonal / (2 sqrt N) (sphere
+    // counts grow as (diagonal / sigma)^2 / 4) and refines from there; half that side, 8x the
+    // voxels, bounds where it ends on the meshes measured (at most the --max-voxels grid).
+    const double sigma = 0.5 * size->extent.norm() /
+                         std::sqrt(std::max(static_cast<double>(canonical.max_spheres()), 1.0));
+    if (sigma > 0.0) voxels = std::min(max_voxels, size->GridVoxels(0.5 * sigma));
+  }
+  // Subdivided boundary voxels hold up to 8 candidates each.
+  if (canonical.subdivide_boundary()) voxels *= 2.0;
+  double bytes = voxels * MemoryCosts::kPerVoxel + MemoryCosts::kGenerateFixed;
+  // Without the mesh's size the worst case may exceed the budget though the mesh is small: it
+  // is then admitted when it can run alone, never refused outright.
+  if (!size && memory_->budget() > 0) bytes = std::min(bytes, double(memory_->budget()));
+  return static_cast<std::int64_t>(bytes);
+}
 
 grpc::ServerWriteReactor<v1::GenerateResponse>* InscribeService::Generate(
     grpc::CallbackServerContext* context, const v1::GenerateRequest* request) {
@@ -188,6 +262,7 @@ grpc::ServerUnaryReactor* InscribeService::GetSphereSet(grpc::CallbackServerCont
                                                         const v1::GetSphereSetRequest* request,
                                                         v1::GetSphereSetResponse* response) {
   return RunUnary(context, "GetSphereSet", 0, CheckKey(request->sphere_set_key(), "sphere_set_key"),
+                  MemoryCosts::kSmallCall, "GetSphereSet",
                   [this, request, response]() -> absl::Status {
                     absl::StatusOr<std::shared_ptr<const SphereSetEntry>> entry =
                         store_->GetSphereSet(request->sphere_set_key());
@@ -201,14 +276,15 @@ grpc::ServerUnaryReactor* InscribeService::GetSphereSet(grpc::CallbackServerCont
 grpc::ServerUnaryReactor* InscribeService::GetHierarchy(grpc::CallbackServerContext* context,
                                                         const v1::GetHierarchyRequest* request,
                                                         v1::GetHierarchyResponse* response) {
-  return RunUnary(context, "GetHierarchy", 0, CheckKey(request->sphere_set_key(), "sphere_set_key"),
-                  [this, request, response]() -> absl::Status {
-                    absl::StatusOr<std::shared_ptr<const SphereHierarchy>> h = store_->GetHierarchy(
-                        request->sphere_set_key(), VolumeFromProto(request->volume()));
-                    if (!h.ok()) return h.status();
-                    response->set_hierarchy((*h)->Serialize());
-                    return absl::OkStatus();
-                  });
+  return RunUnary(
+      context, "GetHierarchy", 0, CheckKey(request->sphere_set_key(), "sphere_set_key"),
+      MemoryCosts::kSmallCall, "GetHierarchy", [this, request, response]() -> absl::Status {
+        absl::StatusOr<std::shared_ptr<const SphereHierarchy>> h =
+            store_->GetHierarchy(request->sphere_set_key(), VolumeFromProto(request->volume()));
+        if (!h.ok()) return h.status();
+        response->set_hierarchy((*h)->Serialize());
+        return absl::OkStatus();
+      });
 }
 
 grpc::ServerUnaryReactor* InscribeService::Distance(grpc::CallbackServerContext* context,
@@ -216,52 +292,71 @@ grpc::ServerUnaryReactor* InscribeService::Distance(grpc::CallbackServerContext*
                                                     v1::DistanceResponse* response) {
   absl::Status precheck = CheckKey(request->sphere_set_a(), "sphere_set_a");
   if (precheck.ok()) precheck = CheckKey(request->sphere_set_b(), "sphere_set_b");
-  const std::int64_t pairs = request->poses_b().values_size() / 7;
+  // Shapes and counts are O(1) to check here; the poses' numbers are checked on the pool.
+  const int numbers_a = request->poses_a().values_size();
+  const int numbers_b = request->poses_b().values_size();
+  const std::int64_t pairs = numbers_b / 7;
+  if (precheck.ok() && (numbers_a % 7 != 0 || numbers_b % 7 != 0)) {
+    precheck = absl::InvalidArgumentError(
+        absl::StrCat(numbers_a % 7 != 0 ? "poses_a" : "poses_b", " has length ",
+                     numbers_a % 7 != 0 ? numbers_a : numbers_b,
+                     "; expected a multiple of 7 (qw, qx, qy, qz, tx, ty, tz per pose)"));
+  }
   if (precheck.ok() && pairs > limits_.max_poses) {
     precheck = absl::ResourceExhaustedError(
         absl::StrCat(pairs, " pose pairs; this server's limit (--max-poses) is ", limits_.max_poses,
                      " per call"));
   }
-  return RunUnary(context, "Distance", 0, precheck, [this, request, response]() -> absl::Status {
-    absl::StatusOr<DistanceRequest> tolerance = ToleranceFromProto(request->tolerance());
-    if (!tolerance.ok()) return tolerance.status();
-    absl::StatusOr<std::vector<RigidPose>> poses_a = PosesFromProto(request->poses_a(), "poses_a");
-    if (!poses_a.ok()) return poses_a.status();
-    absl::StatusOr<std::vector<RigidPose>> poses_b = PosesFromProto(request->poses_b(), "poses_b");
-    if (!poses_b.ok()) return poses_b.status();
-    if (poses_a->size() != 1 && poses_a->size() != poses_b->size()) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("poses_a has ", poses_a->size(), " poses and poses_b ", poses_b->size(),
-                       "; poses_a must have one pose or as many as poses_b"));
-    }
-    const HierarchyVolume volume = VolumeFromProto(request->volume());
-    absl::StatusOr<std::shared_ptr<const SphereHierarchy>> a =
-        store_->GetHierarchy(request->sphere_set_a(), volume);
-    if (!a.ok()) return a.status();
-    absl::StatusOr<std::shared_ptr<const SphereHierarchy>> b =
-        store_->GetHierarchy(request->sphere_set_b(), volume);
-    if (!b.ok()) return b.status();
-    const ServiceClock::time_point start = ServiceClock::now();
-    // B's poses relative to A's, so that the batch call (one frame, A fixed) serves all.
-    std::vector<RigidPose> relative(poses_b->size());
-    for (std::size_t i = 0; i < relative.size(); ++i) {
-      const RigidPose& pa = (*poses_a)[poses_a->size() == 1 ? 0 : i];
-      relative[i] = pa.Inverse() * (*poses_b)[i];
-    }
-    absl::StatusOr<std::vector<DistanceResult>> results =
-        SeparationDistances(**a, **b, relative, *tolerance);
-    if (!results.ok()) return results.status();
-    // Witnesses back to the world frame.
-    for (std::size_t i = 0; i < results->size(); ++i) {
-      const RigidPose& pa = (*poses_a)[poses_a->size() == 1 ? 0 : i];
-      DistanceResult& r = (*results)[i];
-      r.point_a = pa * r.point_a;
-      r.point_b = pa * r.point_b;
-    }
-    AppendDistanceResults(*results, response->mutable_results());
-    response->set_seconds(SecondsSince(start));
-    return absl::OkStatus();
-  });
+  if (precheck.ok() && numbers_a != 7 && numbers_a != numbers_b) {
+    precheck = absl::InvalidArgumentError(
+        absl::StrCat("poses_a has ", numbers_a / 7, " poses and poses_b ", pairs,
+                     "; poses_a must have one pose or as many as poses_b"));
+  }
+  return RunUnary(
+      context, "Distance", 0, precheck, pairs * MemoryCosts::kPerPosePair + MemoryCosts::kSmallCall,
+      absl::StrCat("Distance of ", pairs, " pose pairs"),
+      [this, request, response]() -> absl::Status {
+        absl::StatusOr<DistanceRequest> tolerance = ToleranceFromProto(request->tolerance());
+        if (!tolerance.ok()) return tolerance.status();
+        absl::StatusOr<std::vector<RigidPose>> poses_a =
+            PosesFromProto(request->poses_a(), "poses_a");
+        if (!poses_a.ok()) return poses_a.status();
+        absl::StatusOr<std::vector<RigidPose>> poses_b =
+            PosesFromProto(request->poses_b(), "poses_b");
+        if (!poses_b.ok()) return poses_b.status();
+        if (poses_a->size() != 1 && poses_a->size() != poses_b->size()) {
+          return absl::InvalidArgumentError(
+              absl::StrCat("poses_a has ", poses_a->size(), " poses and poses_b ", poses_b->size(),
+                           "; poses_a must have one pose or as many as poses_b"));
+        }
+        const HierarchyVolume volume = VolumeFromProto(request->volume());
+        absl::StatusOr<std::shared_ptr<const SphereHierarchy>> a =
+            store_->GetHierarchy(request->sphere_set_a(), volume);
+        if (!a.ok()) return a.status();
+        absl::StatusOr<std::shared_ptr<const SphereHierarchy>> b =
+            store_->GetHierarchy(request->sphere_set_b(), volume);
+        if (!b.ok()) return b.status();
+        const ServiceClock::time_point start = ServiceClock::now();
+        // B's poses relative to A's, so that the batch call (one frame, A fixed) serves all.
+        std::vector<RigidPose> relative(poses_b->size());
+        for (std::size_t i = 0; i < relative.size(); ++i) {
+          const RigidPose& pa = (*poses_a)[poses_a->size() == 1 ? 0 : i];
+          relative[i] = pa.Inverse() * (*poses_b)[i];
+        }
+        absl::StatusOr<std::vector<DistanceResult>> results =
+            SeparationDistances(**a, **b, relative, *tolerance);
+        if (!results.ok()) return results.status();
+        // Witnesses back to the world frame.
+        for (std::size_t i = 0; i < results->size(); ++i) {
+          const RigidPose& pa = (*poses_a)[poses_a->size() == 1 ? 0 : i];
+          DistanceResult& r = (*results)[i];
+          r.point_a = pa * r.point_a;
+          r.point_b = pa * r.point_b;
+        }
+        AppendDistanceResults(*results, response->mutable_results());
+        response->set_seconds(SecondsSince(start));
+        return absl::OkStatus();
+      });
 }
 
 grpc::ServerUnaryReactor* InscribeService::CacheStats(grpc::CallbackServerContext* context,
@@ -299,6 +394,9 @@ grpc::ServerUnaryReactor* InscribeService::CacheStats(grpc::CallbackServerContex
   response->set_shared_skipped(s.shared_skipped);
   response->set_shared_corrupt(s.shared_corrupt);
   response->set_shared_available(s.shared_available);
+  response->set_disk_write_errors(s.disk_write_errors);
+  response->set_disk_writes_skipped(s.disk_writes_skipped);
+  response->set_disk_available(s.disk_available);
   reactor->Finish(grpc::Status::OK);
   return reactor;
 }

@@ -24,10 +24,10 @@ using inscribe::server::ServerOptions;
 void LogCall(const CallRecord& call) {
   const auto level = call.status.ok() ? spdlog::level::info : spdlog::level::warn;
   spdlog::log(level,
-              "event=call method={} peer={} code={} triangles={} queued_ms={:.3f} run_ms={:.3f}"
-              " message=\"{}\"",
+              "event=call method={} peer={} code={} triangles={} memory_mb={:.1f} queued_ms={:.3f}"
+              " run_ms={:.3f} message=\"{}\"",
               call.method, call.peer, absl::StatusCodeToString(call.status.code()), call.triangles,
-              1e3 * call.queued_seconds, 1e3 * call.run_seconds,
+              call.memory_bytes / 1048576.0, 1e3 * call.queued_seconds, 1e3 * call.run_seconds,
               std::string(call.status.message()));
 }
 
@@ -39,6 +39,27 @@ void LogSharedTier(const inscribe::server::SharedTierEvent& event) {
   } else {
     spdlog::warn("event=redis_down error=\"{}\" retry_ms={}", std::string(event.error.message()),
                  event.retry_after.count());
+  }
+}
+
+// The disk cache tier off from the start (bad --cache-dir), stopped by a write failure (full,
+// read-only) or writing again. Calls go on either way, served from memory or computed.
+void LogDiskTier(const inscribe::server::DiskTierEvent& event) {
+  using Kind = inscribe::server::DiskTierEvent::Kind;
+  switch (event.kind) {
+    case Kind::kOff:
+      spdlog::warn(
+          "event=disk_cache_off dir=\"{}\" reason=\"{}\" message=\"running with the "
+          "memory cache only\"",
+          event.dir, std::string(event.error.message()));
+      break;
+    case Kind::kDegraded:
+      spdlog::warn("event=disk_cache_degraded dir=\"{}\" reason=\"{}\" retry_ms={}", event.dir,
+                   std::string(event.error.message()), event.retry_after.count());
+      break;
+    case Kind::kRestored:
+      spdlog::info("event=disk_cache_restored dir=\"{}\"", event.dir);
+      break;
   }
 }
 
@@ -62,6 +83,9 @@ int main(int argc, char** argv) {
   sigaddset(&stop_signals, SIGINT);
   sigaddset(&stop_signals, SIGTERM);
   pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
+  // A cache file growing past RLIMIT_FSIZE must fail its write with EFBIG (the disk tier then
+  // stops writing) rather than kill the server with SIGXFSZ.
+  signal(SIGXFSZ, SIG_IGN);
 
   ServerOptions options;
   double shutdown_grace_seconds = 10.0;
@@ -90,6 +114,12 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--max-poses", options.limits.max_poses, "pose pairs in one Distance call")
       ->check(CLI::Range(std::int64_t{1}, std::int64_t{1} << 30))
+      ->capture_default_str();
+  app.add_option("--memory-budget", options.limits.memory_budget_bytes,
+                 "bytes of working memory the calls in flight may need together, by estimate; "
+                 "calls that do not fit get RESOURCE_EXHAUSTED; 0 = unlimited. Not counting "
+                 "--cache-memory-bytes, the baseline and messages in flight")
+      ->check(CLI::Range(std::int64_t{0}, std::int64_t{1} << 50))
       ->capture_default_str();
   app.add_option("--cache-dir", options.cache.disk_dir,
                  "directory of the on-disk result cache (created if missing); empty = memory only")
@@ -140,6 +170,7 @@ int main(int argc, char** argv) {
   spdlog::set_default_logger(logger);
   options.on_call = LogCall;
   options.cache.on_shared_tier_event = LogSharedTier;
+  options.cache.on_disk_tier_event = LogDiskTier;
 
   absl::StatusOr<std::unique_ptr<InscribeServer>> server = InscribeServer::Start(options);
   if (!server.ok()) {
@@ -149,13 +180,14 @@ int main(int argc, char** argv) {
   }
   spdlog::info(
       "event=serving address={} jobs={} max_queue={} max_message_bytes={} max_triangles={} "
-      "max_voxels={} max_spheres={} max_poses={} cache_dir=\"{}\" cache_memory_bytes={} "
+      "max_voxels={} max_spheres={} max_poses={} memory_budget={} cache_dir=\"{}\" "
+      "cache_memory_bytes={} "
       "redis=\"{}\" tls={} auth={} metrics_port={}",
       (*server)->address(), (*server)->jobs(), options.max_queue, options.max_message_bytes,
       options.limits.max_triangles, options.limits.max_voxels, options.limits.max_spheres,
-      options.limits.max_poses, options.cache.disk_dir, options.cache.memory_bytes,
-      inscribe::server::RedactRedisUrl(options.cache.redis_url), options.tls.enabled(),
-      !options.auth_tokens_file.empty(), (*server)->metrics_port());
+      options.limits.max_poses, options.limits.memory_budget_bytes, options.cache.disk_dir,
+      options.cache.memory_bytes, inscribe::server::RedactRedisUrl(options.cache.redis_url),
+      options.tls.enabled(), !options.auth_tokens_file.empty(), (*server)->metrics_port());
   if (!options.auth_tokens_file.empty() && !options.tls.enabled() &&
       !IsLoopbackListen(options.listen)) {
     spdlog::warn(

@@ -4,12 +4,26 @@
 #include <atomic>
 #include <cassert>
 #include <condition_variable>
+#include <functional>
+#include <memory>
 #include <mutex>
 #include <new>
 #include <utility>
 
 #include "oneapi/tbb/global_control.h"
 #include "oneapi/tbb/task_arena.h"
+
+// ThreadSanitizer cannot see that TBB's (uninstrumented) queue orders a job's submission before
+// its start; the annotations below tell it, so that what the submitting thread wrote is not
+// reported as racing with the job that reads it (scripts/sanitize thread).
+#if defined(__SANITIZE_THREAD__)
+#include <sanitizer/tsan_interface.h>
+#define INSCRIBE_HAPPENS_BEFORE(address) __tsan_release(address)
+#define INSCRIBE_HAPPENS_AFTER(address) __tsan_acquire(address)
+#else
+#define INSCRIBE_HAPPENS_BEFORE(address) static_cast<void>(address)
+#define INSCRIBE_HAPPENS_AFTER(address) static_cast<void>(address)
+#endif
 
 namespace inscribe::server {
 
@@ -18,13 +32,18 @@ struct JobPool::Impl {
       : options(pool_options),
         scheduler(tbb::attach{}),
         // max_allowed_parallelism counts the calling thread too: workers = value - 1.
-        parallelism(tbb::global_control::max_allowed_parallelism,
-                    std::max<std::size_t>(tbb::global_control::active_value(
-                                              tbb::global_control::max_allowed_parallelism),
-                                          static_cast<std::size_t>(pool_options.concurrency) + 1)),
+        parallelism(
+            tbb::global_control::max_allowed_parallelism,
+            std::max<std::size_t>(
+                tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism),
+                static_cast<std::size_t>(pool_options.concurrency) +
+                    static_cast<std::size_t>(std::max(pool_options.small_job_threads, 0)) + 1)),
         // No slot is reserved for an external thread: jobs are enqueued, never waited on inside
         // the arena, so all `concurrency` slots go to workers.
-        arena(pool_options.concurrency, /*reserved_for_masters=*/0) {}
+        arena(pool_options.concurrency, /*reserved_for_masters=*/0),
+        // Its own arena: TBB gives each arena its own workers, and a job's parallel loops stay
+        // in the arena they started in, so large jobs cannot take the lane's threads.
+        small_arena(std::max(pool_options.small_job_threads, 1), /*reserved_for_masters=*/0) {}
 
   void Finish() {
     // Decrement under the lock so that WaitIdle cannot return (and the pool be destroyed)
@@ -38,6 +57,7 @@ struct JobPool::Impl {
   tbb::task_scheduler_handle scheduler;
   tbb::global_control parallelism;
   tbb::task_arena arena;
+  tbb::task_arena small_arena;  // used only when options.small_job_threads > 0
   std::atomic<std::int64_t> in_flight{0};
   std::mutex idle_mutex;
   std::condition_variable idle;
@@ -50,6 +70,7 @@ JobPool::JobPool(const JobPoolOptions& options) : impl_(std::make_unique<Impl>(o
 JobPool::~JobPool() {
   WaitIdle();
   impl_->arena.terminate();
+  impl_->small_arena.terminate();
   // Join TBB's workers when nothing else in the process uses TBB (otherwise this returns false
   // at once and they live on). Workers left running at exit race the process's teardown: they
   // may still be running thread-exit handlers (e.g. OpenSSL freeing its per-thread state, used
@@ -57,7 +78,7 @@ JobPool::~JobPool() {
   tbb::finalize(impl_->scheduler, std::nothrow);
 }
 
-bool JobPool::TrySubmit(std::function<void()> job) {
+bool JobPool::TrySubmit(std::function<void()> job, JobSize size) {
   // Reserve a place first, then give it back if over the limit: the count never exceeds
   // max_jobs by more than the number of racing submitters, and never admits more than max_jobs.
   if (impl_->in_flight.fetch_add(1, std::memory_order_acq_rel) >= impl_->options.max_jobs) {
@@ -65,8 +86,19 @@ bool JobPool::TrySubmit(std::function<void()> job) {
     return false;
   }
   Impl* impl = impl_.get();
-  impl->arena.enqueue([impl, job = std::move(job)] {
-    job();
+  tbb::task_arena& lane = size == JobSize::kSmall && impl->options.small_job_threads > 0
+                              ? impl->small_arena
+                              : impl->arena;
+  INSCRIBE_HAPPENS_BEFORE(impl);
+  // TBB keeps the task (and so this lambda) alive until after it returns: the job is moved out
+  // and destroyed before Finish, so that what it holds (the request, its memory reservation) is
+  // released by the time the pool counts it done.
+  lane.enqueue([impl, owned = std::make_unique<std::function<void()>>(std::move(job))] {
+    INSCRIBE_HAPPENS_AFTER(impl);
+    {
+      const std::function<void()> run = std::move(*owned);
+      run();
+    }
     impl->Finish();
   });
   return true;

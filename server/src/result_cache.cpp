@@ -337,9 +337,15 @@ absl::StatusOr<std::unique_ptr<ResultCache>> ResultCache::Open(const ResultCache
   }
   auto impl = std::make_unique<Impl>(options.memory_bytes);
   if (!options.disk_dir.empty()) {
-    absl::StatusOr<std::unique_ptr<DiskTier>> disk = DiskTier::Open(options.disk_dir);
-    if (!disk.ok()) return disk.status();
-    impl->disk = *std::move(disk);
+    absl::StatusOr<std::unique_ptr<DiskTier>> disk =
+        DiskTier::Open(options.disk_dir, options.on_disk_tier_event);
+    if (disk.ok()) {
+      impl->disk = *std::move(disk);
+    } else if (options.on_disk_tier_event) {
+      // Memory (and Redis) only: a cache without its disk tier still answers every lookup.
+      options.on_disk_tier_event(
+          DiskTierEvent{DiskTierEvent::Kind::kOff, options.disk_dir, disk.status(), {}});
+    }
   }
   if (!options.redis_url.empty()) {
     absl::StatusOr<std::unique_ptr<RedisTier>> shared = RedisTier::Create(
@@ -387,6 +393,8 @@ ResultCacheStats ResultCache::stats() const {
     stats.disk_bytes = disk.bytes;
     stats.disk_errors = disk.errors;
     stats.disk_write_errors = disk.write_errors;
+    stats.disk_writes_skipped = disk.writes_skipped;
+    stats.disk_available = disk.available ? 1 : 0;
   }
   if (impl_->shared != nullptr) {
     const RedisTier::Counts shared = impl_->shared->counts();

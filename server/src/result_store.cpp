@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "absl/strings/ascii.h"
+#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/strip.h"
@@ -226,6 +227,12 @@ absl::StatusOr<std::shared_ptr<const StoredMeshEntry>> ResultStore::PutMesh(Mesh
 
 absl::StatusOr<std::shared_ptr<const StoredMeshEntry>> ResultStore::GetMesh(
     const std::string& key) {
+  // Every kind of value shares the cache; a key of another kind (found by fuzz_requests: a
+  // mesh key sent as a sphere set key) would hand back another type's object, cast blindly.
+  if (!absl::StartsWith(key, "sha256:")) {
+    return absl::NotFoundError(absl::StrCat(
+        "unknown mesh ", key, " (mesh keys are sha256:<hex>); upload it with PutMesh first"));
+  }
   absl::StatusOr<CacheLookup> found =
       cache_->Get(key, [&](std::string bytes) { return DecodeMesh(key, std::move(bytes)); });
   if (!found.ok()) {
@@ -308,6 +315,12 @@ absl::StatusOr<std::pair<std::shared_ptr<const SphereSetEntry>, CacheSource>> Re
 
 absl::StatusOr<std::shared_ptr<const SphereSetEntry>> ResultStore::GetSphereSet(
     const std::string& key) {
+  // As in GetMesh: only sphere-set keys may reach the cast below.
+  if (!absl::StartsWith(key, "spheres/")) {
+    return absl::NotFoundError(absl::StrCat("unknown sphere set ", key,
+                                            " (sphere set keys are spheres/v1/<hex>); call "
+                                            "Generate or PutSphereSet to make it"));
+  }
   absl::StatusOr<CacheLookup> found = cache_->Get(key, DecodeSphereSet);
   if (!found.ok()) {
     if (found.status().code() == absl::StatusCode::kNotFound) {

@@ -10,9 +10,11 @@
 #include "absl/status/statusor.h"
 #include "absl/strings/str_cat.h"
 #include "inscribe/separation_distance.h"
+#include "inscribe/server/convert.h"
 #include "inscribe/server/result_cache.h"
 #include "inscribe/sphere_hierarchy.h"
 #include "inscribe/v1/service.pb.h"
+#include "memory_budget.h"
 
 namespace inscribe::server {
 
@@ -51,6 +53,12 @@ inline absl::StatusOr<DistanceRequest> ToleranceFromProto(const v1::DistanceTole
         request.abs_err, ", ", request.rel_err, ", ", request.closer_than));
   }
   return request;
+}
+
+// Estimated working memory of validating and storing `mesh` (InspectMesh, PutMesh), bytes. O(1).
+inline std::int64_t MeshWorkBytes(const v1::Mesh& mesh) {
+  return TriangleCount(mesh) * MemoryCosts::kPerTriangle +
+         mesh.vertices_size() / 3 * MemoryCosts::kPerVertex;
 }
 
 }  // namespace inscribe::server

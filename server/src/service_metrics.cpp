@@ -94,12 +94,15 @@ class StateCollector {
         {Sample(s.bytes, by("tier", "memory"), MetricType::Gauge),
          Sample(s.disk_bytes, by("tier", "disk"), MetricType::Gauge)});
     add("inscribe_cache_errors_total",
-        "Cache tier errors: disk corrupt (entries dropped on read), disk write, redis read "
+        "Cache tier errors: disk corrupt (entries dropped on read), disk write, disk skipped "
+        "(writes not tried while disk writes were stopped), redis read "
         "(unreachable, timed out, refused), redis write, redis corrupt, redis skipped (lookups "
         "and writes that bypassed Redis while it was marked down)",
         MetricType::Counter,
         {Sample(s.disk_errors, {{"tier", "disk"}, {"kind", "corrupt"}}, MetricType::Counter),
          Sample(s.disk_write_errors, {{"tier", "disk"}, {"kind", "write"}}, MetricType::Counter),
+         Sample(s.disk_writes_skipped, {{"tier", "disk"}, {"kind", "skipped"}},
+                MetricType::Counter),
          Sample(s.shared_errors, {{"tier", "redis"}, {"kind", "read"}}, MetricType::Counter),
          Sample(s.shared_write_errors, {{"tier", "redis"}, {"kind", "write"}}, MetricType::Counter),
          Sample(s.shared_corrupt, {{"tier", "redis"}, {"kind", "corrupt"}}, MetricType::Counter),
@@ -107,6 +110,10 @@ class StateCollector {
     add("inscribe_redis_available",
         "1 while the shared Redis tier is configured and answering, else 0", MetricType::Gauge,
         {Sample(s.shared_available, {}, MetricType::Gauge)});
+    add("inscribe_disk_cache_available",
+        "1 while the disk cache tier (--cache-dir) is configured and writing, else 0 (none, "
+        "unwritable at start, or writes stopped after a failure)",
+        MetricType::Gauge, {Sample(s.disk_available, {}, MetricType::Gauge)});
 
     const std::int64_t in_flight = pool_->jobs_in_flight();
     const JobPoolOptions& pool = pool_->options();

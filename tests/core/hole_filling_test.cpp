@@ -126,6 +126,22 @@ TEST(FillHoles, OffByDefault) {
   EXPECT_EQ(closed.mesh.triangles, UnitCube().triangles);
 }
 
+// Found by fuzz_mesh: CGAL 5.5's plane-polygon filling projected this hole of 4 edges along
+// a normal on which two of its corners coincide, passed its own simplicity test and crashed
+// in the constrained triangulation. Such a loop now skips that method.
+TEST(FillHoles, HoleWhoseProjectionFoldsDoesNotCrash) {
+  Mesh mesh;
+  mesh.vertices.resize(4, 3);
+  mesh.vertices << 0, 0, 0, 5, 0, 0, 0, 1, 0, 0, 1, 3;
+  mesh.triangles.resize(3, 3);
+  mesh.triangles << 0, 0, 1, 0, 2, 1, 0, 1, 3;
+  const ValidatedMesh v = ValidateMesh(mesh, FillHoles());
+  // Filled in space: the two triangles and their two-triangle patch close a tetrahedron.
+  EXPECT_EQ(v.report.holes_filled, 1) << v.report.first_error();
+  EXPECT_EQ(v.report.hole_triangles_added, 2);
+  EXPECT_EQ(v.report.border_edges, 4);
+}
+
 TEST(FillHoles, OpenUnitCubeBecomesTheUnitCube) {
   const ValidatedMesh v = ValidateMesh(testing::OpenUnitCube(), FillHoles());
   EXPECT_TRUE(v.report.usable()) << v.report.first_error();

@@ -238,6 +238,12 @@ TEST_F(MeshFileTest, HostileCountsAreRefusedBeforeCgalSizesArrays) {
        "face 0: a list of 1000000000 items is longer than the rest of the file"},
       {"noformat.ply", "ply\nelement vertex 1\nproperty float x\nend_header\n",
        "header has no format line"},
+      // CGAL 5.5 called through a null pointer (UBSan, found by fuzz_mesh).
+      {"ushort.ply",
+       "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+       "property uint16 z\nelement face 1\nproperty list uchar int vertex_indices\n"
+       "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+       "line 6: vertex coordinate z has type uint16; expected float or double"},
   };
   for (const Case& c : cases) {
     absl::StatusOr<Mesh> mesh = ReadMesh(Write(c.name, c.bytes));
@@ -252,6 +258,48 @@ TEST_F(MeshFileTest, HostileCountsAreRefusedBeforeCgalSizesArrays) {
             "0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n"));
   ASSERT_TRUE(honest.ok()) << honest.status();
   EXPECT_EQ(honest->num_triangles(), 4);
+}
+
+// Found by fuzz_mesh (tests/fuzz): CGAL reads OFF counts with `>>` across lines and corner
+// counts as the record's first number ("442949672=6" is 442949672, "4.4e8" is 440000000), and
+// a count line may go on with the first vertex. Each file below made CGAL allocate gigabytes
+// (the first was OOM-killed at 147 bytes) while the line-by-line pre-check passed it.
+TEST_F(MeshFileTest, OffCountsAreReadAsCgalReadsThem) {
+  struct Case {
+    std::string name, bytes, expected;
+  };
+  const std::vector<Case> cases = {
+      {"glued.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n442949672=6 0 1 2\n",
+       "line 6: face 0 announces 442949672 corners but lists 0"},
+      {"float.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n4.4e8 0 1 2\n",
+       "line 6: face 0 announces 440000000 corners but lists 3"},
+      {"shifted.off", "OFF\n2 1 0 0 0 0\n0 0 0\n1000000000 0 1\n",
+       "line 4: face 0 announces 1000000000 corners but lists 2"},
+      // CGAL casts each corner to size_t: undefined behaviour for -1 (UBSan under fuzz_mesh).
+      {"negative.off", "OFF\n4 3 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3-1 2\n",
+       "line 9: face 2 refers to vertex -1, but the file has 4 vertices"},
+      // Refused by the pre-check; the message is the line-by-line diagnosis's.
+      {"split.off", "OFF\n# counts one per line\n1000000000\n1\n0\n0 0 0\n",
+       "not a valid off file: line 3"},
+      {"padded.off", "OFF\n0000000000001000000000 1 0\n0 0 0\n", "1000000000 vertices"},
+  };
+  for (const Case& c : cases) {
+    absl::StatusOr<Mesh> mesh = ReadMesh(Write(c.name, c.bytes));
+    ASSERT_FALSE(mesh.ok()) << c.name;
+    EXPECT_THAT(std::string(mesh.status().message()), HasSubstr(c.expected)) << c.name;
+  }
+  // Counts split over lines, a count line going on with the first vertex, and padded counts
+  // are honest OFF to CGAL, and still read.
+  const std::vector<std::string> honest = {
+      "OFF\n4\n4\n0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n",
+      "OFF 4 4 0 0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n",
+      "OFF\n004 04 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n"};
+  for (const std::string& bytes : honest) {
+    absl::StatusOr<Mesh> mesh = ReadMesh(Write("honest.off", bytes));
+    ASSERT_TRUE(mesh.ok()) << bytes << ": " << mesh.status();
+    EXPECT_EQ(mesh->num_vertices(), 4) << bytes;
+    EXPECT_EQ(mesh->num_triangles(), 4) << bytes;
+  }
 }
 
 TEST_F(MeshFileTest, FaceIndexOutOfRange) {

@@ -10,6 +10,7 @@
 #include <map>
 #include <random>
 #include <set>
+#include <utility>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
@@ -40,6 +41,32 @@ TEST(ValidateMesh, CleanCube) {
   EXPECT_TRUE(v.report.self_intersections_checked);
   EXPECT_NEAR(v.report.volume, 1.0, 1e-15);
   EXPECT_EQ(v.mesh.triangles, UnitCube().triangles);
+}
+
+// Found by fuzz_mesh: a vertex at -1e308 gave an infinite volume on a usable mesh, and hole
+// filling near 1.8e308 aborted inside CGAL (GMP on an infinity); see also the hole case.
+TEST(ValidateMesh, CoordinatesThatOverflowAreAnError) {
+  for (const auto& [lo, hi] : {std::pair{Vector3(0, 0, -1e308), Vector3(1, 1, 1)},
+                               std::pair{Vector3(0, 0, 0), Vector3(1e110, 1e110, 1e110)},
+                               std::pair{Vector3(-1.5e308, 0, 0), Vector3(1.5e308, 1, 1)}}) {
+    const ValidatedMesh v = ValidateMesh(Box(lo, hi));
+    EXPECT_FALSE(v.report.usable()) << hi.transpose();
+    EXPECT_TRUE(HasIssue(v.report, "coordinates_too_large", Severity::kError)) << hi.transpose();
+    EXPECT_THAT(v.report.first_error(), HasSubstr("scale the mesh down"));
+  }
+  // A hole next to a huge vertex: refused before CGAL's hole filling runs.
+  Mesh open = UnitCube();
+  open.vertices(6, 1) = 1.7976931348623157e308;
+  open.triangles.conservativeResize(open.num_triangles() - 1, 3);
+  ValidateOptions fill;
+  fill.fill_holes = true;
+  const ValidatedMesh refused = ValidateMesh(open, fill);
+  EXPECT_TRUE(HasIssue(refused.report, "coordinates_too_large", Severity::kError));
+  EXPECT_EQ(refused.report.holes_filled, 0);
+  // At the bound: usable, with the exact figures.
+  const ValidatedMesh big = ValidateMesh(Box(Vector3::Zero(), Vector3(1e100, 1e100, 1e100)));
+  EXPECT_TRUE(big.report.usable()) << big.report.first_error();
+  EXPECT_NEAR(big.report.volume / 1e300, 1.0, 1e-12);
 }
 
 TEST(ValidateMesh, InvertedMeshIsFixed) {

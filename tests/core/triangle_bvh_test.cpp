@@ -182,6 +182,24 @@ TEST(TriangleBvh, ClosestPointEqualsScanOnSyntheticMeshes) {
   }
 }
 
+// Found by fuzz_requests under UBSan: centroids a subnormal distance apart made the binning
+// scale overflow and cast NaN to int. The scan and the BVH must still agree bit for bit.
+TEST(TriangleBvh, SubnormalCentroidExtent) {
+  const int n = 64;  // well over a leaf, so the builder bins
+  Mesh mesh;
+  mesh.vertices.resize(3 * n, 3);
+  mesh.triangles.resize(n, 3);
+  for (int k = 0; k < n; ++k) {
+    const double x = std::numeric_limits<double>::denorm_min() * (k + 1);
+    mesh.vertices.row(3 * k) = Vector3(x, 0, 0);
+    mesh.vertices.row(3 * k + 1) = Vector3(x, 1, 0);
+    mesh.vertices.row(3 * k + 2) = Vector3(x, 0, 1);
+    mesh.triangles.row(k) << 3 * k, 3 * k + 1, 3 * k + 2;
+  }
+  const TriangleBvh bvh = TriangleBvh::Build(mesh);
+  ExpectClosestMatchesBruteForce(mesh, bvh, QueryPoints(mesh, 20, 5));
+}
+
 TEST(TriangleBvh, ExactTiesGoToTheLowestTriangle) {
   // The cube's centre is equally far (0.5) from all 12 triangles; a point above a face's
   // diagonal is equally far from that face's two triangles.

@@ -75,5 +75,37 @@ TEST(JobPool, DestructorWaitsForAcceptedJobs) {
   EXPECT_EQ(ran.load(), 5);
 }
 
+// Large jobs holding every thread must not delay a small job (the small-job lane), and
+// without the lane the small job waits for them: the same setup, both ways.
+TEST(JobPool, SmallJobsRunWhileLargeJobsHoldEveryThread) {
+  for (const int lane : {1, 0}) {
+    SCOPED_TRACE(lane);
+    JobPoolOptions options{/*concurrency=*/2, /*max_jobs=*/10};
+    options.small_job_threads = lane;
+    JobPool pool(options);
+    std::atomic<bool> release{false};
+    std::atomic<int> large_running{0};
+    for (int i = 0; i < 2; ++i) {
+      ASSERT_TRUE(pool.TrySubmit([&] {
+        ++large_running;
+        while (!release.load()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      }));
+    }
+    while (large_running.load() < 2) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    std::atomic<bool> small_ran{false};
+    ASSERT_TRUE(pool.TrySubmit([&] { small_ran = true; }, JobSize::kSmall));
+    // Generous for a loaded machine: the lane starts the job in microseconds.
+    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    while (!small_ran.load() && std::chrono::steady_clock::now() < until && lane == 1) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    if (lane == 0) std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    EXPECT_EQ(small_ran.load(), lane == 1);
+    release = true;
+    pool.WaitIdle();
+    EXPECT_TRUE(small_ran.load());
+  }
+}
+
 }  // namespace
 }  // namespace inscribe::server

@@ -1,14 +1,23 @@
 // The result cache's disk tier: the documented file layout, entries surviving a restart,
-// corrupt files dropped and recomputed, the directory checks at Open, write failures.
+// corrupt files dropped and recomputed, an unusable directory at Open (memory only), write
+// failures, and a full disk stopping writes until a retry after the backoff succeeds.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <openssl/evp.h>
+#include <signal.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <array>
+#include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
+#include <mutex>
+#include <thread>
+#include <utility>
+#include <vector>
 
 #include "absl/strings/escaping.h"
 #include "absl/strings/str_cat.h"
@@ -240,26 +249,157 @@ TEST(ResultCacheDisk, DecodeFailureCountsAsCorruptAndRecomputes) {
   EXPECT_EQ(ReadFile(EntryFile(dir.cache(), "k/a")), ExpectedFile("k/a", "new"));
 }
 
-TEST(ResultCacheOpen, RejectsNegativeBudgetAndUnusableDirectory) {
+// Collects the disk tier's events (called on the cache's threads).
+struct DiskEvents {
+  std::mutex mutex;
+  std::vector<DiskTierEvent> events;
+
+  std::function<void(const DiskTierEvent&)> Callback() {
+    return [this](const DiskTierEvent& event) {
+      std::lock_guard<std::mutex> lock(mutex);
+      events.push_back(event);
+    };
+  }
+  std::vector<DiskTierEvent> Take() {
+    std::lock_guard<std::mutex> lock(mutex);
+    return std::exchange(events, {});
+  }
+};
+
+// Without its disk tier the cache still computes, keeps results in memory and counts them.
+void ExpectMemoryOnly(ResultCache& cache) {
+  int calls = 0;
+  auto lookup = cache.GetOrCompute("k/a", Returning("value", &calls), MustNotDecode());
+  ASSERT_TRUE(lookup.ok()) << lookup.status();
+  EXPECT_EQ(lookup->source, CacheSource::kComputed);
+  auto again = cache.GetOrCompute("k/a", MustNotCompute(), MustNotDecode());
+  ASSERT_TRUE(again.ok()) << again.status();
+  EXPECT_EQ(again->source, CacheSource::kMemory);
+  const ResultCacheStats stats = cache.stats();
+  EXPECT_EQ(stats.disk_available, 0);
+  EXPECT_EQ(stats.disk_entries + stats.disk_write_errors + stats.disk_writes_skipped, 0);
+}
+
+TEST(ResultCacheOpen, RejectsNegativeBudget) {
   EXPECT_EQ(ResultCache::Open(cache_test::Options(-1, "")).status().code(),
             absl::StatusCode::kInvalidArgument);
+}
+
+TEST(ResultCacheOpen, UnusableDirectoryRunsWithoutTheDiskTier) {
   TempDir dir;
   const fs::path file = dir.path() / "file";
   WriteFile(file, "x");
   for (const fs::path& bad : {file / "cache", file}) {
-    auto cache = ResultCache::Open(cache_test::Options(1 << 20, bad.string()));
-    EXPECT_EQ(cache.status().code(), absl::StatusCode::kFailedPrecondition) << bad;
-    EXPECT_THAT(cache.status().message(), HasSubstr(bad.string()));
+    DiskEvents events;
+    ResultCacheOptions options = cache_test::Options(1 << 20, bad.string());
+    options.on_disk_tier_event = events.Callback();
+    auto cache = ResultCache::Open(options);
+    ASSERT_TRUE(cache.ok()) << cache.status();
+    const std::vector<DiskTierEvent> seen = events.Take();
+    ASSERT_EQ(seen.size(), 1u) << bad;
+    EXPECT_EQ(seen[0].kind, DiskTierEvent::Kind::kOff);
+    EXPECT_EQ(seen[0].dir, bad.string());
+    EXPECT_EQ(seen[0].error.code(), absl::StatusCode::kFailedPrecondition);
+    EXPECT_THAT(seen[0].error.message(), HasSubstr(bad.string()));
+    ExpectMemoryOnly(**cache);
+    EXPECT_TRUE(events.Take().empty());
   }
 }
 
-TEST(ResultCacheOpen, ReadOnlyDirectoryIsFailedPrecondition) {
+TEST(ResultCacheOpen, ReadOnlyDirectoryRunsWithoutTheDiskTier) {
   if (::geteuid() == 0) GTEST_SKIP() << "root writes to read-only directories";
   TempDir dir;
   fs::permissions(dir.path(), fs::perms::owner_read | fs::perms::owner_exec);
-  auto cache = ResultCache::Open(cache_test::Options(1 << 20, dir.path().string()));
-  EXPECT_EQ(cache.status().code(), absl::StatusCode::kFailedPrecondition);
-  EXPECT_THAT(cache.status().message(), HasSubstr(dir.path().string()));
+  DiskEvents events;
+  ResultCacheOptions options = cache_test::Options(1 << 20, dir.path().string());
+  options.on_disk_tier_event = events.Callback();
+  auto cache = ResultCache::Open(options);
+  fs::permissions(dir.path(), fs::perms::owner_all);
+  ASSERT_TRUE(cache.ok()) << cache.status();
+  const std::vector<DiskTierEvent> seen = events.Take();
+  ASSERT_EQ(seen.size(), 1u);
+  EXPECT_EQ(seen[0].kind, DiskTierEvent::Kind::kOff);
+  EXPECT_THAT(seen[0].error.message(), HasSubstr(dir.path().string()));
+  ExpectMemoryOnly(**cache);
+}
+
+// RLIMIT_FSIZE 0 makes every write of a regular file fail with EFBIG, like a full disk, even
+// for root; restored when the test ends. SIGXFSZ is ignored so the write fails instead of
+// killing the test.
+class FileSizeLimit {
+ public:
+  FileSizeLimit() {
+    ::getrlimit(RLIMIT_FSIZE, &saved_);
+    previous_handler_ = ::signal(SIGXFSZ, SIG_IGN);
+  }
+  ~FileSizeLimit() {
+    Lift();
+    ::signal(SIGXFSZ, previous_handler_);
+  }
+  void Impose() {
+    rlimit zero = saved_;
+    zero.rlim_cur = 0;
+    ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &zero), 0);
+  }
+  void Lift() { ::setrlimit(RLIMIT_FSIZE, &saved_); }
+
+ private:
+  rlimit saved_{};
+  sighandler_t previous_handler_ = SIG_DFL;
+};
+
+TEST(ResultCacheDisk, FullDiskStopsWritesUntilTheBackoffThenRestores) {
+  TempDir dir;
+  ASSERT_TRUE(OpenCache(1 << 20, dir.cache())->Put("k/before", Value("stored before")).ok());
+  DiskEvents events;
+  ResultCacheOptions options = cache_test::Options(1 << 20, dir.cache());
+  options.on_disk_tier_event = events.Callback();
+  auto opened = ResultCache::Open(options);
+  ASSERT_TRUE(opened.ok()) << opened.status();
+  ResultCache& cache = **opened;
+  ASSERT_EQ(cache.stats().disk_available, 1);
+
+  FileSizeLimit limit;
+  limit.Impose();
+  ASSERT_TRUE(cache.Put("k/full", Value("not stored")).ok());
+  ASSERT_TRUE(cache.Put("k/skipped", Value("not tried")).ok());
+  limit.Lift();
+  std::vector<DiskTierEvent> seen = events.Take();
+  ASSERT_EQ(seen.size(), 1u);
+  EXPECT_EQ(seen[0].kind, DiskTierEvent::Kind::kDegraded);
+  EXPECT_EQ(seen[0].retry_after, std::chrono::milliseconds(1000));
+  EXPECT_THAT(seen[0].error.message(), HasSubstr(dir.cache()));
+  ResultCacheStats stats = cache.stats();
+  EXPECT_EQ(stats.disk_available, 0);
+  EXPECT_EQ(stats.disk_write_errors, 1);
+  EXPECT_EQ(stats.disk_writes_skipped, 1);
+  EXPECT_EQ(stats.disk_entries, 1);
+  EXPECT_EQ(stats.entries, 2);  // both values are still served, from memory
+  // No temporary file is left behind by the failed write.
+  for (const auto& entry : fs::recursive_directory_iterator(dir.cache())) {
+    EXPECT_THAT(entry.path().string(), ::testing::Not(HasSubstr(".tmp-")));
+  }
+  // Reads go on while writes are stopped.
+  int decodes = 0;
+  auto before = cache.Get("k/before", CountingDecode(&decodes));
+  ASSERT_TRUE(before.ok()) << before.status();
+  EXPECT_EQ(before->source, CacheSource::kDisk);
+  EXPECT_EQ(before->value->bytes, "stored before");
+
+  // Writable again: within the backoff writes are still skipped, after it one write retries.
+  ASSERT_TRUE(cache.Put("k/within", Value("skipped too")).ok());
+  EXPECT_EQ(cache.stats().disk_writes_skipped, 2);
+  std::this_thread::sleep_for(std::chrono::milliseconds(1100));
+  ASSERT_TRUE(cache.Put("k/after", Value("stored after")).ok());
+  seen = events.Take();
+  ASSERT_EQ(seen.size(), 1u);
+  EXPECT_EQ(seen[0].kind, DiskTierEvent::Kind::kRestored);
+  EXPECT_TRUE(seen[0].error.ok());
+  stats = cache.stats();
+  EXPECT_EQ(stats.disk_available, 1);
+  EXPECT_EQ(stats.disk_entries, 2);
+  EXPECT_EQ(ReadFile(EntryFile(dir.cache(), "k/after")), ExpectedFile("k/after", "stored after"));
+  EXPECT_FALSE(fs::exists(EntryFile(dir.cache(), "k/full")));
 }
 
 TEST(ResultCacheOpen, CountsEntriesAndRemovesTemporaryFiles) {

@@ -25,10 +25,13 @@ namespace {
 using ::testing::HasSubstr;
 
 // One pool thread and room for two jobs; the test occupies the thread with a job it releases.
+// No small-job lane (job_pool_test covers it): the small calls here would run on it.
 class ServiceQueueTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    pool_ = std::make_unique<JobPool>(JobPoolOptions{/*concurrency=*/1, /*max_jobs=*/2});
+    JobPoolOptions options{/*concurrency=*/1, /*max_jobs=*/2};
+    options.small_job_threads = 0;  // one queue, so the held thread holds up every call
+    pool_ = std::make_unique<JobPool>(options);
     cache_ = *ResultCache::Open(ResultCacheOptions{});
     service_ = std::make_unique<InscribeService>(pool_.get(), cache_.get(), ServiceLimits{},
                                                  [this](const CallRecord& record) {

@@ -117,6 +117,44 @@ TEST_F(SpheresRpcTest, GenerateErrorsHaveTheirCodes) {
             grpc::StatusCode::INVALID_ARGUMENT);
 }
 
+// Found by fuzz_requests: every kind of value shares the cache, and a mesh key sent as a
+// sphere set key handed the mesh's object to a blind cast; the server crashed.
+TEST_F(SpheresRpcTest, KeysOfAnotherKindAreUnknownNotReinterpreted) {
+  const std::string mesh = PutMesh(testing::UnitCube());
+  v1::GenerateResult generated;
+  ASSERT_TRUE(Generate(SphereRequest(mesh, 0.25), &generated).ok());
+  const std::string set_key = generated.sphere_set_key();
+
+  v1::GetSphereSetRequest get;
+  get.set_sphere_set_key(mesh);
+  v1::GetSphereSetResponse set;
+  grpc::Status s = stub_->GetSphereSet(Context().get(), get, &set);
+  EXPECT_EQ(s.error_code(), grpc::StatusCode::NOT_FOUND);
+  EXPECT_THAT(s.error_message(), HasSubstr("unknown sphere set " + mesh));
+
+  v1::GetHierarchyRequest get_h;
+  get_h.set_sphere_set_key(mesh);
+  v1::GetHierarchyResponse h;
+  EXPECT_EQ(stub_->GetHierarchy(Context().get(), get_h, &h).error_code(),
+            grpc::StatusCode::NOT_FOUND);
+
+  // The other way round: a sphere set key where a mesh key belongs.
+  s = Generate(SphereRequest(set_key, 0.25), &generated);
+  EXPECT_EQ(s.error_code(), grpc::StatusCode::NOT_FOUND);
+  EXPECT_THAT(s.error_message(), HasSubstr("unknown mesh " + set_key));
+  v1::EvaluateRequest evaluate;
+  evaluate.set_mesh_sha256(set_key);
+  evaluate.set_sphere_set_key(mesh);
+  v1::EvaluateResponse quality;
+  EXPECT_EQ(stub_->Evaluate(Context().get(), evaluate, &quality).error_code(),
+            grpc::StatusCode::NOT_FOUND);
+
+  // Still serving, and the right keys still work.
+  get.set_sphere_set_key(set_key);
+  EXPECT_TRUE(stub_->GetSphereSet(Context().get(), get, &set).ok());
+  EXPECT_EQ(set.mesh_sha256(), mesh);
+}
+
 TEST_F(SpheresRpcTest, DeadlineStopsAHugeGeneration) {
   const std::string mesh = PutMesh(testing::Icosphere(4));
   v1::GenerateResult result;

@@ -25,6 +25,9 @@ class InscribedProcess {
 
   bool started() const { return pid_ > 0 && stderr_ != nullptr; }
 
+  // The child's process id (for /proc/<pid>/status, signals); -1 when the spawn failed.
+  pid_t pid() const { return pid_; }
+
   // Reads stderr up to the line "inscribed listening on HOST:PORT" and returns HOST:PORT, or
   // "" when the process ended first.
   std::string WaitUntilListening();

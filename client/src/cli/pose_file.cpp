@@ -1,6 +1,7 @@
 #include "pose_file.h"
 
 #include <fstream>
+#include <sstream>
 #include <vector>
 
 #include "absl/strings/numbers.h"
@@ -10,14 +11,14 @@
 
 namespace inscribe::cli {
 
-absl::StatusOr<std::vector<RigidPose>> ReadPoseFile(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) return absl::NotFoundError(absl::StrCat(path, ": cannot open the pose file"));
+absl::StatusOr<std::vector<RigidPose>> ParsePoses(absl::string_view bytes,
+                                                  const std::string& name) {
   std::vector<RigidPose> poses;
-  std::string line;
-  for (std::int64_t number = 1; std::getline(in, line); ++number) {
+  std::int64_t number = 0;
+  for (absl::string_view line : absl::StrSplit(bytes, '\n')) {
+    ++number;
     auto fail = [&](const std::string& why) {
-      return absl::InvalidArgumentError(absl::StrCat(path, ": line ", number, ": ", why));
+      return absl::InvalidArgumentError(absl::StrCat(name, ": line ", number, ": ", why));
     };
     absl::string_view text = line;
     if (const auto hash = text.find('#'); hash != absl::string_view::npos) {
@@ -43,13 +44,20 @@ absl::StatusOr<std::vector<RigidPose>> ReadPoseFile(const std::string& path) {
     if (!normalized.ok()) return fail(std::string(normalized.status().message()));
     poses.push_back(*normalized);
   }
-  if (in.bad()) return absl::InvalidArgumentError(absl::StrCat(path, ": read error"));
   if (poses.empty()) {
-    return absl::InvalidArgumentError(absl::StrCat(path,
-                                                   ": no poses (one per line: qw qx qy qz "
-                                                   "tx ty tz)"));
+    return absl::InvalidArgumentError(
+        absl::StrCat(name, ": no poses (one per line: qw qx qy qz tx ty tz)"));
   }
   return poses;
+}
+
+absl::StatusOr<std::vector<RigidPose>> ReadPoseFile(const std::string& path) {
+  std::ifstream in(path, std::ios::in | std::ios::binary);
+  if (!in) return absl::NotFoundError(absl::StrCat(path, ": cannot open the pose file"));
+  std::ostringstream contents;
+  contents << in.rdbuf();
+  if (in.bad()) return absl::InvalidArgumentError(absl::StrCat(path, ": read error"));
+  return ParsePoses(contents.str(), path);
 }
 
 }  // namespace inscribe::cli

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
 #include "inscribe/rigid_pose.h"
 
 namespace inscribe::cli {
@@ -14,9 +15,14 @@ namespace inscribe::cli {
 // More poses than this in one file are refused (the results of one call stay in memory).
 inline constexpr std::int64_t kMaxPoses = 2'000'000;
 
-// Reads the file line by line. Quaternions are normalised when within 1e-3 of unit length
-// (rounded values such as 0.7071), refused otherwise. INVALID_ARGUMENT / NOT_FOUND naming the
-// path and line: `poses.txt: line 4: expected 7 numbers qw qx qy qz tx ty tz, found 6`.
+// Parses the bytes of a whole pose file; `name` (the path) starts every error message.
+// Quaternions are normalised when within 1e-3 of unit length (rounded values such as 0.7071),
+// refused otherwise; every pose returned passes CheckPose. INVALID_ARGUMENT naming the line:
+// `poses.txt: line 4: expected 7 numbers qw qx qy qz tx ty tz, found 6`. Cost O(bytes); no
+// memory is sized from the input beyond the poses it holds.
+absl::StatusOr<std::vector<RigidPose>> ParsePoses(absl::string_view bytes, const std::string& name);
+
+// Reads `path` whole and parses it with ParsePoses; NOT_FOUND when it cannot be opened.
 absl::StatusOr<std::vector<RigidPose>> ReadPoseFile(const std::string& path);
 
 }  // namespace inscribe::cli

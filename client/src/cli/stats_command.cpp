@@ -40,7 +40,10 @@ std::vector<std::pair<const char*, std::int64_t>> Counters(const client::ServerC
           {"shared_write_errors", s.shared_write_errors},
           {"shared_skipped", s.shared_skipped},
           {"shared_corrupt", s.shared_corrupt},
-          {"shared_available", s.shared_available}};
+          {"shared_available", s.shared_available},
+          {"disk_write_errors", s.disk_write_errors},
+          {"disk_writes_skipped", s.disk_writes_skipped},
+          {"disk_available", s.disk_available}};
 }
 
 int RunStats(const StatsCliOptions& options) {

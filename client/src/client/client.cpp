@@ -372,6 +372,9 @@ absl::StatusOr<ServerCacheStats> Client::CacheStats(const CallOptions& options) 
   stats.shared_skipped = response->shared_skipped();
   stats.shared_corrupt = response->shared_corrupt();
   stats.shared_available = response->shared_available();
+  stats.disk_write_errors = response->disk_write_errors();
+  stats.disk_writes_skipped = response->disk_writes_skipped();
+  stats.disk_available = response->disk_available();
   return stats;
 }
 

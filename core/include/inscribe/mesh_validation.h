@@ -61,6 +61,11 @@ struct MeshReport {
   std::string first_error() const;
 };
 
+// Largest coordinate magnitude ValidateMesh accepts (mesh units); beyond it the mesh has the
+// error "coordinates_too_large". Volumes (cubes of differences) and CGAL's constructions
+// (products of differences) stay finite below it.
+inline constexpr double kMaxMeshCoordinate = 1e100;
+
 struct ValidateOptions {
   // Self-intersection testing costs O(#T log #T) with exact predicates; it is skipped (and
   // reported as unchecked) for meshes that are not closed 2-manifolds, where it means little.

@@ -185,6 +185,9 @@ struct ServerCacheStats {
   std::int64_t shared_skipped = 0;
   std::int64_t shared_corrupt = 0;
   std::int64_t shared_available = 0;  // 1 while the server's Redis is up
+  std::int64_t disk_write_errors = 0;
+  std::int64_t disk_writes_skipped = 0;  // while the server's disk writes were stopped
+  std::int64_t disk_available = 0;       // 1 while the server's disk tier is writing
 };
 
 // One object pair of a simulator frame: two cached sets and their world poses.

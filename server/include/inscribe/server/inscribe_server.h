@@ -75,6 +75,9 @@ class InscribeServer {
   int metrics_port() const;
   // Jobs (requests) used by the pool after resolving jobs = 0.
   int jobs() const { return jobs_; }
+  // Jobs queued or running on the pool now (each has released what it held once it no longer
+  // counts); for tests and harnesses that wait for the server to be idle.
+  std::int64_t jobs_in_flight() const;
 
   // Graceful stop: marks health NOT_SERVING, answers new calls with UNAVAILABLE, lets accepted
   // calls finish until `deadline`, then cancels what is left, closes every connection and waits

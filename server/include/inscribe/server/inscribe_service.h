@@ -12,6 +12,7 @@
 #include <string>
 
 #include "absl/status/status.h"
+#include "absl/status/statusor.h"
 #include "inscribe/server/job_pool.h"
 #include "inscribe/server/result_cache.h"
 #include "inscribe/v1/service.grpc.pb.h"
@@ -20,6 +21,9 @@ namespace inscribe::server {
 
 class ResultStore;
 class DistanceStreamReactor;
+class MemoryBudget;
+class MeshSizes;
+struct StoredMeshEntry;
 
 // Per-request limits. Each is a flag of `inscribed` with the same name; a breach is
 // RESOURCE_EXHAUSTED with a message naming the flag.
@@ -33,16 +37,26 @@ struct ServiceLimits {
   std::int64_t max_spheres = 1'000'000;
   // --max-poses: pose pairs in one Distance call, or object pairs in one stream frame.
   std::int64_t max_poses = 1'000'000;
+  // --memory-budget: bytes of working memory the calls in flight (queued or running) may need
+  // together, by an up-front estimate from each request's sizes (server/src/memory_budget.h
+  // lists the per-item costs and how they were measured); 0 = unlimited. A call whose estimate
+  // alone exceeds it is RESOURCE_EXHAUSTED naming the flag; one that does not fit next to the
+  // calls in flight is RESOURCE_EXHAUSTED saying to retry, as a full --max-queue is. Not
+  // counted: the result cache (--cache-memory-bytes), the process's baseline and the request
+  // and reply messages gRPC holds (each at most --max-message-bytes). 4 GiB covers the default
+  // limits' largest Generate (--max-voxels) and mesh (--max-triangles) one at a time.
+  std::int64_t memory_budget_bytes = std::int64_t{4} << 30;
 };
 
 // What the service did with one call, for access logs and metrics. Times in seconds.
 struct CallRecord {
-  const char* method = "";      // RPC name, e.g. "InspectMesh"
-  std::string peer;             // grpc peer string, e.g. "ipv4:127.0.0.1:53412"
-  absl::Status status;          // what the caller was sent
-  std::int64_t triangles = 0;   // size of the request's mesh
-  double queued_seconds = 0.0;  // from arrival to the start of the job (0 if never queued)
-  double run_seconds = 0.0;     // time the job ran on the pool
+  const char* method = "";        // RPC name, e.g. "InspectMesh"
+  std::string peer;               // grpc peer string, e.g. "ipv4:127.0.0.1:53412"
+  absl::Status status;            // what the caller was sent
+  std::int64_t triangles = 0;     // size of the request's mesh
+  double queued_seconds = 0.0;    // from arrival to the start of the job (0 if never queued)
+  double run_seconds = 0.0;       // time the job ran on the pool
+  std::int64_t memory_bytes = 0;  // working memory reserved by estimate (--memory-budget)
 };
 
 // Called once per finished call, on a gRPC or pool thread, before the reply is sent; must be
@@ -123,9 +137,21 @@ class InscribeService final : public v1::Inscribe::CallbackService {
   // `precheck` (O(1) checks done on the gRPC thread) failed, else runs `body` on the pool
   // (after checking the caller is still waiting and within its deadline) and replies with its
   // status. `body` may throw std::bad_alloc (RESOURCE_EXHAUSTED) but nothing else escapes.
+  // `memory_bytes` is the call's estimated working memory, reserved from --memory-budget
+  // before it is queued and given back when `body` returns (or the call is refused or
+  // cancelled); `what` names the call in a refusal, e.g. "Distance of 1000 pose pairs".
   grpc::ServerUnaryReactor* RunUnary(grpc::CallbackServerContext* context, const char* method,
                                      std::int64_t triangles, const absl::Status& precheck,
+                                     std::int64_t memory_bytes, std::string what,
                                      std::function<absl::Status()> body);
+
+  // Remembers a stored mesh's size, for GenerateWorkBytes.
+  void RecordMeshSize(const StoredMeshEntry& entry);
+  // Estimated working memory of a Generate on `mesh_key` with `canonical` parameters, from
+  // the mesh's size when this process stored it (O(1)); INVALID_ARGUMENT naming --max-voxels
+  // when its grid would be too fine.
+  absl::StatusOr<std::int64_t> GenerateWorkBytes(const std::string& mesh_key,
+                                                 const v1::GenerateParameters& canonical) const;
 
   // RESOURCE_EXHAUSTED naming --max-queue: the pool refused a job.
   absl::Status QueueFullError() const;
@@ -145,6 +171,8 @@ class InscribeService final : public v1::Inscribe::CallbackService {
 
   JobPool* const pool_;
   std::unique_ptr<ResultStore> store_;
+  std::unique_ptr<MemoryBudget> memory_;   // --memory-budget
+  std::unique_ptr<MeshSizes> mesh_sizes_;  // of meshes stored here, for Generate's estimate
   const ServiceLimits limits_;
   const CallObserver observer_;
   const CallAuthenticator authenticate_;

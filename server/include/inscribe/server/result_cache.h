@@ -29,6 +29,29 @@ struct SharedTierEvent {
   std::chrono::milliseconds retry_after{0};
 };
 
+// A change in the disk tier's health, for the binary to log. Disk trouble never fails a
+// lookup: without the tier, results are computed (or read from Redis) and kept in memory.
+struct DiskTierEvent {
+  enum class Kind {
+    // At Open: the directory cannot be created, listed or written; the cache runs without a
+    // disk tier (memory and Redis only) for its whole life.
+    kOff,
+    // A write failed because the file system is full, read-only, over quota or forbids it
+    // (ENOSPC, EROFS, EACCES, EPERM, EDQUOT, EFBIG, EIO): writes stop (reads of existing
+    // entries go on) until retry_after has passed, when one write is tried again.
+    kDegraded,
+    // That retried write succeeded: writes go on.
+    kRestored,
+  };
+  Kind kind = Kind::kOff;
+  std::string dir;  // ResultCacheOptions::disk_dir
+  // kOff, kDegraded: what failed, naming the path and the system's message. OK for kRestored.
+  absl::Status error;
+  // kDegraded: time until a write is tried again (1 s, doubling per failed retry, at most
+  // 60 s).
+  std::chrono::milliseconds retry_after{0};
+};
+
 struct ResultCacheOptions {
   // --cache-memory-bytes: the in-memory tier holds entries up to this many bytes in all (each
   // entry counts its key's length, its bytes and its object_bytes); the least recently used go
@@ -38,7 +61,8 @@ struct ResultCacheOptions {
   // Entries survive restarts; a file that fails its checks on read is deleted and recomputed.
   // Files are disk_dir/<first 2 hex digits>/<64 hex digits of SHA-256(key)>. One process per
   // directory: Open removes the temporary files it finds, and the disk counters assume no
-  // other writer.
+  // other writer. A directory that cannot be written, at Open or later, costs only the disk
+  // tier (see DiskTierEvent); no lookup fails because of it.
   std::string disk_dir;
   // --redis: URL of the Redis server replicas share as a third tier,
   // "redis://[:PASSWORD@]HOST[:PORT][/DB]"; empty = none. Results are written through to it;
@@ -51,6 +75,10 @@ struct ResultCacheOptions {
   // thread-safe) when the Redis tier goes down or comes back, and once at Open with its first
   // state. May be empty. The cache itself never logs.
   std::function<void(const SharedTierEvent&)> on_shared_tier_event;
+  // Called (on the thread of the Open or the write concerned, with no lock of the cache held;
+  // must be cheap and thread-safe) when the disk tier is off at Open, stops writing, or writes
+  // again. May be empty.
+  std::function<void(const DiskTierEvent&)> on_disk_tier_event;
 };
 
 // `url` with its password replaced by "***" ("redis://:***@host:6379/0"), for logs.
@@ -116,6 +144,10 @@ struct ResultCacheStats {
   std::int64_t shared_skipped = 0;    // reads and writes not tried while Redis was marked down
   std::int64_t shared_corrupt = 0;    // Redis values that failed their checks (deleted)
   std::int64_t shared_available = 0;  // 1 while Redis is configured and not marked down
+  // 1 while the disk tier is configured and writing; 0 without one, when it was off at Open,
+  // or while its writes are stopped after a failure (see DiskTierEvent).
+  std::int64_t disk_available = 0;
+  std::int64_t disk_writes_skipped = 0;  // results not written while disk writes were stopped
 };
 
 // Thread-safe. Keys are printable: 1-200 characters from [A-Za-z0-9._:/-], e.g.
@@ -132,9 +164,10 @@ class ResultCache {
 
   // Creates disk_dir if needed and counts what it holds; connects to Redis once (unreachable
   // is not an error: the tier starts marked down, reported through on_shared_tier_event).
-  // INVALID_ARGUMENT for a negative memory budget or a malformed redis_url (naming the wrong
-  // part, never showing the password); FAILED_PRECONDITION naming the directory when it cannot
-  // be created or written.
+  // A disk_dir that cannot be created, listed or written is not an error either: the cache
+  // runs without a disk tier (reported through on_disk_tier_event, kOff). INVALID_ARGUMENT for
+  // a negative memory budget or a malformed redis_url (naming the wrong part, never showing
+  // the password).
   static absl::StatusOr<std::unique_ptr<ResultCache>> Open(const ResultCacheOptions& options);
 
   // No call may be in progress.

@@ -1,0 +1,365 @@
+// Soak (issue 8): one inscribed process on loopback, N concurrent clients mixing Generate,
+// UpdateDeformation, Distance and DistanceStream for a fixed time, every loop bounded by a
+// deadline and an iteration cap so the run always ends by itself. Reports calls, errors (any
+// failed call, or an answer of the wrong size), p50/p99/max latency per RPC and the server's
+// resident memory at start (after warm-up), at the end and at its peak. Exit status 1 when any
+// call failed or the resident memory grew by more than the cache's memory budget (what the
+// server may legitimately keep) plus a fixed allowance for allocator slack.
+//
+//   soak_bench [--seconds S] [--clients N] [--cache-memory-bytes B] ...   (bench/run-soak)
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdint>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <mutex>
+#include <random>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "absl/strings/str_format.h"
+#include "deformation_sequences.h"
+#include "inscribe/client/client.h"
+#include "inscribe/mesh_io.h"
+#include "inscribe/mesh_validation.h"
+#include "support/inscribed_process.h"
+
+namespace inscribe {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+struct Options {
+  std::string inscribed = INSCRIBED;
+  std::string data_dir = INSCRIBE_SOURCE_DIR "/data";
+  std::vector<std::string> models = {"eight", "knot1", "cow", "fandisk", "elephant", "bunny00"};
+  double seconds = 600.0;
+  int clients = 16;
+  int jobs = 2;                                   // the server's --jobs
+  std::int64_t cache_memory_bytes = 64ll << 20;   // the server's --cache-memory-bytes
+  std::int64_t rss_allowance_bytes = 64ll << 20;  // allocator slack on top of the budget
+  int variants = 8;                               // voxel sizes per model (cache misses)
+  int batch = 200;                                // pose pairs per Distance call
+  int frames = 20;                                // frames per DistanceStream session
+  int pairs_per_frame = 8;
+};
+
+// The four RPCs the soak mixes, with their share of a client's iterations (percent).
+enum Rpc { kGenerate, kUpdateDeformation, kDistance, kDistanceStream, kRpcCount };
+constexpr const char* kRpcNames[kRpcCount] = {"Generate", "UpdateDeformation", "Distance",
+                                              "DistanceStream (session)"};
+constexpr int kRpcShare[kRpcCount] = {10, 20, 45, 25};
+
+struct Model {
+  std::string name;
+  Mesh mesh;
+  double extent = 0.0;  // largest bounding-box side
+  std::string mesh_sha256;
+  std::string base_key;  // sphere set of variant 0, with contacts: deformation reference
+};
+
+// Latencies and errors of one client thread, merged at the end (no sharing while running).
+struct Record {
+  std::vector<double> seconds[kRpcCount];
+  std::int64_t errors[kRpcCount] = {};
+};
+
+std::mutex error_mutex;
+std::int64_t printed_errors = 0;
+
+void Report(Record& record, Rpc rpc, const std::string& what, const absl::Status& status) {
+  ++record.errors[rpc];
+  std::lock_guard<std::mutex> lock(error_mutex);
+  if (printed_errors++ < 20) std::cerr << "soak: " << what << ": " << status << "\n";
+}
+
+// Resident and peak resident memory of `pid` in bytes (VmRSS, VmHWM of /proc/<pid>/status).
+struct Memory {
+  std::int64_t rss = 0, peak = 0;
+};
+Memory ProcessMemory(pid_t pid) {
+  Memory memory;
+  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
+  std::string key;
+  std::int64_t kib = 0;
+  std::string unit;
+  while (status >> key) {
+    if (key == "VmRSS:" && status >> kib >> unit) memory.rss = kib * 1024;
+    if (key == "VmHWM:" && status >> kib >> unit) memory.peak = kib * 1024;
+  }
+  return memory;
+}
+
+client::GenerateSettings Settings(const Model& model, int variant) {
+  client::GenerateSettings settings;
+  settings.voxel_size = model.extent / (16.0 + 2.0 * variant);  // 16..30 voxels along the side
+  settings.skip_quality = true;
+  return settings;
+}
+
+RigidPose RandomPose(std::mt19937_64& random, double scale) {
+  std::normal_distribution<double> normal;
+  RigidPose pose;
+  pose.rotation = Eigen::Quaterniond(normal(random), normal(random), normal(random), normal(random))
+                      .normalized();
+  pose.translation = Vector3(normal(random), normal(random), normal(random)) * scale;
+  return pose;
+}
+
+// One client: random RPCs until `deadline` (and at most `max_iterations`, so a clock problem
+// cannot make it run forever).
+void RunClient(const Options& options, const client::Client& client,
+               const std::vector<Model>& models, Clock::time_point deadline, std::uint64_t seed,
+               Record& record) {
+  std::mt19937_64 random(seed);
+  std::uniform_int_distribution<int> percent(0, 99);
+  std::uniform_int_distribution<std::size_t> pick(0, models.size() - 1);
+  const std::int64_t max_iterations = static_cast<std::int64_t>(options.seconds * 1000) + 100;
+  const std::vector<sequences::DeformationKind> kinds = sequences::AllDeformationKinds();
+  for (std::int64_t i = 0; i < max_iterations && Clock::now() < deadline; ++i) {
+    int roll = percent(random);
+    Rpc rpc = kGenerate;
+    while (roll >= kRpcShare[rpc]) roll -= kRpcShare[rpc], rpc = static_cast<Rpc>(rpc + 1);
+    const Model& a = models[pick(random)];
+    const Model& b = models[pick(random)];
+    const Clock::time_point start = Clock::now();
+    switch (rpc) {
+      case kGenerate: {
+        const int variant = std::uniform_int_distribution<int>(0, options.variants - 1)(random);
+        absl::StatusOr<client::GenerateResult> result =
+            client.Generate(a.mesh_sha256, Settings(a, variant));
+        if (!result.ok())
+          Report(record, rpc, "Generate " + a.name, result.status());
+        else if (result->spheres.spheres.empty()) {
+          Report(record, rpc, "Generate " + a.name, absl::InternalError("no spheres"));
+        }
+        break;
+      }
+      case kUpdateDeformation: {
+        const sequences::DeformationKind kind =
+            kinds[std::uniform_int_distribution<std::size_t>(0, kinds.size() - 1)(random)];
+        const double t = std::uniform_real_distribution<double>(0.05, 1.0)(random);
+        client::DeformationSettings settings;
+        settings.store = percent(random) < 25;  // some moved sets are cached too
+        absl::StatusOr<client::DeformationResult> result = client.UpdateDeformation(
+            a.mesh_sha256, a.base_key, sequences::Deform(a.mesh.vertices, kind, t), settings);
+        if (!result.ok()) Report(record, rpc, "UpdateDeformation " + a.name, result.status());
+        break;
+      }
+      case kDistance: {
+        std::vector<RigidPose> poses_b;
+        for (int k = 0; k < options.batch; ++k) poses_b.push_back(RandomPose(random, a.extent));
+        absl::StatusOr<client::DistanceBatchResult> result =
+            client.Distance(a.base_key, b.base_key, {RigidPose{}}, poses_b);
+        if (!result.ok())
+          Report(record, rpc, "Distance " + a.name, result.status());
+        else if (result->results.size() != poses_b.size()) {
+          Report(record, rpc, "Distance " + a.name, absl::InternalError("wrong answer count"));
+        }
+        break;
+      }
+      case kDistanceStream: {
+        absl::StatusOr<client::DistanceSession> session = client.OpenDistanceSession();
+        if (!session.ok()) {
+          Report(record, rpc, "OpenDistanceSession", session.status());
+          break;
+        }
+        absl::Status status;
+        for (int f = 0; f < options.frames && status.ok(); ++f) {
+          std::vector<client::PosePair> pairs;
+          for (int k = 0; k < options.pairs_per_frame; ++k) {
+            const Model& x = models[pick(random)];
+            const Model& y = models[pick(random)];
+            pairs.push_back({x.base_key, y.base_key, RandomPose(random, x.extent),
+                             RandomPose(random, x.extent)});
+          }
+          absl::StatusOr<std::vector<DistanceResult>> frame = session->Query(pairs);
+          if (!frame.ok())
+            status = frame.status();
+          else if (frame->size() != pairs.size())
+            status = absl::InternalError("frame size");
+        }
+        if (status.ok()) status = session->Close();
+        if (!status.ok()) Report(record, rpc, "DistanceStream", status);
+        break;
+      }
+      case kRpcCount:
+        break;
+    }
+    record.seconds[rpc].push_back(std::chrono::duration<double>(Clock::now() - start).count());
+  }
+}
+
+double Quantile(std::vector<double>& values, double q) {
+  if (values.empty()) return 0.0;
+  const std::size_t k = std::min(values.size() - 1, static_cast<std::size_t>(q * values.size()));
+  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(k), values.end());
+  return values[k];
+}
+
+double MiB(std::int64_t bytes) { return static_cast<double>(bytes) / (1 << 20); }
+
+int Run(const Options& options) {
+  const std::filesystem::path cache_dir =
+      std::filesystem::temp_directory_path() / ("inscribe-soak-" + std::to_string(getpid()));
+  std::filesystem::remove_all(cache_dir);
+  testing::InscribedProcess server(
+      options.inscribed, {"--listen", "127.0.0.1:0", "--jobs", std::to_string(options.jobs),
+                          "--log-level", "warn", "--cache-dir", cache_dir.string(),
+                          "--cache-memory-bytes", std::to_string(options.cache_memory_bytes)});
+  const std::string address = server.WaitUntilListening();
+  if (address.empty()) {
+    std::cerr << "soak: inscribed did not start:\n" << server.log() << "\n";
+    return 2;
+  }
+  server.DrainLogInBackground();
+  client::ClientOptions client_options;
+  client_options.default_timeout = std::chrono::minutes(5);
+  // One channel per client thread, as separate simulator processes would have.
+  std::vector<client::Client> clients;
+  for (int c = 0; c < options.clients; ++c) {
+    clients.emplace_back(client::MakeGrpcConnection(address), client_options);
+  }
+
+  // Warm-up: every mesh stored and its reference set generated once.
+  std::vector<Model> models;
+  for (const std::string& name : options.models) {
+    absl::StatusOr<Mesh> read = ReadMesh(options.data_dir + "/" + name + ".off");
+    absl::StatusOr<ValidatedMesh> prepared =
+        read.ok() ? PrepareMesh(*std::move(read)) : read.status();
+    if (!prepared.ok()) {
+      std::cerr << "soak: " << name << ": " << prepared.status() << " (scripts/fetch-meshes)\n";
+      return 2;
+    }
+    Model model{name, std::move(prepared->mesh), prepared->report.bbox.extent().maxCoeff(), "", ""};
+    absl::StatusOr<client::GenerateResult> base =
+        clients[0].Generate(model.mesh, Settings(model, 0));
+    if (!base.ok()) {
+      std::cerr << "soak: warm-up Generate " << name << ": " << base.status() << "\n";
+      return 2;
+    }
+    model.mesh_sha256 = base->mesh_sha256;
+    model.base_key = base->sphere_set_key;
+    models.push_back(std::move(model));
+  }
+  const Memory start_memory = ProcessMemory(server.pid());
+
+  std::cout << absl::StrFormat(
+      "# soak: %d clients, %.0f s, %d models, server --jobs %d --cache-memory-bytes %.0f MiB\n",
+      options.clients, options.seconds, models.size(), options.jobs,
+      MiB(options.cache_memory_bytes));
+  const Clock::time_point began = Clock::now();
+  const Clock::time_point deadline = began + std::chrono::duration_cast<Clock::duration>(
+                                                 std::chrono::duration<double>(options.seconds));
+  std::vector<Record> records(options.clients);
+  std::vector<std::thread> threads;
+  for (int c = 0; c < options.clients; ++c) {
+    threads.emplace_back(
+        [&, c] { RunClient(options, clients[c], models, deadline, 0x5eed + c, records[c]); });
+  }
+  // The server's memory once a minute (and the peak), while the clients run.
+  std::atomic<bool> done{false};
+  std::thread monitor([&] {
+    Clock::time_point next = began + std::chrono::minutes(1);
+    while (!done.load()) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(200));
+      if (Clock::now() >= next) {
+        next += std::chrono::minutes(1);
+        const Memory m = ProcessMemory(server.pid());
+        std::cout << absl::StrFormat("  %4.0f s: server RSS %.1f MiB (peak %.1f MiB)\n",
+                                     std::chrono::duration<double>(Clock::now() - began).count(),
+                                     MiB(m.rss), MiB(m.peak))
+                  << std::flush;
+      }
+    }
+  });
+  for (std::thread& thread : threads) thread.join();
+  done = true;
+  monitor.join();
+  const double elapsed = std::chrono::duration<double>(Clock::now() - began).count();
+  const Memory end_memory = ProcessMemory(server.pid());
+
+  std::cout << "\n| RPC | calls | errors | calls/s | p50 ms | p99 ms | max ms |\n"
+            << "|---|---:|---:|---:|---:|---:|---:|\n";
+  std::int64_t calls = 0, errors = 0;
+  for (int rpc = 0; rpc < kRpcCount; ++rpc) {
+    std::vector<double> all;
+    std::int64_t rpc_errors = 0;
+    for (Record& r : records) {
+      all.insert(all.end(), r.seconds[rpc].begin(), r.seconds[rpc].end());
+      rpc_errors += r.errors[rpc];
+    }
+    const double max = all.empty() ? 0.0 : *std::max_element(all.begin(), all.end());
+    std::cout << absl::StrFormat("| %s | %d | %d | %.1f | %.1f | %.1f | %.1f |\n", kRpcNames[rpc],
+                                 all.size(), rpc_errors, all.size() / elapsed,
+                                 1e3 * Quantile(all, 0.5), 1e3 * Quantile(all, 0.99), 1e3 * max);
+    calls += static_cast<std::int64_t>(all.size());
+    errors += rpc_errors;
+  }
+  absl::StatusOr<client::ServerCacheStats> stats = clients[0].CacheStats();
+  if (stats.ok()) {
+    std::cout << absl::StrFormat(
+        "\ncache: %d entries, %.1f MiB in memory; %d computations, %d evictions, %d memory hits, "
+        "%d disk hits, %d disk entries\n",
+        stats->entries, MiB(stats->bytes), stats->computations, stats->evictions,
+        stats->memory_hits, stats->disk_hits, stats->disk_entries);
+  } else {
+    ++errors;
+    std::cerr << "soak: CacheStats: " << stats.status() << "\n";
+  }
+  const std::int64_t growth = end_memory.rss - start_memory.rss;
+  const std::int64_t allowed = options.cache_memory_bytes + options.rss_allowance_bytes;
+  std::cout << absl::StrFormat(
+      "server RSS: start %.1f MiB, end %.1f MiB, growth %+.1f MiB (allowed %.1f: cache budget "
+      "%.1f + %.1f), peak %.1f MiB\n",
+      MiB(start_memory.rss), MiB(end_memory.rss), MiB(growth), MiB(allowed),
+      MiB(options.cache_memory_bytes), MiB(options.rss_allowance_bytes), MiB(end_memory.peak));
+  std::cout << absl::StrFormat("total: %d calls in %.0f s, %d errors\n", calls, elapsed, errors);
+
+  const int stopped = server.StopWith(SIGTERM, std::chrono::seconds(30));
+  std::filesystem::remove_all(cache_dir);
+  if (stopped != 0) {
+    std::cerr << "soak: inscribed did not exit cleanly on SIGTERM (wait status " << stopped
+              << ")\n";
+    return 1;
+  }
+  if (errors > 0) return 1;
+  if (growth > allowed) {
+    std::cerr << "soak: server memory grew by more than the cache budget\n";
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace
+}  // namespace inscribe
+
+int main(int argc, char** argv) {
+  inscribe::Options options;
+  CLI::App app{"soak: concurrent clients mixing RPCs against one inscribed on loopback"};
+  app.add_option("--seconds", options.seconds, "how long the clients run")->capture_default_str();
+  app.add_option("--clients", options.clients, "concurrent clients (threads, one channel each)")
+      ->check(CLI::Range(1, 256))
+      ->capture_default_str();
+  app.add_option("--jobs", options.jobs, "the server's --jobs")->capture_default_str();
+  app.add_option("--cache-memory-bytes", options.cache_memory_bytes,
+                 "the server's --cache-memory-bytes")
+      ->capture_default_str();
+  app.add_option("--rss-allowance-bytes", options.rss_allowance_bytes,
+                 "resident-memory growth allowed on top of the cache budget")
+      ->capture_default_str();
+  app.add_option("--models", options.models, "demo meshes (data/NAME.off)")->delimiter(',');
+  app.add_option("--inscribed", options.inscribed, "the server binary")->capture_default_str();
+  app.add_option("--data-dir", options.data_dir, "where the meshes are")->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
+  return inscribe::Run(options);
+}

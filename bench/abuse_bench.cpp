@@ -16,7 +16,6 @@
 #include <atomic>
 #include <chrono>
 #include <cstdlib>
-#include <fstream>
 #include <future>
 #include <iostream>
 #include <limits>
@@ -61,13 +60,7 @@ void Fail(const std::string& what) {
 double Seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
 
 // Peak resident memory of `pid` (VmHWM), bytes.
-std::int64_t PeakRss(pid_t pid) {
-  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
-  for (std::string line; std::getline(status, line);) {
-    if (line.rfind("VmHWM:", 0) == 0) return 1024 * std::stoll(line.substr(6));
-  }
-  return -1;
-}
+std::int64_t PeakRss(pid_t pid) { return testing::ReadProcessMemory(pid).peak_resident; }
 
 struct Latencies {
   std::vector<double> us;

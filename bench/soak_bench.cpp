@@ -17,7 +17,6 @@
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <map>
 #include <mutex>
@@ -80,23 +79,6 @@ void Report(Record& record, Rpc rpc, const std::string& what, const absl::Status
   ++record.errors[rpc];
   std::lock_guard<std::mutex> lock(error_mutex);
   if (printed_errors++ < 20) std::cerr << "soak: " << what << ": " << status << "\n";
-}
-
-// Resident and peak resident memory of `pid` in bytes (VmRSS, VmHWM of /proc/<pid>/status).
-struct Memory {
-  std::int64_t rss = 0, peak = 0;
-};
-Memory ProcessMemory(pid_t pid) {
-  Memory memory;
-  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
-  std::string key;
-  std::int64_t kib = 0;
-  std::string unit;
-  while (status >> key) {
-    if (key == "VmRSS:" && status >> kib >> unit) memory.rss = kib * 1024;
-    if (key == "VmHWM:" && status >> kib >> unit) memory.peak = kib * 1024;
-  }
-  return memory;
 }
 
 client::GenerateSettings Settings(const Model& model, int variant) {
@@ -251,7 +233,7 @@ int Run(const Options& options) {
     model.base_key = base->sphere_set_key;
     models.push_back(std::move(model));
   }
-  const Memory start_memory = ProcessMemory(server.pid());
+  const testing::ProcessMemory start_memory = testing::ReadProcessMemory(server.pid());
 
   std::cout << absl::StrFormat(
       "# soak: %d clients, %.0f s, %d models, server --jobs %d --cache-memory-bytes %.0f MiB\n",
@@ -274,10 +256,10 @@ int Run(const Options& options) {
       std::this_thread::sleep_for(std::chrono::milliseconds(200));
       if (Clock::now() >= next) {
         next += std::chrono::minutes(1);
-        const Memory m = ProcessMemory(server.pid());
+        const testing::ProcessMemory m = testing::ReadProcessMemory(server.pid());
         std::cout << absl::StrFormat("  %4.0f s: server RSS %.1f MiB (peak %.1f MiB)\n",
                                      std::chrono::duration<double>(Clock::now() - began).count(),
-                                     MiB(m.rss), MiB(m.peak))
+                                     MiB(m.resident), MiB(m.peak_resident))
                   << std::flush;
       }
     }
@@ -286,7 +268,7 @@ int Run(const Options& options) {
   done = true;
   monitor.join();
   const double elapsed = std::chrono::duration<double>(Clock::now() - began).count();
-  const Memory end_memory = ProcessMemory(server.pid());
+  const testing::ProcessMemory end_memory = testing::ReadProcessMemory(server.pid());
 
   std::cout << "\n| RPC | calls | errors | calls/s | p50 ms | p99 ms | max ms |\n"
             << "|---|---:|---:|---:|---:|---:|---:|\n";
@@ -316,13 +298,14 @@ int Run(const Options& options) {
     ++errors;
     std::cerr << "soak: CacheStats: " << stats.status() << "\n";
   }
-  const std::int64_t growth = end_memory.rss - start_memory.rss;
+  const std::int64_t growth = end_memory.resident - start_memory.resident;
   const std::int64_t allowed = options.cache_memory_bytes + options.rss_allowance_bytes;
   std::cout << absl::StrFormat(
       "server RSS: start %.1f MiB, end %.1f MiB, growth %+.1f MiB (allowed %.1f: cache budget "
       "%.1f + %.1f), peak %.1f MiB\n",
-      MiB(start_memory.rss), MiB(end_memory.rss), MiB(growth), MiB(allowed),
-      MiB(options.cache_memory_bytes), MiB(options.rss_allowance_bytes), MiB(end_memory.peak));
+      MiB(start_memory.resident), MiB(end_memory.resident), MiB(growth), MiB(allowed),
+      MiB(options.cache_memory_bytes), MiB(options.rss_allowance_bytes),
+      MiB(end_memory.peak_resident));
   std::cout << absl::StrFormat("total: %d calls in %.0f s, %d errors\n", calls, elapsed, errors);
 
   const int stopped = server.StopWith(SIGTERM, std::chrono::seconds(30));

@@ -12,7 +12,6 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
-#include <fstream>
 #include <future>
 #include <limits>
 #include <memory>
@@ -60,14 +59,7 @@ class Server {
   const std::shared_ptr<grpc::Channel>& channel() const { return channel_; }
 
   // Peak resident memory of the process so far (VmHWM), bytes; -1 if unreadable.
-  std::int64_t PeakRss() const {
-    std::ifstream status("/proc/" + std::to_string(process_->pid()) + "/status");
-    std::string line;
-    while (std::getline(status, line)) {
-      if (line.rfind("VmHWM:", 0) == 0) return 1024 * std::stoll(line.substr(6));
-    }
-    return -1;
-  }
+  std::int64_t PeakRss() const { return testing::ReadProcessMemory(process_->pid()).peak_resident; }
 
  private:
   std::unique_ptr<testing::InscribedProcess> process_;

@@ -23,7 +23,6 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <functional>
 #include <iostream>
 #include <iterator>
@@ -430,16 +429,6 @@ TEST(CrashFaults, KillDuringWritesNeverLeavesAPartialEntry) {
 
 // --- d. Cancelled and abandoned calls --------------------------------------------------------
 
-// Resident memory of `pid`, bytes (/proc/<pid>/status VmRSS).
-std::int64_t ResidentBytes(pid_t pid) {
-  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
-  std::string line;
-  while (std::getline(status, line)) {
-    if (line.rfind("VmRSS:", 0) == 0) return 1024 * std::stoll(line.substr(6));
-  }
-  return -1;
-}
-
 // A slow Generate (a fine grid on a real mesh) started on the raw stub and cancelled once its
 // progress passes `cancel_at`.
 void GenerateAndCancel(const std::string& address, const std::string& mesh_sha256,
@@ -485,7 +474,7 @@ TEST(ClientFaults, CancelledGenerateAndKilledStreamClientFreeTheWork) {
   absl::StatusOr<PutMeshResult> stored = client.PutMesh(mesh);
   ASSERT_TRUE(stored.ok()) << stored.status();
   const auto in_flight = [&] { return server.Metric("inscribe_jobs_in_flight"); };
-  const auto rss = [&] { return ResidentBytes(server.pid()); };
+  const auto rss = [&] { return testing::ReadProcessMemory(server.pid()).resident; };
 
   // Each cycle: a Generate that would need far more time than it gets, cancelled mid-way; then
   // a stream client killed in the middle of a heavy frame (100,000 pose pairs: ~25 MB on the

@@ -8,6 +8,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <fstream>
+#include <string>
 #include <utility>
 
 extern char** environ;
@@ -101,6 +103,17 @@ int InscribedProcess::StopWith(int signal, std::chrono::seconds timeout) {
 std::string InscribedProcess::log() const {
   std::lock_guard<std::mutex> lock(log_mutex_);
   return log_;
+}
+
+ProcessMemory ReadProcessMemory(pid_t pid) {
+  ProcessMemory memory;
+  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
+  for (std::string line; std::getline(status, line);) {
+    // "VmRSS:\t  123456 kB"
+    if (line.rfind("VmRSS:", 0) == 0) memory.resident = 1024 * std::stoll(line.substr(6));
+    if (line.rfind("VmHWM:", 0) == 0) memory.peak_resident = 1024 * std::stoll(line.substr(6));
+  }
+  return memory;
 }
 
 int UnusedLoopbackPort() {

@@ -5,6 +5,7 @@
 #include <sys/types.h>
 
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <mutex>
 #include <string>
@@ -51,6 +52,13 @@ class InscribedProcess {
   std::string log_;  // guarded by log_mutex_
   std::thread drain_;
 };
+
+// Memory of a process from /proc/<pid>/status, bytes; -1 where unreadable (e.g. it exited).
+struct ProcessMemory {
+  std::int64_t resident = -1;       // VmRSS: resident now
+  std::int64_t peak_resident = -1;  // VmHWM: the most it has been resident so far
+};
+ProcessMemory ReadProcessMemory(pid_t pid);
 
 // A loopback port that was free a moment ago (bound by the kernel's choice, then released):
 // a server address nothing listens on, for unreachable-server tests.

@@ -115,6 +115,10 @@ std::vector<std::pair<WeightedPoint, std::int32_t>> PaddingPoints(
   const Vector3 mid = (lo + hi) / 2;
   double reach = 0.0;
   for (const Sphere& b : balls) reach = std::max(reach, (b.center - mid).norm() + b.radius);
+  // Further out is as good (the padding only has to lie outside every ball), and it must be
+  // far enough from `mid` to survive rounding: balls 1e-185 across near (1, 2, 1) would put all
+  // four padding points on `mid` and leave the triangulation flat (found by fuzzing).
+  reach = std::max(reach, 1e-6 * mid.cwiseAbs().maxCoeff());
   const double corners[4][3] = {{1, 1, 1}, {1, -1, -1}, {-1, 1, -1}, {-1, -1, 1}};
   std::vector<std::pair<WeightedPoint, std::int32_t>> out;
   for (const auto& c : corners) {
@@ -208,6 +212,10 @@ absl::StatusOr<DualComplex> ComputeDualComplex(const std::vector<Sphere>& balls)
     if (triangulation.dimension() < 3) {
       const auto padding = PaddingPoints(balls);
       triangulation.insert(padding.begin(), padding.end());
+    }
+    // CGAL's alpha shape classifies nothing below dimension 3 (reading it then is undefined).
+    if (triangulation.dimension() < 3) {
+      return absl::InternalError("dual complex: the padded triangulation is not 3-dimensional");
     }
     const AlphaShape shape(triangulation, 0.0);  // takes the triangulation's content
     if (!ExtractComplex(shape, &complex)) {

@@ -380,6 +380,18 @@ TEST(UnionVolume, RejectsAComplexWithIndicesOutOfRange) {
       << v.status();
 }
 
+// Found by fuzzing (UpdateDeformation with bounds on a mesh collapsed to ~1e-185): balls far
+// smaller than the ulp of their position used to leave the padded triangulation flat, and CGAL's
+// alpha shape then read unclassified vertices (UBSan: invalid enum value).
+TEST(UnionVolume, TinyBallsFarFromTheOriginAreMeasured) {
+  for (const double r : {1e-185, 1e-20}) {
+    const std::vector<Sphere> balls = {Ball(1.1, 2, 0.06875, r), Ball(1.1, 2, 0.06875, r / 2)};
+    const absl::StatusOr<double> v = UnionVolume(balls);
+    ASSERT_TRUE(v.ok()) << v.status();
+    EXPECT_NEAR(*v, BallVolume(r), 1e-12 * BallVolume(r));  // 0 for 1e-185 (r^3 underflows)
+  }
+}
+
 // ---- DualComplex.
 
 TEST(DualComplex, SingleBallAndTwoBalls) {

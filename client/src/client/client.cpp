@@ -283,7 +283,10 @@ absl::StatusOr<DeformationResult> Client::UpdateDeformation(const std::string& m
   result.sphere_set_key = std::move(*response->mutable_sphere_set_key());
   // The wire has no presence bit for the bounds: they are there when they were asked for.
   if (settings.bounds) {
-    DeformationResult::Bounds& bounds = result.bounds.emplace();
+    // (Assigned, not emplace(): clang rejects default-constructing a nested struct with member
+    // initialisers through std::optional::emplace.)
+    result.bounds = DeformationResult::Bounds{};
+    DeformationResult::Bounds& bounds = *result.bounds;
     bounds.nerr_lower = response->nerr_lower();
     bounds.nerr_upper = response->nerr_upper();
     bounds.nerr_is_exact = response->nerr_is_exact();

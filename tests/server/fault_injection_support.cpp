@@ -18,6 +18,7 @@
 #include <thread>
 #include <utility>
 
+#include "support/inscribed_process.h"
 #include "support/sphere_sets.h"
 
 extern char** environ;
@@ -44,28 +45,6 @@ pid_t Spawn(std::vector<std::string> argv, FILE** out) {
   ::close(fds[1]);
   *out = ::fdopen(fds[0], "r");
   return pid;
-}
-
-// GET /metrics on loopback; the body, or empty on any failure. The endpoint closes the
-// connection after one response.
-std::string Scrape(int port) {
-  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-  if (fd < 0) return "";
-  sockaddr_in address{};
-  address.sin_family = AF_INET;
-  address.sin_port = htons(static_cast<std::uint16_t>(port));
-  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  std::string response;
-  const std::string request = "GET /metrics HTTP/1.0\r\nHost: 127.0.0.1\r\n\r\n";
-  if (::connect(fd, reinterpret_cast<sockaddr*>(&address), sizeof address) == 0 &&
-      ::write(fd, request.data(), request.size()) == static_cast<ssize_t>(request.size())) {
-    char buffer[4096];
-    ssize_t got;
-    while ((got = ::read(fd, buffer, sizeof buffer)) > 0) response.append(buffer, got);
-  }
-  ::close(fd);
-  const std::size_t body = response.find("\r\n\r\n");
-  return body == std::string::npos ? "" : response.substr(body + 4);
 }
 
 }  // namespace
@@ -116,7 +95,7 @@ Server::Server(std::vector<std::string> args, const std::vector<std::string>& pr
 
 double Server::Metric(const std::string& name) const {
   if (metrics_port_ == 0) return -1;
-  std::istringstream body(Scrape(metrics_port_));
+  std::istringstream body(testing::ScrapeMetrics(metrics_port_));
   std::string line;
   while (std::getline(body, line)) {
     if (line.rfind(name + " ", 0) == 0) return std::strtod(line.c_str() + name.size() + 1, nullptr);

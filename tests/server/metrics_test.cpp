@@ -21,40 +21,13 @@
 #include "absl/strings/strip.h"
 #include "inscribe/client/client.h"
 #include "inscribe/server/inscribe_server.h"
+#include "support/inscribed_process.h"
 #include "support/synthetic_meshes.h"
 
 namespace inscribe::server {
 namespace {
 
 using ::testing::HasSubstr;
-
-// Sends `request` over a plain socket and returns all the server sent back (it closes the
-// connection after one response); empty on any failure.
-std::string Exchange(int port, const std::string& request) {
-  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-  if (fd < 0) return "";
-  sockaddr_in address{};
-  address.sin_family = AF_INET;
-  address.sin_port = htons(static_cast<std::uint16_t>(port));
-  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  std::string response;
-  if (::connect(fd, reinterpret_cast<sockaddr*>(&address), sizeof address) == 0) {
-    if (::write(fd, request.data(), request.size()) == static_cast<ssize_t>(request.size())) {
-      char buffer[4096];
-      ssize_t got;
-      while ((got = ::read(fd, buffer, sizeof buffer)) > 0) response.append(buffer, got);
-    }
-  }
-  ::close(fd);
-  return response;
-}
-
-// GET /metrics; the body, or empty on any failure.
-std::string Scrape(int port) {
-  const std::string response = Exchange(port, "GET /metrics HTTP/1.0\r\nHost: 127.0.0.1\r\n\r\n");
-  const std::size_t body = response.find("\r\n\r\n");
-  return body == std::string::npos ? "" : response.substr(body + 4);
-}
 
 // One sample of the text exposition format: name, labels, value.
 struct Sample {
@@ -133,7 +106,7 @@ TEST_F(MetricsTest, CountsEachCallByMethodAndCode) {
   EXPECT_EQ(client_->GetSphereSet("spheres/v1/" + std::string(64, '0')).status().code(),
             absl::StatusCode::kNotFound);
 
-  const std::vector<Sample> samples = Parse(Scrape(server_->metrics_port()));
+  const std::vector<Sample> samples = Parse(testing::ScrapeMetrics(server_->metrics_port()));
   ASSERT_FALSE(samples.empty());
   // Generate(mesh) uploads first: two PutMesh calls in all, two Generate.
   EXPECT_EQ(Value(samples, "inscribe_rpc_calls_total", {{"method", "PutMesh"}, {"code", "OK"}}), 2);
@@ -169,7 +142,8 @@ TEST_F(MetricsTest, CountsEachCallByMethodAndCode) {
   double in_flight = Value(samples, "inscribe_jobs_in_flight");
   for (int i = 0; i < 100 && in_flight != 0; ++i) {
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    in_flight = Value(Parse(Scrape(server_->metrics_port())), "inscribe_jobs_in_flight");
+    in_flight =
+        Value(Parse(testing::ScrapeMetrics(server_->metrics_port())), "inscribe_jobs_in_flight");
   }
   EXPECT_EQ(in_flight, 0);
   EXPECT_EQ(Value(samples, "inscribe_redis_available"), 0);  // none configured
@@ -183,7 +157,7 @@ TEST_F(MetricsTest, CacheFiguresAgreeWithCacheStats) {
   for (int i = 0; i < 3; ++i) ASSERT_TRUE(client_->Generate(cube, settings).ok());
   absl::StatusOr<client::ServerCacheStats> stats = client_->CacheStats();
   ASSERT_TRUE(stats.ok()) << stats.status();
-  const std::vector<Sample> samples = Parse(Scrape(server_->metrics_port()));
+  const std::vector<Sample> samples = Parse(testing::ScrapeMetrics(server_->metrics_port()));
 
   EXPECT_GE(stats->memory_hits, 2);  // the second and third Generate at least
   EXPECT_EQ(Value(samples, "inscribe_cache_lookups_total", {{"result", "memory"}}),
@@ -207,7 +181,7 @@ TEST_F(MetricsTest, ConcurrentCallsAreEachCountedOnce) {
     });
   }
   for (std::thread& thread : threads) thread.join();
-  const std::vector<Sample> samples = Parse(Scrape(server_->metrics_port()));
+  const std::vector<Sample> samples = Parse(testing::ScrapeMetrics(server_->metrics_port()));
   EXPECT_EQ(Value(samples, "inscribe_rpc_calls_total", {{"method", "InspectMesh"}, {"code", "OK"}}),
             kThreads * kCalls);
   EXPECT_EQ(Value(samples, "inscribe_rpc_queue_seconds_count", {{"method", "InspectMesh"}}),
@@ -216,13 +190,15 @@ TEST_F(MetricsTest, ConcurrentCallsAreEachCountedOnce) {
 
 TEST_F(MetricsTest, AnswersOnlyGetMetricsAndSurvivesBadClients) {
   const int port = server_->metrics_port();
-  EXPECT_THAT(Exchange(port, "GET /other HTTP/1.1\r\n\r\n"), ::testing::StartsWith("HTTP/1.1 404"));
-  EXPECT_THAT(Exchange(port, "POST /metrics HTTP/1.1\r\n\r\n"),
+  EXPECT_THAT(testing::ExchangeOnLoopback(port, "GET /other HTTP/1.1\r\n\r\n"),
+              ::testing::StartsWith("HTTP/1.1 404"));
+  EXPECT_THAT(testing::ExchangeOnLoopback(port, "POST /metrics HTTP/1.1\r\n\r\n"),
               ::testing::StartsWith("HTTP/1.1 405"));
-  EXPECT_THAT(Exchange(port, std::string("\x01\xff garbage\r\n\r\n")),
+  EXPECT_THAT(testing::ExchangeOnLoopback(port, std::string("\x01\xff garbage\r\n\r\n")),
               ::testing::StartsWith("HTTP/1.1 400"));
-  EXPECT_THAT(Exchange(port, std::string(20000, 'A')), ::testing::StartsWith("HTTP/1.1 400"));
-  const std::string head = Exchange(port, "HEAD /metrics HTTP/1.1\r\n\r\n");
+  EXPECT_THAT(testing::ExchangeOnLoopback(port, std::string(20000, 'A')),
+              ::testing::StartsWith("HTTP/1.1 400"));
+  const std::string head = testing::ExchangeOnLoopback(port, "HEAD /metrics HTTP/1.1\r\n\r\n");
   EXPECT_THAT(head, ::testing::StartsWith("HTTP/1.1 200"));
   EXPECT_THAT(head, ::testing::EndsWith("\r\n\r\n"));  // headers only
 
@@ -234,7 +210,7 @@ TEST_F(MetricsTest, AnswersOnlyGetMetricsAndSurvivesBadClients) {
   address.sin_port = htons(static_cast<std::uint16_t>(port));
   address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
   ASSERT_EQ(::connect(idle, reinterpret_cast<sockaddr*>(&address), sizeof address), 0);
-  EXPECT_THAT(Scrape(port), HasSubstr("inscribe_jobs_capacity 17"));
+  EXPECT_THAT(testing::ScrapeMetrics(port), HasSubstr("inscribe_jobs_capacity 17"));
   ::close(idle);
 }
 

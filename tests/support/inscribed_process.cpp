@@ -116,6 +116,31 @@ ProcessMemory ReadProcessMemory(pid_t pid) {
   return memory;
 }
 
+std::string ExchangeOnLoopback(int port, const std::string& request) {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  if (fd < 0) return "";
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_port = htons(static_cast<std::uint16_t>(port));
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  std::string response;
+  if (::connect(fd, reinterpret_cast<sockaddr*>(&address), sizeof address) == 0 &&
+      ::write(fd, request.data(), request.size()) == static_cast<ssize_t>(request.size())) {
+    char buffer[4096];
+    ssize_t got;
+    while ((got = ::read(fd, buffer, sizeof buffer)) > 0) response.append(buffer, got);
+  }
+  ::close(fd);
+  return response;
+}
+
+std::string ScrapeMetrics(int port) {
+  const std::string response =
+      ExchangeOnLoopback(port, "GET /metrics HTTP/1.0\r\nHost: 127.0.0.1\r\n\r\n");
+  const std::size_t body = response.find("\r\n\r\n");
+  return body == std::string::npos ? "" : response.substr(body + 4);
+}
+
 int UnusedLoopbackPort() {
   const int fd = socket(AF_INET, SOCK_STREAM, 0);
   sockaddr_in address{};

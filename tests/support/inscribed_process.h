@@ -60,6 +60,14 @@ struct ProcessMemory {
 };
 ProcessMemory ReadProcessMemory(pid_t pid);
 
+// Sends `request` to 127.0.0.1:`port` over a plain socket and returns all the server sent back
+// until it closed the connection (the metrics endpoint closes after one response); empty on
+// any failure.
+std::string ExchangeOnLoopback(int port, const std::string& request);
+
+// GET /metrics from 127.0.0.1:`port`: the response body, or empty on any failure.
+std::string ScrapeMetrics(int port);
+
 // A loopback port that was free a moment ago (bound by the kernel's choice, then released):
 // a server address nothing listens on, for unreachable-server tests.
 int UnusedLoopbackPort();

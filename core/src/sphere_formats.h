@@ -63,6 +63,10 @@ absl::StatusOr<SphereFile> ParseCsvSphereFile(absl::string_view bytes);
 std::string FormatCsvSphereFile(const SphereFile& file, bool header);
 
 std::string FormatObjSphereFile(const SphereFile& file, int subdivision);
+
+// kYaml: one link of a cuRobo collision_spheres block (see SphereFileReadOptions::yaml_link);
+// the writer expects a link name FormatCuroboYaml accepts.
+absl::StatusOr<SphereFile> ParseYamlSphereFile(absl::string_view bytes, const std::string& link);
 std::string FormatYamlSphereFile(const SphereFile& file, const std::string& link_name);
 
 }  // namespace inscribe::internal

@@ -1,5 +1,4 @@
-// Write-only sphere files for other programs: OBJ meshes of the spheres (viewers) and
-// cuRobo-style YAML collision spheres (robot configurations).
+// Write-only sphere files for other programs: OBJ meshes of the spheres (viewers).
 #include <array>
 #include <cmath>
 #include <map>
@@ -62,17 +61,6 @@ UnitIcosphere MakeUnitIcosphere(int levels) {
   return s;
 }
 
-// A YAML 1.1 float (PyYAML's resolver wants a '.' in the mantissa: "1e+22" would be a
-// string, "1.0e+22" is a float), still the shortest round-trip digits.
-std::string YamlDouble(double value) {
-  std::string s = FormatDouble(value);
-  if (s.find('.') == std::string::npos) {
-    const std::size_t e = s.find('e');
-    s.insert(e == std::string::npos ? s.size() : e, ".0");
-  }
-  return s;
-}
-
 }  // namespace
 
 std::string FormatObjSphereFile(const SphereFile& file, int subdivision) {
@@ -95,19 +83,6 @@ std::string FormatObjSphereFile(const SphereFile& file, int subdivision) {
       absl::StrAppend(&out, "f ", base + a, " ", base + b, " ", base + c, "\n");
     }
     base += unit.vertices.size();
-  }
-  return out;
-}
-
-std::string FormatYamlSphereFile(const SphereFile& file, const std::string& link_name) {
-  std::string out = absl::StrCat("# inscribe spheres: ", file.set.spheres.size(), " spheres");
-  if (!file.mesh_sha256.empty()) absl::StrAppend(&out, ", mesh ", file.mesh_sha256);
-  absl::StrAppend(&out, "\ncollision_spheres:\n  ", link_name, ":",
-                  file.set.spheres.empty() ? " []\n" : "\n");
-  for (const Sphere& s : file.set.spheres) {
-    absl::StrAppend(&out, "    - \"center\": [", YamlDouble(s.center.x()), ", ",
-                    YamlDouble(s.center.y()), ", ", YamlDouble(s.center.z()), "]\n",
-                    "      \"radius\": ", YamlDouble(s.radius), "\n");
   }
   return out;
 }

@@ -151,7 +151,8 @@ absl::Status Prefixed(const absl::Status& status, absl::string_view what) {
   return absl::Status(status.code(), absl::StrCat(what, ": ", status.message()));
 }
 
-// The format of a file whose extension says nothing: JSON starts with '{'; a .sph file's first
+// The format of a file whose extension says nothing: JSON starts with '{'; YAML's first
+// meaningful line is a key ending in ':' (collision_spheres:, robot_cfg:); a .sph file's first
 // line is two integers; anything else with a comma on its first meaningful line is CSV.
 absl::StatusOr<SphereFileFormat> SniffFormat(absl::string_view bytes) {
   absl::string_view first;
@@ -162,6 +163,7 @@ absl::StatusOr<SphereFileFormat> SniffFormat(absl::string_view bytes) {
   });
   if (first.size() >= 3 && first.substr(0, 3) == "\xEF\xBB\xBF") first.remove_prefix(3);
   if (!first.empty() && first[0] == '{') return SphereFileFormat::kJson;
+  if (first == "---" || (!first.empty() && first.back() == ':')) return SphereFileFormat::kYaml;
   if (first.find(',') != absl::string_view::npos) return SphereFileFormat::kCsv;
   const bool only_digits_and_blanks =
       !first.empty() && std::all_of(first.begin(), first.end(), [](char c) {
@@ -174,7 +176,7 @@ absl::StatusOr<SphereFileFormat> SniffFormat(absl::string_view bytes) {
   }
   return absl::InvalidArgumentError(
       "cannot tell the sphere file format from the extension or the contents (expected json, "
-      "sph or csv)");
+      "yaml, sph or csv)");
 }
 
 // Messages without a prefix; the callers add "<format> data" or the path.
@@ -187,8 +189,9 @@ absl::StatusOr<SphereFile> ParseReadable(absl::string_view bytes, SphereFileForm
       return internal::ParseSphSphereFile(bytes, options.sph_level);
     case SphereFileFormat::kCsv:
       return internal::ParseCsvSphereFile(bytes);
-    case SphereFileFormat::kObj:
     case SphereFileFormat::kYaml:
+      return internal::ParseYamlSphereFile(bytes, options.yaml_link);
+    case SphereFileFormat::kObj:
       break;
   }
   return absl::InvalidArgumentError(
@@ -238,8 +241,7 @@ absl::StatusOr<SphereFileFormat> SphereFileFormatFromPath(const std::string& pat
 }
 
 bool IsReadableSphereFileFormat(SphereFileFormat format) {
-  return format == SphereFileFormat::kJson || format == SphereFileFormat::kSph ||
-         format == SphereFileFormat::kCsv;
+  return format != SphereFileFormat::kObj;
 }
 
 absl::StatusOr<std::string> FormatSphereFile(const SphereFile& file, SphereFileFormat format,

@@ -247,7 +247,7 @@ TEST(SphereFileErrors, Files) {
   std::ofstream(dir / "s.obj") << "v 0 0 0\n";
   EXPECT_THAT(Message(ReadSphereFile((dir / "s.obj").string())),
               HasSubstr("s.obj: obj sphere files are write-only"));
-  EXPECT_THAT(Message(ParseSphereFile("", SphereFileFormat::kYaml)), HasSubstr("write-only"));
+  EXPECT_THAT(Message(ParseSphereFile("", SphereFileFormat::kObj)), HasSubstr("write-only"));
   std::ofstream(dir / "bad.csv") << "0,0,0,1\n0,0,0\n";
   EXPECT_THAT(Message(ReadSphereFile((dir / "bad.csv").string())),
               HasSubstr("bad.csv: line 2: expected 4 numbers x,y,z,r, found 3"));

@@ -161,9 +161,10 @@ TEST(SphereFileRoundTrip, JsonIsBitExactForEveryField) {
   EXPECT_TRUE(std::holds_alternative<double>(back->params[0].second));
 }
 
-TEST(SphereFileRoundTrip, CsvAndSphAreBitExactForSpheres) {
+TEST(SphereFileRoundTrip, CsvSphAndYamlAreBitExactForSpheres) {
   const SphereFile original = RandomBits(2000, 7);
-  for (SphereFileFormat format : {SphereFileFormat::kCsv, SphereFileFormat::kSph}) {
+  for (SphereFileFormat format :
+       {SphereFileFormat::kCsv, SphereFileFormat::kSph, SphereFileFormat::kYaml}) {
     SCOPED_TRACE(SphereFileFormatName(format));
     for (bool header : {true, false}) {
       SphereFileWriteOptions options;
@@ -180,8 +181,8 @@ TEST(SphereFileRoundTrip, CsvAndSphAreBitExactForSpheres) {
 }
 
 TEST(SphereFileRoundTrip, EmptySetInEveryReadableFormat) {
-  for (SphereFileFormat format :
-       {SphereFileFormat::kJson, SphereFileFormat::kCsv, SphereFileFormat::kSph}) {
+  for (SphereFileFormat format : {SphereFileFormat::kJson, SphereFileFormat::kCsv,
+                                  SphereFileFormat::kSph, SphereFileFormat::kYaml}) {
     absl::StatusOr<std::string> bytes = FormatSphereFile(SphereFile{}, format);
     ASSERT_TRUE(bytes.ok()) << bytes.status();
     absl::StatusOr<SphereFile> back = ParseSphereFile(*bytes, format);
@@ -410,8 +411,8 @@ TEST_F(SphereFileOnDisk, WritesByExtensionAndReadsBack) {
 
 TEST_F(SphereFileOnDisk, SniffsUnknownExtensions) {
   const SphereFile original = Small();
-  for (SphereFileFormat format :
-       {SphereFileFormat::kJson, SphereFileFormat::kSph, SphereFileFormat::kCsv}) {
+  for (SphereFileFormat format : {SphereFileFormat::kJson, SphereFileFormat::kSph,
+                                  SphereFileFormat::kCsv, SphereFileFormat::kYaml}) {
     SCOPED_TRACE(SphereFileFormatName(format));
     SphereFileWriteOptions options;
     options.format = format;

@@ -1,6 +1,6 @@
-// libFuzzer target: the sphere-file readers. The first byte picks the format (value % 3: json,
-// sph, csv) and, for .sph, the level read (bits 2-3: deepest, 0, 1, 2); the rest goes through
-// ParseSphereFile. A file that parses must keep sphere_io.h's promises (finite spheres with
+// libFuzzer target: the sphere-file readers. The first byte picks the format (value % 4: json,
+// sph, csv, cuRobo yaml) and, for .sph, the level read (bits 2-3: deepest, 0, 1, 2); the rest goes
+// through ParseSphereFile. A file that parses must keep sphere_io.h's promises (finite spheres with
 // radius > 0, contacts empty or one per sphere) and survive FormatSphereFile then
 // ParseSphereFile bit for bit: same spheres, and for JSON the same contacts, hash, params and
 // stats. Any break aborts with the reason.
@@ -58,10 +58,10 @@ void CheckPromises(const inscribe::SphereFile& file) {
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size < 1) return 0;
-  static const inscribe::SphereFileFormat kFormats[] = {inscribe::SphereFileFormat::kJson,
-                                                        inscribe::SphereFileFormat::kSph,
-                                                        inscribe::SphereFileFormat::kCsv};
-  const inscribe::SphereFileFormat format = kFormats[data[0] % 3];
+  static const inscribe::SphereFileFormat kFormats[] = {
+      inscribe::SphereFileFormat::kJson, inscribe::SphereFileFormat::kSph,
+      inscribe::SphereFileFormat::kCsv, inscribe::SphereFileFormat::kYaml};
+  const inscribe::SphereFileFormat format = kFormats[data[0] % 4];
   inscribe::SphereFileReadOptions read;
   read.sph_level = static_cast<int>((data[0] >> 2) & 3) - 1;
   const absl::string_view bytes(reinterpret_cast<const char*>(data + 1), size - 1);

@@ -30,6 +30,7 @@ struct DeformCliOptions {
   bool fill_holes = false;
   std::string output_path;
   std::string format;
+  std::string link;  // cuRobo YAML link, read and written
   bool json = false;
   RemoteOptions remote;
 };
@@ -76,6 +77,7 @@ std::optional<DeformInputs> ReadInputs(const DeformCliOptions& options, int* exi
   *exit_code = kExitBadInput;
   SphereFileReadOptions read;
   if (!options.format.empty()) read.format = *ParseSphereFileFormat(options.format);
+  read.yaml_link = options.link;
   absl::StatusOr<SphereFile> file = ReadSphereFile(options.spheres_path, read);
   if (!file.ok()) {
     std::cerr << "inscribe: " << file.status().message() << "\n";
@@ -341,7 +343,8 @@ int RunDeform(const DeformCliOptions& options) {
       {"shrunk", result->shrunk},
       {"dropped", result->dropped},
   };
-  if (const int code = EmitSphereFile(out, options.output_path, options.format, options.json);
+  if (const int code =
+          EmitSphereFile(out, options.output_path, options.format, options.json, options.link);
       code != kExitOk) {
     return code;
   }
@@ -387,6 +390,8 @@ void AddDeformCommand(CLI::App& app, int* exit_code) {
                   "Write the moved spheres here (format from --format or the extension)");
   cmd->add_option("--format", options->format, "Sphere file format (output; input by extension)")
       ->check(CLI::IsMember({"json", "sph", "csv", "obj", "yaml", "yml"}, CLI::ignore_case));
+  cmd->add_option("--link", options->link,
+                  "cuRobo YAML: the link to read the spheres of, and to write them under");
   cmd->add_flag("--json", options->json,
                 "Print one JSON summary on stdout (spheres, seconds, nerr_lower, nerr_upper, "
                 "max_protrusion, ...)");

@@ -28,6 +28,7 @@ namespace {
 
 struct DistanceCliOptions {
   std::string a_path, b_path, poses_path;
+  SphereFileReadOptions a_read, b_read;  // .sph level, YAML link
   std::string hierarchy = "sphere";
   std::string output_path;
   DistanceRequest request;
@@ -196,12 +197,12 @@ int RunDistance(const DistanceCliOptions& options) {
                  "used with --server; the server answers with --hierarchy sphere or rss\n";
     return kExitUsage;
   }
-  absl::StatusOr<SphereFile> a = ReadSphereFile(options.a_path);
+  absl::StatusOr<SphereFile> a = ReadSphereFile(options.a_path, options.a_read);
   if (!a.ok()) {
     std::cerr << "inscribe: " << a.status().message() << "\n";
     return kExitBadInput;
   }
-  absl::StatusOr<SphereFile> b = ReadSphereFile(options.b_path);
+  absl::StatusOr<SphereFile> b = ReadSphereFile(options.b_path, options.b_read);
   if (!b.ok()) {
     std::cerr << "inscribe: " << b.status().message() << "\n";
     return kExitBadInput;
@@ -247,8 +248,18 @@ void AddDistanceCommand(CLI::App& app, int* exit_code) {
       "distance",
       "Separation distance between two sphere sets, B placed by each pose relative to A "
       "(negative: the deepest overlap); CSV of one row per pose unless --json");
-  cmd->add_option("A", options->a_path, "Sphere file (.json, .sph, .csv)")->required();
-  cmd->add_option("B", options->b_path, "Sphere file (.json, .sph, .csv)")->required();
+  cmd->add_option("A", options->a_path, "Sphere file (.json, .sph, .csv, .yml)")->required();
+  cmd->add_option("B", options->b_path, "Sphere file (.json, .sph, .csv, .yml)")->required();
+  cmd->add_option("--link-a", options->a_read.yaml_link,
+                  "A is a cuRobo YAML: the link whose spheres to use");
+  cmd->add_option("--link-b", options->b_read.yaml_link,
+                  "B is a cuRobo YAML: the link whose spheres to use");
+  cmd->add_option("--sph-level-a", options->a_read.sph_level,
+                  "A is a .sph tree: the level to use (-1 = the leaves)")
+      ->capture_default_str();
+  cmd->add_option("--sph-level-b", options->b_read.sph_level,
+                  "B is a .sph tree: the level to use (-1 = the leaves)")
+      ->capture_default_str();
   cmd->add_option("--poses", options->poses_path,
                   "One pose of B relative to A per line: qw qx qy qz tx ty tz (# comments)")
       ->required();

@@ -23,6 +23,7 @@ struct EvaluateCliOptions {
   std::string spheres_path;
   std::string format;
   int sph_level = -1;
+  std::string link;
   QualityOptions quality;
   bool json = false;
   bool fill_holes = false;
@@ -115,6 +116,7 @@ int RunEvaluate(const EvaluateCliOptions& options) {
   SphereFileReadOptions read;
   if (!options.format.empty()) read.format = *ParseSphereFileFormat(options.format);
   read.sph_level = options.sph_level;
+  read.yaml_link = options.link;
   absl::StatusOr<SphereFile> file = ReadSphereFile(options.spheres_path, read);
   if (!file.ok()) {
     std::cerr << "inscribe: " << file.status().message() << "\n";
@@ -158,9 +160,13 @@ void AddEvaluateCommand(CLI::App& app, int* exit_code) {
       "Quality of any sphere set against a mesh: exact nerr (or its lower bound for spheres "
       "that stick out), protrusion, coverage, boundary-to-union distance, fatness");
   cmd->add_option("MESH", options->mesh_path, "Mesh file (.off, .obj, .stl, .ply)")->required();
-  cmd->add_option("SPHERES", options->spheres_path, "Sphere file (.json, .sph, .csv)")->required();
+  cmd->add_option("SPHERES", options->spheres_path,
+                  "Sphere file (.json, .sph, .csv, cuRobo .yml/.yaml)")
+      ->required();
   cmd->add_option("--format", options->format, "Sphere file format (default: from extension)")
-      ->check(CLI::IsMember({"json", "sph", "csv"}, CLI::ignore_case));
+      ->check(CLI::IsMember({"json", "sph", "csv", "yaml", "yml"}, CLI::ignore_case));
+  cmd->add_option("--link", options->link,
+                  "cuRobo YAML with several links: the link whose spheres to evaluate");
   cmd->add_option("--sph-level", options->sph_level,
                   ".sph tree level to evaluate (-1 = the leaves)")
       ->capture_default_str();

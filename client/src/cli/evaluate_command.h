@@ -1,5 +1,5 @@
 // `inscribe evaluate MESH SPHERES [--json]`: the quality report of any sphere file (ours or
-// another tool's: JSON, .sph, CSV) against a mesh.
+// another tool's: JSON, spheretree .sph, CSV, cuRobo YAML) against a mesh.
 #pragma once
 
 #include <CLI/CLI.hpp>

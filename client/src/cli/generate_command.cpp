@@ -33,6 +33,7 @@ struct GenerateCliOptions {
   std::int64_t quality_samples = 100'000;
   std::string output_path;
   std::string format;
+  std::string link;  // cuRobo YAML link name
   bool json = false;
   bool fill_holes = false;
   bool dilate = false;
@@ -313,7 +314,8 @@ int RunGenerate(GenerateCliOptions options) {
   // The sphere file goes to -o, else to stdout unless --json claims stdout for the summary
   // (as with deform).
   const SphereFile file = MakeSphereFile(options, *generated);
-  if (const int code = EmitSphereFile(file, options.output_path, options.format, options.json);
+  if (const int code =
+          EmitSphereFile(file, options.output_path, options.format, options.json, options.link);
       code != kExitOk) {
     return code;
   }
@@ -369,6 +371,8 @@ void AddGenerateCommand(CLI::App& app, int* exit_code) {
                   "Write the sphere set here (format from --format or the extension)");
   cmd->add_option("--format", options->format, "Sphere file format")
       ->check(CLI::IsMember({"json", "sph", "csv", "obj", "yaml", "yml"}, CLI::ignore_case));
+  cmd->add_option("--link", options->link,
+                  "cuRobo YAML output: the link name the spheres are listed under (default mesh)");
   cmd->add_flag("--dilate", options->dilate,
                 "Grow the spheres to cover more of the boundary (conservative dilation, S_D+); "
                 "they then protrude, contacts are not written and nerr is a lower bound");

@@ -12,7 +12,8 @@ namespace inscribe::cli {
 // stdout for a summary. Returns kExitOk, or prints the reason on stderr and returns
 // kExitBadInput (the file cannot be written) or kExitUnusableMesh (the set cannot be
 // formatted). `format` has been checked by the command line.
+// `yaml_link` names the link cuRobo YAML output lists the spheres under (empty: "mesh").
 int EmitSphereFile(const SphereFile& file, const std::string& output_path,
-                   const std::string& format, bool json_summary);
+                   const std::string& format, bool json_summary, const std::string& yaml_link = "");
 
 }  // namespace inscribe::cli

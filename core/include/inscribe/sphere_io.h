@@ -1,6 +1,7 @@
 // Sphere-set files: inscribe's own JSON (read + write), spheretree `.sph` (read + write), CSV
-// `x,y,z,r` (read + write), and, for viewing or for other tools, OBJ meshes of the spheres and
-// cuRobo-style YAML (write only). Coordinates and radii are in the mesh's own units and frame.
+// `x,y,z,r` (read + write), cuRobo-style YAML `collision_spheres` (read + write, one link or
+// many), and, for viewing, OBJ meshes of the spheres (write only). Coordinates and radii are in the
+// mesh's own units and frame.
 //
 // Every reader refuses bad input with INVALID_ARGUMENT and a message naming the line or the
 // index and the problem (`line 4: expected 4 numbers x,y,z,r, found 3`, `sphere 12: radius -1
@@ -37,7 +38,10 @@ enum class SphereFileFormat {
   kCsv,
   // Each sphere as a triangulated icosphere (vertices on the sphere), for viewers. Write only.
   kObj,
-  // cuRobo's `collision_spheres:` block for one link. Write only.
+  // cuRobo's robot-configuration YAML: a `collision_spheres:` mapping from link name to a
+  // list of {center: [x, y, z], radius: r}. Written for one link (yaml_link_name); read from
+  // any cuRobo file (other keys are ignored), one link at a time (yaml_link). cuRobo's
+  // placeholder spheres (radius <= 0) are skipped when read. Read + write; only spheres.
   kYaml,
 };
 
@@ -51,7 +55,7 @@ absl::string_view SphereFileFormatName(SphereFileFormat format);
 // INVALID_ARGUMENT for any other extension.
 absl::StatusOr<SphereFileFormat> SphereFileFormatFromPath(const std::string& path);
 
-// kJson, kSph and kCsv can be read; kObj and kYaml are write-only.
+// kJson, kSph, kCsv and kYaml can be read; kObj is write-only.
 bool IsReadableSphereFileFormat(SphereFileFormat format);
 
 // A parameter or statistic value; a JSON number with a fraction or exponent is a double, one
@@ -81,6 +85,9 @@ struct SphereFileReadOptions {
   // kSph: the tree level to return (0 = the root); -1 returns the deepest level, the leaves
   // that users compare. Either way only slots with radius > 0 are returned, in file order.
   int sph_level = -1;
+  // kYaml: the link whose spheres to return. Empty: the file's only link; a file with several
+  // links is then refused with a message listing them.
+  std::string yaml_link;
 };
 
 struct SphereFileWriteOptions {
@@ -122,5 +129,24 @@ absl::StatusOr<SphereFile> ReadSphereFile(const std::string& path,
 // not exist; PERMISSION_DENIED; INTERNAL for other I/O failures (message names the path).
 absl::Status WriteSphereFile(const std::string& path, const SphereFile& file,
                              const SphereFileWriteOptions& options = {});
+
+// The spheres of one robot link, in the link's frame.
+struct LinkSpheres {
+  std::string link;  // letters, digits, _ - . / (as URDF link names in practice)
+  std::vector<Sphere> spheres;
+};
+
+// cuRobo's `collision_spheres:` YAML for several links, in the order given, under a
+// `# comment` header line. INVALID_ARGUMENT naming the link for a bad or repeated link name,
+// and naming the link and sphere for a sphere CheckSphere refuses. A link with no spheres is
+// written as `link: []`.
+absl::StatusOr<std::string> FormatCuroboYaml(const std::vector<LinkSpheres>& links,
+                                             absl::string_view comment = "inscribe spheres");
+
+// Every link of a cuRobo YAML's `collision_spheres` mapping, in file order, with spheres of
+// radius <= 0 (cuRobo's placeholders) dropped. INVALID_ARGUMENT (with the YAML line) for
+// malformed YAML, a missing `collision_spheres` mapping, or a sphere without a 3-number centre
+// and a finite radius.
+absl::StatusOr<std::vector<LinkSpheres>> ParseCuroboYaml(absl::string_view bytes);
 
 }  // namespace inscribe

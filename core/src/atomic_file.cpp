@@ -1,4 +1,4 @@
-#include "atomic_file.h"
+#include "inscribe/atomic_file.h"
 
 #include <fcntl.h>
 #include <unistd.h>
@@ -9,7 +9,7 @@
 
 #include "absl/strings/str_cat.h"
 
-namespace inscribe::internal {
+namespace inscribe {
 namespace {
 
 absl::Status IoError(int error, const std::string& what) {
@@ -70,4 +70,4 @@ absl::Status WriteFileAtomically(const std::string& path, absl::string_view byte
   return absl::OkStatus();
 }
 
-}  // namespace inscribe::internal
+}  // namespace inscribe

@@ -22,7 +22,7 @@
 
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
-#include "atomic_file.h"
+#include "inscribe/atomic_file.h"
 #include "inscribe/mesh_validation.h"
 #include "mesh_file_diagnosis.h"
 
@@ -285,7 +285,7 @@ absl::Status WriteMesh(const std::string& path, const Mesh& mesh) {
   if (ext == ".ply") ok = CGAL::IO::write_PLY(out, points, faces, np);
   if (ext == ".stl") ok = CGAL::IO::write_STL(out, points, faces, np);
   if (!ok) return absl::InternalError(absl::StrCat(path, ": CGAL could not format the mesh"));
-  return internal::WriteFileAtomically(path, out.str());
+  return WriteFileAtomically(path, out.str());
 }
 
 }  // namespace inscribe

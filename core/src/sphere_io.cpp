@@ -20,7 +20,7 @@
 
 #include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
-#include "atomic_file.h"
+#include "inscribe/atomic_file.h"
 #include "sphere_formats.h"
 
 namespace inscribe {
@@ -333,7 +333,7 @@ absl::Status WriteSphereFile(const std::string& path, const SphereFile& file,
   absl::StatusOr<std::string> bytes = FormatSphereFile(file, *format, options);
   if (!bytes.ok()) return Prefixed(bytes.status(), path);
 
-  return internal::WriteFileAtomically(path, *bytes);
+  return WriteFileAtomically(path, *bytes);
 }
 
 }  // namespace inscribe

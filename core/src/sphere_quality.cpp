@@ -8,55 +8,15 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
-#include <random>
 
 #include "absl/strings/str_cat.h"
 #include "inscribe/union_of_balls.h"
+#include "surface_sampling.h"
 
 namespace inscribe {
 namespace {
 
 constexpr double kSqrt3 = 1.7320508075688772;
-
-// `count` points uniformly distributed by area over the mesh's triangles. Deterministic for a
-// given seed: each point draws from its own generator seeded by (seed, index), so the points do
-// not depend on scheduling.
-Vertices SampleSurface(const Mesh& mesh, std::int64_t count, std::uint64_t seed) {
-  const std::int64_t triangles = mesh.num_triangles();
-  std::vector<double> cumulative(static_cast<std::size_t>(triangles));
-  double total = 0.0;
-  for (std::int64_t t = 0; t < triangles; ++t) {
-    const Vector3 a = mesh.vertices.row(mesh.triangles(t, 0));
-    const Vector3 b = mesh.vertices.row(mesh.triangles(t, 1));
-    const Vector3 c = mesh.vertices.row(mesh.triangles(t, 2));
-    total += 0.5 * (b - a).cross(c - a).norm();
-    cumulative[static_cast<std::size_t>(t)] = total;
-  }
-  Vertices points(count, 3);
-  tbb::parallel_for(
-      tbb::blocked_range<std::int64_t>(0, count, 1024),
-      [&](const tbb::blocked_range<std::int64_t>& range) {
-        for (std::int64_t i = range.begin(); i != range.end(); ++i) {
-          std::mt19937_64 random(seed * 0x9E3779B97F4A7C15ull + static_cast<std::uint64_t>(i));
-          auto uniform = [&random] { return static_cast<double>(random() >> 11) * 0x1.0p-53; };
-          const double pick = uniform() * total;
-          const std::int64_t t = std::min<std::int64_t>(
-              triangles - 1,
-              std::upper_bound(cumulative.begin(), cumulative.end(), pick) - cumulative.begin());
-          double u = uniform();
-          double v = uniform();
-          if (u + v > 1.0) {
-            u = 1.0 - u;
-            v = 1.0 - v;
-          }
-          const Vector3 a = mesh.vertices.row(mesh.triangles(t, 0));
-          const Vector3 b = mesh.vertices.row(mesh.triangles(t, 1));
-          const Vector3 c = mesh.vertices.row(mesh.triangles(t, 2));
-          points.row(i) = a + u * (b - a) + v * (c - a);
-        }
-      });
-  return points;
-}
 
 // Distance from x to the union of the balls (0 inside one). Brute force over the balls, with
 // an early exit once x is inside one.
@@ -79,15 +39,8 @@ absl::StatusOr<QualityReport> EvaluateSpheres(const BoundaryOracle& oracle,
                                               const QualityOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   const Mesh& mesh = oracle.mesh();
-  for (std::size_t i = 0; i < spheres.size(); ++i) {
-    const Sphere& s = spheres[i];
-    if (!s.center.allFinite() || !std::isfinite(s.radius)) {
-      return absl::InvalidArgumentError(absl::StrCat("sphere ", i, " is not finite"));
-    }
-    if (!(s.radius > 0.0)) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("sphere ", i, ": radius ", s.radius, " is not positive"));
-    }
+  if (absl::Status status = internal::CheckSpheresMeasurable(spheres); !status.ok()) {
+    return status;
   }
   if (options.surface_samples < 0 || options.surface_samples > 100'000'000) {
     return absl::InvalidArgumentError(
@@ -144,8 +97,12 @@ absl::StatusOr<QualityReport> EvaluateSpheres(const BoundaryOracle& oracle,
 
   // Sampled boundary measures.
   report.surface_samples = options.surface_samples;
-  if (options.surface_samples > 0 && mesh.num_triangles() > 0) {
-    const Vertices samples = SampleSurface(mesh, options.surface_samples, options.seed);
+  // The same points as ComputeEnvelopeDistances' boundary samples for the same seed.
+  const Vertices samples =
+      options.surface_samples > 0
+          ? internal::SampleBoundaryByArea(mesh, options.surface_samples, options.seed)
+          : Vertices(0, 3);
+  if (samples.rows() > 0) {
     // Per-sample distances first, then serial sums: the report is the same bit for bit on
     // every run.
     std::vector<double> distances(static_cast<std::size_t>(samples.rows()));

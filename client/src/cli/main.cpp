@@ -12,6 +12,8 @@
 #include "health_command.h"
 #include "info_command.h"
 #include "stats_command.h"
+#include "urdf_command.h"
+#include "view_command.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"inscribe: approximate closed triangle meshes by unions of medial spheres"};
@@ -30,6 +32,8 @@ int main(int argc, char** argv) {
   inscribe::cli::AddDistanceCommand(app, &exit_code);
   inscribe::cli::AddStatsCommand(app, &exit_code);
   inscribe::cli::AddHealthCommand(app, &exit_code);
+  inscribe::cli::AddUrdfCommand(app, &exit_code);
+  inscribe::cli::AddViewCommand(app, &exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -6,7 +6,7 @@
 #include "absl/status/status.h"
 #include "absl/strings/string_view.h"
 
-namespace inscribe::internal {
+namespace inscribe {
 
 // Writes `bytes` to a unique temporary sibling of `path`, fsyncs it and renames it over
 // `path`. On failure `path` is untouched and the temporary removed. Errors: NOT_FOUND (missing
@@ -14,4 +14,4 @@ namespace inscribe::internal {
 // strerror.
 absl::Status WriteFileAtomically(const std::string& path, absl::string_view bytes);
 
-}  // namespace inscribe::internal
+}  // namespace inscribe

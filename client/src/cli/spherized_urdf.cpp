@@ -1,0 +1,135 @@
+#include "spherized_urdf.h"
+
+#include <tinyxml2.h>
+
+#include <cassert>
+#include <charconv>
+#include <map>
+
+#include "absl/status/status.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_replace.h"
+#include "inscribe/sphere_io.h"
+
+namespace inscribe::cli {
+namespace {
+
+using tinyxml2::XMLDocument;
+using tinyxml2::XMLElement;
+using tinyxml2::XMLNode;
+
+// Text that is safe inside <!-- -->: no "--", and no '-' just before the closing "-->".
+std::string CommentText(const std::string& text) {
+  std::string safe = text;
+  while (safe.find("--") != std::string::npos) safe = absl::StrReplaceAll(safe, {{"--", "- -"}});
+  return " " + safe + " ";
+}
+
+XMLElement* SphereCollision(XMLDocument& document, const Sphere& sphere) {
+  XMLElement* collision = document.NewElement("collision");
+  XMLElement* origin = collision->InsertNewChildElement("origin");
+  const std::string xyz =
+      absl::StrCat(ShortestDecimal(sphere.center.x()), " ", ShortestDecimal(sphere.center.y()), " ",
+                   ShortestDecimal(sphere.center.z()));
+  origin->SetAttribute("xyz", xyz.c_str());
+  origin->SetAttribute("rpy", "0 0 0");
+  XMLElement* geometry = collision->InsertNewChildElement("geometry");
+  geometry->InsertNewChildElement("sphere")->SetAttribute("radius",
+                                                          ShortestDecimal(sphere.radius).c_str());
+  return collision;
+}
+
+// Replaces the link's <collision> children by the comment and one <collision> per sphere.
+void ReplaceCollisions(XMLDocument& document, XMLElement& link, const LinkSpherizeResult& result) {
+  // Where the new elements go: after `anchor`, or first when it is null.
+  XMLNode* anchor = nullptr;
+  if (XMLElement* first = link.FirstChildElement("collision"); first != nullptr) {
+    anchor = first->PreviousSibling();
+  } else {
+    for (XMLElement* visual = link.FirstChildElement("visual"); visual != nullptr;
+         visual = visual->NextSiblingElement("visual")) {
+      anchor = visual;
+    }
+    if (anchor == nullptr) anchor = link.LastChild();
+  }
+  while (XMLElement* collision = link.FirstChildElement("collision")) link.DeleteChild(collision);
+
+  XMLNode* last = document.NewComment(
+      CommentText(absl::StrCat("inscribe urdf: ", result.spheres.size(),
+                               " spheres in place of the link's ",
+                               result.from_visual ? "visual" : "collision", " geometry"))
+          .c_str());
+  if (anchor == nullptr) {
+    link.InsertFirstChild(last);
+  } else {
+    link.InsertAfterChild(anchor, last);
+  }
+  for (const Sphere& sphere : result.spheres) {
+    last = link.InsertAfterChild(last, SphereCollision(document, sphere));
+  }
+}
+
+}  // namespace
+
+std::string ShortestDecimal(double value) {
+  char buffer[64];
+  const std::to_chars_result written = std::to_chars(buffer, buffer + sizeof buffer, value);
+  return std::string(buffer, written.ptr);
+}
+
+absl::StatusOr<std::string> SpherizedUrdf(absl::string_view urdf_bytes,
+                                          const std::vector<LinkSpherizeResult>& links) {
+  XMLDocument document;
+  if (document.Parse(urdf_bytes.data(), urdf_bytes.size()) != tinyxml2::XML_SUCCESS ||
+      document.RootElement() == nullptr) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("URDF line ", document.ErrorLineNum(), ": not well-formed XML"));
+  }
+  std::map<std::string, const LinkSpherizeResult*> by_name;
+  for (const LinkSpherizeResult& result : links) by_name.emplace(result.link, &result);
+  for (XMLElement* link = document.RootElement()->FirstChildElement("link"); link != nullptr;
+       link = link->NextSiblingElement("link")) {
+    const char* name = link->Attribute("name");
+    const auto found = by_name.find(name == nullptr ? "" : name);
+    if (found == by_name.end()) continue;
+    const LinkSpherizeResult& result = *found->second;
+    if (result.status == LinkStatus::kSpherized) {
+      ReplaceCollisions(document, *link, result);
+    } else if (result.status == LinkStatus::kSkipped) {
+      link->InsertFirstChild(document.NewComment(
+          CommentText(
+              absl::StrCat("inscribe urdf: not spherized, geometry kept as it was: ", result.error))
+              .c_str()));
+    }
+  }
+  tinyxml2::XMLPrinter printer;
+  document.Print(&printer);
+  return std::string(printer.CStr(), static_cast<std::size_t>(printer.CStrSize() - 1));
+}
+
+std::string SpherizedCuroboYaml(const std::vector<LinkSpherizeResult>& links,
+                                const std::string& robot_name, std::vector<std::string>* left_out) {
+  std::vector<LinkSpheres> spheres;
+  for (const LinkSpherizeResult& result : links) {
+    if (result.status != LinkStatus::kSpherized) continue;
+    // The name alone decides: the spheres passed CheckSphere's rules when they were made.
+    if (!FormatCuroboYaml({LinkSpheres{result.link, {}}}).ok()) {
+      left_out->push_back(result.link);
+      continue;
+    }
+    spheres.push_back({result.link, result.spheres});
+  }
+  // The robot's name goes into a comment line: no control character may end it early.
+  std::string name = robot_name;
+  for (char& c : name) {
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+  }
+  absl::StatusOr<std::string> yaml = FormatCuroboYaml(
+      spheres, absl::StrCat("inscribe urdf", name.empty() ? "" : " of robot " + name,
+                            ": collision spheres per link, link frames, metres"));
+  // Only a bad name or a bad sphere is refused, and neither is left.
+  assert(yaml.ok());
+  return *std::move(yaml);
+}
+
+}  // namespace inscribe::cli

@@ -1,0 +1,36 @@
+// Writing what `inscribe urdf` made: the robot's URDF with spheres for collision geometry, and
+// cuRobo's collision_spheres YAML.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
+#include "urdf_spherize.h"
+
+namespace inscribe::cli {
+
+// `urdf_bytes` (a document ParseUrdf accepted) edited with tinyxml2: in every link whose
+// result is kSpherized, all <collision> elements are replaced, where the first of them was
+// (after the last <visual> when the spheres stand for visual geometry), by an XML comment and
+// one <collision> per sphere: <origin xyz="cx cy cz" rpy="0 0 0"/> and <geometry><sphere
+// radius="r"/></geometry>, link frame, metres, each number the shortest decimal that reads back
+// as the same double. A kSkipped link keeps its collisions and gets, as its first child, a
+// comment with the reason. Joints, visuals, inertials, materials, other links and comments are
+// untouched (the document is re-indented by tinyxml2's printer). Links are matched by name;
+// results naming no link are ignored. INVALID_ARGUMENT if the bytes are not XML.
+absl::StatusOr<std::string> SpherizedUrdf(absl::string_view urdf_bytes,
+                                          const std::vector<LinkSpherizeResult>& links);
+
+// cuRobo's `collision_spheres` YAML (FormatCuroboYaml) with the spheres of every kSpherized
+// link, in the order given; skipped links and links without geometry are left out, and so are
+// links whose names cuRobo's YAML cannot carry as keys (FormatCuroboYaml allows letters,
+// digits and _ - . /): their names are appended to *left_out. Cost O(#spheres).
+std::string SpherizedCuroboYaml(const std::vector<LinkSpherizeResult>& links,
+                                const std::string& robot_name, std::vector<std::string>* left_out);
+
+// The shortest decimal that std::from_chars reads back as exactly `value` (finite).
+std::string ShortestDecimal(double value);
+
+}  // namespace inscribe::cli

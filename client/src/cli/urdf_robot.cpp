@@ -1,0 +1,350 @@
+#include "urdf_robot.h"
+
+#include <tinyxml2.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <optional>
+#include <set>
+#include <system_error>
+#include <utility>
+
+#include "absl/status/status.h"
+#include "absl/strings/match.h"
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
+#include "absl/strings/str_split.h"
+#include "absl/strings/strip.h"
+
+namespace inscribe::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+using tinyxml2::XMLElement;
+
+absl::Status ErrorAt(int line, absl::string_view what) {
+  return absl::InvalidArgumentError(absl::StrCat("URDF line ", line, ": ", what));
+}
+
+// " in link 'NAME'" or "" before the link's name is known.
+std::string InLink(const std::string& link) {
+  return link.empty() ? "" : absl::StrCat(" (link '", link, "')");
+}
+
+// `count` whitespace-separated finite numbers from attribute `name` of `element`; `fallback`
+// when the attribute is absent and not `required`.
+absl::StatusOr<std::vector<double>> ParseNumbers(const XMLElement& element, const char* name,
+                                                 int count, bool required,
+                                                 std::vector<double> fallback,
+                                                 const std::string& link) {
+  const tinyxml2::XMLAttribute* attribute = element.FindAttribute(name);
+  if (attribute == nullptr) {
+    if (!required) return fallback;
+    return ErrorAt(element.GetLineNum(), absl::StrCat("<", element.Name(), "> has no ", name,
+                                                      " attribute", InLink(link)));
+  }
+  const std::string text = attribute->Value();
+  const auto malformed = [&](absl::string_view why) {
+    return ErrorAt(attribute->GetLineNum(), absl::StrCat("<", element.Name(), " ", name, "=\"",
+                                                         text, "\">: ", why, InLink(link)));
+  };
+  if (absl::StrContains(text, "${") || absl::StrContains(text, "$(")) {
+    return malformed("unexpanded xacro expression; run xacro first");
+  }
+  const std::vector<absl::string_view> tokens =
+      absl::StrSplit(text, absl::ByAnyChar(" \t\r\n"), absl::SkipEmpty());
+  if (static_cast<int>(tokens.size()) != count) {
+    return malformed(absl::StrCat("expected ", count, count == 1 ? " number" : " numbers",
+                                  ", found ", tokens.size()));
+  }
+  std::vector<double> values(tokens.size());
+  for (std::size_t i = 0; i < tokens.size(); ++i) {
+    if (!absl::SimpleAtod(tokens[i], &values[i])) {
+      return malformed(absl::StrCat("'", tokens[i], "' is not a number"));
+    }
+    if (!std::isfinite(values[i])) {
+      return malformed(absl::StrCat("'", tokens[i], "' is not finite"));
+    }
+  }
+  return values;
+}
+
+absl::StatusOr<Vector3> ParseVector(const XMLElement& element, const char* name, bool required,
+                                    const Vector3& fallback, const std::string& link) {
+  absl::StatusOr<std::vector<double>> values =
+      ParseNumbers(element, name, 3, required, {fallback.x(), fallback.y(), fallback.z()}, link);
+  if (!values.ok()) return values.status();
+  return Vector3((*values)[0], (*values)[1], (*values)[2]);
+}
+
+// One positive number, e.g. a radius (metres).
+absl::StatusOr<double> ParsePositive(const XMLElement& element, const char* name,
+                                     const std::string& link) {
+  absl::StatusOr<std::vector<double>> values = ParseNumbers(element, name, 1, true, {}, link);
+  if (!values.ok()) return values.status();
+  if ((*values)[0] <= 0.0) {
+    return ErrorAt(element.GetLineNum(),
+                   absl::StrCat("<", element.Name(), "> ", name, " ", (*values)[0],
+                                " is not positive", InLink(link)));
+  }
+  return (*values)[0];
+}
+
+absl::StatusOr<UrdfOrigin> ParseOrigin(const XMLElement& element, const std::string& link) {
+  UrdfOrigin origin;
+  const XMLElement* node = element.FirstChildElement("origin");
+  if (node == nullptr) return origin;
+  absl::StatusOr<Vector3> xyz = ParseVector(*node, "xyz", false, Vector3::Zero(), link);
+  if (!xyz.ok()) return xyz.status();
+  absl::StatusOr<Vector3> rpy = ParseVector(*node, "rpy", false, Vector3::Zero(), link);
+  if (!rpy.ok()) return rpy.status();
+  origin.xyz = *xyz;
+  origin.rpy = *rpy;
+  return origin;
+}
+
+absl::StatusOr<UrdfGeometry> ParseGeometry(const XMLElement& element, const std::string& link) {
+  UrdfGeometry geometry;
+  const XMLElement* holder = element.FirstChildElement("geometry");
+  const XMLElement* shape = holder == nullptr ? nullptr : holder->FirstChildElement();
+  if (shape == nullptr) return geometry;  // kUnsupported, unsupported == ""
+  const std::string kind = shape->Name();
+  if (kind == "mesh") {
+    const char* filename = shape->Attribute("filename");
+    if (filename == nullptr || filename[0] == '\0') {
+      return ErrorAt(shape->GetLineNum(),
+                     absl::StrCat("<mesh> has no filename attribute", InLink(link)));
+    }
+    absl::StatusOr<Vector3> scale = ParseVector(*shape, "scale", false, Vector3::Ones(), link);
+    if (!scale.ok()) return scale.status();
+    if ((scale->array() == 0.0).any()) {
+      return ErrorAt(
+          shape->GetLineNum(),
+          absl::StrCat("<mesh scale> has a zero component: the mesh would be flat", InLink(link)));
+    }
+    geometry.shape = UrdfShape::kMesh;
+    geometry.filename = filename;
+    geometry.scale = *scale;
+  } else if (kind == "box") {
+    absl::StatusOr<Vector3> size = ParseVector(*shape, "size", true, Vector3::Zero(), link);
+    if (!size.ok()) return size.status();
+    if (!(size->array() > 0.0).all()) {
+      return ErrorAt(shape->GetLineNum(),
+                     absl::StrCat("<box size> must be 3 positive numbers", InLink(link)));
+    }
+    geometry.shape = UrdfShape::kBox;
+    geometry.size = *size;
+  } else if (kind == "cylinder") {
+    absl::StatusOr<double> radius = ParsePositive(*shape, "radius", link);
+    if (!radius.ok()) return radius.status();
+    absl::StatusOr<double> length = ParsePositive(*shape, "length", link);
+    if (!length.ok()) return length.status();
+    geometry.shape = UrdfShape::kCylinder;
+    geometry.radius = *radius;
+    geometry.length = *length;
+  } else if (kind == "sphere") {
+    absl::StatusOr<double> radius = ParsePositive(*shape, "radius", link);
+    if (!radius.ok()) return radius.status();
+    geometry.shape = UrdfShape::kSphere;
+    geometry.radius = *radius;
+  } else {
+    geometry.unsupported = kind;
+  }
+  return geometry;
+}
+
+absl::StatusOr<UrdfElement> ParseElement(const XMLElement& element, const std::string& link) {
+  UrdfElement parsed;
+  parsed.line = element.GetLineNum();
+  if (const char* name = element.Attribute("name"); name != nullptr) parsed.name = name;
+  absl::StatusOr<UrdfOrigin> origin = ParseOrigin(element, link);
+  if (!origin.ok()) return origin.status();
+  parsed.origin = *origin;
+  absl::StatusOr<UrdfGeometry> geometry = ParseGeometry(element, link);
+  if (!geometry.ok()) return geometry.status();
+  parsed.geometry = *std::move(geometry);
+  return parsed;
+}
+
+// The first element, in document order, whose name is in the xacro namespace.
+const XMLElement* FindXacro(const XMLElement& element) {
+  if (absl::StartsWith(element.Name(), "xacro:")) return &element;
+  for (const XMLElement* child = element.FirstChildElement(); child != nullptr;
+       child = child->NextSiblingElement()) {
+    if (const XMLElement* found = FindXacro(*child); found != nullptr) return found;
+  }
+  return nullptr;
+}
+
+absl::StatusOr<UrdfLink> ParseLink(const XMLElement& element) {
+  UrdfLink link;
+  link.line = element.GetLineNum();
+  const char* name = element.Attribute("name");
+  if (name == nullptr || name[0] == '\0') {
+    return ErrorAt(link.line, "<link> has no name attribute");
+  }
+  link.name = name;
+  for (const char* kind : {"collision", "visual"}) {
+    for (const XMLElement* child = element.FirstChildElement(kind); child != nullptr;
+         child = child->NextSiblingElement(kind)) {
+      absl::StatusOr<UrdfElement> parsed = ParseElement(*child, link.name);
+      if (!parsed.ok()) return parsed.status();
+      link.elements.push_back(*std::move(parsed));
+    }
+    if (!link.elements.empty()) {
+      link.from_visual = std::string(kind) == "visual";
+      break;
+    }
+  }
+  return link;
+}
+
+bool IsDirectory(const fs::path& path) {
+  std::error_code error;
+  return fs::is_directory(path, error);
+}
+
+bool IsFile(const fs::path& path) {
+  std::error_code error;
+  return fs::exists(path, error) && !fs::is_directory(path, error);
+}
+
+// The last component of a directory path, "/a/pkg/" and "/a/pkg" alike.
+std::string DirectoryName(const fs::path& directory) {
+  const fs::path normal = directory.lexically_normal();
+  return (normal.has_filename() ? normal : normal.parent_path()).filename().string();
+}
+
+std::vector<std::string> SplitPathList(const char* value) {
+  if (value == nullptr) return {};
+  return absl::StrSplit(value, ':', absl::SkipEmpty());
+}
+
+absl::StatusOr<std::string> ExistingFile(const fs::path& path, const std::string& filename) {
+  if (IsFile(path)) return path.lexically_normal().string();
+  return absl::NotFoundError(absl::StrCat("mesh file ", path.lexically_normal().string(),
+                                          " (from '", filename, "') does not exist"));
+}
+
+absl::StatusOr<std::string> ResolvePackageUri(absl::string_view rest, const std::string& filename,
+                                              const PackageSearch& search) {
+  const std::size_t slash = rest.find('/');
+  const std::string package(rest.substr(0, slash));
+  const std::string relative(slash == absl::string_view::npos ? "" : rest.substr(slash + 1));
+  if (package.empty() || relative.empty()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("'", filename, "' is not package://PACKAGE/PATH"));
+  }
+  std::vector<std::string> looked;
+  std::optional<fs::path> found;
+  for (const std::vector<std::string>* list : {&search.package_paths, &search.ros_package_path}) {
+    for (const std::string& directory : *list) {
+      const fs::path d(directory);
+      if (IsDirectory(d / package)) {
+        found = d / package;
+      } else if (DirectoryName(d) == package && IsDirectory(d)) {
+        found = d;
+      }
+      if (found) break;
+      looked.push_back(directory);
+    }
+    if (found) break;
+  }
+  if (!found) {
+    for (const std::string& prefix : search.ament_prefix_path) {
+      const fs::path d = fs::path(prefix) / "share" / package;
+      if (IsDirectory(d)) {
+        found = d;
+        break;
+      }
+      looked.push_back((fs::path(prefix) / "share").string());
+    }
+  }
+  if (!found) {
+    return absl::NotFoundError(absl::StrCat(
+        "package '", package, "' (of '", filename, "') not found; looked in ",
+        looked.empty() ? std::string("no directory (give --package-path or set ROS_PACKAGE_PATH)")
+                       : absl::StrJoin(looked, ", ")));
+  }
+  return ExistingFile(*found / relative, filename);
+}
+
+}  // namespace
+
+Eigen::Matrix3d RotationFromRpy(const Vector3& rpy) {
+  return (Eigen::AngleAxisd(rpy.z(), Vector3::UnitZ()) *
+          Eigen::AngleAxisd(rpy.y(), Vector3::UnitY()) *
+          Eigen::AngleAxisd(rpy.x(), Vector3::UnitX()))
+      .toRotationMatrix();
+}
+
+absl::StatusOr<UrdfRobot> ParseUrdf(absl::string_view bytes) {
+  if (const std::size_t nul = bytes.find('\0'); nul != absl::string_view::npos) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("URDF byte ", nul, " is NUL: this is not an XML text file"));
+  }
+  tinyxml2::XMLDocument document;
+  if (document.Parse(bytes.data(), bytes.size()) != tinyxml2::XML_SUCCESS) {
+    return ErrorAt(document.ErrorLineNum(),
+                   absl::StrCat("not well-formed XML: ", document.ErrorName()));
+  }
+  const XMLElement* root = document.RootElement();
+  if (root == nullptr)
+    return absl::InvalidArgumentError("URDF has no root element: not an XML document");
+  if (std::string(root->Name()) != "robot") {
+    return ErrorAt(root->GetLineNum(),
+                   absl::StrCat("the root element is <", root->Name(), ">, not <robot>"));
+  }
+  if (const XMLElement* xacro = FindXacro(*root); xacro != nullptr) {
+    return ErrorAt(xacro->GetLineNum(),
+                   absl::StrCat("<", xacro->Name(),
+                                "> is unexpanded xacro; run xacro to produce the URDF first"));
+  }
+  UrdfRobot robot;
+  if (const char* name = root->Attribute("name"); name != nullptr) robot.name = name;
+  std::set<std::string> names;
+  for (const XMLElement* element = root->FirstChildElement("link"); element != nullptr;
+       element = element->NextSiblingElement("link")) {
+    absl::StatusOr<UrdfLink> link = ParseLink(*element);
+    if (!link.ok()) return link.status();
+    if (!names.insert(link->name).second) {
+      return ErrorAt(link->line, absl::StrCat("link name '", link->name, "' is used twice"));
+    }
+    robot.links.push_back(*std::move(link));
+  }
+  return robot;
+}
+
+PackageSearch PackageSearchFromEnvironment(std::vector<std::string> package_paths) {
+  PackageSearch search;
+  search.package_paths = std::move(package_paths);
+  search.ros_package_path = SplitPathList(std::getenv("ROS_PACKAGE_PATH"));
+  search.ament_prefix_path = SplitPathList(std::getenv("AMENT_PREFIX_PATH"));
+  return search;
+}
+
+absl::StatusOr<std::string> ResolveMeshFilename(const std::string& filename,
+                                                const std::string& urdf_dir,
+                                                const PackageSearch& search) {
+  absl::string_view rest = filename;
+  if (absl::ConsumePrefix(&rest, "package://")) {
+    return ResolvePackageUri(rest, filename, search);
+  }
+  if (absl::ConsumePrefix(&rest, "file://")) {
+    // file:///abs/path has an empty authority; file://relative is taken as relative.
+  } else if (const std::size_t scheme = filename.find("://"); scheme != std::string::npos) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("mesh '", filename, "': URI scheme '", filename.substr(0, scheme),
+                     "' is not supported (use package://, file:// or a path)"));
+  }
+  if (rest.empty()) {
+    return absl::InvalidArgumentError(absl::StrCat("mesh '", filename, "' has an empty path"));
+  }
+  const fs::path path(std::string{rest});
+  return ExistingFile(path.is_absolute() ? path : fs::path(urdf_dir) / path, filename);
+}
+
+}  // namespace inscribe::cli

@@ -1,0 +1,108 @@
+// A URDF robot description as `inscribe urdf` needs it: each link's collision geometry (its
+// visual geometry when it has no <collision>), with origins and mesh scales, and where the
+// mesh files are (package://, file:// and relative paths). Parsed with tinyxml2. Joints,
+// materials and the rest are not represented: the writer (spherized_urdf.h) edits the
+// original document instead.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
+#include "inscribe/mesh.h"
+
+namespace inscribe::cli {
+
+// <origin xyz="x y z" rpy="roll pitch yaw">: the pose of an element's frame in its link's
+// frame. Metres and radians; both default to zero.
+struct UrdfOrigin {
+  Vector3 xyz = Vector3::Zero();
+  Vector3 rpy = Vector3::Zero();
+};
+
+// URDF's rpy convention: fixed axes, roll about X, then pitch about Y, then yaw about Z, so
+// R = Rz(yaw) * Ry(pitch) * Rx(roll). A point p of the element's frame is R * p + xyz in the
+// link's frame.
+Eigen::Matrix3d RotationFromRpy(const Vector3& rpy);
+
+enum class UrdfShape {
+  kMesh,
+  kBox,
+  kCylinder,
+  kSphere,
+  kUnsupported,  // a <geometry> child URDF does not define (e.g. <capsule>), or none
+};
+
+struct UrdfGeometry {
+  UrdfShape shape = UrdfShape::kUnsupported;
+  // kMesh: the filename attribute as written, and the per-axis scale (default 1 1 1; no zero
+  // component; a negative one mirrors the mesh).
+  std::string filename;
+  Vector3 scale = Vector3::Ones();
+  // kBox: side lengths along the element's x, y, z; metres, > 0.
+  Vector3 size = Vector3::Zero();
+  // kCylinder (axis z, centred on the element's origin) and kSphere: metres, > 0.
+  double radius = 0.0;
+  double length = 0.0;
+  // kUnsupported: the element found under <geometry>, e.g. "capsule"; "" when it is empty.
+  std::string unsupported;
+};
+
+// One <collision> (or <visual>) element.
+struct UrdfElement {
+  std::string name;  // its name attribute; "" when absent
+  UrdfOrigin origin;
+  UrdfGeometry geometry;
+  int line = 0;  // of the element in the file, 1-based
+};
+
+struct UrdfLink {
+  std::string name;
+  int line = 0;
+  // The <collision> children in file order; when the link has none, its <visual> children
+  // (from_visual is then true). Empty for a link without geometry.
+  std::vector<UrdfElement> elements;
+  bool from_visual = false;
+};
+
+struct UrdfRobot {
+  std::string name;             // <robot name>, may be empty
+  std::vector<UrdfLink> links;  // in file order
+};
+
+// Parses a URDF document. INVALID_ARGUMENT, naming the line and, where there is one, the link
+// and the attribute, for: bytes that are not XML, a root that is not <robot>, unexpanded xacro
+// (xacro: elements), a link without a name or with a name used before, a missing or malformed
+// number (xyz, rpy, scale: 3 finite numbers; size: 3 positive; radius, length: one positive),
+// a zero scale component, a <mesh> without filename. Geometry URDF does not define is not an
+// error here (kUnsupported). Cost O(size of the document).
+absl::StatusOr<UrdfRobot> ParseUrdf(absl::string_view bytes);
+
+// Where package://PKG/... URIs are looked for, in this order: for each directory D of
+// package_paths (--package-path) and then of ros_package_path (ROS_PACKAGE_PATH), D/PKG and,
+// when D's own name is PKG, D itself; then for each prefix P of ament_prefix_path
+// (AMENT_PREFIX_PATH, ROS 2 installs), P/share/PKG. The first existing package directory is
+// the package (as ROS does: a package is found once, its files are not searched elsewhere).
+struct PackageSearch {
+  std::vector<std::string> package_paths;
+  std::vector<std::string> ros_package_path;
+  std::vector<std::string> ament_prefix_path;
+};
+
+// `package_paths` plus ROS_PACKAGE_PATH and AMENT_PREFIX_PATH from the environment, split at
+// ':' (empty entries ignored).
+PackageSearch PackageSearchFromEnvironment(std::vector<std::string> package_paths);
+
+// The file a <mesh filename> names: package://PKG/REL through `search`; file://PATH (an
+// absolute path, or relative to urdf_dir) and plain paths (relative ones to urdf_dir, the
+// directory of the URDF file). The file must exist. NOT_FOUND for a package that is not found
+// (listing where it was looked for) or a missing file (naming the path tried);
+// INVALID_ARGUMENT for another URI scheme (e.g. model://) or an empty path. Cost: a few stat
+// calls per search directory.
+absl::StatusOr<std::string> ResolveMeshFilename(const std::string& filename,
+                                                const std::string& urdf_dir,
+                                                const PackageSearch& search);
+
+}  // namespace inscribe::cli

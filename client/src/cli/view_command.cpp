@@ -1,0 +1,227 @@
+#include "view_command.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "absl/strings/str_format.h"
+#include "exit_codes.h"
+#include "inscribe/atomic_file.h"
+#include "inscribe/envelope_distances.h"
+#include "inscribe/sphere_io.h"
+#include "inscribe/sphere_quality.h"
+#include "signed_histogram.h"
+#include "solid_loading.h"
+#include "view_report_html.h"
+
+namespace inscribe::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Bins per histogram: Fig. 7's resolution, fine enough to see both tails.
+constexpr int kHistogramBins = 60;
+
+struct ViewCliOptions {
+  std::string mesh_path;
+  std::string spheres_path;
+  std::string output_path;  // default: spheres_path with extension .html
+  std::string format;
+  std::string link;
+  int sph_level = -1;
+  std::int64_t samples = 100'000;
+  std::uint64_t seed = 1;
+  bool fill_holes = false;
+  std::string title;
+};
+
+double SecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// The voxel size the spheres were generated with, when the file says (inscribe's JSON).
+double FileVoxelSize(const SphereFile& file) {
+  for (const auto& [key, value] : file.params) {
+    if (key == "voxel_size" && std::holds_alternative<double>(value)) {
+      return std::get<double>(value);
+    }
+  }
+  return 0.0;
+}
+
+// Why the page could not be written to `path`, or "" when it probably can: checked before the
+// sampling so that a mistyped -o fails at once. WriteFileAtomically still reports any failure.
+std::string OutputPathProblem(const std::string& path) {
+  std::error_code error;
+  if (fs::is_directory(path, error)) return "it is a directory";
+  fs::path directory = fs::path(path).parent_path();
+  if (directory.empty()) directory = ".";
+  if (!fs::exists(directory, error)) return "directory " + directory.string() + " does not exist";
+  if (!fs::is_directory(directory, error)) return directory.string() + " is not a directory";
+  if (::access(directory.c_str(), W_OK | X_OK) != 0) {
+    return "directory " + directory.string() + " is not writable (" + std::strerror(errno) + ")";
+  }
+  return "";
+}
+
+int RunView(const ViewCliOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  SphereFileReadOptions read;
+  if (!options.format.empty()) read.format = *ParseSphereFileFormat(options.format);
+  read.sph_level = options.sph_level;
+  read.yaml_link = options.link;
+  absl::StatusOr<SphereFile> file = ReadSphereFile(options.spheres_path, read);
+  if (!file.ok()) {
+    std::cerr << "inscribe: " << file.status().message() << "\n";
+    return kExitBadInput;
+  }
+  const std::vector<Sphere>& spheres = file->set.spheres;
+  if (spheres.empty()) {
+    std::cerr << "inscribe: " << options.spheres_path << ": no spheres to show\n";
+    return kExitBadInput;
+  }
+  const std::string output =
+      !options.output_path.empty()
+          ? options.output_path
+          : fs::path(options.spheres_path).replace_extension(".html").string();
+  std::error_code output_error, spheres_error;
+  const fs::path output_canonical = fs::weakly_canonical(output, output_error);
+  const fs::path spheres_canonical = fs::weakly_canonical(options.spheres_path, spheres_error);
+  if (!output_error && !spheres_error && output_canonical == spheres_canonical) {
+    std::cerr << "inscribe: the page would overwrite the sphere file " << options.spheres_path
+              << "; choose another path with -o\n";
+    return kExitUsage;
+  }
+  if (const std::string problem = OutputPathProblem(output); !problem.empty()) {
+    std::cerr << "inscribe: cannot write the page to " << output << ": " << problem << "\n";
+    return kExitBadInput;
+  }
+
+  int exit_code = kExitOk;
+  std::optional<LoadedSolid> solid =
+      LoadSolid(options.mesh_path, &exit_code, LoadSolidOptions{options.fill_holes});
+  if (!solid) return exit_code;
+  if (!file->mesh_sha256.empty() && file->mesh_sha256 != solid->sha256) {
+    std::cerr << "inscribe: warning: " << options.spheres_path << " was made for mesh "
+              << file->mesh_sha256 << ", not " << solid->sha256 << "\n";
+  }
+
+  const auto evaluate_start = std::chrono::steady_clock::now();
+  QualityOptions quality;
+  quality.surface_samples = options.samples;
+  quality.seed = options.seed;
+  quality.voxel_size = FileVoxelSize(*file);
+  absl::StatusOr<QualityReport> report = EvaluateSpheres(solid->oracle, spheres, quality);
+  if (!report.ok()) {
+    std::cerr << "inscribe: " << report.status().message() << "\n";
+    return report.status().code() == absl::StatusCode::kInvalidArgument ? kExitBadInput
+                                                                        : kExitUnusableMesh;
+  }
+  Vertices centre_rows(static_cast<std::int64_t>(spheres.size()), 3);
+  for (std::size_t i = 0; i < spheres.size(); ++i) {
+    centre_rows.row(static_cast<std::int64_t>(i)) = spheres[i].center.transpose();
+  }
+  const std::vector<double> centre_distances = solid->oracle.SignedDistances(centre_rows);
+  const double evaluate_seconds = SecondsSince(evaluate_start);
+
+  EnvelopeDistanceRequest request;
+  request.boundary_samples = options.samples;
+  request.envelope_samples = options.samples;
+  request.seed = options.seed;
+  absl::StatusOr<EnvelopeDistanceResult> envelope =
+      ComputeEnvelopeDistances(solid->oracle, spheres, request);
+  if (!envelope.ok()) {
+    // INVALID_ARGUMENT and RESOURCE_EXHAUSTED (an envelope too small to sample: thousands of
+    // copies of one ball) are the sphere set's; anything else is a bug.
+    const absl::StatusCode code = envelope.status().code();
+    const bool bad_input =
+        code == absl::StatusCode::kInvalidArgument || code == absl::StatusCode::kResourceExhausted;
+    std::cerr << "inscribe: " << (bad_input ? options.spheres_path + ": " : "internal error: ")
+              << envelope.status().message() << "\n";
+    return bad_input ? kExitBadInput : kExitInternal;
+  }
+
+  ViewPageFacts facts;
+  facts.mesh_name = fs::path(options.mesh_path).filename().string();
+  facts.spheres_name = fs::path(options.spheres_path).filename().string();
+  facts.title =
+      !options.title.empty() ? options.title : facts.mesh_name + " \u00b7 " + facts.spheres_name;
+  facts.mesh_sha256 = solid->sha256;
+  facts.quality = *report;
+  facts.protrusion.reserve(spheres.size());
+  for (std::size_t i = 0; i < spheres.size(); ++i) {
+    facts.protrusion.push_back(std::max(0.0, spheres[i].radius + centre_distances[i]));
+  }
+  // Histograms at least 1e-9 of the diagonal wide: the rounding of exact-distance radii.
+  const double min_range = std::max(1e-9 * report->bbox_diagonal, 1e-300);
+  facts.boundary_to_envelope =
+      MakeSignedHistogram(envelope->boundary_to_envelope, kHistogramBins, min_range);
+  facts.envelope_to_boundary =
+      MakeSignedHistogram(envelope->envelope_to_boundary, kHistogramBins, min_range);
+  facts.envelope_area = envelope->envelope_area;
+  facts.load_seconds = solid->seconds;
+  facts.evaluate_seconds = evaluate_seconds;
+  facts.envelope_seconds = envelope->seconds;
+
+  const absl::StatusOr<std::string> page =
+      ViewPageHtml(ViewPageData(solid->oracle.mesh(), spheres, facts), facts.title);
+  if (!page.ok()) {
+    std::cerr << "inscribe: internal error: " << page.status().message() << "\n";
+    return kExitInternal;
+  }
+  if (absl::Status written = WriteFileAtomically(output, *page); !written.ok()) {
+    std::cerr << "inscribe: " << written.message() << "\n";
+    return kExitBadInput;
+  }
+  std::cout << output << "\n";
+  std::cerr << absl::StrFormat("inscribe: %d spheres, %.0f KB page, %.2f s\n", spheres.size(),
+                               page->size() / 1024.0, SecondsSince(start));
+  return kExitOk;
+}
+
+}  // namespace
+
+void AddViewCommand(CLI::App& app, int* exit_code) {
+  auto options = std::make_shared<ViewCliOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "view",
+      "One self-contained HTML page (three.js embedded, no network needed) showing the mesh "
+      "and the spheres in 3D with the quality report and histograms of signed distances "
+      "between the boundary and the spheres' envelope (the paper's Fig. 7)");
+  cmd->add_option("MESH", options->mesh_path, "Mesh file (.off, .obj, .stl, .ply)")->required();
+  cmd->add_option("SPHERES", options->spheres_path,
+                  "Sphere file (.json, .sph, .csv, cuRobo .yml/.yaml)")
+      ->required();
+  cmd->add_option("-o,--output", options->output_path,
+                  "HTML file to write (default: SPHERES with the extension .html)");
+  cmd->add_option("--format", options->format, "Sphere file format (default: from extension)")
+      ->check(CLI::IsMember({"json", "sph", "csv", "yaml", "yml"}, CLI::ignore_case));
+  cmd->add_option("--link", options->link,
+                  "cuRobo YAML with several links: the link whose spheres to show");
+  cmd->add_option("--sph-level", options->sph_level, ".sph tree level to show (-1 = the leaves)")
+      ->capture_default_str();
+  cmd->add_option("--samples", options->samples,
+                  "Points sampled on the boundary and on the envelope for coverage, Hausdorff "
+                  "distance and the histograms")
+      ->capture_default_str()
+      ->check(CLI::Range(std::int64_t{1}, std::int64_t{10'000'000}));
+  cmd->add_option("--seed", options->seed, "Seed of the samples")->capture_default_str();
+  cmd->add_flag("--fill-holes", options->fill_holes,
+                "Close the mesh's holes first (see inscribe info --fill-holes)");
+  cmd->add_option("--title", options->title,
+                  "Heading of the page (default: the mesh and sphere file names)");
+  cmd->callback([options, exit_code] { *exit_code = RunView(*options); });
+}
+
+}  // namespace inscribe::cli

@@ -1,0 +1,286 @@
+// URDF parsing, rpy rotations, mesh filename resolution and the primitive meshes of
+// `inscribe urdf` (client/src/cli/urdf_robot.h, primitive_meshes.h).
+#include "urdf_robot.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "inscribe/mesh_validation.h"
+#include "primitive_meshes.h"
+
+namespace inscribe::cli {
+namespace {
+
+using ::testing::HasSubstr;
+namespace fs = std::filesystem;
+
+// URDF's rpy written out by hand: R = Rz(yaw) Ry(pitch) Rx(roll), element by element.
+Eigen::Matrix3d HandRpy(double roll, double pitch, double yaw) {
+  const double cr = std::cos(roll), sr = std::sin(roll), cp = std::cos(pitch), sp = std::sin(pitch),
+               cy = std::cos(yaw), sy = std::sin(yaw);
+  Eigen::Matrix3d r;
+  r << cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr,  //
+      sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr,   //
+      -sp, cp * sr, cp * cr;
+  return r;
+}
+
+TEST(UrdfRpy, SingleAxesAreTheRightHandedElementaryRotations) {
+  const double a = 0.4, c = std::cos(a), s = std::sin(a);
+  Eigen::Matrix3d rx, ry, rz;
+  rx << 1, 0, 0, 0, c, -s, 0, s, c;
+  ry << c, 0, s, 0, 1, 0, -s, 0, c;
+  rz << c, -s, 0, s, c, 0, 0, 0, 1;
+  EXPECT_TRUE(RotationFromRpy(Vector3(a, 0, 0)).isApprox(rx, 1e-15));
+  EXPECT_TRUE(RotationFromRpy(Vector3(0, a, 0)).isApprox(ry, 1e-15));
+  EXPECT_TRUE(RotationFromRpy(Vector3(0, 0, a)).isApprox(rz, 1e-15));
+  // Yaw a quarter turn takes the element's x axis to the link's y axis.
+  EXPECT_TRUE((RotationFromRpy(Vector3(0, 0, M_PI / 2)) * Vector3::UnitX())
+                  .isApprox(Vector3::UnitY(), 1e-15));
+}
+
+TEST(UrdfRpy, CombinedAnglesMatchTheHandComputedFixedAxisProduct) {
+  for (const Vector3& rpy :
+       {Vector3(0.3, -0.5, 1.1), Vector3(-2.0, 1.2, 3.0), Vector3(M_PI, M_PI / 2, -M_PI / 4)}) {
+    const Eigen::Matrix3d r = RotationFromRpy(rpy);
+    EXPECT_LT((r - HandRpy(rpy.x(), rpy.y(), rpy.z())).cwiseAbs().maxCoeff(), 1e-15);
+    EXPECT_NEAR(r.determinant(), 1.0, 1e-14);
+  }
+}
+
+constexpr char kRobot[] = R"(<?xml version="1.0"?>
+<robot name="r">
+  <link name="base">
+    <visual><geometry><mesh filename="package://p/v.stl"/></geometry></visual>
+    <collision name="hull">
+      <origin xyz="1 2 3" rpy="0.1 0.2 0.3"/>
+      <geometry><mesh filename="package://p/m.off" scale="2 -1 0.5"/></geometry>
+    </collision>
+    <collision><geometry><box size="1 2 3"/></geometry></collision>
+  </link>
+  <link name="eye"><visual><origin xyz="0 0 1"/>
+    <geometry><cylinder radius="0.5" length="2"/></geometry></visual></link>
+  <link name="ball"><collision><geometry><sphere radius="0.25"/></geometry></collision></link>
+  <link name="capsule"><collision><geometry><capsule radius="1" length="2"/></geometry>
+    </collision></link>
+  <link name="empty"/>
+  <joint name="j" type="fixed"><parent link="base"/><child link="eye"/></joint>
+</robot>
+)";
+
+TEST(UrdfParse, ReadsCollisionsVisualFallbackOriginsAndEveryShape) {
+  const absl::StatusOr<UrdfRobot> robot = ParseUrdf(kRobot);
+  ASSERT_TRUE(robot.ok()) << robot.status();
+  EXPECT_EQ(robot->name, "r");
+  ASSERT_EQ(robot->links.size(), 5u);
+
+  const UrdfLink& base = robot->links[0];
+  EXPECT_EQ(base.name, "base");
+  EXPECT_FALSE(base.from_visual);  // collisions win over the visual
+  ASSERT_EQ(base.elements.size(), 2u);
+  const UrdfElement& hull = base.elements[0];
+  EXPECT_EQ(hull.name, "hull");
+  EXPECT_EQ(hull.line, 5);
+  EXPECT_EQ(hull.geometry.shape, UrdfShape::kMesh);
+  EXPECT_EQ(hull.geometry.filename, "package://p/m.off");
+  EXPECT_EQ(hull.geometry.scale, Vector3(2, -1, 0.5));
+  EXPECT_EQ(hull.origin.xyz, Vector3(1, 2, 3));
+  EXPECT_EQ(hull.origin.rpy, Vector3(0.1, 0.2, 0.3));
+  EXPECT_EQ(base.elements[1].geometry.shape, UrdfShape::kBox);
+  EXPECT_EQ(base.elements[1].geometry.size, Vector3(1, 2, 3));
+  EXPECT_EQ(base.elements[1].origin.xyz, Vector3::Zero());
+
+  const UrdfLink& eye = robot->links[1];
+  EXPECT_TRUE(eye.from_visual);
+  ASSERT_EQ(eye.elements.size(), 1u);
+  EXPECT_EQ(eye.elements[0].geometry.shape, UrdfShape::kCylinder);
+  EXPECT_EQ(eye.elements[0].geometry.radius, 0.5);
+  EXPECT_EQ(eye.elements[0].geometry.length, 2.0);
+  EXPECT_EQ(eye.elements[0].origin.xyz, Vector3(0, 0, 1));
+
+  EXPECT_EQ(robot->links[2].elements.at(0).geometry.shape, UrdfShape::kSphere);
+  EXPECT_EQ(robot->links[2].elements.at(0).geometry.radius, 0.25);
+  EXPECT_EQ(robot->links[3].elements.at(0).geometry.shape, UrdfShape::kUnsupported);
+  EXPECT_EQ(robot->links[3].elements.at(0).geometry.unsupported, "capsule");
+  EXPECT_TRUE(robot->links[4].elements.empty());
+}
+
+// The message of ParseUrdf's error for `urdf`, which must fail with INVALID_ARGUMENT.
+std::string ParseError(const std::string& urdf) {
+  const absl::StatusOr<UrdfRobot> robot = ParseUrdf(urdf);
+  EXPECT_FALSE(robot.ok()) << urdf;
+  if (robot.ok()) return "";
+  EXPECT_EQ(robot.status().code(), absl::StatusCode::kInvalidArgument);
+  return std::string(robot.status().message());
+}
+
+std::string OneLink(const std::string& body) {
+  return "<robot name=\"r\">\n<link name=\"a\">\n" + body + "\n</link>\n</robot>\n";
+}
+
+std::string MeshCollision(const std::string& attributes, const std::string& origin = "") {
+  return "<collision>" + origin + "<geometry><mesh " + attributes + "/></geometry></collision>";
+}
+
+TEST(UrdfParse, ErrorsNameTheLineTheLinkAndTheProblem) {
+  EXPECT_THAT(ParseError("<robot>\n<link name=\"a\">\n</robot>"), HasSubstr("not well-formed XML"));
+  EXPECT_THAT(ParseError(std::string("\x89PNG\r\n\x1a\n\0\0garbage", 16)), HasSubstr("NUL"));
+  EXPECT_THAT(ParseError("\x01\x02garbage<<<"), HasSubstr("XML"));
+  EXPECT_THAT(ParseError(""), HasSubstr("XML"));
+  EXPECT_THAT(ParseError("<sdf version=\"1.6\"/>"), HasSubstr("<sdf>, not <robot>"));
+  EXPECT_THAT(ParseError("<robot>\n<xacro:include filename=\"x.xacro\"/>\n</robot>"),
+              HasSubstr("line 2: <xacro:include> is unexpanded xacro"));
+  EXPECT_THAT(ParseError("<robot>\n<link/>\n</robot>"),
+              HasSubstr("line 2: <link> has no name attribute"));
+  EXPECT_THAT(ParseError("<robot>\n<link name=\"a\"/>\n<link name=\"a\"/>\n</robot>"),
+              HasSubstr("line 3: link name 'a' is used twice"));
+  EXPECT_THAT(ParseError(OneLink(MeshCollision("filename=\"m.off\"", "<origin xyz=\"nan 0 0\"/>"))),
+              HasSubstr("line 3: <origin xyz=\"nan 0 0\">: 'nan' is not finite (link 'a')"));
+  EXPECT_THAT(ParseError(OneLink(MeshCollision("filename=\"m.off\"", "<origin rpy=\"0 1\"/>"))),
+              HasSubstr("expected 3 numbers, found 2"));
+  EXPECT_THAT(
+      ParseError(OneLink(MeshCollision("filename=\"m.off\"", "<origin xyz=\"0 ${l} 0\"/>"))),
+      HasSubstr("unexpanded xacro expression"));
+  EXPECT_THAT(ParseError(OneLink(MeshCollision("filename=\"m.off\" scale=\"1 0 1\""))),
+              HasSubstr("zero component"));
+  EXPECT_THAT(ParseError(OneLink(MeshCollision("filename=\"m.off\" scale=\"1 x 1\""))),
+              HasSubstr("'x' is not a number"));
+  EXPECT_THAT(ParseError(OneLink(MeshCollision("scale=\"1 1 1\""))),
+              HasSubstr("line 3: <mesh> has no filename attribute (link 'a')"));
+  EXPECT_THAT(
+      ParseError(OneLink("<collision><geometry><box size=\"1 -2 3\"/></geometry></collision>")),
+      HasSubstr("<box size> must be 3 positive numbers"));
+  EXPECT_THAT(ParseError(OneLink("<visual><geometry>\n<cylinder radius=\"1\"/></geometry>"
+                                 "</visual>")),
+              HasSubstr("line 4: <cylinder> has no length attribute"));
+  EXPECT_THAT(ParseError(OneLink("<collision><geometry><sphere radius=\"0\"/></geometry>"
+                                 "</collision>")),
+              HasSubstr("radius 0 is not positive"));
+  EXPECT_THAT(ParseError(OneLink(MeshCollision("filename=\"m.off\" scale=\"1e999 1 1\""))),
+              HasSubstr("not"));
+}
+
+class UrdfResolve : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    root_ = fs::temp_directory_path() / ("inscribe_urdf_resolve_" + std::to_string(::getpid()));
+    fs::remove_all(root_);
+    for (const char* file : {"ws/arm/meshes/link.stl", "solo/meshes/s.off",
+                             "install/share/ament_pkg/m.obj", "robot/local.off"}) {
+      fs::create_directories((root_ / file).parent_path());
+      std::ofstream(root_ / file) << "x";
+    }
+  }
+  void TearDown() override { fs::remove_all(root_); }
+
+  std::string Path(const std::string& relative) const {
+    return (root_ / relative).lexically_normal().string();
+  }
+  std::string UrdfDir() const { return Path("robot"); }
+
+  fs::path root_;
+};
+
+TEST_F(UrdfResolve, PackageUrisAreFoundInPackagePathsRosPackagePathAndAmentPrefixes) {
+  PackageSearch search;
+  search.package_paths = {Path("nowhere"), Path("ws")};
+  EXPECT_EQ(*ResolveMeshFilename("package://arm/meshes/link.stl", UrdfDir(), search),
+            Path("ws/arm/meshes/link.stl"));
+  // A directory that is itself the package.
+  search.package_paths = {Path("solo") + "/"};
+  EXPECT_EQ(*ResolveMeshFilename("package://solo/meshes/s.off", UrdfDir(), search),
+            Path("solo/meshes/s.off"));
+
+  ::setenv("ROS_PACKAGE_PATH", (Path("nowhere") + "::" + Path("ws")).c_str(), 1);
+  ::setenv("AMENT_PREFIX_PATH", Path("install").c_str(), 1);
+  const PackageSearch from_environment = PackageSearchFromEnvironment({});
+  ::unsetenv("ROS_PACKAGE_PATH");
+  ::unsetenv("AMENT_PREFIX_PATH");
+  EXPECT_EQ(from_environment.ros_package_path.size(), 2u);  // the empty entry is dropped
+  EXPECT_EQ(*ResolveMeshFilename("package://arm/meshes/link.stl", UrdfDir(), from_environment),
+            Path("ws/arm/meshes/link.stl"));
+  EXPECT_EQ(*ResolveMeshFilename("package://ament_pkg/m.obj", UrdfDir(), from_environment),
+            Path("install/share/ament_pkg/m.obj"));
+}
+
+TEST_F(UrdfResolve, FileUrisAndPlainPathsAreAbsoluteOrRelativeToTheUrdf) {
+  const PackageSearch none;
+  EXPECT_EQ(*ResolveMeshFilename("file://" + Path("solo/meshes/s.off"), UrdfDir(), none),
+            Path("solo/meshes/s.off"));
+  EXPECT_EQ(*ResolveMeshFilename("file://local.off", UrdfDir(), none), Path("robot/local.off"));
+  EXPECT_EQ(*ResolveMeshFilename("local.off", UrdfDir(), none), Path("robot/local.off"));
+  EXPECT_EQ(*ResolveMeshFilename("../solo/meshes/s.off", UrdfDir(), none),
+            Path("solo/meshes/s.off"));
+  EXPECT_EQ(*ResolveMeshFilename(Path("ws/arm/meshes/link.stl"), UrdfDir(), none),
+            Path("ws/arm/meshes/link.stl"));
+}
+
+TEST_F(UrdfResolve, FailuresSayWhatWasLookedFor) {
+  PackageSearch search;
+  search.package_paths = {Path("ws")};
+  const absl::StatusOr<std::string> unknown =
+      ResolveMeshFilename("package://leg/m.stl", UrdfDir(), search);
+  EXPECT_EQ(unknown.status().code(), absl::StatusCode::kNotFound);
+  EXPECT_THAT(unknown.status().message(), HasSubstr("package 'leg'"));
+  EXPECT_THAT(unknown.status().message(), HasSubstr(Path("ws")));
+  EXPECT_THAT(ResolveMeshFilename("package://leg/m.stl", UrdfDir(), {}).status().message(),
+              HasSubstr("--package-path"));
+
+  const absl::StatusOr<std::string> missing =
+      ResolveMeshFilename("package://arm/meshes/gone.stl", UrdfDir(), search);
+  EXPECT_EQ(missing.status().code(), absl::StatusCode::kNotFound);
+  EXPECT_THAT(missing.status().message(), HasSubstr(Path("ws/arm/meshes/gone.stl")));
+  EXPECT_EQ(ResolveMeshFilename("gone.off", UrdfDir(), search).status().code(),
+            absl::StatusCode::kNotFound);
+  // A directory is not a mesh file.
+  EXPECT_EQ(ResolveMeshFilename("package://arm/meshes", UrdfDir(), search).status().code(),
+            absl::StatusCode::kNotFound);
+
+  EXPECT_THAT(ResolveMeshFilename("model://arm/m.stl", UrdfDir(), search).status().message(),
+              HasSubstr("URI scheme 'model' is not supported"));
+  EXPECT_EQ(ResolveMeshFilename("package://arm", UrdfDir(), search).status().code(),
+            absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(ResolveMeshFilename("file://", UrdfDir(), search).status().code(),
+            absl::StatusCode::kInvalidArgument);
+}
+
+TEST(PrimitiveMeshes, BoxIsAnExactValidSolid) {
+  const Vector3 size(0.2, 0.5, 1.5);
+  const ValidatedMesh box = ValidateMesh(BoxMesh(size));
+  EXPECT_TRUE(box.report.usable()) << box.report.first_error();
+  EXPECT_EQ(box.report.flipped_triangles, 0);  // outward as built
+  EXPECT_EQ(box.report.triangles, 12);
+  EXPECT_NEAR(box.report.volume, size.prod(), 1e-15);
+  EXPECT_TRUE(box.report.bbox.max.isApprox(size / 2, 1e-15));
+  EXPECT_TRUE(box.report.bbox.min.isApprox(-size / 2, 1e-15));
+}
+
+TEST(PrimitiveMeshes, CylinderIsAValidPrismInsideTheCylinder) {
+  for (int sides : {3, 7, kCylinderSides}) {
+    SCOPED_TRACE(sides);
+    const double radius = 0.3, length = 1.2;
+    const ValidatedMesh cylinder = ValidateMesh(CylinderMesh(radius, length, sides));
+    EXPECT_TRUE(cylinder.report.usable()) << cylinder.report.first_error();
+    EXPECT_EQ(cylinder.report.flipped_triangles, 0);
+    EXPECT_EQ(cylinder.report.triangles, 4 * sides);
+    // The regular n-gon's area is n r^2 sin(2 pi / n) / 2.
+    const double prism = 0.5 * sides * radius * radius * std::sin(2 * M_PI / sides) * length;
+    EXPECT_NEAR(cylinder.report.volume, prism, 1e-12);
+    EXPECT_LT(cylinder.report.volume, M_PI * radius * radius * length);
+    EXPECT_NEAR(cylinder.report.bbox.max.z(), length / 2, 1e-15);
+    EXPECT_LE(cylinder.report.bbox.max.head<2>().norm(), radius * std::sqrt(2.0));
+  }
+  // 64 sides: within 0.11% of the true cylinder's volume.
+  const double ratio = ValidateMesh(CylinderMesh(1.0, 1.0)).report.volume / M_PI;
+  EXPECT_GT(ratio, 0.998);
+}
+
+}  // namespace
+}  // namespace inscribe::cli

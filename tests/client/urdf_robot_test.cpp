@@ -135,6 +135,12 @@ TEST(UrdfParse, ErrorsNameTheLineTheLinkAndTheProblem) {
   EXPECT_THAT(ParseError("\x01\x02garbage<<<"), HasSubstr("XML"));
   EXPECT_THAT(ParseError(""), HasSubstr("XML"));
   EXPECT_THAT(ParseError("<sdf version=\"1.6\"/>"), HasSubstr("<sdf>, not <robot>"));
+  // tinyxml2 alone takes text and elements beside the root (found by fuzz_urdf).
+  EXPECT_THAT(ParseError("<robot name=\"r\"/>\n\"/></geometry>"),
+              HasSubstr("line 2: not well-formed XML: text '\"/>' outside the root element"));
+  EXPECT_THAT(ParseError("junk\n<robot name=\"r\"/>"), HasSubstr("line 1: not well-formed XML"));
+  EXPECT_THAT(ParseError("<robot name=\"r\"/>\n<robot name=\"s\"/>"),
+              HasSubstr("line 2: not well-formed XML: a second top-level element <robot>"));
   EXPECT_THAT(ParseError("<robot>\n<xacro:include filename=\"x.xacro\"/>\n</robot>"),
               HasSubstr("line 2: <xacro:include> is unexpanded xacro"));
   EXPECT_THAT(ParseError("<robot>\n<link/>\n</robot>"),

@@ -298,6 +298,23 @@ absl::StatusOr<UrdfRobot> ParseUrdf(absl::string_view bytes) {
     return ErrorAt(root->GetLineNum(),
                    absl::StrCat("the root element is <", root->Name(), ">, not <robot>"));
   }
+  // tinyxml2 accepts text and further elements beside the root, which XML does not: the
+  // writer would print them back where tinyxml2 itself then refuses the output (found by
+  // fuzz_urdf), and a second <robot> would be ignored without a word.
+  for (const tinyxml2::XMLNode* node = document.FirstChild(); node != nullptr;
+       node = node->NextSibling()) {
+    if (node->ToText() != nullptr) {
+      return ErrorAt(node->GetLineNum(),
+                     absl::StrCat("not well-formed XML: text '",
+                                  absl::StripAsciiWhitespace(node->Value()).substr(0, 40),
+                                  "' outside the root element <robot>"));
+    }
+    if (node->ToElement() != nullptr && node != root) {
+      return ErrorAt(node->GetLineNum(),
+                     absl::StrCat("not well-formed XML: a second top-level element <",
+                                  node->Value(), "> (a URDF has one root element, <robot>)"));
+    }
+  }
   if (const XMLElement* xacro = FindXacro(*root); xacro != nullptr) {
     return ErrorAt(xacro->GetLineNum(),
                    absl::StrCat("<", xacro->Name(),

@@ -1,6 +1,6 @@
 // Peers' sphere files through the command line: cuRobo YAML (one link or a whole robot) and
 // spheretree .sph written by `generate`, then read back by `evaluate`, `distance` and
-// `deform` with the same results as inscribe's own JSON.
+// `deform` with the same results as inscribe's own JSON; `convert` between every format.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -8,6 +8,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "client/cli_run.h"
 #include "inscribe/sphere_io.h"
@@ -118,6 +119,109 @@ TEST_F(CliPeerFormats, FormatOptionReadsYamlWhateverTheExtension) {
   const nlohmann::json sniffed = Evaluate(Path("spheres.txt"));
   EXPECT_EQ(by_option.at("nerr").get<double>(), sniffed.at("nerr").get<double>());
   EXPECT_EQ(by_option.at("spheres"), Evaluate(Path("eight.json")).at("spheres"));
+}
+
+// The spheres of a file as the core reads them, bit for bit comparable.
+std::vector<Sphere> SpheresOf(const std::string& path, const SphereFileReadOptions& read = {}) {
+  absl::StatusOr<SphereFile> file = ReadSphereFile(path, read);
+  EXPECT_TRUE(file.ok()) << file.status();
+  return file.ok() ? file->set.spheres : std::vector<Sphere>{};
+}
+
+void ExpectSameSpheres(const std::vector<Sphere>& a, const std::vector<Sphere>& b) {
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].center, b[i].center) << "sphere " << i;
+    EXPECT_EQ(a[i].radius, b[i].radius) << "sphere " << i;
+  }
+}
+
+TEST_F(CliPeerFormats, ConvertCarriesEverySphereBitForBitThroughEveryFormat) {
+  const std::vector<Sphere> original = SpheresOf(Path("eight.json"));
+  ASSERT_GT(original.size(), 10u);
+
+  const CliRun to_sph =
+      RunCli("convert " + Quote(Path("eight.json")) + " -o " + Quote(Path("c.sph")));
+  ASSERT_EQ(to_sph.exit_code, 0) << to_sph.err;
+  EXPECT_THAT(to_sph.out, HasSubstr("wrote " + std::to_string(original.size()) + " spheres"));
+  // What .sph cannot hold is named, not lost silently.
+  EXPECT_THAT(to_sph.err, AllOf(HasSubstr("left out"), HasSubstr("contacts"), HasSubstr("params")));
+  EXPECT_THAT(Slurp(Path("c.sph")), ::testing::StartsWith("2 " + std::to_string(original.size())));
+
+  const CliRun to_yaml = RunCli("convert " + Quote(Path("c.sph")) + " -o " + Quote(Path("c.yml")) +
+                                " --yaml-link arm/link_1 --json");
+  ASSERT_EQ(to_yaml.exit_code, 0) << to_yaml.err;
+  const nlohmann::json summary = nlohmann::json::parse(to_yaml.out);
+  EXPECT_EQ(summary.at("spheres"), original.size());
+  EXPECT_EQ(summary.at("format"), "yaml");
+  EXPECT_TRUE(summary.at("left_out").empty());  // .sph had nothing but spheres
+  EXPECT_THAT(Slurp(Path("c.yml")), HasSubstr("collision_spheres:\n  arm/link_1:\n"));
+
+  // The link read is the link written, unless --yaml-link says otherwise; stdout by default.
+  const CliRun to_csv = RunCli("convert " + Quote(Path("c.yml")) + " --link arm/link_1 --to csv");
+  ASSERT_EQ(to_csv.exit_code, 0) << to_csv.err;
+  std::ofstream(Path("c.csv")) << to_csv.out;
+  const CliRun to_json = RunCli("convert " + Quote(Path("c.csv")) + " -o " + Quote(Path("c.json")));
+  ASSERT_EQ(to_json.exit_code, 0) << to_json.err;
+  EXPECT_EQ(to_json.err, "");  // JSON holds all a CSV has
+
+  for (const char* name : {"c.sph", "c.csv", "c.json"}) {
+    SCOPED_TRACE(name);
+    ExpectSameSpheres(SpheresOf(Path(name)), original);
+  }
+  SphereFileReadOptions link;
+  link.yaml_link = "arm/link_1";
+  ExpectSameSpheres(SpheresOf(Path("c.yml"), link), original);
+  // And evaluate agrees with the original on the converted file.
+  EXPECT_EQ(Evaluate(Path("c.json")).at("nerr").get<double>(),
+            Evaluate(Path("eight.json")).at("nerr").get<double>());
+
+  // OBJ is for viewers: one icosphere (42 vertices at subdivision 1) per sphere.
+  const CliRun to_obj = RunCli("convert " + Quote(Path("eight.json")) + " --to obj");
+  ASSERT_EQ(to_obj.exit_code, 0) << to_obj.err;
+  std::size_t vertices = 0;
+  for (std::size_t at = to_obj.out.find("\nv "); at != std::string::npos;
+       at = to_obj.out.find("\nv ", at + 1)) {
+    ++vertices;
+  }
+  EXPECT_EQ(vertices, 42 * original.size());
+}
+
+TEST_F(CliPeerFormats, ConvertReadsTheSphTreeLevelAsked) {
+  // A spheretree tree of 3 levels, degree 2: root, 2 children, 4 leaves of which one unused.
+  std::ofstream(Path("tree.sph")) << "3 2\n0 0 0 4 1\n-1 0 0 2 1\n1 0 0 2 1\n"
+                                     "-1.5 0 0 1 1\n-0.5 0 0 1 1\n1.5 0 0 1 1\n0 0 0 0 0\n";
+  const CliRun leaves = RunCli("convert " + Quote(Path("tree.sph")) + " --to csv");
+  ASSERT_EQ(leaves.exit_code, 0) << leaves.err;
+  EXPECT_EQ(leaves.out, "x,y,z,r\n-1.5,0,0,1\n-0.5,0,0,1\n1.5,0,0,1\n");
+  const CliRun level1 = RunCli("convert " + Quote(Path("tree.sph")) + " --sph-level 1 --to csv");
+  ASSERT_EQ(level1.exit_code, 0) << level1.err;
+  EXPECT_EQ(level1.out, "x,y,z,r\n-1,0,0,2\n1,0,0,2\n");
+}
+
+TEST_F(CliPeerFormats, ConvertRefusesBadInputAndOptionsClearly) {
+  const std::string json = Quote(Path("eight.json"));
+  const auto expect = [](const CliRun& run, int code, const std::string& message) {
+    EXPECT_EQ(run.exit_code, code) << run.err;
+    EXPECT_THAT(run.err, HasSubstr(message));
+  };
+  expect(RunCli("convert " + Quote(Path("missing.json"))), 2, "missing.json");
+  std::ofstream(Path("garbage.csv")) << "1,2,3,4\n1,2,three,4\n";
+  expect(RunCli("convert " + Quote(Path("garbage.csv"))), 2, "line 2");
+  std::ofstream(Path("negative.csv")) << "1,2,3,-4\n";
+  expect(RunCli("convert " + Quote(Path("negative.csv"))), 2, "radius -4 is not positive");
+  expect(RunCli("convert " + json + " -o " + Quote(Path("out.txt"))), 64, "--to");
+  expect(RunCli("convert " + json + " -o " + Quote(Path("no/such/dir/out.sph"))), 2, "no/such/dir");
+  expect(RunCli("convert " + json + " --to yaml --yaml-link 'two words'"), 64, "two words");
+  expect(RunCli("convert " + json + " --json"), 64, "needs -o");
+  expect(RunCli("convert " + json + " --from obj"), 64, "obj");
+  // A robot file with two links names them when none is picked.
+  std::ofstream(Path("two.yml")) << "collision_spheres:\n  a:\n    - center: [0, 0, 0]\n"
+                                    "      radius: 1\n  b:\n    - center: [1, 0, 0]\n"
+                                    "      radius: 1\n";
+  expect(RunCli("convert " + Quote(Path("two.yml"))), 2, "a, b");
+  // Nothing half-written is left behind by a refused conversion.
+  EXPECT_FALSE(fs::exists(Path("out.txt")));
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include <exception>
 #include <iostream>
 
+#include "convert_command.h"
 #include "deform_command.h"
 #include "distance_command.h"
 #include "evaluate_command.h"
@@ -34,6 +35,7 @@ int main(int argc, char** argv) {
   inscribe::cli::AddHealthCommand(app, &exit_code);
   inscribe::cli::AddUrdfCommand(app, &exit_code);
   inscribe::cli::AddViewCommand(app, &exit_code);
+  inscribe::cli::AddConvertCommand(app, &exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

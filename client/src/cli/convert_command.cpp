@@ -1,0 +1,131 @@
+#include "convert_command.h"
+
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "absl/strings/str_join.h"
+#include "exit_codes.h"
+#include "inscribe/sphere_io.h"
+#include "sphere_output.h"
+
+namespace inscribe::cli {
+namespace {
+
+struct ConvertCliOptions {
+  std::string input_path;
+  std::string output_path;
+  std::string from;  // input format; empty: ReadSphereFile's choice (extension, else sniffed)
+  std::string to;    // output format; empty: from the output's extension, else JSON
+  int sph_level = -1;
+  std::string link;       // the cuRobo YAML link to read
+  std::string yaml_link;  // the cuRobo YAML link to write under
+  bool json = false;
+};
+
+// What the output format leaves out of `file`, e.g. {"contacts", "params"}: only JSON keeps
+// more than the spheres.
+std::vector<std::string> DroppedParts(const SphereFile& file, SphereFileFormat to) {
+  std::vector<std::string> dropped;
+  if (to == SphereFileFormat::kJson) return dropped;
+  if (!file.set.contacts.empty()) dropped.push_back("contacts (deform needs them)");
+  if (!file.mesh_sha256.empty()) dropped.push_back("mesh hash");
+  if (!file.params.empty()) dropped.push_back("params");
+  if (!file.stats.empty()) dropped.push_back("stats");
+  return dropped;
+}
+
+int RunConvert(const ConvertCliOptions& options) {
+  if (options.json && options.output_path.empty()) {
+    std::cerr << "inscribe: --json prints a summary on stdout, so it needs -o for the file\n";
+    return kExitUsage;
+  }
+  // The output format, settled before anything is read: an unknown extension is a usage error.
+  SphereFileFormat to = SphereFileFormat::kJson;
+  if (!options.to.empty()) {
+    to = *ParseSphereFileFormat(options.to);
+  } else if (!options.output_path.empty()) {
+    absl::StatusOr<SphereFileFormat> by_extension = SphereFileFormatFromPath(options.output_path);
+    if (!by_extension.ok()) {
+      std::cerr << "inscribe: " << by_extension.status().message()
+                << "; name the format with --to\n";
+      return kExitUsage;
+    }
+    to = *by_extension;
+  }
+
+  // Written under the link it was read from, unless told otherwise.
+  const std::string yaml_link = !options.yaml_link.empty() ? options.yaml_link : options.link;
+  if (to == SphereFileFormat::kYaml && !yaml_link.empty()) {
+    if (absl::Status name = FormatCuroboYaml({LinkSpheres{yaml_link, {}}}).status(); !name.ok()) {
+      std::cerr << "inscribe: " << name.message() << "\n";
+      return kExitUsage;
+    }
+  }
+
+  SphereFileReadOptions read;
+  if (!options.from.empty()) read.format = *ParseSphereFileFormat(options.from);
+  read.sph_level = options.sph_level;
+  read.yaml_link = options.link;
+  absl::StatusOr<SphereFile> file = ReadSphereFile(options.input_path, read);
+  if (!file.ok()) {
+    std::cerr << "inscribe: " << file.status().message() << "\n";
+    return kExitBadInput;
+  }
+  const int written =
+      EmitSphereFile(*file, options.output_path, std::string(SphereFileFormatName(to)),
+                     /*json_summary=*/false, yaml_link);
+  if (written != kExitOk) return written;
+
+  const std::vector<std::string> dropped = DroppedParts(*file, to);
+  if (!dropped.empty()) {
+    std::cerr << "inscribe: note: " << SphereFileFormatName(to)
+              << " holds only the spheres; left out: " << absl::StrJoin(dropped, ", ") << "\n";
+  }
+  if (options.json) {
+    nlohmann::json summary;
+    summary["input"] = options.input_path;
+    summary["output"] = options.output_path;
+    summary["format"] = SphereFileFormatName(to);
+    summary["spheres"] = file->set.spheres.size();
+    summary["mesh_sha256"] = file->mesh_sha256;
+    summary["left_out"] = dropped;
+    std::cout << summary.dump() << "\n";
+  } else if (!options.output_path.empty()) {
+    std::cout << "wrote " << file->set.spheres.size() << " spheres to " << options.output_path
+              << " (" << SphereFileFormatName(to) << ")\n";
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+void AddConvertCommand(CLI::App& app, int* exit_code) {
+  auto options = std::make_shared<ConvertCliOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "convert",
+      "A sphere file in another format: inscribe JSON, spheretree .sph, CSV, cuRobo YAML, or "
+      "OBJ meshes of the spheres; the spheres are copied bit for bit");
+  cmd->add_option("SPHERES", options->input_path,
+                  "Sphere file (.json, .sph, .csv, cuRobo .yml/.yaml)")
+      ->required();
+  cmd->add_option("-o,--output", options->output_path,
+                  "Output file, written atomically (default: stdout)");
+  cmd->add_option("--from", options->from, "Input format (default: from extension or content)")
+      ->check(CLI::IsMember({"json", "sph", "csv", "yaml", "yml"}, CLI::ignore_case));
+  cmd->add_option("--to", options->to, "Output format (default: from -o's extension, else json)")
+      ->check(CLI::IsMember({"json", "sph", "csv", "obj", "yaml", "yml"}, CLI::ignore_case));
+  cmd->add_option("--sph-level", options->sph_level, ".sph tree level to read (-1 = the leaves)")
+      ->capture_default_str();
+  cmd->add_option("--link", options->link,
+                  "cuRobo YAML with several links: the link to read (also the link written)");
+  cmd->add_option("--yaml-link", options->yaml_link,
+                  "Link name the spheres are listed under in YAML output (default: --link, "
+                  "else mesh)");
+  cmd->add_flag("--json", options->json, "Print one JSON summary on stdout (needs -o)");
+  cmd->callback([options, exit_code] { *exit_code = RunConvert(*options); });
+}
+
+}  // namespace inscribe::cli

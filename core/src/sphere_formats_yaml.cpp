@@ -149,7 +149,10 @@ absl::StatusOr<std::string> FormatCuroboYaml(const std::vector<LinkSpheres>& lin
         return absl::InvalidArgumentError(absl::StrCat("link ", link.link, ": ", status.message()));
       }
     }
-    absl::StrAppend(&out, "  ", link.link, ":", link.spheres.empty() ? " []\n" : "\n");
+    // Quoted: YAML resolves plain keys such as null, true, no, 1 or .inf to other types
+    // (PyYAML, which cuRobo loads with, would hand it None, a bool or a number for a link
+    // named so; found by fuzz_urdf). Link names need no escapes inside the quotes.
+    absl::StrAppend(&out, "  \"", link.link, "\":", link.spheres.empty() ? " []\n" : "\n");
     for (const Sphere& s : link.spheres) {
       absl::StrAppend(&out, "    - \"center\": [", YamlDouble(s.center.x()), ", ",
                       YamlDouble(s.center.y()), ", ", YamlDouble(s.center.z()), "]\n",

@@ -53,7 +53,7 @@ class CliPeerFormats : public ::testing::Test {
 TEST_F(CliPeerFormats, YamlAndSphEvaluateExactlyAsJson) {
   const nlohmann::json json = Evaluate(Path("eight.json"));
   const std::string yaml = Slurp(Path("eight.yml"));
-  EXPECT_THAT(yaml, HasSubstr("collision_spheres:\n  eight_link:\n"));
+  EXPECT_THAT(yaml, HasSubstr("collision_spheres:\n  \"eight_link\":\n"));
   for (const char* name : {"eight.yml", "eight.sph"}) {
     SCOPED_TRACE(name);
     const nlohmann::json peer = Evaluate(Path(name));
@@ -155,7 +155,7 @@ TEST_F(CliPeerFormats, ConvertCarriesEverySphereBitForBitThroughEveryFormat) {
   EXPECT_EQ(summary.at("spheres"), original.size());
   EXPECT_EQ(summary.at("format"), "yaml");
   EXPECT_TRUE(summary.at("left_out").empty());  // .sph had nothing but spheres
-  EXPECT_THAT(Slurp(Path("c.yml")), HasSubstr("collision_spheres:\n  arm/link_1:\n"));
+  EXPECT_THAT(Slurp(Path("c.yml")), HasSubstr("collision_spheres:\n  \"arm/link_1\":\n"));
 
   // The link read is the link written, unless --yaml-link says otherwise; stdout by default.
   const CliRun to_csv = RunCli("convert " + Quote(Path("c.yml")) + " --link arm/link_1 --to csv");

@@ -186,8 +186,8 @@ TEST(SpherizedUrdf, ReplacesCollisionsOfSpherizedLinksAndAnnotatesSkippedOnes) {
   colon.spheres = {{Vector3(1, 2, 3), 0.5}};
   std::vector<std::string> left_out;
   const std::string yaml = SpherizedCuroboYaml({a, b, c, colon}, "r", &left_out);
-  EXPECT_THAT(yaml, HasSubstr("collision_spheres:\n  a:\n"));
-  EXPECT_THAT(yaml, HasSubstr("\n  b:\n"));
+  EXPECT_THAT(yaml, HasSubstr("collision_spheres:\n  \"a\":\n"));
+  EXPECT_THAT(yaml, HasSubstr("\n  \"b\":\n"));
   EXPECT_THAT(yaml, ::testing::Not(HasSubstr("  c:")));
   EXPECT_THAT(left_out, ElementsAre("d:e"));
 }

@@ -224,7 +224,7 @@ TEST(SphereFileGolden, WritesCsvSphYaml) {
             "# inscribe spheres: 2 spheres, mesh " + kHash +
                 "\n"
                 "collision_spheres:\n"
-                "  mesh:\n"
+                "  \"mesh\":\n"
                 "    - \"center\": [0.0, 0.0, 0.0]\n"
                 "      \"radius\": 1.0\n"
                 "    - \"center\": [1.5, -2.0, 0.25]\n"
@@ -235,10 +235,10 @@ TEST(SphereFileGolden, WritesCsvSphYaml) {
   SphereFileWriteOptions options;
   options.yaml_link_name = "panda_link0";
   EXPECT_EQ(*FormatSphereFile(odd, SphereFileFormat::kYaml, options),
-            "# inscribe spheres: 1 spheres\ncollision_spheres:\n  panda_link0:\n"
+            "# inscribe spheres: 1 spheres\ncollision_spheres:\n  \"panda_link0\":\n"
             "    - \"center\": [1.0e+22, -5.0e-324, 1.5e-07]\n      \"radius\": 2.0e-300\n");
   EXPECT_THAT(*FormatSphereFile(SphereFile{}, SphereFileFormat::kYaml),
-              ::testing::EndsWith("  mesh: []\n"));
+              ::testing::EndsWith("  \"mesh\": []\n"));
 }
 
 TEST(SphereFileGolden, ReadsHandWrittenJson) {

@@ -81,7 +81,9 @@ TEST(CuroboYaml, ManyLinksRoundTripBitExact) {
   std::mt19937_64 rng(3);
   std::uniform_real_distribution<double> coordinate(-2, 2), radius(1e-6, 0.5);
   std::vector<LinkSpheres> links;
-  for (const char* name : {"panda_link0", "panda_link1", "arm/elbow", "gripper-left.pad"}) {
+  // Names YAML would read as null, a bool, a number or a float unless quoted (fuzz_urdf).
+  for (const char* name : {"panda_link0", "panda_link1", "arm/elbow", "gripper-left.pad", "null",
+                           "true", "no", "1", ".inf", "...", "-", "0x1F", "1e3"}) {
     LinkSpheres link{name, {}};
     for (int i = 0; i < 50; ++i) {
       link.spheres.push_back(
@@ -95,7 +97,7 @@ TEST(CuroboYaml, ManyLinksRoundTripBitExact) {
   ASSERT_TRUE(bytes.ok()) << bytes.status();
   EXPECT_THAT(*bytes, HasSubstr("# a robot\n# second line\ncollision_spheres:\n"));
   EXPECT_THAT(*bytes, HasSubstr("\"center\": [1.0e+22, -0.0, 5.0e-324]"));  // YAML 1.1 floats
-  EXPECT_THAT(*bytes, HasSubstr("  empty_link: []\n"));
+  EXPECT_THAT(*bytes, HasSubstr("  \"empty_link\": []\n"));
   const absl::StatusOr<std::vector<LinkSpheres>> back = ParseCuroboYaml(*bytes);
   ASSERT_TRUE(back.ok()) << back.status();
   ASSERT_EQ(back->size(), links.size());

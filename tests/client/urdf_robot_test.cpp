@@ -139,6 +139,18 @@ TEST(UrdfParse, ErrorsNameTheLineTheLinkAndTheProblem) {
   EXPECT_THAT(ParseError("<robot name=\"r\"/>\n\"/></geometry>"),
               HasSubstr("line 2: not well-formed XML: text '\"/>' outside the root element"));
   EXPECT_THAT(ParseError("junk\n<robot name=\"r\"/>"), HasSubstr("line 1: not well-formed XML"));
+  // tinyxml2 alone turns an unknown entity into stale bytes (found by fuzz_urdf).
+  EXPECT_THAT(ParseError("<robot name=\"r\">\n<link name=\"a&amp;b&gp;c\"/>\n</robot>"),
+              HasSubstr("line 2: <link name>: '&gp;' is not an XML entity"));
+  EXPECT_THAT(ParseError("<robot name=\"r\">\n<joint name=\"R & D\"/>\n</robot>"),
+              HasSubstr("line 2: <joint name>: '& D' is not an XML entity"));
+  EXPECT_THAT(ParseError("<robot name=\"r\">\n<material>A &copy; B</material>\n</robot>"),
+              HasSubstr("line 2: text in <material>: '&copy;'"));
+  const absl::StatusOr<UrdfRobot> entities = ParseUrdf(
+      "<robot name=\"&lt;&gt;&amp;&quot;&apos;&#49;&#x32;\"><link name=\"a\">"
+      "<!-- & --><![CDATA[ & ]]></link></robot>");
+  ASSERT_TRUE(entities.ok()) << entities.status();
+  EXPECT_EQ(entities->name, "<>&\"'12");
   EXPECT_THAT(ParseError("<robot name=\"r\"/>\n<robot name=\"s\"/>"),
               HasSubstr("line 2: not well-formed XML: a second top-level element <robot>"));
   EXPECT_THAT(ParseError("<robot>\n<xacro:include filename=\"x.xacro\"/>\n</robot>"),

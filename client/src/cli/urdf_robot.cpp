@@ -2,6 +2,7 @@
 
 #include <tinyxml2.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -202,6 +203,53 @@ absl::StatusOr<UrdfLink> ParseLink(const XMLElement& element) {
   return link;
 }
 
+// The first '&' in `text` that does not start a reference tinyxml2 reads correctly (&lt;
+// &gt; &amp; &quot; &apos; &#...;), as the text from it to the next ';' or at most 12 bytes;
+// empty when there is none.
+std::string UnknownEntity(absl::string_view text) {
+  for (std::size_t at = text.find('&'); at != absl::string_view::npos;
+       at = text.find('&', at + 1)) {
+    const absl::string_view rest = text.substr(at + 1);
+    bool known = absl::StartsWith(rest, "#");
+    for (const char* name : {"lt;", "gt;", "amp;", "quot;", "apos;"}) {
+      known = known || absl::StartsWith(rest, name);
+    }
+    if (!known) {
+      const std::size_t semicolon = text.find(';', at);
+      const std::size_t length = semicolon == absl::string_view::npos ? 12 : semicolon - at + 1;
+      return std::string(text.substr(at, std::min<std::size_t>(length, 12)));
+    }
+  }
+  return "";
+}
+
+// Every attribute value and text of `element` and below, read without entity processing
+// (tinyxml2 9 turns an unknown entity into stale bytes of the value, silently: the writer
+// would print garbage, e.g. into joint names; found by fuzz_urdf). XML has no other entities
+// without a DTD, which tinyxml2 does not read.
+absl::Status CheckEntities(const XMLElement& element) {
+  for (const tinyxml2::XMLAttribute* a = element.FirstAttribute(); a != nullptr; a = a->Next()) {
+    if (const std::string entity = UnknownEntity(a->Value()); !entity.empty()) {
+      return ErrorAt(a->GetLineNum(),
+                     absl::StrCat("<", element.Name(), " ", a->Name(), ">: '", entity,
+                                  "' is not an XML entity (write a literal & as &amp;)"));
+    }
+  }
+  for (const tinyxml2::XMLNode* child = element.FirstChild(); child != nullptr;
+       child = child->NextSibling()) {
+    if (const tinyxml2::XMLText* text = child->ToText(); text != nullptr && !text->CData()) {
+      if (const std::string entity = UnknownEntity(text->Value()); !entity.empty()) {
+        return ErrorAt(text->GetLineNum(),
+                       absl::StrCat("text in <", element.Name(), ">: '", entity,
+                                    "' is not an XML entity (write a literal & as &amp;)"));
+      }
+    } else if (const XMLElement* inner = child->ToElement(); inner != nullptr) {
+      if (absl::Status status = CheckEntities(*inner); !status.ok()) return status;
+    }
+  }
+  return absl::OkStatus();
+}
+
 bool IsDirectory(const fs::path& path) {
   std::error_code error;
   return fs::is_directory(path, error);
@@ -313,6 +361,13 @@ absl::StatusOr<UrdfRobot> ParseUrdf(absl::string_view bytes) {
       return ErrorAt(node->GetLineNum(),
                      absl::StrCat("not well-formed XML: a second top-level element <",
                                   node->Value(), "> (a URDF has one root element, <robot>)"));
+    }
+  }
+  {
+    tinyxml2::XMLDocument raw(/*processEntities=*/false);
+    raw.Parse(bytes.data(), bytes.size());  // accepted above; only the entity mode differs
+    if (raw.RootElement() != nullptr) {
+      if (absl::Status status = CheckEntities(*raw.RootElement()); !status.ok()) return status;
     }
   }
   if (const XMLElement* xacro = FindXacro(*root); xacro != nullptr) {

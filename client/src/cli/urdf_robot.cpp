@@ -223,10 +223,8 @@ std::string UnknownEntity(absl::string_view text) {
   return "";
 }
 
-// Every attribute value and text of `element` and below, read without entity processing
-// (tinyxml2 9 turns an unknown entity into stale bytes of the value, silently: the writer
-// would print garbage, e.g. into joint names; found by fuzz_urdf). XML has no other entities
-// without a DTD, which tinyxml2 does not read.
+// Every attribute value and text of `element` and below (of a document read without entity
+// processing) must use only the entities XML has without a DTD, which tinyxml2 does not read.
 absl::Status CheckEntities(const XMLElement& element) {
   for (const tinyxml2::XMLAttribute* a = element.FirstAttribute(); a != nullptr; a = a->Next()) {
     if (const std::string entity = UnknownEntity(a->Value()); !entity.empty()) {
@@ -248,6 +246,33 @@ absl::Status CheckEntities(const XMLElement& element) {
     }
   }
   return absl::OkStatus();
+}
+
+// What tinyxml2 accepts but XML does not, on `bytes` that tinyxml2 parsed: text or another
+// element beside the root (the writer would print them back where tinyxml2 itself then refuses
+// the output, and a second <robot> would be ignored without a word), and unknown entities
+// (tinyxml2 9 turns one into stale bytes of the value, silently: the writer would print
+// garbage, e.g. into joint names). All found by fuzz_urdf. Read again without entity
+// processing, the only way to see the entities as written.
+absl::Status CheckStrictXml(absl::string_view bytes) {
+  tinyxml2::XMLDocument raw(/*processEntities=*/false);
+  raw.Parse(bytes.data(), bytes.size());
+  const XMLElement* root = raw.RootElement();
+  for (const tinyxml2::XMLNode* node = raw.FirstChild(); node != nullptr;
+       node = node->NextSibling()) {
+    if (node->ToText() != nullptr) {
+      return ErrorAt(node->GetLineNum(),
+                     absl::StrCat("not well-formed XML: text '",
+                                  absl::StripAsciiWhitespace(node->Value()).substr(0, 40),
+                                  "' outside the root element <robot>"));
+    }
+    if (node->ToElement() != nullptr && node != root) {
+      return ErrorAt(node->GetLineNum(),
+                     absl::StrCat("not well-formed XML: a second top-level element <",
+                                  node->Value(), "> (a URDF has one root element, <robot>)"));
+    }
+  }
+  return root == nullptr ? absl::OkStatus() : CheckEntities(*root);
 }
 
 bool IsDirectory(const fs::path& path) {
@@ -346,30 +371,7 @@ absl::StatusOr<UrdfRobot> ParseUrdf(absl::string_view bytes) {
     return ErrorAt(root->GetLineNum(),
                    absl::StrCat("the root element is <", root->Name(), ">, not <robot>"));
   }
-  // tinyxml2 accepts text and further elements beside the root, which XML does not: the
-  // writer would print them back where tinyxml2 itself then refuses the output (found by
-  // fuzz_urdf), and a second <robot> would be ignored without a word.
-  for (const tinyxml2::XMLNode* node = document.FirstChild(); node != nullptr;
-       node = node->NextSibling()) {
-    if (node->ToText() != nullptr) {
-      return ErrorAt(node->GetLineNum(),
-                     absl::StrCat("not well-formed XML: text '",
-                                  absl::StripAsciiWhitespace(node->Value()).substr(0, 40),
-                                  "' outside the root element <robot>"));
-    }
-    if (node->ToElement() != nullptr && node != root) {
-      return ErrorAt(node->GetLineNum(),
-                     absl::StrCat("not well-formed XML: a second top-level element <",
-                                  node->Value(), "> (a URDF has one root element, <robot>)"));
-    }
-  }
-  {
-    tinyxml2::XMLDocument raw(/*processEntities=*/false);
-    raw.Parse(bytes.data(), bytes.size());  // accepted above; only the entity mode differs
-    if (raw.RootElement() != nullptr) {
-      if (absl::Status status = CheckEntities(*raw.RootElement()); !status.ok()) return status;
-    }
-  }
+  if (absl::Status strict = CheckStrictXml(bytes); !strict.ok()) return strict;
   if (const XMLElement* xacro = FindXacro(*root); xacro != nullptr) {
     return ErrorAt(xacro->GetLineNum(),
                    absl::StrCat("<", xacro->Name(),

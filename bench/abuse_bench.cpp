@@ -28,7 +28,7 @@
 
 #include "absl/strings/str_format.h"
 #include "inscribe/client/client.h"
-#include "inscribe/server/convert.h"
+#include "inscribe/wire/convert.h"
 #include "inscribe/v1/service.grpc.pb.h"
 #include "support/inscribed_process.h"
 #include "support/synthetic_meshes.h"
@@ -115,7 +115,7 @@ class Attacks {
     stub_ = v1::Inscribe::NewStub(channel_);
     Mesh broken = testing::Icosphere(5);
     broken.vertices(7, 1) = std::numeric_limits<double>::quiet_NaN();
-    server::MeshToProto(broken, invalid_mesh_.mutable_mesh());
+    wire::MeshToProto(broken, invalid_mesh_.mutable_mesh());
     billion_voxels_.set_mesh_sha256(cube_key);
     billion_voxels_.mutable_parameters()->set_voxel_size(1e-3);
     million_poses_.set_sphere_set_a(set);
@@ -229,8 +229,8 @@ int Run(const Options& options) {
   client_options.default_timeout = std::chrono::minutes(5);
   client::Client setup(client::MakeGrpcConnection(address), client_options);
   client::GenerateSettings settings;
-  settings.voxel_size = 0.1;
-  settings.skip_quality = true;
+  settings.parameters.voxel_size = 0.1;
+  settings.parameters.evaluate = false;
   absl::StatusOr<client::GenerateResult> set = setup.Generate(testing::Icosphere(3), settings);
   absl::StatusOr<client::PutMeshResult> cube = setup.PutMesh(testing::UnitCube());
   if (!set.ok() || !cube.ok()) {
@@ -242,7 +242,7 @@ int Run(const Options& options) {
       "inscribed --jobs %d --memory-budget %d --cache-memory-bytes %d --max-message-bytes %d; "
       "light client: Distance of %d pairs on %d spheres; %d abusers; %.0f s per phase\n\n",
       options.jobs, options.memory_budget, cache_bytes, options.max_message_bytes,
-      options.light_pairs, set->spheres.size(), options.abusers, options.seconds);
+      options.light_pairs, set->set.size(), options.abusers, options.seconds);
 
   const Latencies alone =
       RunLight(address, set->sphere_set_key, options.light_pairs,

@@ -27,6 +27,7 @@
 #include "absl/strings/str_join.h"
 #include "inscribe/client/client.h"
 #include "inscribe/client/routing.h"
+#include "inscribe/wire/keys.h"
 #include "inscribe/mesh_io.h"
 #include "inscribe/mesh_validation.h"
 #include "support/inscribed_process.h"
@@ -149,8 +150,8 @@ std::vector<Model> LoadModels(const Options& options) {
 // side, so one generation takes a fraction of a second).
 client::GenerateSettings Settings(const Model& model, int variant) {
   client::GenerateSettings settings;
-  settings.voxel_size = model.extent / (16.0 + variant);
-  settings.skip_quality = true;
+  settings.parameters.voxel_size = model.extent / (16.0 + variant);
+  settings.parameters.evaluate = false;
   return settings;
 }
 
@@ -245,7 +246,7 @@ void DistanceThroughput(const Options& options, const std::vector<Model>& models
     });
     // Where each call went: the owner of its set's route key (no replica failed meanwhile).
     for (std::size_t k = 0; k < keys.size(); ++k) {
-      calls[client::RendezvousOrder(client::RouteKey(keys[k]), names).front()] += per_key[k];
+      calls[client::RendezvousOrder(wire::RouteKey(keys[k]), names).front()] += per_key[k];
     }
     const double rate = static_cast<double>(queries) / seconds;
     if (replicas == 1) single = rate;

@@ -111,9 +111,9 @@ absl::StatusOr<Model> LoadModel(const client::Client& client, const Options& opt
   Model model;
   model.name = name;
   model.diagonal = prepared->report.bbox.diagonal();
-  model.settings.max_spheres = options.max_spheres;
-  model.settings.dilate = true;
-  model.settings.skip_quality = true;
+  model.settings.parameters.max_spheres = options.max_spheres;
+  model.settings.parameters.dilate = true;
+  model.settings.parameters.evaluate = false;
   client::GenerateOptions call;
   call.timeout = std::chrono::minutes(10);
   absl::StatusOr<client::GenerateResult> generated =

@@ -83,8 +83,8 @@ void Report(Record& record, Rpc rpc, const std::string& what, const absl::Status
 
 client::GenerateSettings Settings(const Model& model, int variant) {
   client::GenerateSettings settings;
-  settings.voxel_size = model.extent / (16.0 + 2.0 * variant);  // 16..30 voxels along the side
-  settings.skip_quality = true;
+  settings.parameters.voxel_size = model.extent / (16.0 + 2.0 * variant);  // 16..30 voxels along the side
+  settings.parameters.evaluate = false;
   return settings;
 }
 
@@ -121,7 +121,7 @@ void RunClient(const Options& options, const client::Client& client,
             client.Generate(a.mesh_sha256, Settings(a, variant));
         if (!result.ok())
           Report(record, rpc, "Generate " + a.name, result.status());
-        else if (result->spheres.spheres.empty()) {
+        else if (result->set.spheres.empty()) {
           Report(record, rpc, "Generate " + a.name, absl::InternalError("no spheres"));
         }
         break;

@@ -4,7 +4,6 @@
 # from anywhere.
 add_library(inscribe_client STATIC
   ${CMAKE_CURRENT_LIST_DIR}/src/client/client.cpp
-  ${CMAKE_CURRENT_LIST_DIR}/src/client/distance_query_proto.h
   ${CMAKE_CURRENT_LIST_DIR}/src/client/distance_session.cpp
   ${CMAKE_CURRENT_LIST_DIR}/src/client/grpc_connection.cpp
   ${CMAKE_CURRENT_LIST_DIR}/src/client/routed_connection.cpp)
@@ -13,5 +12,5 @@ target_include_directories(inscribe_client
   PUBLIC $<BUILD_INTERFACE:${CMAKE_CURRENT_LIST_DIR}/include>)
 target_link_libraries(inscribe_client
   PUBLIC inscribe::core inscribe::proto absl::status absl::statusor
-  PRIVATE inscribe_convert gRPC::grpc++ OpenSSL::Crypto inscribe_build_flags)
+  PRIVATE inscribe::wire gRPC::grpc++ OpenSSL::Crypto inscribe_build_flags)
 set_target_properties(inscribe_client PROPERTIES POSITION_INDEPENDENT_CODE ON)

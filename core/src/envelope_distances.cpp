@@ -129,7 +129,7 @@ absl::Status CheckRequest(const std::vector<Sphere>& spheres,
   if (spheres.empty()) {
     return absl::InvalidArgumentError("no spheres: the union of an empty set has no envelope");
   }
-  if (absl::Status status = internal::CheckSpheresMeasurable(spheres); !status.ok()) {
+  if (absl::Status status = CheckSpheres(spheres); !status.ok()) {
     return status;
   }
   for (const auto& [name, count] : {std::pair{"boundary", request.boundary_samples},

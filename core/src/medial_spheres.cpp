@@ -305,7 +305,10 @@ class VoxelSearch {
   SearchParams params_;
 };
 
-absl::Status ValidateOptions(const MedialSphereOptions& options, bool need_voxel_size) {
+
+}  // namespace
+
+absl::Status CheckMedialSphereOptions(const MedialSphereOptions& options, bool need_voxel_size) {
   if (need_voxel_size && !(std::isfinite(options.voxel_size) && options.voxel_size > 0.0)) {
     return absl::InvalidArgumentError(
         absl::StrCat("voxel size must be a positive finite number, got ", options.voxel_size));
@@ -336,13 +339,12 @@ absl::Status ValidateOptions(const MedialSphereOptions& options, bool need_voxel
   }
   return absl::OkStatus();
 }
-}  // namespace
 
 absl::StatusOr<MedialSphereResult> GenerateMedialSpheres(const BoundaryOracle& oracle,
                                                          const MedialSphereOptions& options,
                                                          const GenerationControl& control) {
   const Clock::time_point start = Clock::now();
-  if (absl::Status status = ValidateOptions(options, /*need_voxel_size=*/true); !status.ok()) {
+  if (absl::Status status = CheckMedialSphereOptions(options, /*need_voxel_size=*/true); !status.ok()) {
     return status;
   }
   const Mesh& mesh = oracle.mesh();

@@ -1,11 +1,9 @@
 #include "inscribe/mesh_hash.h"
 
-#include <openssl/evp.h>
-
-#include <cassert>
 #include <cstring>
-#include <memory>
 #include <vector>
+
+#include "inscribe/sha256.h"
 
 namespace inscribe {
 namespace {
@@ -20,14 +18,12 @@ void AppendLittleEndian(std::vector<std::uint8_t>& out, std::uint64_t bits, int 
 }  // namespace
 
 Sha256Digest MeshSha256(const Mesh& mesh) {
-  std::unique_ptr<EVP_MD_CTX, decltype(&EVP_MD_CTX_free)> ctx(EVP_MD_CTX_new(), EVP_MD_CTX_free);
-  assert(ctx != nullptr);
-  EVP_DigestInit_ex(ctx.get(), EVP_sha256(), nullptr);
+  Sha256Hasher hasher;
 
   std::vector<std::uint8_t> buffer(std::begin(kMagic), std::end(kMagic));
   AppendLittleEndian(buffer, static_cast<std::uint64_t>(mesh.num_vertices()), 8);
   AppendLittleEndian(buffer, static_cast<std::uint64_t>(mesh.num_triangles()), 8);
-  EVP_DigestUpdate(ctx.get(), buffer.data(), buffer.size());
+  hasher.Update(buffer.data(), buffer.size());
 
   // Stream in chunks so hashing a large mesh does not double its memory.
   constexpr std::size_t kChunk = 1 << 16;
@@ -35,7 +31,7 @@ Sha256Digest MeshSha256(const Mesh& mesh) {
   buffer.reserve(kChunk + 64);
   auto flush = [&](bool force) {
     if (force || buffer.size() >= kChunk) {
-      EVP_DigestUpdate(ctx.get(), buffer.data(), buffer.size());
+      hasher.Update(buffer.data(), buffer.size());
       buffer.clear();
     }
   };
@@ -57,22 +53,9 @@ Sha256Digest MeshSha256(const Mesh& mesh) {
   }
   flush(true);
 
-  Sha256Digest digest{};
-  unsigned int length = 0;
-  EVP_DigestFinal_ex(ctx.get(), digest.data(), &length);
-  assert(length == digest.size());
-  return digest;
+  return hasher.Finish();
 }
 
-std::string FormatSha256(const Sha256Digest& digest) {
-  static constexpr char kHex[] = "0123456789abcdef";
-  std::string out = "sha256:";
-  out.reserve(7 + 64);
-  for (std::uint8_t byte : digest) {
-    out.push_back(kHex[byte >> 4]);
-    out.push_back(kHex[byte & 15]);
-  }
-  return out;
-}
+std::string FormatSha256(const Sha256Digest& digest) { return "sha256:" + HexDigits(digest); }
 
 }  // namespace inscribe

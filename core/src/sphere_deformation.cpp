@@ -114,9 +114,8 @@ absl::Status CheckReferenceSphere(const SphereSet& set, std::size_t i,
   const Sphere& s = set.spheres[i];
   const SurfaceContact& contact = set.contacts[i];
   const std::string what = absl::StrCat("reference sphere ", i, ": ");
-  if (!s.center.allFinite() || !std::isfinite(s.radius) || !(s.radius > 0.0)) {
-    return absl::InvalidArgumentError(
-        absl::StrCat(what, "centre and radius must be finite with radius > 0"));
+  if (absl::Status valid = CheckSphere(s, i); !valid.ok()) {
+    return absl::InvalidArgumentError(absl::StrCat("reference ", valid.message()));
   }
   const double offset = (s.center - contact_point).norm();
   if (!(std::abs(offset - s.radius) <= 1e-6 * s.radius)) {
@@ -327,13 +326,7 @@ absl::StatusOr<DeformationErrorBounds> BoundDeformationError(const BoundaryOracl
   if (!std::isfinite(xi) || xi < 0.0) {
     return absl::InvalidArgumentError(absl::StrCat("xi must be finite and >= 0, got ", xi));
   }
-  for (std::size_t i = 0; i < spheres.size(); ++i) {
-    if (!spheres[i].center.allFinite() || !std::isfinite(spheres[i].radius) ||
-        spheres[i].radius < 0.0) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("sphere ", i, ": centre and radius must be finite with radius >= 0"));
-    }
-  }
+  if (absl::Status valid = CheckSpheres(spheres); !valid.ok()) return valid;
   DeformationErrorBounds out;
   out.volume_mesh = SignedVolume(oracle.mesh());
   if (!(out.volume_mesh > 0.0)) {

@@ -32,18 +32,6 @@ constexpr double kInsideMargin = 1e-12;
 // fraction of r^2 below 0 is rounding of a tangent configuration: one point.
 constexpr long double kTangentTolerance = 1e-12L;
 
-absl::Status ValidateSpheres(const std::vector<Sphere>& spheres) {
-  for (std::size_t i = 0; i < spheres.size(); ++i) {
-    const Sphere& s = spheres[i];
-    if (!s.center.allFinite() || !std::isfinite(s.radius) || !(s.radius > 0.0)) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("sphere ", i, ": centre (", s.center.x(), ", ", s.center.y(), ", ",
-                       s.center.z(), ") and radius ", s.radius, " must be finite with radius > 0"));
-    }
-  }
-  return absl::OkStatus();
-}
-
 // Flat binary tree over the balls' bounding boxes (median split of the centres on the widest
 // axis, leaves of up to kLeafSize balls). An inner node's children are nodes[first] and
 // nodes[first + 1]; a leaf lists order[first, first + count). Depth <= log2(n) + 1 since the
@@ -315,7 +303,7 @@ std::vector<std::array<std::int32_t, 2>> SingletonEdges(const DualComplex& compl
 
 absl::StatusOr<EnvelopePoints> ComputeEnvelopePoints(const std::vector<Sphere>& spheres,
                                                      const DilationOptions& options) {
-  if (absl::Status s = ValidateSpheres(spheres); !s.ok()) return s;
+  if (absl::Status s = CheckSpheres(spheres); !s.ok()) return s;
   EnvelopePoints out;
   if (spheres.empty()) return out;
   absl::StatusOr<DualComplex> complex = ComputeDualComplex(spheres);
@@ -342,12 +330,17 @@ absl::StatusOr<EnvelopePoints> ComputeEnvelopePoints(const std::vector<Sphere>& 
   return out;
 }
 
-absl::StatusOr<DilationResult> DilateSpheres(const BoundaryOracle& oracle, const SphereSet& spheres,
-                                             const DilationOptions& options) {
+absl::Status CheckDilationOptions(const DilationOptions& options) {
   if (!(options.growth >= 0.0 && options.growth <= 1.0)) {
     return absl::InvalidArgumentError(
         absl::StrCat("dilation growth must lie in [0, 1], got ", options.growth));
   }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<DilationResult> DilateSpheres(const BoundaryOracle& oracle, const SphereSet& spheres,
+                                             const DilationOptions& options) {
+  if (absl::Status s = CheckDilationOptions(options); !s.ok()) return s;
   const Clock::time_point start = Clock::now();
   const std::vector<Sphere>& balls = spheres.spheres;
   absl::StatusOr<EnvelopePoints> envelope = ComputeEnvelopePoints(balls, options);

@@ -23,10 +23,6 @@ bool ParseDouble(absl::string_view token, double* value, std::string* why);
 // `token` quoted for an error message: at most 24 bytes, non-printable bytes as \xNN.
 std::string QuoteToken(absl::string_view token);
 
-// OK, or INVALID_ARGUMENT "sphere <index>: ..." for a non-finite coordinate or radius, or a
-// radius that is not > 0.
-absl::Status CheckSphere(std::size_t index, const Sphere& sphere);
-
 // What every writer requires: CheckSphere for all spheres, contacts empty or one per sphere
 // with triangle >= 0 and finite weights, mesh_sha256 empty or well formed.
 absl::Status CheckSphereSetForWrite(const SphereFile& file);

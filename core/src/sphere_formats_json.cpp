@@ -118,7 +118,7 @@ absl::Status ReadSpheres(const Json& doc, SphereSet* set) {
     Sphere sphere;
     sphere.center = Vector3(xyzr[0], xyzr[1], xyzr[2]);
     sphere.radius = xyzr[3];
-    if (absl::Status status = CheckSphere(i, sphere); !status.ok()) return status;
+    if (absl::Status status = CheckSphere(sphere, i); !status.ok()) return status;
     set->spheres.push_back(sphere);
   }
   return absl::OkStatus();

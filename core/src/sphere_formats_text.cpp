@@ -252,7 +252,7 @@ absl::StatusOr<SphereFile> ParseCsvSphereFile(absl::string_view bytes) {
         Sphere sphere;
         sphere.center = Vector3(values[0], values[1], values[2]);
         sphere.radius = values[3];
-        if (absl::Status check = CheckSphere(file.set.spheres.size(), sphere); !check.ok()) {
+        if (absl::Status check = CheckSphere(sphere, file.set.spheres.size()); !check.ok()) {
           return LineError(line, check.message());
         }
         file.set.spheres.push_back(sphere);

@@ -145,7 +145,7 @@ absl::StatusOr<std::string> FormatCuroboYaml(const std::vector<LinkSpheres>& lin
       return absl::InvalidArgumentError(absl::StrCat("link ", link.link, " is listed twice"));
     }
     for (std::size_t i = 0; i < link.spheres.size(); ++i) {
-      if (absl::Status status = internal::CheckSphere(i, link.spheres[i]); !status.ok()) {
+      if (absl::Status status = CheckSphere(link.spheres[i], i); !status.ok()) {
         return absl::InvalidArgumentError(absl::StrCat("link ", link.link, ": ", status.message()));
       }
     }

@@ -25,14 +25,6 @@ constexpr std::size_t kMaxSpheres = std::size_t{1} << 30;
 // are padded by more than that when built.
 constexpr double kContainSlack = 1e-10;
 
-absl::Status CheckSphere(const Sphere& s, std::size_t i) {
-  if (!s.center.allFinite() || !std::isfinite(s.radius) || !(s.radius > 0.0)) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("sphere ", i, ": centre and radius must be finite with radius > 0"));
-  }
-  return absl::OkStatus();
-}
-
 // The smallest sphere around spheres[indices[0..count)], padded outward so that rounding in
 // CGAL's floating-point algorithm never leaves a sphere sticking out.
 Sphere EnclosingSphere(const std::vector<Sphere>& spheres, const std::int32_t* indices,

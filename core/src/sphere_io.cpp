@@ -71,26 +71,6 @@ std::string QuoteToken(absl::string_view token) {
   return out;
 }
 
-absl::Status CheckSphere(std::size_t index, const Sphere& sphere) {
-  static constexpr const char* kAxis[] = {"x", "y", "z"};
-  for (int k = 0; k < 3; ++k) {
-    if (!std::isfinite(sphere.center[k])) {
-      return absl::InvalidArgumentError(absl::StrCat("sphere ", index, ": center ", kAxis[k], " ",
-                                                     FormatDouble(sphere.center[k]),
-                                                     " is not finite"));
-    }
-  }
-  if (!std::isfinite(sphere.radius)) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("sphere ", index, ": radius ", FormatDouble(sphere.radius), " is not finite"));
-  }
-  if (!(sphere.radius > 0)) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "sphere ", index, ": radius ", FormatDouble(sphere.radius), " is not positive"));
-  }
-  return absl::OkStatus();
-}
-
 absl::Status CheckMeshSha256(absl::string_view hash) {
   if (hash.empty()) return absl::OkStatus();
   constexpr absl::string_view kPrefix = "sha256:";
@@ -110,7 +90,7 @@ absl::Status CheckMeshSha256(absl::string_view hash) {
 absl::Status CheckSphereSetForWrite(const SphereFile& file) {
   const SphereSet& set = file.set;
   for (std::size_t i = 0; i < set.spheres.size(); ++i) {
-    if (absl::Status status = CheckSphere(i, set.spheres[i]); !status.ok()) return status;
+    if (absl::Status status = CheckSphere(set.spheres[i], i); !status.ok()) return status;
   }
   if (set.has_contacts() && set.contacts.size() != set.spheres.size()) {
     return absl::InvalidArgumentError(absl::StrCat(set.contacts.size(), " contacts for ",

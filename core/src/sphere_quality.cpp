@@ -34,14 +34,7 @@ double DistanceToUnion(const Vector3& x, const std::vector<Sphere>& spheres) {
 
 }  // namespace
 
-absl::StatusOr<QualityReport> EvaluateSpheres(const BoundaryOracle& oracle,
-                                              const std::vector<Sphere>& spheres,
-                                              const QualityOptions& options) {
-  const auto start = std::chrono::steady_clock::now();
-  const Mesh& mesh = oracle.mesh();
-  if (absl::Status status = internal::CheckSpheresMeasurable(spheres); !status.ok()) {
-    return status;
-  }
+absl::Status CheckQualityOptions(const QualityOptions& options) {
   if (options.surface_samples < 0 || options.surface_samples > 100'000'000) {
     return absl::InvalidArgumentError(
         absl::StrCat("surface samples must lie in [0, 100000000], got ", options.surface_samples));
@@ -50,6 +43,18 @@ absl::StatusOr<QualityReport> EvaluateSpheres(const BoundaryOracle& oracle,
     return absl::InvalidArgumentError(
         absl::StrCat("voxel size must be finite and >= 0, got ", options.voxel_size));
   }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<QualityReport> EvaluateSpheres(const BoundaryOracle& oracle,
+                                              const std::vector<Sphere>& spheres,
+                                              const QualityOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  const Mesh& mesh = oracle.mesh();
+  if (absl::Status status = CheckSpheres(spheres); !status.ok()) {
+    return status;
+  }
+  if (absl::Status status = CheckQualityOptions(options); !status.ok()) return status;
   QualityReport report;
   report.spheres = static_cast<std::int64_t>(spheres.size());
   report.bbox_diagonal = ComputeBoundingBox(mesh.vertices).diagonal();

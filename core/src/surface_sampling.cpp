@@ -50,18 +50,4 @@ Vertices SampleBoundaryByArea(const Mesh& mesh, std::int64_t count, std::uint64_
   return points;
 }
 
-absl::Status CheckSpheresMeasurable(const std::vector<Sphere>& spheres) {
-  for (std::size_t i = 0; i < spheres.size(); ++i) {
-    const Sphere& s = spheres[i];
-    if (!s.center.allFinite() || !std::isfinite(s.radius)) {
-      return absl::InvalidArgumentError(absl::StrCat("sphere ", i, " is not finite"));
-    }
-    if (!(s.radius > 0.0)) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("sphere ", i, ": radius ", s.radius, " is not positive"));
-    }
-  }
-  return absl::OkStatus();
-}
-
 }  // namespace inscribe::internal

@@ -20,8 +20,4 @@ namespace inscribe::internal {
 // when the mesh has no triangle of positive area. Parallel (TBB); cost O(#T + count log #T).
 Vertices SampleBoundaryByArea(const Mesh& mesh, std::int64_t count, std::uint64_t seed);
 
-// INVALID_ARGUMENT naming the first sphere (by index) whose centre or radius is not finite or
-// whose radius is not positive; OK otherwise (also for an empty set).
-absl::Status CheckSpheresMeasurable(const std::vector<Sphere>& spheres);
-
 }  // namespace inscribe::internal

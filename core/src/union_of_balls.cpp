@@ -55,15 +55,7 @@ absl::Status ValidateBalls(const std::vector<Sphere>& balls) {
   }
   for (std::size_t i = 0; i < balls.size(); ++i) {
     const Sphere& b = balls[i];
-    if (!b.center.allFinite()) {
-      return absl::InvalidArgumentError(absl::StrCat("ball ", i, ": non-finite centre (",
-                                                     b.center.x(), ", ", b.center.y(), ", ",
-                                                     b.center.z(), ")"));
-    }
-    if (!std::isfinite(b.radius) || !(b.radius > 0.0)) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("ball ", i, ": radius ", b.radius, " (must be finite and > 0)"));
-    }
+    if (absl::Status valid = CheckSphere(b, i); !valid.ok()) return valid;
     // Weights r^2 and squared distances must not overflow.
     if (b.radius > kMaxMagnitude || b.center.cwiseAbs().maxCoeff() > kMaxMagnitude) {
       return absl::InvalidArgumentError(absl::StrCat("ball ", i, ": centre or radius above ",

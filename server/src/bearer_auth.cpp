@@ -1,7 +1,6 @@
 #include "bearer_auth.h"
 
 #include <openssl/crypto.h>
-#include <openssl/evp.h>
 
 #include <cerrno>
 #include <cstring>
@@ -77,13 +76,6 @@ absl::StatusOr<BearerAuthenticator> BearerAuthenticator::FromText(absl::string_v
         "--auth-tokens file ", source, " holds no token (only blank lines and # comments)"));
   }
   return BearerAuthenticator(std::move(digests));
-}
-
-BearerAuthenticator::Digest BearerAuthenticator::Sha256(absl::string_view text) {
-  Digest digest{};
-  unsigned int length = 0;
-  EVP_Digest(text.data(), text.size(), digest.data(), &length, EVP_sha256(), nullptr);
-  return digest;
 }
 
 absl::Status BearerAuthenticator::Check(const grpc::ServerContextBase& context) const {

@@ -12,6 +12,7 @@
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
+#include "inscribe/sha256.h"
 
 namespace grpc {
 class ServerContextBase;
@@ -56,10 +57,9 @@ class BearerAuthenticator {
   std::size_t token_count() const { return digests_.size(); }
 
  private:
-  using Digest = std::array<unsigned char, 32>;
+  using Digest = Sha256Digest;
   explicit BearerAuthenticator(std::vector<Digest> digests) : digests_(std::move(digests)) {}
 
-  static Digest Sha256(absl::string_view text);
 
   std::vector<Digest> digests_;
 };

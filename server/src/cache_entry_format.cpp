@@ -1,8 +1,5 @@
 #include "cache_entry_format.h"
 
-#include <openssl/evp.h>
-
-#include <cassert>
 
 namespace inscribe::server {
 namespace {
@@ -23,16 +20,6 @@ std::uint64_t ReadLittleEndian(absl::string_view in, int bytes) {
 }
 
 }  // namespace
-
-Sha256Digest Sha256(absl::string_view data) {
-  Sha256Digest digest{};
-  unsigned int length = 0;
-  const int ok =
-      EVP_Digest(data.data(), data.size(), digest.data(), &length, EVP_sha256(), nullptr);
-  assert(ok == 1 && length == digest.size());
-  static_cast<void>(ok);
-  return digest;
-}
 
 std::size_t EntryHeaderSize(std::size_t key_size) {
   return kMagic.size() + 4 + key_size + 8 + kDigestSize;

@@ -17,13 +17,9 @@
 #include <string>
 
 #include "absl/strings/string_view.h"
+#include "inscribe/sha256.h"
 
 namespace inscribe::server {
-
-using Sha256Digest = std::array<unsigned char, 32>;
-
-// OpenSSL's SHA-256; about 1-2 ms per MB.
-Sha256Digest Sha256(absl::string_view data);
 
 // Bytes of the header for a key of `key_size` characters.
 std::size_t EntryHeaderSize(std::size_t key_size);

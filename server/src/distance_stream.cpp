@@ -2,9 +2,6 @@
 // long-lived bidirectional call. One frame is in the reactor at a time (read, compute on the
 // pool, write, read the next), so frames can never be reordered and a slow client slows only
 // itself. The hierarchies a stream names are resolved once and held for the stream's life.
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <atomic>
 #include <memory>
@@ -16,7 +13,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "inscribe/separation_distance.h"
-#include "inscribe/server/convert.h"
+#include "inscribe/wire/convert.h"
 #include "inscribe/server/inscribe_service.h"
 #include "memory_budget.h"
 #include "result_store.h"
@@ -28,8 +25,6 @@ namespace {
 // Distinct (set, volume) pairs one stream may hold: each pins a hierarchy in memory even after
 // the cache has evicted it, so a stream cannot pin an unbounded amount.
 constexpr std::size_t kMaxStreamSets = 1024;
-// Pairs per parallel chunk; cancellation is checked between chunks (~1 ms of work).
-constexpr std::size_t kChunk = 64;
 
 }  // namespace
 
@@ -153,7 +148,7 @@ class DistanceStreamReactor final
     frame_reservation_.Release();
     state_ = State::kFinished;
     final_status_ = status;
-    Finish(ToGrpcStatus(status));
+    Finish(wire::ToGrpcStatus(status));
   }
 
   // On the pool: answers frame_ into result_, then writes it (or ends the stream).
@@ -179,16 +174,11 @@ class DistanceStreamReactor final
   absl::Status ComputeFrame() {
     result_.Clear();
     result_.set_frame(frame_.frame());
-    absl::StatusOr<DistanceRequest> tolerance = ToleranceFromProto(frame_.tolerance());
+    absl::StatusOr<DistanceRequest> tolerance = wire::ToleranceFromProto(frame_.tolerance());
     if (!tolerance.ok()) return tolerance.status();
-    const HierarchyVolume volume = VolumeFromProto(frame_.volume());
+    const HierarchyVolume volume = wire::VolumeFromProto(frame_.volume());
     const std::size_t n = static_cast<std::size_t>(frame_.pairs_size());
-    struct Query {
-      const SphereHierarchy* a;
-      const SphereHierarchy* b;
-      RigidPose pose_a, pose_b;
-    };
-    std::vector<Query> queries(n);
+    std::vector<PosedPair> pairs(n);
     for (std::size_t i = 0; i < n; ++i) {
       const v1::DistancePair& pair = frame_.pairs(static_cast<int>(i));
       // Field names are built only for an error: this loop is on every frame's path.
@@ -202,42 +192,20 @@ class DistanceStreamReactor final
       absl::StatusOr<const SphereHierarchy*> b =
           Hierarchy(pair.sphere_set_b(), volume, "sphere_set_b");
       if (!b.ok()) return in_pair(b.status());
-      absl::StatusOr<RigidPose> pose_a = PoseFromProto(pair.pose_a(), "pose_a");
+      absl::StatusOr<RigidPose> pose_a = wire::PoseFromProto(pair.pose_a(), "pose_a");
       if (!pose_a.ok()) return in_pair(pose_a.status());
-      absl::StatusOr<RigidPose> pose_b = PoseFromProto(pair.pose_b(), "pose_b");
+      absl::StatusOr<RigidPose> pose_b = wire::PoseFromProto(pair.pose_b(), "pose_b");
       if (!pose_b.ok()) return in_pair(pose_b.status());
-      queries[i] = Query{*a, *b, *pose_a, *pose_b};
+      pairs[i] = PosedPair{*a, *b, *pose_a, *pose_b};
     }
-    std::vector<DistanceResult> results(n);
-    std::vector<absl::Status> errors(n);
-    auto run = [&](std::size_t begin, std::size_t end) {
-      if (cancelled_.load()) return;
-      for (std::size_t i = begin; i < end; ++i) {
-        const Query& q = queries[i];
-        absl::StatusOr<DistanceResult> r =
-            SeparationDistance(*q.a, q.pose_a, *q.b, q.pose_b, *tolerance);
-        if (r.ok()) {
-          results[i] = *r;
-        } else {
-          errors[i] = r.status();
-        }
-      }
-    };
-    // A few pairs (the usual frame) cost microseconds: forking would cost more than it saves.
-    if (n <= kChunk) {
-      run(0, n);
-    } else {
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kChunk),
-                        [&](const tbb::blocked_range<std::size_t>& r) { run(r.begin(), r.end()); });
-    }
+    absl::StatusOr<std::vector<DistanceResult>> results =
+        PairSeparationDistances(pairs, *tolerance, &cancelled_);
     if (cancelled_.load()) return absl::CancelledError("client went away mid-frame");
-    for (std::size_t i = 0; i < n; ++i) {
-      if (!errors[i].ok()) {
-        return absl::Status(errors[i].code(), absl::StrCat("frame ", frame_.frame(), " pairs[", i,
-                                                           "]: ", errors[i].message()));
-      }
+    if (!results.ok()) {
+      return absl::Status(results.status().code(),
+                          absl::StrCat("frame ", frame_.frame(), " ", results.status().message()));
     }
-    AppendDistanceResults(results, result_.mutable_results());
+    wire::AppendDistanceResults(*results, result_.mutable_results());
     return absl::OkStatus();
   }
 

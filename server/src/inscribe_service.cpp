@@ -9,7 +9,7 @@
 #include "absl/strings/str_cat.h"
 #include "inscribe/mesh_hash.h"
 #include "inscribe/mesh_validation.h"
-#include "inscribe/server/convert.h"
+#include "inscribe/wire/convert.h"
 #include "memory_budget.h"
 #include "mesh_sizes.h"
 #include "result_store.h"
@@ -22,7 +22,7 @@ namespace {
 // own problems are issues in the report, not errors.
 absl::Status RunInspectMesh(const v1::InspectMeshRequest& request,
                             v1::InspectMeshResponse* response) {
-  absl::StatusOr<Mesh> mesh = MeshFromProto(request.mesh());
+  absl::StatusOr<Mesh> mesh = wire::MeshFromProto(request.mesh());
   if (!mesh.ok()) return mesh.status();
   ValidateOptions options;
   options.check_self_intersections = !request.skip_self_intersections();
@@ -32,7 +32,7 @@ absl::Status RunInspectMesh(const v1::InspectMeshRequest& request,
   if (report.non_finite_vertices == 0 && report.out_of_range_indices == 0) {
     response->set_mesh_sha256(FormatSha256(MeshSha256(validated.mesh)));
   }
-  MeshReportToProto(report, response->mutable_report());
+  wire::MeshReportToProto(report, response->mutable_report());
   return absl::OkStatus();
 }
 
@@ -73,7 +73,7 @@ void InscribeService::Finish(grpc::ServerUnaryReactor* reactor, CallRecord& reco
                              const absl::Status& status) {
   record.status = status;
   Observe(record);
-  reactor->Finish(ToGrpcStatus(status));
+  reactor->Finish(wire::ToGrpcStatus(status));
   CallEnded();
 }
 
@@ -163,10 +163,10 @@ grpc::ServerUnaryReactor* InscribeService::RunUnary(grpc::CallbackServerContext*
 }
 
 absl::Status InscribeService::CheckMesh(const v1::Mesh& mesh) const {
-  if (absl::Status shape = CheckMeshShape(mesh); !shape.ok()) return shape;
-  if (TriangleCount(mesh) > limits_.max_triangles) {
+  if (absl::Status shape = wire::CheckMeshShape(mesh); !shape.ok()) return shape;
+  if (wire::TriangleCount(mesh) > limits_.max_triangles) {
     return absl::ResourceExhaustedError(absl::StrCat(
-        "mesh has ", TriangleCount(mesh), " triangles; this server's limit (--max-triangles) is ",
+        "mesh has ", wire::TriangleCount(mesh), " triangles; this server's limit (--max-triangles) is ",
         limits_.max_triangles));
   }
   return absl::OkStatus();
@@ -175,9 +175,9 @@ absl::Status InscribeService::CheckMesh(const v1::Mesh& mesh) const {
 grpc::ServerUnaryReactor* InscribeService::InspectMesh(grpc::CallbackServerContext* context,
                                                        const v1::InspectMeshRequest* request,
                                                        v1::InspectMeshResponse* response) {
-  return RunUnary(context, "InspectMesh", TriangleCount(request->mesh()),
+  return RunUnary(context, "InspectMesh", wire::TriangleCount(request->mesh()),
                   CheckMesh(request->mesh()), MeshWorkBytes(request->mesh()),
-                  absl::StrCat("InspectMesh of ", TriangleCount(request->mesh()), " triangles"),
+                  absl::StrCat("InspectMesh of ", wire::TriangleCount(request->mesh()), " triangles"),
                   [request, response] { return RunInspectMesh(*request, response); });
 }
 

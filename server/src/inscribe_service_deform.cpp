@@ -10,7 +10,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "inscribe/mesh_hash.h"
-#include "inscribe/server/convert.h"
+#include "inscribe/wire/convert.h"
 #include "inscribe/server/inscribe_service.h"
 #include "inscribe/sphere_deformation.h"
 #include "inscribe/sphere_quality.h"
@@ -86,7 +86,7 @@ grpc::ServerUnaryReactor* InscribeService::PutSphereSet(grpc::CallbackServerCont
   return RunUnary(context, "PutSphereSet", 0, precheck, spheres * MemoryCosts::kPerSphere / 4,
                   absl::StrCat("PutSphereSet of ", spheres, " spheres"),
                   [this, request, response]() -> absl::Status {
-                    absl::StatusOr<SphereSet> set = SphereSetFromProto(request->spheres());
+                    absl::StatusOr<SphereSet> set = wire::SphereSetFromProto(request->spheres());
                     if (!set.ok()) return set.status();
                     bool already = false;
                     absl::StatusOr<std::shared_ptr<const SphereSetEntry>> entry =
@@ -134,7 +134,7 @@ grpc::ServerUnaryReactor* InscribeService::UpdateDeformation(
         absl::StatusOr<std::shared_ptr<const StoredMeshEntry>> mesh = store_->GetMesh(*mesh_key);
         if (!mesh.ok()) return mesh.status();
         absl::StatusOr<Vertices> vertices =
-            DeformedVertices(*request, (*mesh)->mesh.num_vertices());
+            DeformedVertices(*request, (*mesh)->mesh().num_vertices());
         if (!vertices.ok()) return vertices.status();
 
         DeformationOptions options;
@@ -142,10 +142,9 @@ grpc::ServerUnaryReactor* InscribeService::UpdateDeformation(
         options.strict = request->strict();
         options.direction = request->interpolated_normal() ? ContactDirection::kInterpolatedNormal
                                                            : ContactDirection::kCarriedFrame;
-        // As the stored mesh's own oracle: the pseudonormal sign fails near buried sheets.
-        if (request->ray_parity() || (*mesh)->report.self_intersecting_pairs > 0) {
-          options.oracle.inside_test = InsideTest::kRayParity;
-        }
+        // As the stored mesh's own oracle, unless the caller asks for ray parity.
+        options.oracle.inside_test = request->ray_parity() ? InsideTest::kRayParity
+                                                           : InsideTestFor((*mesh)->solid.report);
         absl::StatusOr<std::shared_ptr<const DeformerEntry>> entry =
             store_->GetDeformer(*mesh_key, request->sphere_set_key(), options);
         if (!entry.ok()) return entry.status();
@@ -166,29 +165,11 @@ grpc::ServerUnaryReactor* InscribeService::UpdateDeformation(
           response->set_reference_spheres(
               static_cast<std::int64_t>((*entry)->deformer.reference_spheres().size()));
         }
-        SphereSetToProto(moved->set, response->mutable_spheres());
-        response->set_xi(moved->xi);
-        response->set_max_protrusion(moved->max_protrusion);
-        response->set_shrunk(moved->shrunk);
-        response->set_dropped(moved->dropped);
-        response->set_seconds(moved->seconds);
-        response->set_closest_point_queries(moved->closest_point_queries);
-        response->set_max_shrink_steps(moved->max_shrink_steps);
-        for (const std::int32_t i : moved->reference_index) response->add_reference_index(i);
+        wire::DeformedSpheresToProto(*moved, response);
         const std::string deformed_key =
             FormatSha256(MeshSha256(Mesh{*std::move(vertices), (*entry)->triangles}));
         response->set_deformed_mesh_sha256(deformed_key);
-        if (request->bounds()) {
-          response->set_nerr_lower(bounds->nerr_lower);
-          response->set_nerr_upper(bounds->nerr_upper);
-          response->set_nerr_is_exact(bounds->exact);
-          response->set_bounds_seconds(bounds->seconds);
-          response->set_volume_mesh(bounds->volume_mesh);
-          response->set_volume_union(bounds->volume_union);
-          if (bounds->uniform_xi_holds) {
-            response->set_nerr_upper_uniform_xi(bounds->nerr_upper_uniform_xi);
-          }
-        }
+        if (request->bounds()) wire::DeformationBoundsToProto(*bounds, response);
         if (request->store()) {
           // Named by no mesh (the deformed one is not stored); its key routes like the
           // reference set's, so a routing client's Distance on it finds it here.
@@ -243,7 +224,7 @@ grpc::ServerUnaryReactor* InscribeService::Evaluate(grpc::CallbackServerContext*
         MemoryBudget::Reservation cached_reservation;  // held until the report is made
         SphereSet inline_set;
         if (request->has_sphere_set()) {
-          absl::StatusOr<SphereSet> set = SphereSetFromProto(request->sphere_set(), "sphere_set");
+          absl::StatusOr<SphereSet> set = wire::SphereSetFromProto(request->sphere_set(), "sphere_set");
           if (!set.ok()) return set.status();
           inline_set = *std::move(set);
         } else {
@@ -272,9 +253,9 @@ grpc::ServerUnaryReactor* InscribeService::Evaluate(grpc::CallbackServerContext*
           options.coverage_tolerance = request->coverage_tolerance();
         }
         const std::vector<Sphere>& spheres = cached ? cached->set.spheres : inline_set.spheres;
-        absl::StatusOr<QualityReport> report = EvaluateSpheres((*mesh)->oracle, spheres, options);
+        absl::StatusOr<QualityReport> report = EvaluateSpheres((*mesh)->solid.oracle, spheres, options);
         if (!report.ok()) return report.status();
-        QualityReportToProto(*report, response->mutable_quality());
+        wire::QualityReportToProto(*report, response->mutable_quality());
         return absl::OkStatus();
       });
 }

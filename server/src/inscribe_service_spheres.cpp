@@ -14,7 +14,7 @@
 #include "absl/strings/str_format.h"
 #include "inscribe/medial_spheres.h"
 #include "inscribe/separation_distance.h"
-#include "inscribe/server/convert.h"
+#include "inscribe/wire/convert.h"
 #include "inscribe/server/inscribe_service.h"
 #include "memory_budget.h"
 #include "mesh_sizes.h"
@@ -26,11 +26,11 @@ namespace inscribe::server {
 grpc::ServerUnaryReactor* InscribeService::PutMesh(grpc::CallbackServerContext* context,
                                                    const v1::PutMeshRequest* request,
                                                    v1::PutMeshResponse* response) {
-  return RunUnary(context, "PutMesh", TriangleCount(request->mesh()), CheckMesh(request->mesh()),
+  return RunUnary(context, "PutMesh", wire::TriangleCount(request->mesh()), CheckMesh(request->mesh()),
                   MeshWorkBytes(request->mesh()),
-                  absl::StrCat("PutMesh of ", TriangleCount(request->mesh()), " triangles"),
+                  absl::StrCat("PutMesh of ", wire::TriangleCount(request->mesh()), " triangles"),
                   [this, request, response]() -> absl::Status {
-                    absl::StatusOr<Mesh> mesh = MeshFromProto(request->mesh());
+                    absl::StatusOr<Mesh> mesh = wire::MeshFromProto(request->mesh());
                     if (!mesh.ok()) return mesh.status();
                     bool already = false;
                     absl::StatusOr<std::shared_ptr<const StoredMeshEntry>> stored =
@@ -38,7 +38,7 @@ grpc::ServerUnaryReactor* InscribeService::PutMesh(grpc::CallbackServerContext* 
                     if (!stored.ok()) return stored.status();
                     RecordMeshSize(**stored);
                     response->set_mesh_sha256((*stored)->key);
-                    MeshReportToProto((*stored)->report, response->mutable_report());
+                    wire::MeshReportToProto((*stored)->solid.report, response->mutable_report());
                     response->set_already_stored(already);
                     return absl::OkStatus();
                   });
@@ -66,13 +66,14 @@ class GenerateReactor final : public grpc::ServerWriteReactor<v1::GenerateRespon
     if (precheck.ok()) precheck = CheckKey(request_->mesh_sha256(), "mesh_sha256");
     std::int64_t bytes = 0;
     if (precheck.ok()) {
-      absl::StatusOr<v1::GenerateParameters> canonical =
-          CanonicalParameters(request_->parameters());
-      if (!canonical.ok()) {
-        precheck = canonical.status();
+      absl::StatusOr<SphereSetParameters> parameters =
+          wire::SphereSetParametersFromProto(*request_, service_->limits_.max_voxels);
+      if (!parameters.ok()) {
+        precheck = parameters.status();
       } else {
+        parameters_ = *std::move(parameters);
         absl::StatusOr<std::int64_t> estimate =
-            service_->GenerateWorkBytes(request_->mesh_sha256(), *canonical);
+            service_->GenerateWorkBytes(request_->mesh_sha256(), parameters_);
         precheck = estimate.status();
         if (estimate.ok()) bytes = *estimate;
       }
@@ -142,7 +143,8 @@ class GenerateReactor final : public grpc::ServerWriteReactor<v1::GenerateRespon
     const ServiceClock::time_point started = ServiceClock::now();
     absl::StatusOr<std::pair<std::shared_ptr<const SphereSetEntry>, CacheSource>> result;
     try {
-      result = service_->store_->Generate(*request_, control);
+      result = service_->store_->Generate(request_->mesh_sha256(), parameters_,
+                                          request_->parameters().fill_holes(), control);
     } catch (const std::bad_alloc&) {
       result = absl::ResourceExhaustedError("server ran out of memory generating spheres");
     }
@@ -191,13 +193,14 @@ class GenerateReactor final : public grpc::ServerWriteReactor<v1::GenerateRespon
     if (status_.ok()) {
       StartWriteAndFinish(final_.get(), grpc::WriteOptions(), grpc::Status::OK);
     } else {
-      Finish(ToGrpcStatus(status_));
+      Finish(wire::ToGrpcStatus(status_));
     }
   }
 
   InscribeService* const service_;
   grpc::CallbackServerContext* const context_;
   const v1::GenerateRequest* const request_;
+  SphereSetParameters parameters_;  // the request's, checked in Start
   std::atomic<bool> cancel_{false};
   MemoryBudget::Reservation reservation_;  // set in Start, released in Complete
   CallRecord record_;
@@ -211,19 +214,19 @@ class GenerateReactor final : public grpc::ServerWriteReactor<v1::GenerateRespon
 
 void InscribeService::RecordMeshSize(const StoredMeshEntry& entry) {
   MeshSize size;
-  size.vertices = entry.mesh.num_vertices();
-  size.triangles = entry.mesh.num_triangles();
-  size.extent = ComputeBoundingBox(entry.mesh.vertices).extent();
+  size.vertices = entry.mesh().num_vertices();
+  size.triangles = entry.mesh().num_triangles();
+  size.extent = ComputeBoundingBox(entry.mesh().vertices).extent();
   mesh_sizes_->Record(entry.key, size);
 }
 
 absl::StatusOr<std::int64_t> InscribeService::GenerateWorkBytes(
-    const std::string& mesh_key, const v1::GenerateParameters& canonical) const {
+    const std::string& mesh_key, const SphereSetParameters& parameters) const {
   const std::optional<MeshSize> size = mesh_sizes_->Find(mesh_key);
   const double max_voxels = static_cast<double>(limits_.max_voxels);
   double voxels = max_voxels;  // unknown mesh (stored by another process): the worst case
-  if (size && canonical.voxel_size() > 0.0) {
-    voxels = size->GridVoxels(canonical.voxel_size());
+  if (size && parameters.voxel_size) {
+    voxels = size->GridVoxels(*parameters.voxel_size);
     if (voxels > max_voxels) {
       // Refused here, before the call is queued; core would refuse it too (MakeGrid), but
       // only after a pool thread and a cache lookup.
@@ -231,7 +234,7 @@ absl::StatusOr<std::int64_t> InscribeService::GenerateWorkBytes(
           "parameters.voxel_size %g gives a grid of %.3g voxels over the mesh's bounding box "
           "(%g x %g x %g); this server's limit (--max-voxels) is %d voxels; use a larger voxel "
           "size",
-          canonical.voxel_size(), voxels, size->extent.x(), size->extent.y(), size->extent.z(),
+          *parameters.voxel_size, voxels, size->extent.x(), size->extent.y(), size->extent.z(),
           limits_.max_voxels));
     }
   } else if (size) {
@@ -239,11 +242,11 @@ absl::StatusOr<std::int64_t> InscribeService::GenerateWorkBytes(
     // counts grow as (diagonal / sigma)^2 / 4) and refines from there; half that side, 8x the
     // voxels, bounds where it ends on the meshes measured (at most the --max-voxels grid).
     const double sigma = 0.5 * size->extent.norm() /
-                         std::sqrt(std::max(static_cast<double>(canonical.max_spheres()), 1.0));
+                         std::sqrt(std::max(static_cast<double>(*EffectiveMaxSpheres(parameters)), 1.0));
     if (sigma > 0.0) voxels = std::min(max_voxels, size->GridVoxels(0.5 * sigma));
   }
   // Subdivided boundary voxels hold up to 8 candidates each.
-  if (canonical.subdivide_boundary()) voxels *= 2.0;
+  if (parameters.medial.subdivide_boundary) voxels *= 2.0;
   double bytes = voxels * MemoryCosts::kPerVoxel + MemoryCosts::kGenerateFixed;
   // Without the mesh's size the worst case may exceed the budget though the mesh is small: it
   // is then admitted when it can run alone, never refused outright.
@@ -280,7 +283,7 @@ grpc::ServerUnaryReactor* InscribeService::GetHierarchy(grpc::CallbackServerCont
       context, "GetHierarchy", 0, CheckKey(request->sphere_set_key(), "sphere_set_key"),
       MemoryCosts::kSmallCall, "GetHierarchy", [this, request, response]() -> absl::Status {
         absl::StatusOr<std::shared_ptr<const SphereHierarchy>> h =
-            store_->GetHierarchy(request->sphere_set_key(), VolumeFromProto(request->volume()));
+            store_->GetHierarchy(request->sphere_set_key(), wire::VolumeFromProto(request->volume()));
         if (!h.ok()) return h.status();
         response->set_hierarchy((*h)->Serialize());
         return absl::OkStatus();
@@ -316,20 +319,20 @@ grpc::ServerUnaryReactor* InscribeService::Distance(grpc::CallbackServerContext*
       context, "Distance", 0, precheck, pairs * MemoryCosts::kPerPosePair + MemoryCosts::kSmallCall,
       absl::StrCat("Distance of ", pairs, " pose pairs"),
       [this, request, response]() -> absl::Status {
-        absl::StatusOr<DistanceRequest> tolerance = ToleranceFromProto(request->tolerance());
+        absl::StatusOr<DistanceRequest> tolerance = wire::ToleranceFromProto(request->tolerance());
         if (!tolerance.ok()) return tolerance.status();
         absl::StatusOr<std::vector<RigidPose>> poses_a =
-            PosesFromProto(request->poses_a(), "poses_a");
+            wire::PosesFromProto(request->poses_a(), "poses_a");
         if (!poses_a.ok()) return poses_a.status();
         absl::StatusOr<std::vector<RigidPose>> poses_b =
-            PosesFromProto(request->poses_b(), "poses_b");
+            wire::PosesFromProto(request->poses_b(), "poses_b");
         if (!poses_b.ok()) return poses_b.status();
         if (poses_a->size() != 1 && poses_a->size() != poses_b->size()) {
           return absl::InvalidArgumentError(
               absl::StrCat("poses_a has ", poses_a->size(), " poses and poses_b ", poses_b->size(),
                            "; poses_a must have one pose or as many as poses_b"));
         }
-        const HierarchyVolume volume = VolumeFromProto(request->volume());
+        const HierarchyVolume volume = wire::VolumeFromProto(request->volume());
         absl::StatusOr<std::shared_ptr<const SphereHierarchy>> a =
             store_->GetHierarchy(request->sphere_set_a(), volume);
         if (!a.ok()) return a.status();
@@ -337,23 +340,15 @@ grpc::ServerUnaryReactor* InscribeService::Distance(grpc::CallbackServerContext*
             store_->GetHierarchy(request->sphere_set_b(), volume);
         if (!b.ok()) return b.status();
         const ServiceClock::time_point start = ServiceClock::now();
-        // B's poses relative to A's, so that the batch call (one frame, A fixed) serves all.
-        std::vector<RigidPose> relative(poses_b->size());
-        for (std::size_t i = 0; i < relative.size(); ++i) {
-          const RigidPose& pa = (*poses_a)[poses_a->size() == 1 ? 0 : i];
-          relative[i] = pa.Inverse() * (*poses_b)[i];
+        std::vector<PosedPair> pairs(poses_b->size());
+        for (std::size_t i = 0; i < pairs.size(); ++i) {
+          pairs[i] = PosedPair{a->get(), b->get(), (*poses_a)[poses_a->size() == 1 ? 0 : i],
+                               (*poses_b)[i]};
         }
         absl::StatusOr<std::vector<DistanceResult>> results =
-            SeparationDistances(**a, **b, relative, *tolerance);
+            PairSeparationDistances(pairs, *tolerance);
         if (!results.ok()) return results.status();
-        // Witnesses back to the world frame.
-        for (std::size_t i = 0; i < results->size(); ++i) {
-          const RigidPose& pa = (*poses_a)[poses_a->size() == 1 ? 0 : i];
-          DistanceResult& r = (*results)[i];
-          r.point_a = pa * r.point_a;
-          r.point_b = pa * r.point_b;
-        }
-        AppendDistanceResults(*results, response->mutable_results());
+        wire::AppendDistanceResults(*results, response->mutable_results());
         response->set_seconds(SecondsSince(start));
         return absl::OkStatus();
       });

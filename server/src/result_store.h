@@ -15,6 +15,8 @@
 #include "inscribe/mesh.h"
 #include "inscribe/mesh_validation.h"
 #include "inscribe/server/result_cache.h"
+#include "inscribe/solid.h"
+#include "inscribe/sphere_set_generation.h"
 #include "inscribe/sphere.h"
 #include "inscribe/sphere_deformation.h"
 #include "inscribe/sphere_hierarchy.h"
@@ -25,9 +27,9 @@ namespace inscribe::server {
 // A validated mesh ready for queries: the cache object under "sha256:<hex>".
 struct StoredMeshEntry {
   std::string key;  // "sha256:<64 hex>"
-  Mesh mesh;        // orientation fixed, holes filled when asked
-  MeshReport report;
-  BoundaryOracle oracle;
+  Solid solid;      // orientation fixed, holes filled when asked
+
+  const Mesh& mesh() const { return solid.mesh(); }
 };
 
 // A generated sphere set: the cache object under "spheres/v1/<hex>". `result` is what Generate
@@ -70,10 +72,13 @@ class ResultStore {
   // NOT_FOUND for a key the cache does not hold (in memory or on disk).
   absl::StatusOr<std::shared_ptr<const StoredMeshEntry>> GetMesh(const std::string& key);
 
-  // The sphere set for (mesh, parameters): cached, or generated with `control` (progress and
-  // cancellation). INVALID_ARGUMENT for bad parameters, NOT_FOUND for an unknown mesh.
+  // The sphere set for (mesh, parameters): cached, or generated (GenerateSphereSet) with
+  // `control` (progress and cancellation). `fill_holes`: the mesh was stored repaired (part
+  // of the key). RESOURCE_EXHAUSTED over the --max-spheres limit, NOT_FOUND for an unknown
+  // mesh, GenerateSphereSet's errors.
   absl::StatusOr<std::pair<std::shared_ptr<const SphereSetEntry>, CacheSource>> Generate(
-      const v1::GenerateRequest& request, const GenerationControl& control);
+      const std::string& mesh_key, const SphereSetParameters& parameters, bool fill_holes,
+      const GenerationControl& control);
   absl::StatusOr<std::shared_ptr<const SphereSetEntry>> GetSphereSet(const std::string& key);
 
   // Stores an uploaded set under "spheres/v1/<64 hex>": the first 16 hex digits of the mesh
@@ -101,13 +106,5 @@ class ResultStore {
   ResultCache* const cache_;
   const StoreLimits limits_;
 };
-
-// The canonical form of `parameters` (defaults filled in) or INVALID_ARGUMENT naming the bad
-// field; the sphere-set key hashes this with the mesh key and the algorithm version:
-// "spheres/v1/" + the mesh key's first 16 hex digits + the first 48 of that SHA-256.
-absl::StatusOr<v1::GenerateParameters> CanonicalParameters(
-    const v1::GenerateParameters& parameters);
-std::string SphereSetKey(const std::string& mesh_key, const v1::GenerateParameters& canonical,
-                         bool with_quality);
 
 }  // namespace inscribe::server

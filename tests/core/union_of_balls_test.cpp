@@ -350,12 +350,12 @@ TEST(UnionVolume, RejectsBadInputNamingTheBall) {
   const struct {
     Sphere bad;
     const char* mentions;
-  } cases[] = {{Ball(nan, 0, 0, 1), "ball 1: non-finite centre"},
-               {Ball(0, inf, 0, 1), "ball 1: non-finite centre"},
-               {Ball(0, 0, 0, 0), "ball 1: radius 0"},
-               {Ball(0, 0, 0, -2), "ball 1: radius -2"},
-               {Ball(0, 0, 0, nan), "ball 1: radius nan"},
-               {Ball(0, 0, 0, inf), "ball 1: radius inf"},
+  } cases[] = {{Ball(nan, 0, 0, 1), "sphere 1: center x nan is not finite"},
+               {Ball(0, inf, 0, 1), "sphere 1: center y inf is not finite"},
+               {Ball(0, 0, 0, 0), "sphere 1: radius 0 is not positive"},
+               {Ball(0, 0, 0, -2), "sphere 1: radius -2 is not positive"},
+               {Ball(0, 0, 0, nan), "sphere 1: radius nan is not finite"},
+               {Ball(0, 0, 0, inf), "sphere 1: radius inf is not finite"},
                {Ball(0, 0, 0, 1e200), "ball 1: centre or radius above"},
                {Ball(-1e160, 0, 0, 1), "ball 1: centre or radius above"}};
   for (const auto& c : cases) {

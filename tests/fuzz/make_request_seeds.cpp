@@ -9,7 +9,7 @@
 #include <fstream>
 #include <string>
 
-#include "inscribe/server/convert.h"
+#include "inscribe/wire/convert.h"
 #include "request_fuzz_server.h"
 
 namespace {

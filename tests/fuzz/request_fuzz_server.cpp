@@ -9,7 +9,7 @@
 #include "grpcpp/create_channel.h"
 #include "grpcpp/security/credentials.h"
 #include "inscribe/mesh.h"
-#include "inscribe/server/convert.h"
+#include "inscribe/wire/convert.h"
 
 namespace inscribe::fuzz {
 namespace {
@@ -117,7 +117,7 @@ FuzzServer* Start() {
       grpc::CreateChannel(fuzz->server->address(), grpc::InsecureChannelCredentials()));
 
   v1::PutMeshRequest put_mesh;
-  server::MeshToProto(UnitCube(), put_mesh.mutable_mesh());
+  wire::MeshToProto(UnitCube(), put_mesh.mutable_mesh());
   v1::PutMeshResponse mesh_reply;
   grpc::Status status = fuzz->stub->PutMesh(Context().get(), put_mesh, &mesh_reply);
   if (!status.ok()) Die("PutMesh of the cube: " + status.error_message());
@@ -134,7 +134,7 @@ FuzzServer* Start() {
   v1::PutSphereSetRequest put_set;
   SphereSet two;
   two.spheres = {Sphere{Vector3(0, 0, 0), 1.0}, Sphere{Vector3(3, 0, 0), 0.5}};
-  server::SphereSetToProto(two, put_set.mutable_spheres());
+  wire::SphereSetToProto(two, put_set.mutable_spheres());
   v1::PutSphereSetResponse set_reply;
   status = fuzz->stub->PutSphereSet(Context().get(), put_set, &set_reply);
   if (!status.ok()) Die("PutSphereSet: " + status.error_message());

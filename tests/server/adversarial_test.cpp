@@ -19,7 +19,7 @@
 #include <thread>
 #include <vector>
 
-#include "inscribe/server/convert.h"
+#include "inscribe/wire/convert.h"
 #include "inscribe/v1/service.grpc.pb.h"
 #include "support/inscribed_process.h"
 #include "support/synthetic_meshes.h"
@@ -95,7 +95,7 @@ grpc::Status Generate(v1::Inscribe::Stub& stub, const v1::GenerateRequest& reque
 
 v1::Mesh ToProto(const Mesh& mesh) {
   v1::Mesh out;
-  MeshToProto(mesh, &out);
+  wire::MeshToProto(mesh, &out);
   return out;
 }
 
@@ -258,7 +258,7 @@ TEST(Adversarial, BillionVoxelGenerateIsRefusedBeforeWork) {
   request.mutable_parameters()->set_voxel_size(kNaN);
   status = Generate(server.stub(), request);
   EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
-  EXPECT_THAT(status.error_message(), HasSubstr("voxel_size"));
+  EXPECT_THAT(status.error_message(), HasSubstr("voxel size"));
   ExpectServes(server);
 }
 

@@ -40,15 +40,15 @@ TEST(Client, GenerateSendsEverySettingAndConvertsTheResult) {
         return result;
       });
   GenerateSettings settings;
-  settings.max_spheres = 300;
-  settings.object_angle = 0.5;
-  settings.epsilon = 1e-3;
-  settings.samples = 64;
-  settings.subdivide_boundary = true;
-  settings.dilate = true;
-  settings.dilation_growth = 0.5;
+  settings.parameters.max_spheres = 300;
+  settings.parameters.medial.object_angle = 0.5;
+  settings.parameters.medial.epsilon = 1e-3;
+  settings.parameters.medial.samples = 64;
+  settings.parameters.medial.subdivide_boundary = true;
+  settings.parameters.dilate = true;
+  settings.parameters.dilation.growth = 0.5;
   settings.fill_holes = true;
-  settings.skip_quality = true;
+  settings.parameters.evaluate = false;
   GenerateOptions options;
   options.progress_interval = 0.25;
   std::vector<double> progress;
@@ -60,9 +60,9 @@ TEST(Client, GenerateSendsEverySettingAndConvertsTheResult) {
   EXPECT_THAT(progress, ElementsAre(0.25, 0.75));
   EXPECT_EQ(result->sphere_set_key, "spheres/v1/two");
   EXPECT_EQ(result->mesh_sha256, "sha256:cube");
-  ASSERT_EQ(result->spheres.size(), 2u);
-  EXPECT_EQ(result->spheres.spheres[1].center, Vector3(1, 2, 3));
-  EXPECT_EQ(result->spheres.spheres[1].radius, 0.25);
+  ASSERT_EQ(result->set.size(), 2u);
+  EXPECT_EQ(result->set.spheres[1].center, Vector3(1, 2, 3));
+  EXPECT_EQ(result->set.spheres[1].radius, 0.25);
   EXPECT_EQ(result->voxel_size, 0.125);
   EXPECT_EQ(result->seconds, 1.5);
   EXPECT_EQ(result->cache, "computed");
@@ -100,7 +100,7 @@ TEST(Client, GenerateFromAMeshUploadsItAgainOnceWhenTheServerLostIt) {
     }
   }
   GenerateSettings settings;
-  settings.voxel_size = 0.125;
+  settings.parameters.voxel_size = 0.125;
   settings.fill_holes = true;
   absl::StatusOr<GenerateResult> result =
       Client(connection).Generate(testing::UnitCube(), settings);
@@ -216,7 +216,7 @@ TEST(Client, UpdateDeformationSendsVerticesRowByRowAndReadsTheBounds) {
       client.UpdateDeformation("sha256:cube", "spheres/v1/two", vertices, settings);
   ASSERT_TRUE(moved.ok()) << moved.status();
   EXPECT_THAT(moved->reference_index, ElementsAre(0, 3));
-  EXPECT_EQ(moved->spheres.spheres[0].radius, 0.5);
+  EXPECT_EQ(moved->set.spheres[0].radius, 0.5);
   EXPECT_EQ(moved->max_shrink_steps, 5);
   EXPECT_EQ(moved->sphere_set_key, "spheres/v1/moved");
   EXPECT_EQ(moved->deformed_mesh_sha256, "sha256:moved");

@@ -56,8 +56,8 @@ class ClientRpcTest : public ::testing::Test {
   // PutMesh, then Generate at `voxel_size`; fails the test on any error.
   GenerateResult Generated(const Mesh& mesh, double voxel_size, bool dilate = false) {
     GenerateSettings settings;
-    settings.voxel_size = voxel_size;
-    settings.dilate = dilate;
+    settings.parameters.voxel_size = voxel_size;
+    settings.parameters.dilate = dilate;
     absl::StatusOr<GenerateResult> result = client_->Generate(mesh, settings);
     EXPECT_TRUE(result.ok()) << result.status();
     return result.ok() ? *std::move(result) : GenerateResult();
@@ -128,23 +128,23 @@ TEST_F(ClientRpcTest, GenerateMatchesTheLibraryThenComesFromMemory) {
   EXPECT_EQ(stored->report.triangles, 1280);
 
   GenerateSettings settings;
-  settings.voxel_size = 0.1;
+  settings.parameters.voxel_size = 0.1;
   absl::StatusOr<GenerateResult> first = client_->Generate(stored->mesh_sha256, settings);
   ASSERT_TRUE(first.ok()) << first.status();
   EXPECT_EQ(first->cache, "computed");
   EXPECT_THAT(first->sphere_set_key, StartsWith("spheres/v1/"));
   EXPECT_EQ(first->mesh_sha256, stored->mesh_sha256);
   EXPECT_EQ(first->voxel_size, 0.1);
-  ExpectSameSpheres(first->spheres, LibrarySpheres(mesh, 0.1));
+  ExpectSameSpheres(first->set, LibrarySpheres(mesh, 0.1));
   ASSERT_TRUE(first->quality.has_value());
-  EXPECT_EQ(first->quality->spheres, static_cast<std::int64_t>(first->spheres.size()));
+  EXPECT_EQ(first->quality->spheres, static_cast<std::int64_t>(first->set.size()));
 
   // The mesh overload: uploads (already stored), then the cached set.
   absl::StatusOr<GenerateResult> second = client_->Generate(mesh, settings);
   ASSERT_TRUE(second.ok()) << second.status();
   EXPECT_EQ(second->cache, "memory");
   EXPECT_EQ(second->sphere_set_key, first->sphere_set_key);
-  ExpectSameSpheres(second->spheres, first->spheres);
+  ExpectSameSpheres(second->set, first->set);
 }
 
 TEST_F(ClientRpcTest, GenerateOnARealMeshMatchesTheLibrary) {
@@ -152,16 +152,16 @@ TEST_F(ClientRpcTest, GenerateOnARealMeshMatchesTheLibrary) {
   const Mesh mesh = testing::LoadTestMesh("eight.off");
   const double voxel_size = 0.05 * ComputeBoundingBox(mesh.vertices).diagonal();
   GenerateSettings settings;
-  settings.voxel_size = voxel_size;
-  settings.skip_quality = true;
+  settings.parameters.voxel_size = voxel_size;
+  settings.parameters.evaluate = false;
   int progress_calls = 0;
   GenerateOptions options;
   options.on_progress = [&](double) { ++progress_calls; };
   absl::StatusOr<GenerateResult> result = client_->Generate(mesh, settings, options);
   ASSERT_TRUE(result.ok()) << result.status();
   EXPECT_FALSE(result->quality.has_value());
-  EXPECT_GT(result->spheres.size(), 10u);
-  ExpectSameSpheres(result->spheres, LibrarySpheres(mesh, voxel_size));
+  EXPECT_GT(result->set.size(), 10u);
+  ExpectSameSpheres(result->set, LibrarySpheres(mesh, voxel_size));
 }
 
 TEST_F(ClientRpcTest, GetSphereSetAndGetHierarchyReturnTheGeneratedSet) {
@@ -169,16 +169,16 @@ TEST_F(ClientRpcTest, GetSphereSetAndGetHierarchyReturnTheGeneratedSet) {
   absl::StatusOr<StoredSphereSet> stored = client_->GetSphereSet(generated.sphere_set_key);
   ASSERT_TRUE(stored.ok()) << stored.status();
   EXPECT_EQ(stored->mesh_sha256, generated.mesh_sha256);
-  ExpectSameSpheres(stored->spheres, generated.spheres);
+  ExpectSameSpheres(stored->spheres, generated.set);
 
   for (const HierarchyVolume volume : {HierarchyVolume::kRss, HierarchyVolume::kSphere}) {
     absl::StatusOr<SphereHierarchy> hierarchy =
         client_->GetHierarchy(generated.sphere_set_key, volume);
     ASSERT_TRUE(hierarchy.ok()) << hierarchy.status();
     EXPECT_EQ(hierarchy->volume(), volume);
-    ASSERT_EQ(hierarchy->spheres().size(), generated.spheres.size());
-    for (std::size_t i = 0; i < generated.spheres.size(); ++i) {
-      EXPECT_EQ(hierarchy->spheres()[i].center, generated.spheres.spheres[i].center);
+    ASSERT_EQ(hierarchy->spheres().size(), generated.set.size());
+    for (std::size_t i = 0; i < generated.set.size(); ++i) {
+      EXPECT_EQ(hierarchy->spheres()[i].center, generated.set.spheres[i].center);
     }
   }
   EXPECT_EQ(client_->GetSphereSet("spheres/v1/" + std::string(64, 'c')).status().code(),
@@ -200,7 +200,7 @@ TEST_F(ClientRpcTest, DistanceMatchesBruteForce) {
     ASSERT_EQ(batch->results.size(), poses_b.size());
     for (std::size_t i = 0; i < poses_b.size(); ++i) {
       SCOPED_TRACE(i);
-      ExpectBruteForce(batch->results[i], sphere.spheres.spheres, poses_a[i], box.spheres.spheres,
+      ExpectBruteForce(batch->results[i], sphere.set.spheres, poses_a[i], box.set.spheres,
                        poses_b[i]);
     }
   }
@@ -209,7 +209,7 @@ TEST_F(ClientRpcTest, DistanceMatchesBruteForce) {
       client_->Distance(box.sphere_set_key, sphere.sphere_set_key, {poses_a[0]}, poses_b);
   ASSERT_TRUE(shared.ok()) << shared.status();
   for (std::size_t i = 0; i < poses_b.size(); ++i) {
-    ExpectBruteForce(shared->results[i], box.spheres.spheres, poses_a[0], sphere.spheres.spheres,
+    ExpectBruteForce(shared->results[i], box.set.spheres, poses_a[0], sphere.set.spheres,
                      poses_b[i]);
   }
 }
@@ -220,8 +220,8 @@ TEST_F(ClientRpcTest, DistanceSessionMatchesBruteForceOver200Frames) {
       Generated(testing::Box(Vector3(0, 0, 0), Vector3(1.0, 0.5, 0.5)), 0.1, /*dilate=*/true);
   absl::StatusOr<DistanceSession> session = client_->OpenDistanceSession();
   ASSERT_TRUE(session.ok()) << session.status();
-  const std::vector<Sphere>& s = sphere.spheres.spheres;
-  const std::vector<Sphere>& b = box.spheres.spheres;
+  const std::vector<Sphere>& s = sphere.set.spheres;
+  const std::vector<Sphere>& b = box.set.spheres;
   std::mt19937_64 rng(3);
   for (int frame = 0; frame < 200; ++frame) {
     SCOPED_TRACE(frame);
@@ -327,13 +327,13 @@ TEST_F(ClientRpcTest, EvaluateByKeyAndInlineMatchesTheLibrary) {
   options.voxel_size = 0.2;
   options.coverage_tolerance = 0.01;
   absl::StatusOr<QualityReport> expected =
-      EvaluateSpheres(OracleOf(mesh), generated.spheres.spheres, options);
+      EvaluateSpheres(OracleOf(mesh), generated.set.spheres, options);
   ASSERT_TRUE(expected.ok()) << expected.status();
 
   // The set's own mesh by key (mesh_sha256 empty), and the set sent inline with its mesh.
   absl::StatusOr<QualityReport> by_key = client_->Evaluate("", generated.sphere_set_key, settings);
   absl::StatusOr<QualityReport> inline_set =
-      client_->Evaluate(generated.mesh_sha256, generated.spheres, settings);
+      client_->Evaluate(generated.mesh_sha256, generated.set, settings);
   for (const absl::StatusOr<QualityReport>* report : {&by_key, &inline_set}) {
     ASSERT_TRUE(report->ok()) << report->status();
     const QualityReport& r = **report;
@@ -357,7 +357,7 @@ TEST_F(ClientRpcTest, EvaluateByKeyAndInlineMatchesTheLibrary) {
 TEST_F(ClientRpcTest, UpdateDeformationByARigidTranslationMovesEverySphere) {
   const Mesh mesh = testing::Icosphere(2);
   const GenerateResult generated = Generated(mesh, 0.2);
-  ASSERT_TRUE(generated.spheres.has_contacts());
+  ASSERT_TRUE(generated.set.has_contacts());
   const Vector3 shift(0.25, -0.5, 1.0);
   Vertices moved = ValidateMesh(mesh).mesh.vertices;  // the stored mesh's vertex order
   moved.rowwise() += shift.transpose();
@@ -368,12 +368,12 @@ TEST_F(ClientRpcTest, UpdateDeformationByARigidTranslationMovesEverySphere) {
       client_->UpdateDeformation("", generated.sphere_set_key, moved, settings);
   ASSERT_TRUE(result.ok()) << result.status();
   EXPECT_EQ(result->dropped, 0);
-  EXPECT_EQ(result->reference_spheres, static_cast<std::int64_t>(generated.spheres.size()));
-  ASSERT_EQ(result->spheres.size(), generated.spheres.size());
-  for (std::size_t i = 0; i < result->spheres.size(); ++i) {
+  EXPECT_EQ(result->reference_spheres, static_cast<std::int64_t>(generated.set.size()));
+  ASSERT_EQ(result->set.size(), generated.set.size());
+  for (std::size_t i = 0; i < result->set.size(); ++i) {
     const std::size_t from = static_cast<std::size_t>(result->reference_index[i]);
-    const Sphere& before = generated.spheres.spheres[from];
-    const Sphere& after = result->spheres.spheres[i];
+    const Sphere& before = generated.set.spheres[from];
+    const Sphere& after = result->set.spheres[i];
     EXPECT_LT((after.center - (before.center + shift)).norm(), 1e-9) << i;
     EXPECT_NEAR(after.radius, before.radius, 1e-9) << i;
   }
@@ -381,13 +381,13 @@ TEST_F(ClientRpcTest, UpdateDeformationByARigidTranslationMovesEverySphere) {
   ASSERT_THAT(result->sphere_set_key, StartsWith("spheres/v1/"));
   absl::StatusOr<StoredSphereSet> stored = client_->GetSphereSet(result->sphere_set_key);
   ASSERT_TRUE(stored.ok()) << stored.status();
-  ExpectSameSpheres(stored->spheres, result->spheres);
+  ExpectSameSpheres(stored->spheres, result->set);
 }
 
 // One Client shared by threads making batch calls and running their own sessions at once.
 TEST_F(ClientRpcTest, ConcurrentCallsAndSessionsShareOneClient) {
   const GenerateResult sphere = Generated(testing::Icosphere(1), 0.3, /*dilate=*/true);
-  const std::vector<Sphere>& s = sphere.spheres.spheres;
+  const std::vector<Sphere>& s = sphere.set.spheres;
   constexpr int kThreads = 4;
   std::atomic<int> wrong{0}, failed{0};
   std::vector<std::thread> threads;

@@ -90,7 +90,7 @@ std::vector<UnaryRpc> UnaryRpcs() {
        },
        [](const Client& client, std::optional<milliseconds> timeout) {
          GenerateSettings settings;
-         settings.voxel_size = 0.125;
+         settings.parameters.voxel_size = 0.125;
          GenerateOptions options;
          options.timeout = timeout;
          return client.Generate("sha256:cube", settings, options).status();

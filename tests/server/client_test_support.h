@@ -11,7 +11,7 @@
 #include "inscribe/client/client.h"
 #include "inscribe/client/connection.h"
 #include "inscribe/mesh_validation.h"
-#include "inscribe/server/convert.h"
+#include "inscribe/wire/convert.h"
 #include "inscribe/sphere_hierarchy.h"
 #include "support/synthetic_meshes.h"
 
@@ -49,7 +49,7 @@ class MockConnection : public Connection {
 inline v1::InspectMeshResponse CubeResponse() {
   v1::InspectMeshResponse response;
   response.set_mesh_sha256("sha256:cube");
-  server::MeshReportToProto(ValidateMesh(testing::UnitCube()).report, response.mutable_report());
+  wire::MeshReportToProto(ValidateMesh(testing::UnitCube()).report, response.mutable_report());
   return response;
 }
 

@@ -17,6 +17,7 @@
 
 #include "inscribe/client/client.h"
 #include "inscribe/client/routing.h"
+#include "inscribe/wire/keys.h"
 #include "inscribe/mesh_hash.h"
 #include "support/inscribed_process.h"
 #include "support/test_meshes.h"
@@ -45,8 +46,8 @@ std::vector<Mesh> SmallMeshes() {
 
 GenerateSettings CoarseFor(const Mesh& mesh) {
   GenerateSettings settings;
-  settings.voxel_size = 0.05 * ComputeBoundingBox(mesh.vertices).diagonal();
-  settings.skip_quality = true;
+  settings.parameters.voxel_size = 0.05 * ComputeBoundingBox(mesh.vertices).diagonal();
+  settings.parameters.evaluate = false;
   return settings;
 }
 
@@ -77,7 +78,7 @@ class FailoverTest : public ::testing::Test {
 
   // Rendezvous order of a key's replicas.
   std::vector<int> Order(const std::string& key) const {
-    return RendezvousOrder(RouteKey(key), names_);
+    return RendezvousOrder(wire::RouteKey(key), names_);
   }
 
   std::vector<ServerCacheStats> Stats(const std::vector<int>& which) const {
@@ -118,7 +119,7 @@ TEST_F(FailoverTest, EachMeshComputesOnItsOwnReplicaAndItsKeysRouteTogether) {
     EXPECT_EQ(made->sphere_set_key.substr(0, 11 + 16),
               "spheres/v1/" + made->mesh_sha256.substr(7, 16));
     EXPECT_EQ(made->sphere_set_key.size(), 11u + 64u);
-    EXPECT_EQ(RouteKey(made->sphere_set_key), RouteKey(made->mesh_sha256));
+    EXPECT_EQ(wire::RouteKey(made->sphere_set_key), wire::RouteKey(made->mesh_sha256));
 
     // Asked again: answered from the owner's memory, computed nowhere.
     absl::StatusOr<GenerateResult> again = routed_->Generate(mesh, CoarseFor(mesh));
@@ -140,7 +141,7 @@ TEST_F(FailoverTest, EachMeshComputesOnItsOwnReplicaAndItsKeysRouteTogether) {
   ASSERT_TRUE(made.ok()) << made.status();
   const std::string route = made->mesh_sha256.substr(7, 16);
   absl::StatusOr<PutSphereSetResult> uploaded =
-      routed_->PutSphereSet(made->spheres, made->mesh_sha256);
+      routed_->PutSphereSet(made->set, made->mesh_sha256);
   ASSERT_TRUE(uploaded.ok()) << uploaded.status();
   EXPECT_EQ(uploaded->sphere_set_key.substr(11, 16), route);
   DeformationSettings store;

@@ -59,8 +59,8 @@ using ::testing::HasSubstr;
 
 GenerateSettings CoarseFor(const Mesh& mesh) {
   GenerateSettings settings;
-  settings.voxel_size = 0.05 * ComputeBoundingBox(mesh.vertices).diagonal();
-  settings.skip_quality = true;
+  settings.parameters.voxel_size = 0.05 * ComputeBoundingBox(mesh.vertices).diagonal();
+  settings.parameters.evaluate = false;
   return settings;
 }
 
@@ -144,7 +144,7 @@ TEST(DiskFaults, CorruptEntriesAreDroppedRecomputedAndReplaced) {
       ASSERT_TRUE(again.ok()) << again.status();
       EXPECT_EQ(again->cache, "computed");
       EXPECT_EQ(again->sphere_set_key, original.sphere_set_key);
-      ExpectSameSpheres(again->spheres, original.spheres);
+      ExpectSameSpheres(again->set, original.set);
       absl::StatusOr<ServerCacheStats> stats = server.client().CacheStats();
       ASSERT_TRUE(stats.ok()) << stats.status();
       EXPECT_EQ(stats->disk_errors, 2);  // each file read once, failed its checks, dropped
@@ -158,7 +158,7 @@ TEST(DiskFaults, CorruptEntriesAreDroppedRecomputedAndReplaced) {
     absl::StatusOr<GenerateResult> from_disk = server.client().Generate(mesh, settings);
     ASSERT_TRUE(from_disk.ok()) << from_disk.status();
     EXPECT_EQ(from_disk->cache, "disk");
-    ExpectSameSpheres(from_disk->spheres, original.spheres);
+    ExpectSameSpheres(from_disk->set, original.set);
     absl::StatusOr<ServerCacheStats> stats = server.client().CacheStats();
     ASSERT_TRUE(stats.ok()) << stats.status();
     EXPECT_EQ(stats->disk_errors, 0);
@@ -374,11 +374,11 @@ TEST(CrashFaults, KillDuringWritesNeverLeavesAPartialEntry) {
         while (!stop.load()) {
           if (t == 0) {  // a Generate now and then: a few distinct voxel sizes
             GenerateSettings settings = CoarseFor(mesh);
-            settings.voxel_size = diagonal * (0.04 + 0.001 * (next_seed++ % 20));
+            settings.parameters.voxel_size = diagonal * (0.04 + 0.001 * (next_seed++ % 20));
             absl::StatusOr<GenerateResult> made = client.Generate(mesh, settings);
             if (!made.ok()) return;
             std::lock_guard<std::mutex> lock(mutex);
-            acknowledged[made->sphere_set_key] = made->spheres;
+            acknowledged[made->sphere_set_key] = made->set;
             continue;
           }
           const std::uint64_t seed = next_seed++;

@@ -97,8 +97,8 @@ class MetricsTest : public ::testing::Test {
 TEST_F(MetricsTest, CountsEachCallByMethodAndCode) {
   const Mesh cube = testing::UnitCube();
   client::GenerateSettings settings;
-  settings.voxel_size = 0.25;
-  settings.skip_quality = true;
+  settings.parameters.voxel_size = 0.25;
+  settings.parameters.evaluate = false;
   ASSERT_TRUE(client_->PutMesh(cube).ok());
   absl::StatusOr<client::GenerateResult> first = client_->Generate(cube, settings);
   ASSERT_TRUE(first.ok()) << first.status();
@@ -152,8 +152,8 @@ TEST_F(MetricsTest, CountsEachCallByMethodAndCode) {
 TEST_F(MetricsTest, CacheFiguresAgreeWithCacheStats) {
   const Mesh cube = testing::UnitCube();
   client::GenerateSettings settings;
-  settings.voxel_size = 0.2;
-  settings.skip_quality = true;
+  settings.parameters.voxel_size = 0.2;
+  settings.parameters.evaluate = false;
   for (int i = 0; i < 3; ++i) ASSERT_TRUE(client_->Generate(cube, settings).ok());
   absl::StatusOr<client::ServerCacheStats> stats = client_->CacheStats();
   ASSERT_TRUE(stats.ok()) << stats.status();

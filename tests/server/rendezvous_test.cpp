@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "inscribe/client/routing.h"
+#include "inscribe/wire/keys.h"
 
 namespace inscribe::client {
 namespace {
@@ -27,20 +28,20 @@ std::string RandomHex(std::mt19937_64& bits, int digits) {
 
 TEST(RouteKey, IsTheMeshDigitsOfMeshAndSetKeys) {
   const std::string hex = "0123456789abcdef" + std::string(48, 'e');
-  EXPECT_EQ(RouteKey("sha256:" + hex), "0123456789abcdef");
-  EXPECT_EQ(RouteKey("spheres/v1/" + hex), "0123456789abcdef");
-  EXPECT_EQ(RouteKey("spheres/v1/0123456789abcdef" + std::string(48, '7')), "0123456789abcdef");
+  EXPECT_EQ(wire::RouteKey("sha256:" + hex), "0123456789abcdef");
+  EXPECT_EQ(wire::RouteKey("spheres/v1/" + hex), "0123456789abcdef");
+  EXPECT_EQ(wire::RouteKey("spheres/v1/0123456789abcdef" + std::string(48, '7')), "0123456789abcdef");
   // Anything else routes as a whole.
-  EXPECT_EQ(RouteKey("sha256:0123456789ABCDEF" + std::string(48, 'e')),
+  EXPECT_EQ(wire::RouteKey("sha256:0123456789ABCDEF" + std::string(48, 'e')),
             "sha256:0123456789ABCDEF" + std::string(48, 'e'));
-  EXPECT_EQ(RouteKey("sha256:0123456789abcde"), "sha256:0123456789abcde");  // too short
-  EXPECT_EQ(RouteKey("sha256:0123456789abcdeg" + std::string(48, 'e')),
+  EXPECT_EQ(wire::RouteKey("sha256:0123456789abcde"), "sha256:0123456789abcde");  // too short
+  EXPECT_EQ(wire::RouteKey("sha256:0123456789abcdeg" + std::string(48, 'e')),
             "sha256:0123456789abcdeg" + std::string(48, 'e'));
-  EXPECT_EQ(RouteKey("spheres/v2/" + hex), "spheres/v2/" + hex);
-  EXPECT_EQ(RouteKey("hierarchy/v1/sphere/spheres/v1/" + hex),
+  EXPECT_EQ(wire::RouteKey("spheres/v2/" + hex), "spheres/v2/" + hex);
+  EXPECT_EQ(wire::RouteKey("hierarchy/v1/sphere/spheres/v1/" + hex),
             "hierarchy/v1/sphere/spheres/v1/" + hex);
-  EXPECT_EQ(RouteKey("spheres/v1/two"), "spheres/v1/two");
-  EXPECT_EQ(RouteKey(""), "");
+  EXPECT_EQ(wire::RouteKey("spheres/v1/two"), "spheres/v1/two");
+  EXPECT_EQ(wire::RouteKey(""), "");
 }
 
 // Chi-square statistic of `counts` against equal shares.

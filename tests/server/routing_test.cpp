@@ -3,6 +3,7 @@
 // of a moved key, DistanceStream failover, round robin, and concurrent calls while a replica
 // goes down. RouteKey and RendezvousOrder themselves: rendezvous_test.cpp.
 #include "inscribe/client/routing.h"
+#include "inscribe/wire/keys.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -68,8 +69,8 @@ class Fleet {
   Fleet& operator=(const Fleet&) = delete;
 
   // The replica rendezvous hashing gives `key` first, and the one after it.
-  int Owner(const std::string& key) const { return RendezvousOrder(RouteKey(key), names)[0]; }
-  int Second(const std::string& key) const { return RendezvousOrder(RouteKey(key), names)[1]; }
+  int Owner(const std::string& key) const { return RendezvousOrder(wire::RouteKey(key), names)[0]; }
+  int Second(const std::string& key) const { return RendezvousOrder(wire::RouteKey(key), names)[1]; }
 
   // Replicas reached since the last call, in order.
   std::vector<int> TakeCalls() {
@@ -102,7 +103,7 @@ class Fleet {
     ON_CALL(m, PutMesh(_, _)).WillByDefault([this, i](const v1::PutMeshRequest& r, Deadline) {
       Record(i);
       v1::PutMeshResponse response = PutMeshOk();
-      response.set_mesh_sha256(HashOf(*server::MeshFromProto(r.mesh())));
+      response.set_mesh_sha256(HashOf(*wire::MeshFromProto(r.mesh())));
       return absl::StatusOr<v1::PutMeshResponse>(response);
     });
     ON_CALL(m, Generate(_, _, _)).WillByDefault(Answering(i, GenerateOk()));
@@ -175,7 +176,7 @@ TEST(RoutedConnection, SendsEachCallToTheOwnerOfTheKeyItNames) {
     ASSERT_TRUE(client.PutMesh(mesh).ok());
     EXPECT_EQ(fleet.TakeCalls(), expected) << "PutMesh";
     GenerateSettings settings;
-    settings.voxel_size = 0.1;
+    settings.parameters.voxel_size = 0.1;
     ASSERT_TRUE(client.Generate(mesh_key, settings).ok());
     EXPECT_EQ(fleet.TakeCalls(), expected) << "Generate";
     SphereSet set;
@@ -210,7 +211,7 @@ TEST(RoutedConnection, FailsOverInRendezvousOrderAndTriesADownReplicaLast) {
   Fleet fleet(3, options);
   std::mt19937_64 bits(9);
   const std::string key = SetKeyOf(MeshKey(bits), bits);
-  const std::vector<int> order = RendezvousOrder(RouteKey(key), fleet.names);
+  const std::vector<int> order = RendezvousOrder(wire::RouteKey(key), fleet.names);
   EXPECT_CALL(*fleet.replicas[order[0]], GetSphereSet(_, _))
       .WillOnce([&](const v1::GetSphereSetRequest&, Deadline) {
         fleet.Record(order[0]);
@@ -230,7 +231,7 @@ TEST(RoutedConnection, FailsOverInRendezvousOrderAndTriesADownReplicaLast) {
   for (int k = 0; k < 50; ++k) {
     v1::GetSphereSetRequest other;
     other.set_sphere_set_key(SetKeyOf(MeshKey(bits), bits));
-    const std::vector<int> o = RendezvousOrder(RouteKey(other.sphere_set_key()), fleet.names);
+    const std::vector<int> o = RendezvousOrder(wire::RouteKey(other.sphere_set_key()), fleet.names);
     ASSERT_TRUE(fleet.routed->GetSphereSet(other, In(milliseconds(5000))).ok());
     EXPECT_THAT(fleet.TakeCalls(), ElementsAre(o[0] == order[0] ? o[1] : o[0]));
   }
@@ -386,7 +387,7 @@ TEST(RoutedConnection, DistanceSessionKeepsAnsweringAcrossAFailover) {
   Fleet fleet(3);
   std::mt19937_64 bits(37);
   const std::string key = SetKeyOf(MeshKey(bits), bits);
-  const std::vector<int> order = RendezvousOrder(RouteKey(key), fleet.names);
+  const std::vector<int> order = RendezvousOrder(wire::RouteKey(key), fleet.names);
   std::vector<std::int64_t> owner_frames, second_frames;
   auto first_stream = std::make_unique<NiceMock<MockDistanceStream>>();
   EXPECT_CALL(*first_stream, RoundTrip(_, _))
@@ -505,7 +506,7 @@ TEST(RoutedConnection, ConcurrentCallsLoseNothingWhileAReplicaGoesDown) {
         v1::DistanceRequest request;
         request.set_sphere_set_a(SetKeyOf(MeshKey(bits), bits));
         const std::vector<int> order =
-            RendezvousOrder(RouteKey(request.sphere_set_a()), fleet.names);
+            RendezvousOrder(wire::RouteKey(request.sphere_set_a()), fleet.names);
         const bool down_before = down.load();
         absl::StatusOr<v1::DistanceResponse> answer =
             fleet.routed->Distance(request, In(milliseconds(10'000)));

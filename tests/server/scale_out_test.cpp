@@ -67,8 +67,8 @@ class ScaleOut : public ::testing::Test {
 
 client::GenerateSettings Settings(const Mesh& mesh, double fraction) {
   client::GenerateSettings settings;
-  settings.voxel_size = fraction * ComputeBoundingBox(mesh.vertices).diagonal();
-  settings.skip_quality = true;
+  settings.parameters.voxel_size = fraction * ComputeBoundingBox(mesh.vertices).diagonal();
+  settings.parameters.evaluate = false;
   return settings;
 }
 
@@ -93,17 +93,17 @@ TEST_F(ScaleOut, ReplicasServeEachOthersResultsFromRedis) {
   // Replica 3 has neither: both come from Redis, nothing is computed.
   absl::StatusOr<client::StoredSphereSet> stored = clients_[2].GetSphereSet(coarse->sphere_set_key);
   ASSERT_TRUE(stored.ok()) << stored.status();
-  EXPECT_EQ(stored->spheres.size(), coarse->spheres.size());
+  EXPECT_EQ(stored->spheres.size(), coarse->set.size());
   EXPECT_EQ(stored->mesh_sha256, put->mesh_sha256);
   absl::StatusOr<client::GenerateResult> again =
       clients_[2].Generate(put->mesh_sha256, Settings(mesh, 0.05));
   ASSERT_TRUE(again.ok()) << again.status();
   EXPECT_EQ(again->cache, "redis");
   EXPECT_EQ(again->sphere_set_key, fine->sphere_set_key);
-  ASSERT_EQ(again->spheres.size(), fine->spheres.size());
-  for (std::size_t i = 0; i < fine->spheres.size(); ++i) {
-    EXPECT_EQ(again->spheres.spheres[i].center, fine->spheres.spheres[i].center);
-    EXPECT_EQ(again->spheres.spheres[i].radius, fine->spheres.spheres[i].radius);
+  ASSERT_EQ(again->set.size(), fine->set.size());
+  for (std::size_t i = 0; i < fine->set.size(); ++i) {
+    EXPECT_EQ(again->set.spheres[i].center, fine->set.spheres[i].center);
+    EXPECT_EQ(again->set.spheres[i].radius, fine->set.spheres[i].radius);
   }
   EXPECT_EQ(again->seconds, fine->seconds);  // the original run's time: not run again
   const client::ServerCacheStats third = Stats(2);

@@ -10,7 +10,7 @@
 #include "inscribe/client/client.h"
 #include "inscribe/mesh_hash.h"
 #include "inscribe/mesh_validation.h"
-#include "inscribe/server/convert.h"
+#include "inscribe/wire/convert.h"
 #include "inscribe/server/inscribe_server.h"
 #include "inscribe/v1/service.grpc.pb.h"
 #include "support/synthetic_meshes.h"
@@ -48,7 +48,7 @@ class InscribeServerTest : public ::testing::Test {
   // One InspectMesh call with a 30 s deadline; the response is written to *response.
   grpc::Status Inspect(const Mesh& mesh, v1::InspectMeshResponse* response) {
     v1::InspectMeshRequest request;
-    MeshToProto(mesh, request.mutable_mesh());
+    wire::MeshToProto(mesh, request.mutable_mesh());
     return Inspect(request, response);
   }
   grpc::Status Inspect(const v1::InspectMeshRequest& request, v1::InspectMeshResponse* response) {
@@ -129,7 +129,7 @@ TEST_F(InscribeServerTest, OpenCubeIsNotUsableAndSaysWhy) {
 
 TEST_F(InscribeServerTest, SkipSelfIntersectionsIsHonoured) {
   v1::InspectMeshRequest request;
-  MeshToProto(testing::UnitCube(), request.mutable_mesh());
+  wire::MeshToProto(testing::UnitCube(), request.mutable_mesh());
   request.set_skip_self_intersections(true);
   v1::InspectMeshResponse response;
   ASSERT_TRUE(Inspect(request, &response).ok());

@@ -14,7 +14,7 @@
 #include "grpcpp/security/server_credentials.h"
 #include "grpcpp/server.h"
 #include "grpcpp/server_builder.h"
-#include "inscribe/server/convert.h"
+#include "inscribe/wire/convert.h"
 #include "inscribe/server/inscribe_service.h"
 #include "inscribe/server/job_pool.h"
 #include "support/synthetic_meshes.h"
@@ -70,7 +70,7 @@ class ServiceQueueTest : public ::testing::Test {
 
   grpc::Status Inspect(std::chrono::milliseconds timeout) {
     v1::InspectMeshRequest request;
-    MeshToProto(testing::UnitCube(), request.mutable_mesh());
+    wire::MeshToProto(testing::UnitCube(), request.mutable_mesh());
     grpc::ClientContext context;
     context.set_deadline(std::chrono::system_clock::now() + timeout);
     v1::InspectMeshResponse response;

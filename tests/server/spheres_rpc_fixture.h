@@ -14,7 +14,7 @@
 
 #include "grpcpp/create_channel.h"
 #include "grpcpp/security/credentials.h"
-#include "inscribe/server/convert.h"
+#include "inscribe/wire/convert.h"
 #include "inscribe/server/inscribe_server.h"
 #include "inscribe/v1/service.grpc.pb.h"
 
@@ -59,7 +59,7 @@ class SpheresRpcTest : public ::testing::Test {
 
   std::string PutMesh(const Mesh& mesh) {
     v1::PutMeshRequest request;
-    MeshToProto(mesh, request.mutable_mesh());
+    wire::MeshToProto(mesh, request.mutable_mesh());
     v1::PutMeshResponse response;
     const grpc::Status status = stub_->PutMesh(Context().get(), request, &response);
     EXPECT_TRUE(status.ok()) << status.error_message();

@@ -18,7 +18,7 @@
 #include "inscribe/mesh_hash.h"
 #include "inscribe/mesh_validation.h"
 #include "inscribe/separation_distance.h"
-#include "inscribe/server/convert.h"
+#include "inscribe/wire/convert.h"
 #include "inscribe/server/inscribe_server.h"
 #include "inscribe/sphere_hierarchy.h"
 #include "inscribe/v1/service.grpc.pb.h"
@@ -36,13 +36,13 @@ TEST_F(SpheresRpcTest, PutMeshKeysByContentAndRefusesUnusableMeshes) {
   EXPECT_EQ(key, FormatSha256(MeshSha256(ValidateMesh(cube).mesh)));
 
   v1::PutMeshRequest again;
-  MeshToProto(cube, again.mutable_mesh());
+  wire::MeshToProto(cube, again.mutable_mesh());
   v1::PutMeshResponse response;
   ASSERT_TRUE(stub_->PutMesh(Context().get(), again, &response).ok());
   EXPECT_TRUE(response.already_stored());
 
   v1::PutMeshRequest open;
-  MeshToProto(testing::OpenUnitCube(), open.mutable_mesh());
+  wire::MeshToProto(testing::OpenUnitCube(), open.mutable_mesh());
   const grpc::Status refused = stub_->PutMesh(Context().get(), open, &response);
   EXPECT_EQ(refused.error_code(), grpc::StatusCode::FAILED_PRECONDITION);
   EXPECT_THAT(refused.error_message(), HasSubstr("not_closed"));
@@ -112,7 +112,7 @@ TEST_F(SpheresRpcTest, GenerateErrorsHaveTheirCodes) {
   angle.mutable_parameters()->set_object_angle(4.0);
   s = Generate(angle, &result);
   EXPECT_EQ(s.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
-  EXPECT_THAT(s.error_message(), HasSubstr("object_angle"));
+  EXPECT_THAT(s.error_message(), HasSubstr("parameters: object angle"));
   EXPECT_EQ(Generate(SphereRequest("not a key!", 0.2), &result).error_code(),
             grpc::StatusCode::INVALID_ARGUMENT);
 }
@@ -182,7 +182,7 @@ TEST_F(SpheresRpcTest, SphereSetHierarchyAndDistanceMatchTheLibrary) {
   v1::GetSphereSetResponse set;
   ASSERT_TRUE(stub_->GetSphereSet(Context().get(), get, &set).ok());
   EXPECT_EQ(set.mesh_sha256(), mesh);
-  absl::StatusOr<SphereSet> spheres = SphereSetFromProto(set.spheres());
+  absl::StatusOr<SphereSet> spheres = wire::SphereSetFromProto(set.spheres());
   ASSERT_TRUE(spheres.ok());
 
   v1::GetHierarchyRequest get_h;
@@ -211,8 +211,8 @@ TEST_F(SpheresRpcTest, SphereSetHierarchyAndDistanceMatchTheLibrary) {
   v1::DistanceRequest distance;
   distance.set_sphere_set_a(generated.sphere_set_key());
   distance.set_sphere_set_b(generated.sphere_set_key());
-  PosesToProto(poses_a, distance.mutable_poses_a());
-  PosesToProto(poses_b, distance.mutable_poses_b());
+  wire::PosesToProto(poses_a, distance.mutable_poses_a());
+  wire::PosesToProto(poses_b, distance.mutable_poses_b());
   v1::DistanceResponse answer;
   const grpc::Status s = stub_->Distance(Context().get(), distance, &answer);
   ASSERT_TRUE(s.ok()) << s.error_message();

@@ -38,7 +38,7 @@ class StreamRpcTest : public SpheresRpcTest {
     v1::GenerateResult result;
     const grpc::Status s = Generate(request, &result);
     EXPECT_TRUE(s.ok()) << s.error_message();
-    absl::StatusOr<SphereSet> set = SphereSetFromProto(result.spheres());
+    absl::StatusOr<SphereSet> set = wire::SphereSetFromProto(result.spheres());
     EXPECT_TRUE(set.ok()) << set.status();
     return {result.sphere_set_key(), set.ok() ? *set : SphereSet{}};
   }
@@ -46,7 +46,7 @@ class StreamRpcTest : public SpheresRpcTest {
   grpc::Status PutSpheres(const SphereSet& set, const std::string& mesh_key,
                           v1::PutSphereSetResponse* response) {
     v1::PutSphereSetRequest request;
-    SphereSetToProto(set, request.mutable_spheres());
+    wire::SphereSetToProto(set, request.mutable_spheres());
     request.set_mesh_sha256(mesh_key);
     return stub_->PutSphereSet(Context().get(), request, response);
   }
@@ -142,7 +142,7 @@ TEST_F(StreamRpcTest, UpdateDeformationMatchesTheCoreDeformerAndKeepsIt) {
     }
     absl::StatusOr<DeformedSpheres> expected = local->Update(moved);
     ASSERT_TRUE(expected.ok()) << expected.status();
-    absl::StatusOr<SphereSet> got = SphereSetFromProto(response.spheres());
+    absl::StatusOr<SphereSet> got = wire::SphereSetFromProto(response.spheres());
     ASSERT_TRUE(got.ok());
     ASSERT_EQ(got->size(), expected->set.size());
     for (std::size_t i = 0; i < got->size(); ++i) {
@@ -180,7 +180,7 @@ TEST_F(StreamRpcTest, UpdateDeformationByTranslationMovesEverySphereAndStoresOnR
   v1::UpdateDeformationResponse response;
   const grpc::Status s = stub_->UpdateDeformation(Context().get(), request, &response);
   ASSERT_TRUE(s.ok()) << s.error_message();
-  absl::StatusOr<SphereSet> got = SphereSetFromProto(response.spheres());
+  absl::StatusOr<SphereSet> got = wire::SphereSetFromProto(response.spheres());
   ASSERT_TRUE(got.ok());
   ASSERT_EQ(got->size(), set.size());
   for (std::size_t i = 0; i < set.size(); ++i) {
@@ -195,8 +195,8 @@ TEST_F(StreamRpcTest, UpdateDeformationByTranslationMovesEverySphereAndStoresOnR
   v1::DistanceRequest distance;
   distance.set_sphere_set_a(key);
   distance.set_sphere_set_b(response.sphere_set_key());
-  PosesToProto({RigidPose{}}, distance.mutable_poses_a());
-  PosesToProto({RigidPose{}}, distance.mutable_poses_b());
+  wire::PosesToProto({RigidPose{}}, distance.mutable_poses_a());
+  wire::PosesToProto({RigidPose{}}, distance.mutable_poses_b());
   v1::DistanceResponse answer;
   ASSERT_TRUE(stub_->Distance(Context().get(), distance, &answer).ok());
   absl::StatusOr<DistanceResult> brute =
@@ -259,7 +259,7 @@ TEST_F(StreamRpcTest, EvaluateByKeyAndInlineEqualsTheLibrary) {
   by_key.set_samples(20'000);
   by_key.set_voxel_size(0.05);
   v1::EvaluateRequest inline_set = by_key;
-  SphereSetToProto(set, inline_set.mutable_sphere_set());
+  wire::SphereSetToProto(set, inline_set.mutable_sphere_set());
   inline_set.set_mesh_sha256(mesh);
   for (const v1::EvaluateRequest& request : {by_key, inline_set}) {
     v1::EvaluateResponse response;
@@ -313,8 +313,8 @@ TEST_F(StreamRpcTest, DistanceStreamAnswersEveryFrameLikeBruteForce) {
       pair->set_sphere_set_a(p == 2 ? b.first : a.first);
       pair->set_sphere_set_b(b.first);
       poses.emplace_back(testing::RandomPose(rng, 2.0), testing::RandomPose(rng, 2.0));
-      PoseToProto(poses.back().first, pair->mutable_pose_a());
-      PoseToProto(poses.back().second, pair->mutable_pose_b());
+      wire::PoseToProto(poses.back().first, pair->mutable_pose_a());
+      wire::PoseToProto(poses.back().second, pair->mutable_pose_b());
     }
     ASSERT_TRUE(stream->Write(request));
     v1::DistanceFrameResult result;
@@ -366,8 +366,8 @@ TEST_F(StreamRpcTest, DistanceStreamErrorEndsTheStreamNamingThePair) {
       v1::DistancePair* pair = frame.add_pairs();
       pair->set_sphere_set_a(a.first);
       pair->set_sphere_set_b(a.first);
-      PoseToProto(RigidPose{}, pair->mutable_pose_a());
-      PoseToProto(RigidPose{Eigen::Quaterniond::Identity(), Vector3(3, 0, 0)},
+      wire::PoseToProto(RigidPose{}, pair->mutable_pose_a());
+      wire::PoseToProto(RigidPose{Eigen::Quaterniond::Identity(), Vector3(3, 0, 0)},
                   pair->mutable_pose_b());
     }
     v1::DistanceFrameResult result;
@@ -406,8 +406,8 @@ TEST_F(StreamRpcTest, ClientDisconnectMidFrameStopsTheWork) {
     v1::DistancePair* pair = frame.add_pairs();
     pair->set_sphere_set_a(a.first);
     pair->set_sphere_set_b(a.first);
-    PoseToProto(testing::RandomPose(rng, 0.3), pair->mutable_pose_a());
-    PoseToProto(testing::RandomPose(rng, 0.3), pair->mutable_pose_b());
+    wire::PoseToProto(testing::RandomPose(rng, 0.3), pair->mutable_pose_a());
+    wire::PoseToProto(testing::RandomPose(rng, 0.3), pair->mutable_pose_b());
   }
   auto wait_for_streams = [&](std::size_t n) {
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);

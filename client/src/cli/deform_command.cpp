@@ -11,6 +11,7 @@
 #include "inscribe/mesh_hash.h"
 #include "inscribe/mesh_io.h"
 #include "inscribe/mesh_validation.h"
+#include "inscribe/solid.h"
 #include "inscribe/sphere_deformation.h"
 #include "inscribe/sphere_io.h"
 #include "nlohmann/json.hpp"
@@ -134,8 +135,11 @@ std::optional<DeformInputs> ReadInputs(const DeformCliOptions& options, int* exi
   in.deformed_self_intersecting_pairs =
       ValidateMesh(in.deformed, check).report.self_intersecting_pairs;
   in.deformed_sha256 = FormatSha256(MeshSha256(in.deformed));
-  in.ray_parity =
-      solid->report.self_intersecting_pairs > 0 || in.deformed_self_intersecting_pairs > 0;
+  // The inside-test rule holds for both solids: ray parity if either intersects itself.
+  MeshReport deformed_report;
+  deformed_report.self_intersecting_pairs = in.deformed_self_intersecting_pairs;
+  in.ray_parity = InsideTestFor(solid->report) == InsideTest::kRayParity ||
+                  InsideTestFor(deformed_report) == InsideTest::kRayParity;
   in.file = *std::move(file);
   in.reference = *std::move(solid);
   *exit_code = kExitOk;
@@ -174,26 +178,10 @@ std::optional<client::DeformationResult> DeformHere(const DeformCliOptions& opti
     return std::nullopt;
   }
   client::DeformationResult r;
-  r.spheres = std::move(moved->set);
-  r.reference_index = std::move(moved->reference_index);
-  r.xi = moved->xi;
-  r.max_protrusion = moved->max_protrusion;
-  r.shrunk = moved->shrunk;
-  r.dropped = moved->dropped;
-  r.closest_point_queries = moved->closest_point_queries;
-  r.max_shrink_steps = moved->max_shrink_steps;
-  r.seconds = moved->seconds;
+  static_cast<DeformedSpheres&>(r) = *std::move(moved);
   r.reference_spheres = static_cast<std::int64_t>(deformer->reference_spheres().size());
   r.deformed_mesh_sha256 = in.deformed_sha256;
-  client::DeformationResult::Bounds b;
-  b.nerr_lower = bounds->nerr_lower;
-  b.nerr_upper = bounds->nerr_upper;
-  b.nerr_is_exact = bounds->exact;
-  b.volume_mesh = bounds->volume_mesh;
-  b.volume_union = bounds->volume_union;
-  if (bounds->uniform_xi_holds) b.nerr_upper_uniform_xi = bounds->nerr_upper_uniform_xi;
-  b.seconds = bounds->seconds;
-  r.bounds = b;
+  r.bounds = *std::move(bounds);
   return r;
 }
 
@@ -254,15 +242,15 @@ void PrintText(const DeformCliOptions& options, const client::DeformationResult&
   auto line = [](const char* key, const std::string& value) {
     std::cout << absl::StrFormat("%-26s %s\n", key, value);
   };
-  const client::DeformationResult::Bounds& bounds = *result.bounds;
+  const DeformationErrorBounds& bounds = *result.bounds;
   line("reference", options.reference_path);
   line("deformed", options.deformed_path);
-  line("spheres", absl::StrFormat("%d (%d shrunk, %d dropped)", result.spheres.size(),
+  line("spheres", absl::StrFormat("%d (%d shrunk, %d dropped)", result.set.size(),
                                   result.shrunk, result.dropped));
   line("xi", absl::StrFormat("%.6g", result.xi));
   line("max protrusion", absl::StrFormat("%.6g", result.max_protrusion));
-  line(bounds.nerr_is_exact ? "nerr (exact)" : "nerr bounds (Lemmas 1, 2)",
-       bounds.nerr_is_exact
+  line(bounds.exact ? "nerr (exact)" : "nerr bounds (Lemmas 1, 2)",
+       bounds.exact
            ? absl::StrFormat("%.6f", bounds.nerr_lower)
            : absl::StrFormat("%.6f .. %.6f", bounds.nerr_lower, bounds.nerr_upper));
   line("update", absl::StrFormat("%.4f s (%d closest-point queries)", result.seconds,
@@ -272,13 +260,13 @@ void PrintText(const DeformCliOptions& options, const client::DeformationResult&
 
 void PrintSummary(const DeformCliOptions& options, const DeformInputs& in,
                   const client::DeformationResult& result, double load_seconds) {
-  const client::DeformationResult::Bounds& bounds = *result.bounds;
+  const DeformationErrorBounds& bounds = *result.bounds;
   nlohmann::json summary;
   summary["reference_mesh"] = options.reference_path;
   summary["reference_mesh_sha256"] = in.reference_sha256;
   summary["deformed_mesh"] = options.deformed_path;
   summary["mesh_sha256"] = in.deformed_sha256;
-  summary["spheres"] = result.spheres.size();
+  summary["spheres"] = result.set.size();
   summary["reference_spheres"] = result.reference_spheres;
   summary["shrunk"] = result.shrunk;
   summary["dropped"] = result.dropped;
@@ -295,10 +283,10 @@ void PrintSummary(const DeformCliOptions& options, const DeformInputs& in,
   summary["nerr_lower"] = bounds.nerr_lower;
   summary["nerr_upper"] = bounds.nerr_upper;
   // JSON has no infinity: null when Lemma 2's uniform-xi premise fails.
-  summary["nerr_upper_uniform_xi"] = bounds.nerr_upper_uniform_xi
-                                         ? nlohmann::json(*bounds.nerr_upper_uniform_xi)
+  summary["nerr_upper_uniform_xi"] = bounds.uniform_xi_holds
+                                         ? nlohmann::json(bounds.nerr_upper_uniform_xi)
                                          : nlohmann::json(nullptr);
-  summary["nerr_is_exact"] = bounds.nerr_is_exact;
+  summary["nerr_is_exact"] = bounds.exact;
   summary["self_intersecting_pairs"] = in.deformed_self_intersecting_pairs;
   if (options.remote.enabled()) summary["server"] = options.remote.server;
   if (!options.output_path.empty()) summary["output"] = options.output_path;
@@ -319,10 +307,10 @@ int RunDeform(const DeformCliOptions& options) {
     result = DeformHere(options, *in, &exit_code);
   }
   if (!result) return exit_code;
-  const client::DeformationResult::Bounds& bounds = *result->bounds;
+  const DeformationErrorBounds& bounds = *result->bounds;
 
   SphereFile out;
-  out.set = result->spheres;
+  out.set = result->set;
   out.mesh_sha256 = in->deformed_sha256;
   out.params = {
       {"reference_mesh_sha256", in->reference_sha256},
@@ -338,7 +326,7 @@ int RunDeform(const DeformCliOptions& options) {
       {"volume_union", bounds.volume_union},
       {"nerr_lower", bounds.nerr_lower},
       {"nerr_upper", bounds.nerr_upper},
-      {"nerr_is_exact", bounds.nerr_is_exact},
+      {"nerr_is_exact", bounds.exact},
       {"max_protrusion", result->max_protrusion},
       {"shrunk", result->shrunk},
       {"dropped", result->dropped},

@@ -74,14 +74,14 @@ std::optional<Evaluated> EvaluateHere(const EvaluateCliOptions& options, const S
   std::optional<LoadedSolid> solid =
       LoadSolid(options.mesh_path, exit_code, LoadSolidOptions{options.fill_holes});
   if (!solid) return std::nullopt;
-  absl::StatusOr<QualityReport> report = EvaluateSpheres(solid->oracle, file.set.spheres, quality);
+  absl::StatusOr<QualityReport> report = EvaluateSpheres(solid->solid.oracle, file.set.spheres, quality);
   if (!report.ok()) {
     std::cerr << "inscribe: " << report.status().message() << "\n";
     *exit_code = report.status().code() == absl::StatusCode::kInvalidArgument ? kExitBadInput
                                                                               : kExitUnusableMesh;
     return std::nullopt;
   }
-  return Evaluated{solid->sha256, *std::move(report)};
+  return Evaluated{solid->solid.sha256, *std::move(report)};
 }
 
 // Remote mode: PutMesh, then Evaluate with the spheres sent inline.

@@ -11,7 +11,7 @@
 #include "grpcpp/client_context.h"
 #include "grpcpp/create_channel.h"
 #include "grpcpp/security/credentials.h"
-#include "inscribe/server/convert.h"
+#include "inscribe/wire/convert.h"
 #include "remote_options.h"
 
 namespace inscribe::cli {
@@ -44,7 +44,7 @@ absl::StatusOr<HealthCheckResponse::ServingStatus> Check(const std::string& targ
   request.set_service(options.service);
   HealthCheckResponse response;
   const grpc::Status status = stub->Check(&context, request, &response);
-  if (!status.ok()) return server::FromGrpcStatus(status);
+  if (!status.ok()) return wire::FromGrpcStatus(status);
   return response.status();
 }
 

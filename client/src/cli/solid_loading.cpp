@@ -30,30 +30,17 @@ std::optional<LoadedSolid> LoadSolid(const std::string& path, int* exit_code,
     *exit_code = kExitBadInput;
     return std::nullopt;
   }
-  ValidateOptions validate;
-  validate.fill_holes = options.fill_holes;
-  absl::StatusOr<ValidatedMesh> validated = PrepareMesh(*std::move(mesh), validate);
-  if (!validated.ok()) {
-    std::cerr << "inscribe: " << path << ": " << validated.status().message() << "\n";
+  SolidOptions solid_options;
+  solid_options.validate.fill_holes = options.fill_holes;
+  absl::StatusOr<Solid> solid = PrepareSolid(*std::move(mesh), solid_options);
+  if (!solid.ok()) {
+    std::cerr << "inscribe: " << path << ": " << solid.status().message() << "\n";
     *exit_code = kExitUnusableMesh;
     return std::nullopt;
   }
-  NoteRepairs(path, validated->report);
-  BoundaryOracleOptions oracle_options;
-  // The pseudonormal sign is wrong near sheets buried inside a self-intersecting solid.
-  if (validated->report.self_intersecting_pairs > 0) {
-    oracle_options.inside_test = InsideTest::kRayParity;
-  }
-  const std::string sha256 = FormatSha256(MeshSha256(validated->mesh));
-  absl::StatusOr<BoundaryOracle> oracle =
-      BoundaryOracle::Build(std::move(validated->mesh), oracle_options);
-  if (!oracle.ok()) {
-    std::cerr << "inscribe: " << path << ": " << oracle.status().message() << "\n";
-    *exit_code = kExitUnusableMesh;
-    return std::nullopt;
-  }
+  NoteRepairs(path, solid->report);
   return LoadedSolid{
-      std::move(validated->report), sha256, *std::move(oracle),
+      *std::move(solid),
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()};
 }
 

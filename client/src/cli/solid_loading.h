@@ -9,14 +9,13 @@
 #include "inscribe/boundary_oracle.h"
 #include "inscribe/client/client.h"
 #include "inscribe/mesh_validation.h"
+#include "inscribe/solid.h"
 #include "remote_options.h"
 
 namespace inscribe::cli {
 
 struct LoadedSolid {
-  MeshReport report;
-  std::string sha256;  // "sha256:<hex>" of the validated mesh
-  BoundaryOracle oracle;
+  Solid solid;
   double seconds = 0.0;  // reading + validation + oracle build
 };
 
@@ -27,8 +26,8 @@ struct LoadSolidOptions {
 };
 
 // Prints the reason on stderr and sets *exit_code (kExitBadInput for unreadable files,
-// kExitUnusableMesh for meshes that are not closed solids) when it returns nothing. Meshes
-// whose report shows self-intersections get the ray-parity inside test (see InsideTest).
+// kExitUnusableMesh for meshes that are not closed solids) when it returns nothing. The solid
+// is core's PrepareSolid (its inside-test rule included).
 std::optional<LoadedSolid> LoadSolid(const std::string& path, int* exit_code,
                                      const LoadSolidOptions& options = {});
 

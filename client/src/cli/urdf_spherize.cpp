@@ -12,9 +12,9 @@
 #include "absl/status/status.h"
 #include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
-#include "inscribe/boundary_oracle.h"
 #include "inscribe/mesh_io.h"
-#include "inscribe/mesh_validation.h"
+#include "inscribe/solid.h"
+#include "inscribe/sphere_set_generation.h"
 #include "primitive_meshes.h"
 
 namespace inscribe::cli {
@@ -22,7 +22,7 @@ namespace {
 
 // An element ready for generation: a validated solid, or a sphere kept as it is.
 struct PreparedElement {
-  std::optional<BoundaryOracle> oracle;  // mesh elements
+  std::optional<Solid> solid;            // mesh elements
   std::optional<Sphere> sphere;          // <sphere> elements, in the link frame
   double volume = -1.0;                  // of the mesh (m^3); -1 for a sphere
 };
@@ -44,52 +44,38 @@ absl::StatusOr<PreparedElement> PrepareElement(const UrdfElement& element,
   }
   absl::StatusOr<Mesh> mesh = ElementMeshInLinkFrame(element, options);
   if (!mesh.ok()) return mesh.status();
-  absl::StatusOr<ValidatedMesh> validated = PrepareMesh(*std::move(mesh));
-  if (!validated.ok()) {
+  absl::StatusOr<Solid> solid = PrepareSolid(*std::move(mesh));
+  if (!solid.ok()) {
     return absl::FailedPreconditionError(
-        absl::StrCat("the mesh is not a usable closed solid: ", validated.status().message()));
+        absl::StrCat("the mesh is not a usable closed solid: ", solid.status().message()));
   }
-  BoundaryOracleOptions oracle_options;
-  // As LoadSolid: the pseudonormal sign is wrong near sheets buried in a self-intersecting solid.
-  if (validated->report.self_intersecting_pairs > 0) {
-    oracle_options.inside_test = InsideTest::kRayParity;
-  }
-  prepared.volume = validated->report.volume;
-  absl::StatusOr<BoundaryOracle> oracle =
-      BoundaryOracle::Build(std::move(validated->mesh), oracle_options);
-  if (!oracle.ok()) return oracle.status();
-  prepared.oracle.emplace(*std::move(oracle));
+  prepared.volume = solid->report.volume;
+  prepared.solid.emplace(*std::move(solid));
   return prepared;
 }
 
 // The spheres of one validated mesh element: a fixed voxel size, or the finest grid within
 // `budget` spheres. Adds the generation runs to *runs.
-absl::StatusOr<std::vector<Sphere>> GenerateElement(const BoundaryOracle& oracle,
+absl::StatusOr<std::vector<Sphere>> GenerateElement(const Solid& solid,
                                                     const UrdfSpherizeOptions& options,
                                                     std::int64_t budget, int* runs) {
-  MedialSphereResult result;
+  SphereSetParameters parameters;
+  parameters.medial = options.medial;
   if (options.voxel_size > 0.0) {
-    MedialSphereOptions medial = options.medial;
-    medial.voxel_size = options.voxel_size;
-    absl::StatusOr<MedialSphereResult> run = GenerateMedialSpheres(oracle, medial);
-    if (!run.ok()) return run.status();
-    result = *std::move(run);
-    *runs += 1;
+    parameters.voxel_size = options.voxel_size;
   } else {
-    SphereBudgetOptions search;
-    search.max_spheres = budget;
-    search.base = options.medial;
-    absl::StatusOr<SphereBudgetResult> found = GenerateWithSphereBudget(oracle, search);
-    if (!found.ok()) return found.status();
-    *runs += found->runs;
-    result = std::move(found->best);
+    parameters.max_spheres = budget;
   }
-  if (result.set.spheres.empty()) {
+  parameters.evaluate = false;
+  absl::StatusOr<GeneratedSphereSet> result = GenerateSphereSet(solid, parameters);
+  if (!result.ok()) return result.status();
+  *runs += result->runs;
+  if (result->set.spheres.empty()) {
     return absl::FailedPreconditionError(
-        absl::StrCat("no sphere at voxel size ", result.voxel_size,
+        absl::StrCat("no sphere at voxel size ", result->voxel_size,
                      " m: the element is thinner than a voxel; give a smaller --voxel-size"));
   }
-  return std::move(result.set.spheres);
+  return std::move(result->set.spheres);
 }
 
 // SpherizeLink without the timing and the exception guard.
@@ -125,7 +111,7 @@ void SpherizeElements(const UrdfLink& link, const UrdfSpherizeOptions& options,
       continue;
     }
     absl::StatusOr<std::vector<Sphere>> generated =
-        GenerateElement(*prepared[i].oracle, options, budgets[i], &result->generation_runs);
+        GenerateElement(*prepared[i].solid, options, budgets[i], &result->generation_runs);
     if (!generated.ok()) return skip(link.elements[i], generated.status().message());
     spheres.insert(spheres.end(), generated->begin(), generated->end());
   }

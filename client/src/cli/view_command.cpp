@@ -112,9 +112,9 @@ int RunView(const ViewCliOptions& options) {
   std::optional<LoadedSolid> solid =
       LoadSolid(options.mesh_path, &exit_code, LoadSolidOptions{options.fill_holes});
   if (!solid) return exit_code;
-  if (!file->mesh_sha256.empty() && file->mesh_sha256 != solid->sha256) {
+  if (!file->mesh_sha256.empty() && file->mesh_sha256 != solid->solid.sha256) {
     std::cerr << "inscribe: warning: " << options.spheres_path << " was made for mesh "
-              << file->mesh_sha256 << ", not " << solid->sha256 << "\n";
+              << file->mesh_sha256 << ", not " << solid->solid.sha256 << "\n";
   }
 
   const auto evaluate_start = std::chrono::steady_clock::now();
@@ -122,7 +122,7 @@ int RunView(const ViewCliOptions& options) {
   quality.surface_samples = options.samples;
   quality.seed = options.seed;
   quality.voxel_size = FileVoxelSize(*file);
-  absl::StatusOr<QualityReport> report = EvaluateSpheres(solid->oracle, spheres, quality);
+  absl::StatusOr<QualityReport> report = EvaluateSpheres(solid->solid.oracle, spheres, quality);
   if (!report.ok()) {
     std::cerr << "inscribe: " << report.status().message() << "\n";
     return report.status().code() == absl::StatusCode::kInvalidArgument ? kExitBadInput
@@ -132,7 +132,7 @@ int RunView(const ViewCliOptions& options) {
   for (std::size_t i = 0; i < spheres.size(); ++i) {
     centre_rows.row(static_cast<std::int64_t>(i)) = spheres[i].center.transpose();
   }
-  const std::vector<double> centre_distances = solid->oracle.SignedDistances(centre_rows);
+  const std::vector<double> centre_distances = solid->solid.oracle.SignedDistances(centre_rows);
   const double evaluate_seconds = SecondsSince(evaluate_start);
 
   EnvelopeDistanceRequest request;
@@ -140,7 +140,7 @@ int RunView(const ViewCliOptions& options) {
   request.envelope_samples = options.samples;
   request.seed = options.seed;
   absl::StatusOr<EnvelopeDistanceResult> envelope =
-      ComputeEnvelopeDistances(solid->oracle, spheres, request);
+      ComputeEnvelopeDistances(solid->solid.oracle, spheres, request);
   if (!envelope.ok()) {
     // INVALID_ARGUMENT and RESOURCE_EXHAUSTED (an envelope too small to sample: thousands of
     // copies of one ball) are the sphere set's; anything else is a bug.
@@ -157,7 +157,7 @@ int RunView(const ViewCliOptions& options) {
   facts.spheres_name = fs::path(options.spheres_path).filename().string();
   facts.title =
       !options.title.empty() ? options.title : facts.mesh_name + " \u00b7 " + facts.spheres_name;
-  facts.mesh_sha256 = solid->sha256;
+  facts.mesh_sha256 = solid->solid.sha256;
   facts.quality = *report;
   facts.protrusion.reserve(spheres.size());
   for (std::size_t i = 0; i < spheres.size(); ++i) {
@@ -175,7 +175,7 @@ int RunView(const ViewCliOptions& options) {
   facts.envelope_seconds = envelope->seconds;
 
   const absl::StatusOr<std::string> page =
-      ViewPageHtml(ViewPageData(solid->oracle.mesh(), spheres, facts), facts.title);
+      ViewPageHtml(ViewPageData(solid->solid.oracle.mesh(), spheres, facts), facts.title);
   if (!page.ok()) {
     std::cerr << "inscribe: internal error: " << page.status().message() << "\n";
     return kExitInternal;

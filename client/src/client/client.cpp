@@ -8,8 +8,8 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/string_view.h"
-#include "distance_query_proto.h"
-#include "inscribe/server/convert.h"
+#include "inscribe/wire/convert.h"
+#include "inscribe/wire/convert.h"
 
 namespace inscribe::client {
 namespace {
@@ -73,7 +73,7 @@ absl::StatusOr<PutMeshResult> PutMeshUntil(Connection& connection, const RetryPo
   absl::StatusOr<v1::PutMeshResponse> response =
       Retried(retry, deadline, [&](Deadline d) { return connection.PutMesh(request, d); });
   if (!response.ok()) return response.status();
-  absl::StatusOr<MeshReport> report = server::MeshReportFromProto(response->report());
+  absl::StatusOr<MeshReport> report = wire::MeshReportFromProto(response->report());
   if (!report.ok()) return Malformed("PutMesh", report.status().message());
   return PutMeshResult{std::move(*response->mutable_mesh_sha256()), *std::move(report),
                        response->already_stored()};
@@ -83,18 +83,7 @@ v1::GenerateRequest GenerateRequestFor(const std::string& mesh_sha256,
                                        const GenerateSettings& settings,
                                        const GenerateOptions& options) {
   v1::GenerateRequest request;
-  request.set_mesh_sha256(mesh_sha256);
-  v1::GenerateParameters* p = request.mutable_parameters();
-  p->set_voxel_size(settings.voxel_size);
-  p->set_max_spheres(settings.max_spheres);
-  p->set_object_angle(settings.object_angle);
-  p->set_epsilon(settings.epsilon);
-  p->set_samples(settings.samples);
-  p->set_subdivide_boundary(settings.subdivide_boundary);
-  p->set_dilate(settings.dilate);
-  p->set_dilation_growth(settings.dilation_growth);
-  p->set_fill_holes(settings.fill_holes);
-  request.set_skip_quality(settings.skip_quality);
+  wire::GenerateRequestToProto(mesh_sha256, settings.parameters, settings.fill_holes, &request);
   request.set_progress_interval(options.progress_interval);
   return request;
 }
@@ -106,15 +95,12 @@ absl::StatusOr<GenerateResult> GenerateUntil(Connection& connection, const Retry
   absl::StatusOr<v1::GenerateResult> response = Retried(
       retry, deadline, [&](Deadline d) { return connection.Generate(request, d, on_progress); });
   if (!response.ok()) return response.status();
-  absl::StatusOr<SphereSet> spheres = server::SphereSetFromProto(response->spheres());
-  if (!spheres.ok()) return Malformed("Generate", spheres.status().message());
+  absl::StatusOr<GeneratedSphereSet> generated = wire::GeneratedSphereSetFromProto(*response);
+  if (!generated.ok()) return Malformed("Generate", generated.status().message());
   GenerateResult result;
+  static_cast<GeneratedSphereSet&>(result) = *std::move(generated);
   result.sphere_set_key = std::move(*response->mutable_sphere_set_key());
   result.mesh_sha256 = std::move(*response->mutable_mesh_sha256());
-  result.spheres = *std::move(spheres);
-  result.voxel_size = response->voxel_size();
-  result.seconds = response->seconds();
-  if (response->has_quality()) result.quality = server::QualityReportFromProto(response->quality());
   result.cache = std::move(*response->mutable_cache());
   return result;
 }
@@ -129,7 +115,7 @@ absl::StatusOr<QualityReport> EvaluateUntil(Connection& connection, const RetryP
       Retried(retry, deadline, [&](Deadline d) { return connection.Evaluate(request, d); });
   if (!response.ok()) return response.status();
   if (!response->has_quality()) return Malformed("Evaluate", "no quality report");
-  return server::QualityReportFromProto(response->quality());
+  return wire::QualityReportFromProto(response->quality());
 }
 
 }  // namespace
@@ -140,13 +126,13 @@ Client::Client(std::shared_ptr<Connection> connection, ClientOptions options)
 absl::StatusOr<InspectMeshResult> Client::InspectMesh(const Mesh& mesh,
                                                       const InspectMeshOptions& options) const {
   v1::InspectMeshRequest request;
-  server::MeshToProto(mesh, request.mutable_mesh());
+  wire::MeshToProto(mesh, request.mutable_mesh());
   request.set_skip_self_intersections(options.skip_self_intersections);
   absl::StatusOr<v1::InspectMeshResponse> response =
       Retried(options_.retry, DeadlineAfter(options.timeout, options_),
               [&](Deadline d) { return connection_->InspectMesh(request, d); });
   if (!response.ok()) return response.status();
-  absl::StatusOr<MeshReport> report = server::MeshReportFromProto(response->report());
+  absl::StatusOr<MeshReport> report = wire::MeshReportFromProto(response->report());
   if (!report.ok()) return Malformed("InspectMesh", report.status().message());
   return InspectMeshResult{std::move(*response->mutable_mesh_sha256()), *std::move(report)};
 }
@@ -154,7 +140,7 @@ absl::StatusOr<InspectMeshResult> Client::InspectMesh(const Mesh& mesh,
 absl::StatusOr<PutMeshResult> Client::PutMesh(const Mesh& mesh, bool fill_holes,
                                               const CallOptions& options) const {
   v1::PutMeshRequest request;
-  server::MeshToProto(mesh, request.mutable_mesh());
+  wire::MeshToProto(mesh, request.mutable_mesh());
   request.set_fill_holes(fill_holes);
   return PutMeshUntil(*connection_, options_.retry, request,
                       DeadlineAfter(options.timeout, options_));
@@ -173,7 +159,7 @@ absl::StatusOr<GenerateResult> Client::Generate(const Mesh& mesh, const Generate
   // One deadline for the uploads and generations together; the mesh is converted once.
   const Deadline deadline = DeadlineAfter(options.timeout, options_);
   v1::PutMeshRequest put;
-  server::MeshToProto(mesh, put.mutable_mesh());
+  wire::MeshToProto(mesh, put.mutable_mesh());
   put.set_fill_holes(settings.fill_holes);
   absl::StatusOr<PutMeshResult> stored = PutMeshUntil(*connection_, options_.retry, put, deadline);
   if (!stored.ok()) return stored.status();
@@ -193,7 +179,7 @@ absl::StatusOr<PutSphereSetResult> Client::PutSphereSet(const SphereSet& spheres
                                                         const std::string& mesh_sha256,
                                                         const CallOptions& options) const {
   v1::PutSphereSetRequest request;
-  server::SphereSetToProto(spheres, request.mutable_spheres());
+  wire::SphereSetToProto(spheres, request.mutable_spheres());
   request.set_mesh_sha256(mesh_sha256);
   absl::StatusOr<v1::PutSphereSetResponse> response =
       Retried(options_.retry, DeadlineAfter(options.timeout, options_),
@@ -211,7 +197,7 @@ absl::StatusOr<StoredSphereSet> Client::GetSphereSet(const std::string& sphere_s
       Retried(options_.retry, DeadlineAfter(options.timeout, options_),
               [&](Deadline d) { return connection_->GetSphereSet(request, d); });
   if (!response.ok()) return response.status();
-  absl::StatusOr<SphereSet> spheres = server::SphereSetFromProto(response->spheres());
+  absl::StatusOr<SphereSet> spheres = wire::SphereSetFromProto(response->spheres());
   if (!spheres.ok()) return Malformed("GetSphereSet", spheres.status().message());
   return StoredSphereSet{*std::move(spheres), std::move(*response->mutable_mesh_sha256())};
 }
@@ -221,7 +207,7 @@ absl::StatusOr<SphereHierarchy> Client::GetHierarchy(const std::string& sphere_s
                                                      const CallOptions& options) const {
   v1::GetHierarchyRequest request;
   request.set_sphere_set_key(sphere_set_key);
-  request.set_volume(VolumeToProto(volume));
+  request.set_volume(wire::VolumeToProto(volume));
   absl::StatusOr<v1::GetHierarchyResponse> response =
       Retried(options_.retry, DeadlineAfter(options.timeout, options_),
               [&](Deadline d) { return connection_->GetHierarchy(request, d); });
@@ -260,43 +246,15 @@ absl::StatusOr<DeformationResult> Client::UpdateDeformation(const std::string& m
               [&](Deadline d) { return connection_->UpdateDeformation(request, d); });
   if (!response.ok()) return response.status();
 
-  absl::StatusOr<SphereSet> spheres = server::SphereSetFromProto(response->spheres());
-  if (!spheres.ok()) return Malformed("UpdateDeformation", spheres.status().message());
-  if (static_cast<std::size_t>(response->reference_index_size()) != spheres->size()) {
-    return Malformed("UpdateDeformation",
-                     absl::StrCat("reference_index has ", response->reference_index_size(),
-                                  " entries for ", spheres->size(), " spheres"));
-  }
+  absl::StatusOr<DeformedSpheres> moved = wire::DeformedSpheresFromProto(*response);
+  if (!moved.ok()) return Malformed("UpdateDeformation", moved.status().message());
   DeformationResult result;
-  result.spheres = *std::move(spheres);
-  result.reference_index.assign(response->reference_index().begin(),
-                                response->reference_index().end());
-  result.xi = response->xi();
-  result.max_protrusion = response->max_protrusion();
-  result.shrunk = response->shrunk();
-  result.dropped = response->dropped();
-  result.closest_point_queries = response->closest_point_queries();
-  result.max_shrink_steps = response->max_shrink_steps();
-  result.seconds = response->seconds();
+  static_cast<DeformedSpheres&>(result) = *std::move(moved);
   result.reference_spheres = response->reference_spheres();
   result.deformed_mesh_sha256 = std::move(*response->mutable_deformed_mesh_sha256());
   result.sphere_set_key = std::move(*response->mutable_sphere_set_key());
   // The wire has no presence bit for the bounds: they are there when they were asked for.
-  if (settings.bounds) {
-    // (Assigned, not emplace(): clang rejects default-constructing a nested struct with member
-    // initialisers through std::optional::emplace.)
-    result.bounds = DeformationResult::Bounds{};
-    DeformationResult::Bounds& bounds = *result.bounds;
-    bounds.nerr_lower = response->nerr_lower();
-    bounds.nerr_upper = response->nerr_upper();
-    bounds.nerr_is_exact = response->nerr_is_exact();
-    bounds.volume_mesh = response->volume_mesh();
-    bounds.volume_union = response->volume_union();
-    if (response->has_nerr_upper_uniform_xi()) {
-      bounds.nerr_upper_uniform_xi = response->nerr_upper_uniform_xi();
-    }
-    bounds.seconds = response->bounds_seconds();
-  }
+  if (settings.bounds) result.bounds = wire::DeformationBoundsFromProto(*response);
   return result;
 }
 
@@ -308,16 +266,16 @@ absl::StatusOr<DistanceBatchResult> Client::Distance(const std::string& sphere_s
   v1::DistanceRequest request;
   request.set_sphere_set_a(sphere_set_a);
   request.set_sphere_set_b(sphere_set_b);
-  request.set_volume(VolumeToProto(options.volume));
-  server::PosesToProto(poses_a, request.mutable_poses_a());
-  server::PosesToProto(poses_b, request.mutable_poses_b());
-  ToleranceToProto(options.tolerance, request.mutable_tolerance());
+  request.set_volume(wire::VolumeToProto(options.volume));
+  wire::PosesToProto(poses_a, request.mutable_poses_a());
+  wire::PosesToProto(poses_b, request.mutable_poses_b());
+  wire::ToleranceToProto(options.tolerance, request.mutable_tolerance());
   absl::StatusOr<v1::DistanceResponse> response =
       Retried(options_.retry, DeadlineAfter(options.timeout, options_),
               [&](Deadline d) { return connection_->Distance(request, d); });
   if (!response.ok()) return response.status();
   absl::StatusOr<std::vector<DistanceResult>> results =
-      server::DistanceResultsFromProto(response->results());
+      wire::DistanceResultsFromProto(response->results());
   if (!results.ok()) return Malformed("Distance", results.status().message());
   if (results->size() != poses_b.size()) {
     return Malformed("Distance", absl::StrCat("results has ", results->size(), " entries for ",
@@ -343,7 +301,7 @@ absl::StatusOr<QualityReport> Client::Evaluate(const std::string& mesh_sha256,
                                                const CallOptions& options) const {
   v1::EvaluateRequest request;
   request.set_mesh_sha256(mesh_sha256);
-  server::SphereSetToProto(spheres, request.mutable_sphere_set());
+  wire::SphereSetToProto(spheres, request.mutable_sphere_set());
   return EvaluateUntil(*connection_, options_.retry, request, settings,
                        DeadlineAfter(options.timeout, options_));
 }

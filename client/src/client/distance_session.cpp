@@ -3,9 +3,9 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
-#include "distance_query_proto.h"
+#include "inscribe/wire/convert.h"
 #include "inscribe/client/client.h"
-#include "inscribe/server/convert.h"
+#include "inscribe/wire/convert.h"
 
 namespace inscribe::client {
 
@@ -25,15 +25,15 @@ absl::StatusOr<std::vector<DistanceResult>> DistanceSession::Query(
 
   v1::DistanceFrame frame;
   frame.set_frame(next_frame_);
-  frame.set_volume(VolumeToProto(options_.volume));
-  ToleranceToProto(options_.tolerance, frame.mutable_tolerance());
+  frame.set_volume(wire::VolumeToProto(options_.volume));
+  wire::ToleranceToProto(options_.tolerance, frame.mutable_tolerance());
   frame.mutable_pairs()->Reserve(static_cast<int>(pairs.size()));
   for (const PosePair& pair : pairs) {
     v1::DistancePair* out = frame.add_pairs();
     out->set_sphere_set_a(pair.sphere_set_a);
     out->set_sphere_set_b(pair.sphere_set_b);
-    server::PoseToProto(pair.pose_a, out->mutable_pose_a());
-    server::PoseToProto(pair.pose_b, out->mutable_pose_b());
+    wire::PoseToProto(pair.pose_a, out->mutable_pose_a());
+    wire::PoseToProto(pair.pose_b, out->mutable_pose_b());
   }
 
   // Every failure below ends the session: the server's status, or a reply this frame cannot
@@ -48,7 +48,7 @@ absl::StatusOr<std::vector<DistanceResult>> DistanceSession::Query(
     failure =
         absl::InternalError(absl::StrCat("malformed DistanceStream response: frame ", next_frame_,
                                          " was answered as frame ", reply->frame()));
-  } else if (results = server::DistanceResultsFromProto(reply->results()); !results.ok()) {
+  } else if (results = wire::DistanceResultsFromProto(reply->results()); !results.ok()) {
     failure = absl::InternalError(
         absl::StrCat("malformed DistanceStream response: ", results.status().message()));
   } else if (results->size() != pairs.size()) {

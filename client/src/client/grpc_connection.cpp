@@ -20,7 +20,7 @@
 #include "grpcpp/support/channel_arguments.h"
 #include "grpcpp/support/sync_stream.h"
 #include "inscribe/client/connection.h"
-#include "inscribe/server/convert.h"
+#include "inscribe/wire/convert.h"
 #include "inscribe/v1/service.grpc.pb.h"
 
 namespace inscribe::client {
@@ -44,7 +44,7 @@ absl::StatusOr<Response> CallUnary(Stub& stub, const std::string& token,
   PrepareContext(context, token, deadline);
   Response response;
   const grpc::Status status = (stub.*method)(&context, request, &response);
-  if (!status.ok()) return server::FromGrpcStatus(status);
+  if (!status.ok()) return wire::FromGrpcStatus(status);
   return response;
 }
 
@@ -150,7 +150,7 @@ class GrpcDistanceStream final : public DistanceStreamConnection {
     const bool answered = stream_->Write(frame) && stream_->Read(&result);
     absl::Status status;
     if (!answered) {
-      status = server::FromGrpcStatus(stream_->Finish());
+      status = wire::FromGrpcStatus(stream_->Finish());
       finished_ = true;
       if (status.ok()) {
         status = absl::InternalError(
@@ -180,7 +180,7 @@ class GrpcDistanceStream final : public DistanceStreamConnection {
     v1::DistanceFrameResult unexpected;
     int extra = 0;
     while (stream_->Read(&unexpected)) ++extra;
-    ended_ = server::FromGrpcStatus(stream_->Finish());
+    ended_ = wire::FromGrpcStatus(stream_->Finish());
     if (ended_.ok() && extra > 0) {
       ended_ =
           absl::InternalError(absl::StrCat("DistanceStream sent ", extra, " results for no frame"));
@@ -230,7 +230,7 @@ class GrpcConnection final : public Connection {
       }
     }
     const grpc::Status status = reader->Finish();
-    if (!status.ok()) return server::FromGrpcStatus(status);
+    if (!status.ok()) return wire::FromGrpcStatus(status);
     if (!has_result) return absl::InternalError("Generate stream ended without a result");
     return result;
   }

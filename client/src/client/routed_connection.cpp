@@ -1,7 +1,5 @@
 // A Connection over several replicas: rendezvous hashing on each call's route key, failover on
 // UNAVAILABLE (see routing.h).
-#include <openssl/evp.h>
-
 #include <algorithm>
 #include <array>
 #include <atomic>
@@ -23,46 +21,22 @@
 #include "absl/strings/strip.h"
 #include "inscribe/client/routing.h"
 #include "inscribe/mesh_hash.h"
-#include "inscribe/server/convert.h"
+#include "inscribe/sha256.h"
+#include "inscribe/wire/convert.h"
+#include "inscribe/wire/keys.h"
 
 namespace inscribe::client {
 namespace {
 
-// Hex digits of a mesh hash that route it and every key derived from it (the server puts them
-// first in sphere set keys: server/src/result_store.cpp).
-constexpr std::size_t kRouteDigits = 16;
-
-using Digest = std::array<unsigned char, EVP_MAX_MD_SIZE>;
-
-// SHA-256 of `bytes` (OpenSSL: the same value in every process and on every platform, unlike
-// std::hash or absl::Hash, which may differ between runs). ~2 ns per byte.
-Digest Sha256(absl::string_view bytes) {
-  Digest digest{};
-  unsigned int length = 0;
-  EVP_Digest(bytes.data(), bytes.size(), digest.data(), &length, EVP_sha256(), nullptr);
-  return digest;
-}
-
-std::string Hex(const Digest& digest, std::size_t digits) {
-  return absl::BytesToHexString(
-             absl::string_view(reinterpret_cast<const char*>(digest.data()), (digits + 1) / 2))
-      .substr(0, digits);
-}
 
 // The route key of a mesh as sent: the hash the server stores it under unless it fixes the
 // orientation or fills holes (PutMesh then puts it twice, see RoutedConnection::PutMesh).
 // O(#V + #T): a copy and one SHA-256 pass, small beside sending the mesh. A malformed mesh
 // routes anywhere: every replica answers INVALID_ARGUMENT.
 std::string MeshRouteKey(const v1::Mesh& mesh) {
-  absl::StatusOr<Mesh> core = server::MeshFromProto(mesh);
+  absl::StatusOr<Mesh> core = wire::MeshFromProto(mesh);
   if (!core.ok()) return "";
-  return RouteKey(FormatSha256(MeshSha256(*core)));
-}
-
-// What routes a set uploaded without a mesh: a hash of its numbers. The server's key for it is
-// another hash, so PutSphereSet may have to put it twice (see PutTwiceIfKeyMoved).
-std::string ContentRouteKey(const v1::SphereSet& spheres) {
-  return Hex(Sha256(spheres.SerializeAsString()), kRouteDigits);
+  return wire::RouteKey(FormatSha256(MeshSha256(*core)));
 }
 
 // The replicas and what is known of their health; shared by the connection and its streams.
@@ -191,7 +165,7 @@ class RoutedDistanceStream final : public DistanceStreamConnection {
     }
     if (!route_key_.has_value()) {
       // Every pair of a frame must be held by one replica: the first pair's set A routes it.
-      route_key_ = frame.pairs_size() > 0 ? RouteKey(frame.pairs(0).sphere_set_a()) : "";
+      route_key_ = frame.pairs_size() > 0 ? wire::RouteKey(frame.pairs(0).sphere_set_a()) : "";
     }
     std::unique_ptr<DistanceStreamConnection> opened;
     const Answer<v1::DistanceFrameResult> answer = CallInOrder<v1::DistanceFrameResult>(
@@ -262,7 +236,7 @@ class RoutedConnection final : public Connection {
       const v1::GenerateRequest& request, Deadline deadline,
       const std::function<void(double fraction)>& on_progress) override {
     // After a failover the progress starts again from the next replica's.
-    return Call<v1::GenerateResult>(RouteKey(request.mesh_sha256()), deadline, [&](Connection& c) {
+    return Call<v1::GenerateResult>(wire::RouteKey(request.mesh_sha256()), deadline, [&](Connection& c) {
       return c.Generate(request, deadline, on_progress);
     });
   }
@@ -271,8 +245,8 @@ class RoutedConnection final : public Connection {
   // its key's replica too (as PutMesh does), a second upload for (n-1)/n of such sets.
   absl::StatusOr<v1::PutSphereSetResponse> PutSphereSet(const v1::PutSphereSetRequest& request,
                                                         Deadline deadline) override {
-    const std::string route = request.mesh_sha256().empty() ? ContentRouteKey(request.spheres())
-                                                            : RouteKey(request.mesh_sha256());
+    const std::string route = request.mesh_sha256().empty() ? wire::ContentRouteKey(request.spheres().SerializeAsString())
+                                                            : wire::RouteKey(request.mesh_sha256());
     return PutTwiceIfKeyMoved<v1::PutSphereSetResponse>(
         route, deadline, [&](Connection& c) { return c.PutSphereSet(request, deadline); },
         [](const v1::PutSphereSetResponse& r) { return r.sphere_set_key(); });
@@ -281,21 +255,21 @@ class RoutedConnection final : public Connection {
   absl::StatusOr<v1::GetSphereSetResponse> GetSphereSet(const v1::GetSphereSetRequest& request,
                                                         Deadline deadline) override {
     return Call<v1::GetSphereSetResponse>(
-        RouteKey(request.sphere_set_key()), deadline,
+        wire::RouteKey(request.sphere_set_key()), deadline,
         [&](Connection& c) { return c.GetSphereSet(request, deadline); });
   }
 
   absl::StatusOr<v1::GetHierarchyResponse> GetHierarchy(const v1::GetHierarchyRequest& request,
                                                         Deadline deadline) override {
     return Call<v1::GetHierarchyResponse>(
-        RouteKey(request.sphere_set_key()), deadline,
+        wire::RouteKey(request.sphere_set_key()), deadline,
         [&](Connection& c) { return c.GetHierarchy(request, deadline); });
   }
 
   absl::StatusOr<v1::UpdateDeformationResponse> UpdateDeformation(
       const v1::UpdateDeformationRequest& request, Deadline deadline) override {
     return Call<v1::UpdateDeformationResponse>(
-        RouteKey(request.sphere_set_key()), deadline,
+        wire::RouteKey(request.sphere_set_key()), deadline,
         [&](Connection& c) { return c.UpdateDeformation(request, deadline); });
   }
 
@@ -303,7 +277,7 @@ class RoutedConnection final : public Connection {
   // replicas share a Redis tier).
   absl::StatusOr<v1::DistanceResponse> Distance(const v1::DistanceRequest& request,
                                                 Deadline deadline) override {
-    return Call<v1::DistanceResponse>(RouteKey(request.sphere_set_a()), deadline,
+    return Call<v1::DistanceResponse>(wire::RouteKey(request.sphere_set_a()), deadline,
                                       [&](Connection& c) { return c.Distance(request, deadline); });
   }
 
@@ -312,7 +286,7 @@ class RoutedConnection final : public Connection {
     const std::string& key = request.spheres_case() == v1::EvaluateRequest::kSphereSetKey
                                  ? request.sphere_set_key()
                                  : request.mesh_sha256();
-    return Call<v1::EvaluateResponse>(RouteKey(key), deadline,
+    return Call<v1::EvaluateResponse>(wire::RouteKey(key), deadline,
                                       [&](Connection& c) { return c.Evaluate(request, deadline); });
   }
 
@@ -351,7 +325,7 @@ class RoutedConnection final : public Connection {
     if (!first.response.ok() || replicas_->policy() != RoutingPolicy::kRendezvous) {
       return std::move(first.response);
     }
-    const std::string stored_route = RouteKey(stored_key(*first.response));
+    const std::string stored_route = wire::RouteKey(stored_key(*first.response));
     if (stored_route == route_key) return std::move(first.response);
     const std::vector<int> order = replicas_->Order(stored_route);
     if (order.front() == first.replica) return std::move(first.response);
@@ -363,25 +337,13 @@ class RoutedConnection final : public Connection {
 
 }  // namespace
 
-std::string RouteKey(absl::string_view key) {
-  absl::string_view hex = key;
-  if (absl::ConsumePrefix(&hex, "sha256:") || absl::ConsumePrefix(&hex, "spheres/v1/")) {
-    if (hex.size() >= kRouteDigits &&
-        std::all_of(hex.begin(), hex.begin() + kRouteDigits,
-                    [](char c) { return absl::ascii_isdigit(c) || (c >= 'a' && c <= 'f'); })) {
-      return std::string(hex.substr(0, kRouteDigits));
-    }
-  }
-  return std::string(key);
-}
-
 std::vector<int> RendezvousOrder(absl::string_view route_key,
                                  const std::vector<std::string>& names) {
   // Score of each (key, name): the first 8 bytes of SHA-256(key NUL name), big-endian. The NUL
   // keeps ("ab", "c") and ("a", "bc") apart.
   std::vector<std::uint64_t> score(names.size());
   for (std::size_t i = 0; i < names.size(); ++i) {
-    const Digest digest = Sha256(absl::StrCat(route_key, absl::string_view("\0", 1), names[i]));
+    const Sha256Digest digest = Sha256(absl::StrCat(route_key, absl::string_view("\0", 1), names[i]));
     for (int b = 0; b < 8; ++b) score[i] = (score[i] << 8) | digest[b];
   }
   std::vector<int> order(names.size());

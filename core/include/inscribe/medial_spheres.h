@@ -87,6 +87,10 @@ struct MedialSphereResult {
   MedialSphereStats stats;
 };
 
+// OK, or INVALID_ARGUMENT naming the first option out of range (as GenerateMedialSpheres
+// refuses it). `need_voxel_size`: voxel_size must be positive and finite too. O(1).
+absl::Status CheckMedialSphereOptions(const MedialSphereOptions& options, bool need_voxel_size);
+
 // One run at fixed voxel_size. Parallel over voxels (TBB); the output is the same bit for bit
 // for the same mesh and options regardless of thread count or scheduling.
 // Errors: INVALID_ARGUMENT for sigma <= 0 or non-finite, theta outside (0, pi), epsilon < 0,

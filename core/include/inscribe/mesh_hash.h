@@ -1,15 +1,12 @@
 // Content hash of a mesh: the key under which sphere sets are cached.
 #pragma once
 
-#include <array>
-#include <cstdint>
 #include <string>
 
 #include "inscribe/mesh.h"
+#include "inscribe/sha256.h"
 
 namespace inscribe {
-
-using Sha256Digest = std::array<std::uint8_t, 32>;
 
 // SHA-256 over a canonical little-endian encoding of the mesh:
 //   "inscribe.mesh.v1" (16 bytes), uint64 #V, uint64 #T,

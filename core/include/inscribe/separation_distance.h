@@ -2,6 +2,7 @@
 // VI): the fast stand-in for exact mesh-mesh distance.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <limits>
 #include <vector>
@@ -56,6 +57,24 @@ absl::StatusOr<DistanceResult> SeparationDistance(const SphereHierarchy& a, cons
 absl::StatusOr<std::vector<DistanceResult>> SeparationDistances(
     const SphereHierarchy& a, const SphereHierarchy& b, const std::vector<RigidPose>& poses_b,
     const DistanceRequest& request = {});
+
+// One posed pair of a batch: two hierarchies (not owned; they must outlive the call) and
+// their world poses.
+struct PosedPair {
+  const SphereHierarchy* a = nullptr;
+  const SphereHierarchy* b = nullptr;
+  RigidPose pose_a, pose_b;
+};
+
+// SeparationDistance for every pair (entry i answers pairs[i]; witnesses in the world frame).
+// Batches of up to 64 pairs run on the calling thread; larger ones in parallel (TBB), in
+// chunks of 64 pairs between which `cancel` (may be null) is polled: CANCELLED once it is set.
+// Errors: INVALID_ARGUMENT for a bad request, and "pairs[i]: ..." for the first pair with a
+// null hierarchy or a bad pose.
+absl::StatusOr<std::vector<DistanceResult>> PairSeparationDistances(
+    const std::vector<PosedPair>& pairs, const DistanceRequest& request = {},
+    const std::atomic<bool>* cancel = nullptr);
+
 
 // The same answer by comparing every sphere pair: O(#a #b), the reference the hierarchies are
 // tested against, and the `--hierarchy none` of the CLI. Tolerances are ignored (exact);

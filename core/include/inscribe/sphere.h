@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "absl/status/status.h"
 #include "inscribe/mesh.h"
 
 namespace inscribe {
@@ -31,5 +32,13 @@ struct SphereSet {
   std::size_t size() const { return spheres.size(); }
   bool has_contacts() const { return !contacts.empty(); }
 };
+
+// The one validity rule for a sphere every stage accepts: a finite centre and a finite radius
+// > 0. OK, or INVALID_ARGUMENT naming the sphere and the first bad number ("sphere 3: center y
+// nan is not finite", "sphere 3: radius -1 is not positive"). O(1).
+absl::Status CheckSphere(const Sphere& sphere, std::size_t index);
+
+// CheckSphere for every sphere, in order; the first failure. O(n).
+absl::Status CheckSpheres(const std::vector<Sphere>& spheres);
 
 }  // namespace inscribe

@@ -71,6 +71,9 @@ struct EnvelopePoints {
 absl::StatusOr<EnvelopePoints> ComputeEnvelopePoints(const std::vector<Sphere>& spheres,
                                                      const DilationOptions& options = {});
 
+// OK, or INVALID_ARGUMENT for a growth outside [0, 1]. O(1).
+absl::Status CheckDilationOptions(const DilationOptions& options);
+
 struct DilationResult {
   // The same spheres in the same order with the same centres; radii never smaller. Contacts
   // are dropped: a grown sphere no longer touches the boundary at one point.

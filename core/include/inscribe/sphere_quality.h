@@ -70,6 +70,10 @@ struct QualityReport {
   double seconds = 0.0;
 };
 
+// OK, or INVALID_ARGUMENT for surface samples outside [0, 1e8] or a negative or non-finite
+// voxel size. O(1).
+absl::Status CheckQualityOptions(const QualityOptions& options);
+
 // Errors: INVALID_ARGUMENT for a sphere with non-finite centre or radius <= 0 (naming its
 // index), bad options, a mesh with no positive volume; INTERNAL from the union volume.
 // Cost: union volume O(n log n); protrusion n queries; sampling O(samples * n) (parallel).

@@ -17,7 +17,9 @@
 #include "inscribe/separation_distance.h"
 #include "inscribe/sphere.h"
 #include "inscribe/sphere_hierarchy.h"
+#include "inscribe/sphere_deformation.h"
 #include "inscribe/sphere_quality.h"
+#include "inscribe/sphere_set_generation.h"
 
 namespace inscribe::client {
 
@@ -68,21 +70,11 @@ struct PutMeshResult {
   bool already_stored = false;
 };
 
-// What to generate (paper Sections III-IV; see GenerateParameters in spheres.proto, which
-// this mirrors field by field: 0 means the server's default where that says so). Exactly one
-// of voxel_size and max_spheres must be > 0.
+// What to generate (paper Sections III-IV): core's parameters, whose defaults and checks are
+// core's (SphereSetParameters), and the mesh repair Generate(mesh, ...) asks PutMesh for.
 struct GenerateSettings {
-  double voxel_size = 0.0;
-  std::int64_t max_spheres = 0;
-  double object_angle = 0.0;
-  double epsilon = 0.0;
-  int samples = 0;
-  bool subdivide_boundary = false;
-  bool dilate = false;
-  double dilation_growth = 0.0;
+  SphereSetParameters parameters;
   bool fill_holes = false;
-  // Skip the quality report (exact union volume, surface sampling).
-  bool skip_quality = false;
 };
 
 struct GenerateOptions : CallOptions {
@@ -91,13 +83,12 @@ struct GenerateOptions : CallOptions {
   double progress_interval = 0.0;  // seconds; 0 = the server's 0.5 s
 };
 
-struct GenerateResult {
+// The generated set with everything the server computed about it (GeneratedSphereSet: sigma,
+// epsilon, runs, statistics, dilation, quality, seconds; `seconds` is the original run's when
+// the answer was cached), and where the server found it.
+struct GenerateResult : GeneratedSphereSet {
   std::string sphere_set_key;  // "spheres/v1/<64 hex>"
   std::string mesh_sha256;
-  SphereSet spheres;
-  double voxel_size = 0.0;
-  double seconds = 0.0;  // the computation's wall time (the original run's when cached)
-  std::optional<QualityReport> quality;  // absent when skip_quality
   std::string cache;  // "memory", "disk", "redis" (the replicas' shared tier), "computed", "joined"
 };
 
@@ -120,30 +111,14 @@ struct DeformationSettings {
   bool store = false;   // also cache the moved set and return its key
 };
 
-struct DeformationResult {
-  SphereSet spheres;  // with contacts: can serve as a later reference
-  std::vector<std::int32_t> reference_index;
-  double xi = 0.0;
-  double max_protrusion = 0.0;
-  std::int64_t shrunk = 0;
-  std::int64_t dropped = 0;
-  std::int64_t closest_point_queries = 0;
-  int max_shrink_steps = 0;
-  double seconds = 0.0;  // server time of the update
+// The moved spheres with the update's figures (DeformedSpheres; the set has contacts, so it can
+// serve as a later reference), and what the server adds.
+struct DeformationResult : DeformedSpheres {
   std::int64_t reference_spheres = 0;
   std::string deformed_mesh_sha256;
   std::string sphere_set_key;  // when settings.store
-  // When settings.bounds:
-  struct Bounds {
-    double nerr_lower = 0.0;
-    double nerr_upper = 0.0;
-    bool nerr_is_exact = false;
-    double volume_mesh = 0.0;
-    double volume_union = 0.0;
-    std::optional<double> nerr_upper_uniform_xi;  // absent when Lemma 2's premise fails
-    double seconds = 0.0;
-  };
-  std::optional<Bounds> bounds;
+  // When settings.bounds (volume_union_shrunk and volume_union_inner are not sent).
+  std::optional<DeformationErrorBounds> bounds;
 };
 
 struct DistanceOptions : CallOptions {

@@ -39,11 +39,6 @@ struct RoutingOptions {
   std::chrono::milliseconds down_for{2000};
 };
 
-// The part of a key that routes it: for "sha256:<hex>" and for every key derived from a mesh
-// ("spheres/v1/<hex>", whose first 16 hex digits are the mesh's), the first 16 hex digits;
-// otherwise the whole key. Equal for a mesh and everything computed from it.
-std::string RouteKey(absl::string_view key);
-
 // The replica order for `route_key` under rendezvous hashing: indices into `names`, best first.
 std::vector<int> RendezvousOrder(absl::string_view route_key,
                                  const std::vector<std::string>& names);

@@ -15,6 +15,7 @@
 #include "absl/status/statusor.h"
 #include "inscribe/server/job_pool.h"
 #include "inscribe/server/result_cache.h"
+#include "inscribe/sphere_set_generation.h"
 #include "inscribe/v1/service.grpc.pb.h"
 
 namespace inscribe::server {
@@ -147,11 +148,11 @@ class InscribeService final : public v1::Inscribe::CallbackService {
 
   // Remembers a stored mesh's size, for GenerateWorkBytes.
   void RecordMeshSize(const StoredMeshEntry& entry);
-  // Estimated working memory of a Generate on `mesh_key` with `canonical` parameters, from
+  // Estimated working memory of a Generate on `mesh_key` with `parameters`, from
   // the mesh's size when this process stored it (O(1)); INVALID_ARGUMENT naming --max-voxels
   // when its grid would be too fine.
   absl::StatusOr<std::int64_t> GenerateWorkBytes(const std::string& mesh_key,
-                                                 const v1::GenerateParameters& canonical) const;
+                                                 const SphereSetParameters& parameters) const;
 
   // RESOURCE_EXHAUSTED naming --max-queue: the pool refused a job.
   absl::Status QueueFullError() const;

@@ -9,12 +9,29 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <variant>
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
 
+namespace inscribe {
+class SphereHierarchy;
+}  // namespace inscribe
+
 namespace inscribe::server {
+
+// The kinds of decoded object a cache entry can hold (defined by the server's store).
+struct StoredMeshEntry;
+struct SphereSetEntry;
+struct DeformerEntry;
+
+// A cache entry's decoded object: none, or exactly one of a closed set of kinds. A value can
+// only be read back as the kind it holds (CachedValue::Get), never cast to another.
+using CachedObject =
+    std::variant<std::monostate, std::shared_ptr<const StoredMeshEntry>,
+                 std::shared_ptr<const SphereSetEntry>, std::shared_ptr<const SphereHierarchy>,
+                 std::shared_ptr<const DeformerEntry>>;
 
 // A change in the shared (Redis) tier's health, for the binary to log.
 struct SharedTierEvent {
@@ -89,15 +106,17 @@ std::string RedactRedisUrl(absl::string_view url);
 // costs no parsing. Immutable once cached; shared by every caller holding it.
 struct CachedValue {
   std::string bytes;
-  std::shared_ptr<const void> object;  // may be null
-  std::int64_t object_bytes = 0;       // memory the object holds, for the LRU budget
+  CachedObject object;             // may be empty (std::monostate)
+  std::int64_t object_bytes = 0;   // memory the object holds, for the LRU budget
   // False for values that only make sense in this process (e.g. a deformer holding a refit
   // oracle): kept in memory only, never written to the disk or Redis tier.
   bool persist = true;
 
+  // The object when it is a T, else null (another kind, or none).
   template <typename T>
-  std::shared_ptr<const T> As() const {
-    return std::static_pointer_cast<const T>(object);
+  std::shared_ptr<const T> Get() const {
+    const auto* held = std::get_if<std::shared_ptr<const T>>(&object);
+    return held != nullptr ? *held : nullptr;
   }
 };
 

@@ -1,6 +1,7 @@
-// Conversion between the wire types of proto/inscribe/v1 and the core types, and between
-// grpc::Status and absl::Status. The only place where the two worlds meet: the server and the
-// client library both go through these functions, so a field is mapped exactly once.
+// Conversion between the wire types of proto/inscribe/v1 and the core types, both ways, and
+// between grpc::Status and absl::Status. The only place where the two worlds meet: the server
+// and the client library both go through these functions, so a field is mapped exactly once
+// (a new field is one proto change plus its lines here).
 #pragma once
 
 #include <cstdint>
@@ -16,11 +17,15 @@
 #include "inscribe/rigid_pose.h"
 #include "inscribe/separation_distance.h"
 #include "inscribe/sphere.h"
+#include "inscribe/sphere_deformation.h"
+#include "inscribe/sphere_hierarchy.h"
 #include "inscribe/sphere_quality.h"
+#include "inscribe/sphere_set_generation.h"
 #include "inscribe/v1/mesh.pb.h"
+#include "inscribe/v1/service.pb.h"
 #include "inscribe/v1/spheres.pb.h"
 
-namespace inscribe::server {
+namespace inscribe::wire {
 
 // OK when the packed arrays of `mesh` have lengths that are multiples of 3, otherwise
 // INVALID_ARGUMENT naming the field (prefixed by `field`, e.g. "mesh.vertices") and its
@@ -77,9 +82,47 @@ void AppendDistanceResults(const std::vector<DistanceResult>& results, v1::Dista
 absl::StatusOr<std::vector<DistanceResult>> DistanceResultsFromProto(
     const v1::DistanceResults& results);
 
+// HIERARCHY_VOLUME_UNSPECIFIED and SPHERE are the sphere hierarchy.
+v1::HierarchyVolume VolumeToProto(HierarchyVolume volume);
+HierarchyVolume VolumeFromProto(v1::HierarchyVolume volume);
+
+// closer_than is sent only when asked (core's "unset" is +infinity, the wire's is absence);
+// other values, NaN included, go as they are for the receiver to judge.
+void ToleranceToProto(const DistanceRequest& tolerance, v1::DistanceTolerance* out);
+// INVALID_ARGUMENT for negative or non-finite errors or a NaN closer_than.
+absl::StatusOr<DistanceRequest> ToleranceFromProto(const v1::DistanceTolerance& tolerance);
+
+// Generation parameters. A field at core's default is left unset (or 0 where the proto says
+// "0 = default"), so the wire never restates a default. `fill_holes` is the mesh repair the
+// caller asked for; parameters.evaluate goes as skip_quality.
+void GenerateRequestToProto(const std::string& mesh_sha256, const SphereSetParameters& parameters,
+                            bool fill_holes, v1::GenerateRequest* out);
+// The core parameters of a request, core's defaults where the wire leaves a field unset, then
+// CheckSphereSetParameters: INVALID_ARGUMENT "parameters: <why>". Exactly one of voxel_size
+// and max_spheres must be > 0 on the wire. `max_voxels_limit` (> 0) caps the voxel limit and
+// stands in for an unset one.
+absl::StatusOr<SphereSetParameters> SphereSetParametersFromProto(const v1::GenerateRequest& request,
+                                                                 std::int64_t max_voxels_limit);
+
+// Everything of a generated set but its key, mesh and cache source.
+void GeneratedSphereSetToProto(const GeneratedSphereSet& generated, v1::GenerateResult* out);
+// The inverse; INVALID_ARGUMENT as SphereSetFromProto for bad spheres.
+absl::StatusOr<GeneratedSphereSet> GeneratedSphereSetFromProto(const v1::GenerateResult& result);
+
+// A deformation update's spheres and figures, and its error bounds.
+void DeformedSpheresToProto(const DeformedSpheres& moved, v1::UpdateDeformationResponse* out);
+// INVALID_ARGUMENT for bad spheres or a reference_index of another length than the spheres.
+absl::StatusOr<DeformedSpheres> DeformedSpheresFromProto(
+    const v1::UpdateDeformationResponse& response);
+void DeformationBoundsToProto(const DeformationErrorBounds& bounds,
+                              v1::UpdateDeformationResponse* out);
+// The bounds the wire carries (volume_union_shrunk and volume_union_inner are not sent;
+// nerr_upper_uniform_xi is +infinity and uniform_xi_holds false when absent).
+DeformationErrorBounds DeformationBoundsFromProto(const v1::UpdateDeformationResponse& response);
+
 // absl and gRPC share the canonical status codes (same numbers, same meaning), so these map
 // code and message unchanged; error details are not carried.
 grpc::Status ToGrpcStatus(const absl::Status& status);
 absl::Status FromGrpcStatus(const grpc::Status& status);
 
-}  // namespace inscribe::server
+}  // namespace inscribe::wire

@@ -1,0 +1,31 @@
+#include "inscribe/solid.h"
+
+#include <utility>
+
+#include "inscribe/mesh_hash.h"
+
+namespace inscribe {
+
+InsideTest InsideTestFor(const MeshReport& report) {
+  return report.self_intersecting_pairs > 0 ? InsideTest::kRayParity : InsideTest::kPseudonormal;
+}
+
+absl::StatusOr<Solid> MakeSolid(ValidatedMesh validated, std::string sha256,
+                                BoundaryOracleBackend backend) {
+  if (!validated.report.usable()) {
+    return absl::FailedPreconditionError(validated.report.first_error());
+  }
+  if (sha256.empty()) sha256 = FormatSha256(MeshSha256(validated.mesh));
+  BoundaryOracleOptions options;
+  options.inside_test = InsideTestFor(validated.report);
+  options.backend = backend;
+  absl::StatusOr<BoundaryOracle> oracle = BoundaryOracle::Build(validated.mesh, options);
+  if (!oracle.ok()) return oracle.status();
+  return Solid{std::move(validated.report), std::move(sha256), *std::move(oracle)};
+}
+
+absl::StatusOr<Solid> PrepareSolid(Mesh mesh, const SolidOptions& options) {
+  return MakeSolid(ValidateMesh(std::move(mesh), options.validate), "", options.backend);
+}
+
+}  // namespace inscribe

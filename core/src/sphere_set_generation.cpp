@@ -1,0 +1,106 @@
+#include "inscribe/sphere_set_generation.h"
+
+#include <chrono>
+#include <cmath>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+
+namespace inscribe {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double SecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+}  // namespace
+
+absl::Status CheckSphereSetParameters(const SphereSetParameters& p) {
+  if (p.voxel_size && p.max_spheres) {
+    return absl::InvalidArgumentError("give a voxel size or a sphere budget, not both");
+  }
+  if (p.voxel_size && !(std::isfinite(*p.voxel_size) && *p.voxel_size > 0.0)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("voxel size must be a positive finite number, got ", *p.voxel_size));
+  }
+  if (p.max_spheres && *p.max_spheres <= 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("the sphere budget must be at least 1, got ", *p.max_spheres));
+  }
+  if (absl::Status s = CheckMedialSphereOptions(p.medial, /*need_voxel_size=*/false); !s.ok()) {
+    return s;
+  }
+  if (p.dilate) {
+    if (absl::Status s = CheckDilationOptions(p.dilation); !s.ok()) return s;
+  }
+  if (p.evaluate) {
+    if (absl::Status s = CheckQualityOptions(p.quality); !s.ok()) return s;
+  }
+  return absl::OkStatus();
+}
+
+std::optional<std::int64_t> EffectiveMaxSpheres(const SphereSetParameters& parameters) {
+  if (parameters.max_spheres) return parameters.max_spheres;
+  if (parameters.voxel_size) return std::nullopt;
+  return kDefaultMaxSpheres;
+}
+
+absl::StatusOr<GeneratedSphereSet> GenerateSphereSet(const Solid& solid,
+                                                     const SphereSetParameters& parameters,
+                                                     const GenerationControl& control) {
+  const Clock::time_point start = Clock::now();
+  if (absl::Status s = CheckSphereSetParameters(parameters); !s.ok()) return s;
+  GeneratedSphereSet out;
+  MedialSphereResult medial;
+  if (const std::optional<std::int64_t> budget = EffectiveMaxSpheres(parameters)) {
+    SphereBudgetOptions search;
+    search.max_spheres = *budget;
+    search.base = parameters.medial;
+    absl::StatusOr<SphereBudgetResult> found =
+        GenerateWithSphereBudget(solid.oracle, search, control);
+    if (!found.ok()) return found.status();
+    out.runs = found->runs;
+    medial = std::move(found->best);
+  } else {
+    MedialSphereOptions options = parameters.medial;
+    options.voxel_size = *parameters.voxel_size;
+    absl::StatusOr<MedialSphereResult> run = GenerateMedialSpheres(solid.oracle, options, control);
+    if (!run.ok()) return run.status();
+    out.runs = 1;
+    medial = *std::move(run);
+  }
+  out.generation_seconds = SecondsSince(start);
+  out.voxel_size = medial.voxel_size;
+  out.epsilon = medial.epsilon;
+  out.stats = medial.stats;
+  out.set = std::move(medial.set);
+
+  // S_D+ (Section VI-A) replaces S_D from here on: it is what gets evaluated and returned.
+  if (parameters.dilate) {
+    absl::StatusOr<DilationResult> dilated =
+        DilateSpheres(solid.oracle, out.set, parameters.dilation);
+    if (!dilated.ok()) {
+      return absl::Status(dilated.status().code(),
+                          absl::StrCat("dilating the spheres: ", dilated.status().message()));
+    }
+    out.set = std::move(dilated->set);
+    dilated->set = {};
+    out.dilation = *std::move(dilated);
+  }
+  if (parameters.evaluate) {
+    QualityOptions quality = parameters.quality;
+    quality.voxel_size = out.voxel_size;
+    absl::StatusOr<QualityReport> report = EvaluateSpheres(solid.oracle, out.set.spheres, quality);
+    if (!report.ok()) {
+      return absl::Status(report.status().code(),
+                          absl::StrCat("evaluating the result: ", report.status().message()));
+    }
+    out.quality = *std::move(report);
+  }
+  out.seconds = SecondsSince(start);
+  return out;
+}
+
+}  // namespace inscribe

@@ -1,0 +1,110 @@
+// The key scheme: keys of sets made before an option existed stay what they were (the literals
+// below were computed from the version-1 canonical text by a separate script), every parameter
+// changes the key, and a mesh and everything derived from it route alike.
+#include "inscribe/wire/keys.h"
+
+#include <gtest/gtest.h>
+
+#include <set>
+#include <string>
+
+namespace inscribe::wire {
+namespace {
+
+const std::string kMesh = "sha256:"
+                          "0123456789abcdef0123456789abcdef0123456789abcdef0123456789abcdef";
+
+TEST(Keys, GeneratedKeysMatchVersionOneText) {
+  SphereSetParameters by_size;
+  by_size.voxel_size = 0.1;
+  EXPECT_EQ(GeneratedSphereSetKey(kMesh, by_size, false),
+            "spheres/v1/0123456789abcdeff9791a86a7a609b2b9c0cb9cf97e7688efd65e9bf382ee05");
+
+  SphereSetParameters dilated;  // neither given: core's default budget, 500
+  dilated.max_spheres = 500;
+  dilated.dilate = true;
+  dilated.dilation.growth = 0.5;
+  dilated.evaluate = false;
+  EXPECT_EQ(GeneratedSphereSetKey(kMesh, dilated, true),
+            "spheres/v1/0123456789abcdefe4f0ed8ca1ed48e91844bf8870a4bcde1685ca90d28e3de1");
+}
+
+TEST(Keys, EveryParameterChangesTheKey) {
+  SphereSetParameters base;
+  base.max_spheres = 100;
+  std::set<std::string> keys;
+  const auto add = [&](const SphereSetParameters& p, bool fill_holes = false) {
+    const std::string key = GeneratedSphereSetKey(kMesh, p, fill_holes);
+    EXPECT_EQ(key.size(), std::string("spheres/v1/").size() + 64);
+    EXPECT_EQ(RouteKey(key), RouteKey(kMesh));
+    keys.insert(key);
+  };
+  add(base);
+  add(base, /*fill_holes=*/true);
+  SphereSetParameters p = base;
+  p.max_spheres = 101;
+  add(p);
+  p = base;
+  p.max_spheres.reset();
+  p.voxel_size = 0.25;
+  add(p);
+  p = base, p.medial.object_angle = 0.5, add(p);
+  p = base, p.medial.epsilon = 1e-3, add(p);
+  p = base, p.medial.samples = 16, add(p);
+  p = base, p.medial.subdivide_boundary = true, add(p);
+  p = base, p.medial.screen_samples = 0, add(p);
+  p = base, p.medial.corner_screen = false, add(p);
+  p = base, p.medial.pair_angle_margin = 0.1, add(p);
+  p = base, p.dilate = true, add(p);
+  p = base, p.dilate = true, p.dilation.growth = 0.0, add(p);
+  p = base, p.evaluate = false, add(p);
+  p = base, p.quality.surface_samples = 5000, add(p);
+  EXPECT_EQ(keys.size(), 15u);
+  // Growth means nothing without dilation, nor quality samples without evaluation.
+  p = base, p.dilation.growth = 0.3;
+  EXPECT_EQ(GeneratedSphereSetKey(kMesh, p, false), GeneratedSphereSetKey(kMesh, base, false));
+  SphereSetParameters unevaluated = base;
+  unevaluated.evaluate = false;
+  p = unevaluated, p.quality.surface_samples = 7;
+  EXPECT_EQ(GeneratedSphereSetKey(kMesh, p, false),
+            GeneratedSphereSetKey(kMesh, unevaluated, false));
+}
+
+TEST(Keys, RoutePrefixTakesLowercaseHexDigitsOfMeshAndSetKeys) {
+  EXPECT_EQ(RoutePrefix(kMesh), "0123456789abcdef");
+  EXPECT_EQ(RoutePrefix("spheres/v1/0123456789abcdefff"), "0123456789abcdef");
+  EXPECT_EQ(RoutePrefix("sha256:0123456789ABCDEF0000"), "");
+  EXPECT_EQ(RoutePrefix("sha256:0123"), "");
+  EXPECT_EQ(RoutePrefix("hierarchy/v1/sphere/x"), "");
+  EXPECT_EQ(RouteKey("other-key"), "other-key");
+  EXPECT_EQ(RouteKey(kMesh), "0123456789abcdef");
+}
+
+TEST(Keys, UploadedAndDerivedKeys) {
+  const std::string with_mesh = UploadedSphereSetKey(kMesh, "", "numbers");
+  EXPECT_EQ(RouteKey(with_mesh), RouteKey(kMesh));
+  const std::string derived = UploadedSphereSetKey("", with_mesh, "numbers");
+  EXPECT_EQ(RouteKey(derived), RouteKey(kMesh));
+  EXPECT_NE(derived, with_mesh);
+  const std::string alone = UploadedSphereSetKey("", "", "numbers");
+  EXPECT_EQ(alone.substr(0, 11), "spheres/v1/");
+  EXPECT_EQ(RoutePrefix(alone), alone.substr(11, 16));
+  EXPECT_NE(UploadedSphereSetKey("", "", "other numbers"), alone);
+  EXPECT_EQ(ContentRouteKey("numbers").size(), kRouteDigits);
+
+  DeformationOptions options;
+  const std::string deformer = DeformerKey(kMesh, with_mesh, options);
+  EXPECT_EQ(deformer.substr(0, 12), "deformer/v1/");
+  EXPECT_EQ(deformer.substr(12, 16), RouteKey(kMesh));
+  options.strict = true;
+  EXPECT_NE(DeformerKey(kMesh, with_mesh, options), deformer);
+
+  EXPECT_EQ(HierarchyKey(with_mesh, HierarchyVolume::kRss), "hierarchy/v1/rss/" + with_mesh);
+  EXPECT_TRUE(IsMeshKey(kMesh));
+  EXPECT_FALSE(IsMeshKey(with_mesh));
+  EXPECT_TRUE(IsSphereSetKey(with_mesh));
+  EXPECT_FALSE(IsSphereSetKey(kMesh));
+}
+
+}  // namespace
+}  // namespace inscribe::wire

@@ -1,0 +1,109 @@
+#include "inscribe/wire/keys.h"
+
+#include <algorithm>
+
+#include "absl/strings/ascii.h"
+#include "absl/strings/match.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "absl/strings/strip.h"
+#include "inscribe/sha256.h"
+
+namespace inscribe::wire {
+namespace {
+
+// Bumped whenever generation, dilation or quality would give different results for the same
+// input, so that old cache entries (memory, disk or Redis) are never served for new code.
+constexpr char kSphereAlgorithmVersion[] = "inscribe-spheres-1";
+constexpr char kHierarchyVersion[] = "v1";
+// Hashed with an uploaded set's numbers: uploaded keys never collide with generated ones.
+constexpr char kUploadedSetVersion[] = "inscribe-uploaded-spheres-1";
+constexpr char kDeformerVersion[] = "inscribe-deformer-1";
+
+// `prefix` (a RoutePrefix, or "") then the SHA-256 of `canonical`, 64 hex digits in all: the
+// prefix takes the place of the digest's last digits. The 192 bits left keep collisions out
+// of reach (about 2^96 keys of one mesh before the first).
+std::string DerivedKeyHex(const std::string& prefix, absl::string_view canonical) {
+  const std::string digest = Sha256Hex(canonical);
+  if (prefix.empty()) return digest;
+  return prefix + digest.substr(0, digest.size() - prefix.size());
+}
+
+}  // namespace
+
+std::string RoutePrefix(absl::string_view key) {
+  absl::string_view hex = key;
+  if (!absl::ConsumePrefix(&hex, "sha256:") && !absl::ConsumePrefix(&hex, "spheres/v1/")) {
+    return "";
+  }
+  if (hex.size() < kRouteDigits) return "";
+  const absl::string_view digits = hex.substr(0, kRouteDigits);
+  const bool lower_hex = std::all_of(digits.begin(), digits.end(), [](char c) {
+    return absl::ascii_isdigit(c) || (c >= 'a' && c <= 'f');
+  });
+  return lower_hex ? std::string(digits) : "";
+}
+
+std::string RouteKey(absl::string_view key) {
+  std::string prefix = RoutePrefix(key);
+  return prefix.empty() ? std::string(key) : prefix;
+}
+
+std::string ContentRouteKey(absl::string_view spheres_bytes) {
+  return Sha256Hex(spheres_bytes).substr(0, kRouteDigits);
+}
+
+std::string GeneratedSphereSetKey(const std::string& mesh_key, const SphereSetParameters& p,
+                                  bool fill_holes) {
+  // Fixed text, every number with 17 significant digits: the same settings always hash alike.
+  // Options added after version 1 of this text appear only when they differ from their
+  // defaults, so that the keys of sets made before they existed stay what they were.
+  const MedialSphereOptions medial_defaults;
+  const QualityOptions quality_defaults;
+  std::string canonical = absl::StrFormat(
+      "%s\n%s\nvoxel_size=%.17g\nmax_spheres=%d\nobject_angle=%.17g\nepsilon=%.17g\nsamples=%d\n"
+      "subdivide_boundary=%d\ndilate=%d\ndilation_growth=%.17g\nfill_holes=%d\nquality=%d\n",
+      kSphereAlgorithmVersion, mesh_key, p.voxel_size.value_or(0.0), p.max_spheres.value_or(0),
+      p.medial.object_angle, p.medial.epsilon, p.medial.samples, p.medial.subdivide_boundary,
+      p.dilate, p.dilate ? p.dilation.growth : 0.0, fill_holes, p.evaluate);
+  if (p.medial.screen_samples != medial_defaults.screen_samples) {
+    absl::StrAppendFormat(&canonical, "screen_samples=%d\n", p.medial.screen_samples);
+  }
+  if (p.medial.corner_screen != medial_defaults.corner_screen) {
+    absl::StrAppendFormat(&canonical, "corner_screen=%d\n", p.medial.corner_screen);
+  }
+  if (p.medial.pair_angle_margin != medial_defaults.pair_angle_margin) {
+    absl::StrAppendFormat(&canonical, "pair_angle_margin=%.17g\n", p.medial.pair_angle_margin);
+  }
+  if (p.evaluate && p.quality.surface_samples != quality_defaults.surface_samples) {
+    absl::StrAppendFormat(&canonical, "quality_samples=%d\n", p.quality.surface_samples);
+  }
+  return "spheres/v1/" + DerivedKeyHex(RoutePrefix(mesh_key), canonical);
+}
+
+std::string UploadedSphereSetKey(const std::string& mesh_key, const std::string& derived_from,
+                                 absl::string_view spheres_bytes) {
+  const std::string prefix = RoutePrefix(mesh_key.empty() ? derived_from : mesh_key);
+  return "spheres/v1/" +
+         DerivedKeyHex(prefix, absl::StrCat(kUploadedSetVersion, "\n", mesh_key, "\n",
+                                            spheres_bytes));
+}
+
+std::string DeformerKey(const std::string& mesh_key, const std::string& set_key,
+                        const DeformationOptions& options) {
+  const std::string canonical = absl::StrFormat(
+      "%s\n%s\n%s\nxi=%.17g\nstrict=%d\ndirection=%d\ninside=%d\n", kDeformerVersion, mesh_key,
+      set_key, options.xi, options.strict, static_cast<int>(options.direction),
+      static_cast<int>(options.oracle.inside_test));
+  return "deformer/v1/" + DerivedKeyHex(RoutePrefix(mesh_key), canonical);
+}
+
+std::string HierarchyKey(const std::string& set_key, HierarchyVolume volume) {
+  return absl::StrCat("hierarchy/", kHierarchyVersion, "/", HierarchyVolumeName(volume), "/",
+                      set_key);
+}
+
+bool IsMeshKey(absl::string_view key) { return absl::StartsWith(key, "sha256:"); }
+bool IsSphereSetKey(absl::string_view key) { return absl::StartsWith(key, "spheres/"); }
+
+}  // namespace inscribe::wire

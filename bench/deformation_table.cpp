@@ -29,6 +29,7 @@
 #include "inscribe/medial_spheres.h"
 #include "inscribe/mesh_io.h"
 #include "inscribe/mesh_validation.h"
+#include "inscribe/solid.h"
 #include "inscribe/sphere_deformation.h"
 #include "inscribe/sphere_quality.h"
 
@@ -139,9 +140,7 @@ absl::Status RunSequence(const SequenceSpec& spec, const Options& options, Resul
   }
   const Mesh& reference = prepared->mesh;
   BoundaryOracleOptions oracle_options;
-  if (prepared->report.self_intersecting_pairs > 0) {
-    oracle_options.inside_test = InsideTest::kRayParity;
-  }
+  oracle_options.inside_test = InsideTestFor(prepared->report);
   absl::StatusOr<BoundaryOracle> oracle = BoundaryOracle::Build(reference, oracle_options);
   if (!oracle.ok()) return oracle.status();
 

@@ -19,6 +19,7 @@
 #include "inscribe/medial_spheres.h"
 #include "inscribe/mesh_io.h"
 #include "inscribe/mesh_validation.h"
+#include "inscribe/solid.h"
 #include "inscribe/sphere_quality.h"
 
 namespace {
@@ -101,9 +102,7 @@ int main(int argc, char** argv) {
       continue;
     }
     BoundaryOracleOptions oracle_options;
-    if (validated->report.self_intersecting_pairs > 0) {
-      oracle_options.inside_test = InsideTest::kRayParity;
-    }
+    oracle_options.inside_test = InsideTestFor(validated->report);
     absl::StatusOr<BoundaryOracle> oracle = BoundaryOracle::Build(validated->mesh, oracle_options);
     if (!oracle.ok()) {
       std::printf("| %s | oracle: %s |\n", model.c_str(),

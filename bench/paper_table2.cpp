@@ -43,6 +43,7 @@
 #include "inscribe/mesh_validation.h"
 #include "inscribe/rigid_pose.h"
 #include "inscribe/separation_distance.h"
+#include "inscribe/solid.h"
 #include "inscribe/sphere_dilation.h"
 #include "inscribe/sphere_hierarchy.h"
 #include "inscribe/sphere_quality.h"
@@ -240,9 +241,7 @@ absl::StatusOr<Model> PrepareModel(const std::string& name, const Options& optio
   absl::StatusOr<ValidatedMesh> prepared = PrepareMesh(ScaledToBox(*std::move(read)), validate);
   if (!prepared.ok()) return prepared.status();
   BoundaryOracleOptions oracle_options;
-  if (prepared->report.self_intersecting_pairs > 0) {
-    oracle_options.inside_test = InsideTest::kRayParity;
-  }
+  oracle_options.inside_test = InsideTestFor(prepared->report);
   absl::StatusOr<BoundaryOracle> oracle = BoundaryOracle::Build(prepared->mesh, oracle_options);
   if (!oracle.ok()) return oracle.status();
   row.model = name;

@@ -340,13 +340,13 @@ grpc::ServerUnaryReactor* InscribeService::Distance(grpc::CallbackServerContext*
             store_->GetHierarchy(request->sphere_set_b(), volume);
         if (!b.ok()) return b.status();
         const ServiceClock::time_point start = ServiceClock::now();
-        std::vector<PosedPair> pairs(poses_b->size());
-        for (std::size_t i = 0; i < pairs.size(); ++i) {
-          pairs[i] = PosedPair{a->get(), b->get(), (*poses_a)[poses_a->size() == 1 ? 0 : i],
+        std::vector<PosedPair> posed(poses_b->size());
+        for (std::size_t i = 0; i < posed.size(); ++i) {
+          posed[i] = PosedPair{a->get(), b->get(), (*poses_a)[poses_a->size() == 1 ? 0 : i],
                                (*poses_b)[i]};
         }
         absl::StatusOr<std::vector<DistanceResult>> results =
-            PairSeparationDistances(pairs, *tolerance);
+            PairSeparationDistances(posed, *tolerance);
         if (!results.ok()) return results.status();
         wire::AppendDistanceResults(*results, response->mutable_results());
         response->set_seconds(SecondsSince(start));

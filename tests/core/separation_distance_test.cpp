@@ -205,3 +205,72 @@ TEST(SeparationDistance, RefusesBadPosesAndTolerances) {
 
 }  // namespace
 }  // namespace inscribe
+
+namespace inscribe {
+namespace {
+
+// PairSeparationDistances, the batch the service's Distance and DistanceStream run: every
+// pair's answer is SeparationDistance's for that pair, bit for bit, and the minimum over all
+// sphere pairs (brute force); below and above the 64-pair chunk that goes parallel.
+TEST(PairSeparationDistances, EveryPairMatchesBruteForce) {
+  const std::vector<std::vector<Sphere>> sets = {testing::RandomSpheres(120, 11),
+                                                 testing::RandomSpheres(80, 12),
+                                                 testing::RandomSpheres(30, 13)};
+  std::vector<SphereHierarchy> hierarchies;
+  for (const auto& s : sets) hierarchies.push_back(Build(s, HierarchyVolume::kRss));
+  for (const auto& s : sets) hierarchies.push_back(Build(s, HierarchyVolume::kSphere));
+  std::mt19937_64 rng(7);
+  for (const std::size_t n : {std::size_t{5}, std::size_t{300}}) {
+    std::vector<PosedPair> pairs;
+    std::vector<std::pair<std::size_t, std::size_t>> which;
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::size_t a = rng() % hierarchies.size(), b = rng() % hierarchies.size();
+      pairs.push_back(PosedPair{&hierarchies[a], &hierarchies[b], testing::RandomPose(rng, 3.0),
+                                testing::RandomPose(rng, 3.0)});
+      which.emplace_back(a % sets.size(), b % sets.size());
+    }
+    absl::StatusOr<std::vector<DistanceResult>> batch = PairSeparationDistances(pairs);
+    ASSERT_TRUE(batch.ok()) << batch.status();
+    ASSERT_EQ(batch->size(), n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const PosedPair& p = pairs[i];
+      absl::StatusOr<DistanceResult> one = SeparationDistance(*p.a, p.pose_a, *p.b, p.pose_b);
+      ASSERT_TRUE(one.ok());
+      EXPECT_EQ((*batch)[i].distance, one->distance) << i;
+      EXPECT_EQ((*batch)[i].point_a, one->point_a) << i;
+      EXPECT_EQ((*batch)[i].point_b, one->point_b) << i;
+      absl::StatusOr<DistanceResult> brute = BruteForceSeparationDistance(
+          sets[which[i].first], p.pose_a, sets[which[i].second], p.pose_b);
+      ASSERT_TRUE(brute.ok());
+      EXPECT_NEAR((*batch)[i].distance, brute->distance, 1e-12) << i;
+      ExpectWitnesses((*batch)[i], sets[which[i].first], p.pose_a, sets[which[i].second],
+                      p.pose_b);
+    }
+  }
+}
+
+TEST(PairSeparationDistances, RefusesBadPairsAndStopsWhenCancelled) {
+  const SphereHierarchy h = Build(testing::RandomSpheres(20, 3), HierarchyVolume::kSphere);
+  std::vector<PosedPair> pairs(100, PosedPair{&h, &h, RigidPose{}, RigidPose{}});
+  EXPECT_TRUE(PairSeparationDistances({}).ok());
+  pairs[70].b = nullptr;
+  absl::StatusOr<std::vector<DistanceResult>> missing = PairSeparationDistances(pairs);
+  EXPECT_EQ(missing.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_NE(std::string(missing.status().message()).find("pairs[70]"), std::string::npos);
+  pairs[70].b = &h;
+  pairs[3].pose_b.translation.x() = std::nan("");
+  absl::StatusOr<std::vector<DistanceResult>> nan = PairSeparationDistances(pairs);
+  EXPECT_EQ(nan.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_NE(std::string(nan.status().message()).find("pairs[3]"), std::string::npos);
+  pairs[3].pose_b = RigidPose{};
+  DistanceRequest bad;
+  bad.abs_err = -1.0;
+  EXPECT_EQ(PairSeparationDistances(pairs, bad).status().code(),
+            absl::StatusCode::kInvalidArgument);
+  const std::atomic<bool> cancel{true};
+  EXPECT_EQ(PairSeparationDistances(pairs, {}, &cancel).status().code(),
+            absl::StatusCode::kCancelled);
+}
+
+}  // namespace
+}  // namespace inscribe

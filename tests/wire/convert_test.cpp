@@ -127,3 +127,201 @@ TEST(StatusConvert, CodesAndMessagesSurviveBothWays) {
 
 }  // namespace
 }  // namespace inscribe::wire
+
+namespace inscribe::wire {
+namespace {
+
+using ::testing::HasSubstr;
+
+bool SameParameters(const SphereSetParameters& a, const SphereSetParameters& b) {
+  const MedialSphereOptions &m = a.medial, &n = b.medial;
+  return a.voxel_size == b.voxel_size && a.max_spheres == b.max_spheres &&
+         m.object_angle == n.object_angle && m.epsilon == n.epsilon && m.samples == n.samples &&
+         m.screen_samples == n.screen_samples && m.corner_screen == n.corner_screen &&
+         m.pair_angle_margin == n.pair_angle_margin &&
+         m.subdivide_boundary == n.subdivide_boundary && m.max_voxels == n.max_voxels &&
+         a.dilate == b.dilate && (!a.dilate || a.dilation.growth == b.dilation.growth) &&
+         a.evaluate == b.evaluate &&
+         (!a.evaluate || a.quality.surface_samples == b.quality.surface_samples);
+}
+
+TEST(GenerateParameters, EveryOptionSurvivesTheWire) {
+  const std::int64_t limit = 20'000'000;
+  SphereSetParameters all;
+  all.voxel_size = 0.125;
+  all.medial.object_angle = 0.5;
+  all.medial.epsilon = 1e-3;
+  all.medial.samples = 20;
+  all.medial.screen_samples = 0;
+  all.medial.corner_screen = false;
+  all.medial.pair_angle_margin = 0.1;
+  all.medial.subdivide_boundary = true;
+  all.medial.max_voxels = 12345;
+  all.dilate = true;
+  all.dilation.growth = 0.0;
+  all.quality.surface_samples = 777;
+  SphereSetParameters budget;
+  budget.max_spheres = 42;
+  budget.evaluate = false;
+  SphereSetParameters defaults;  // the default budget goes as max_spheres
+  for (const SphereSetParameters& p : {all, budget, defaults}) {
+    v1::GenerateRequest request;
+    GenerateRequestToProto("sha256:x", p, true, &request);
+    EXPECT_EQ(request.mesh_sha256(), "sha256:x");
+    EXPECT_TRUE(request.parameters().fill_holes());
+    absl::StatusOr<SphereSetParameters> back = SphereSetParametersFromProto(request, limit);
+    ASSERT_TRUE(back.ok()) << back.status();
+    SphereSetParameters expected = p;
+    if (!expected.voxel_size) expected.max_spheres = EffectiveMaxSpheres(p);
+    if (p.medial.max_voxels == MedialSphereOptions().max_voxels) expected.medial.max_voxels = limit;
+    EXPECT_TRUE(SameParameters(*back, expected));
+  }
+  // Defaults are never restated on the wire.
+  v1::GenerateRequest plain;
+  GenerateRequestToProto("sha256:x", defaults, false, &plain);
+  const v1::GenerateParameters& wire = plain.parameters();
+  EXPECT_FALSE(wire.has_screen_samples() || wire.has_corner_screen() ||
+               wire.has_pair_angle_margin() || wire.has_dilation_growth() ||
+               wire.has_quality_samples());
+  EXPECT_EQ(wire.object_angle(), 0.0);
+  EXPECT_EQ(wire.samples(), 0);
+  EXPECT_EQ(wire.max_voxels(), 0);
+}
+
+TEST(GenerateParameters, TheServersVoxelLimitCapsTheRequest) {
+  v1::GenerateRequest request;
+  request.mutable_parameters()->set_voxel_size(0.1);
+  request.mutable_parameters()->set_max_voxels(5000);
+  EXPECT_EQ(SphereSetParametersFromProto(request, 1000)->medial.max_voxels, 1000);
+  EXPECT_EQ(SphereSetParametersFromProto(request, 9000)->medial.max_voxels, 5000);
+  request.mutable_parameters()->set_max_voxels(-3);
+  EXPECT_EQ(SphereSetParametersFromProto(request, 9000).status().code(),
+            absl::StatusCode::kInvalidArgument);
+}
+
+TEST(GenerateParameters, BadRequestsNameTheProblem) {
+  v1::GenerateRequest neither;
+  EXPECT_THAT(SphereSetParametersFromProto(neither, 100).status().message(),
+              HasSubstr("exactly one of voxel_size"));
+  v1::GenerateRequest both;
+  both.mutable_parameters()->set_voxel_size(0.1);
+  both.mutable_parameters()->set_max_spheres(10);
+  EXPECT_EQ(SphereSetParametersFromProto(both, 100).status().code(),
+            absl::StatusCode::kInvalidArgument);
+  v1::GenerateRequest angle;
+  angle.mutable_parameters()->set_max_spheres(10);
+  angle.mutable_parameters()->set_object_angle(-1.0);
+  EXPECT_THAT(SphereSetParametersFromProto(angle, 100).status().message(),
+              HasSubstr("parameters: object angle"));
+  v1::GenerateRequest samples;
+  samples.mutable_parameters()->set_max_spheres(10);
+  samples.mutable_parameters()->set_quality_samples(-1);
+  EXPECT_THAT(SphereSetParametersFromProto(samples, 100).status().message(),
+              HasSubstr("surface samples"));
+}
+
+TEST(GeneratedSphereSet, RoundTripsEveryFigure) {
+  GeneratedSphereSet g;
+  g.set.spheres = {Sphere{Vector3(1, 2, 3), 0.5}, Sphere{Vector3(-1, 0, 0.25), 0.125}};
+  g.set.contacts = {SurfaceContact{3, Vector3(0.2, 0.3, 0.5)},
+                    SurfaceContact{0, Vector3(1, 0, 0)}};
+  g.voxel_size = 0.0625;
+  g.epsilon = 1e-4;
+  g.runs = 6;
+  g.stats.grid_voxels = 11, g.stats.visited_voxels = 12, g.stats.boundary_voxels = 13;
+  g.stats.screened_voxels = 14, g.stats.crossing_pairs = 15, g.stats.searched_pairs = 16;
+  g.stats.candidates = 17, g.stats.closest_point_queries = 18, g.stats.seconds = 0.5;
+  DilationResult d;
+  d.v_points = 21, d.edge_points = 22, d.degenerate = 23, d.grown = 24;
+  d.max_growth = 0.01, d.seconds = 0.25;
+  g.dilation = d;
+  QualityReport q;
+  q.nerr = 0.03, q.spheres = 2, q.coverage = 0.9;
+  g.quality = q;
+  g.generation_seconds = 1.5;
+  g.seconds = 2.5;
+  v1::GenerateResult wire;
+  GeneratedSphereSetToProto(g, &wire);
+  absl::StatusOr<GeneratedSphereSet> back = GeneratedSphereSetFromProto(wire);
+  ASSERT_TRUE(back.ok()) << back.status();
+  ASSERT_EQ(back->set.size(), 2u);
+  EXPECT_EQ(back->set.spheres[1].center, g.set.spheres[1].center);
+  EXPECT_EQ(back->set.contacts[0].barycentric, g.set.contacts[0].barycentric);
+  EXPECT_EQ(back->voxel_size, g.voxel_size);
+  EXPECT_EQ(back->epsilon, g.epsilon);
+  EXPECT_EQ(back->runs, 6);
+  EXPECT_EQ(back->stats.grid_voxels, 11);
+  EXPECT_EQ(back->stats.candidates, 17);
+  EXPECT_EQ(back->stats.closest_point_queries, 18);
+  EXPECT_EQ(back->stats.seconds, 0.5);
+  ASSERT_TRUE(back->dilation.has_value());
+  EXPECT_EQ(back->dilation->degenerate, 23);
+  EXPECT_EQ(back->dilation->max_growth, 0.01);
+  ASSERT_TRUE(back->quality.has_value());
+  EXPECT_EQ(back->quality->nerr, 0.03);
+  EXPECT_EQ(back->generation_seconds, 1.5);
+  EXPECT_EQ(back->seconds, 2.5);
+  g.dilation.reset();
+  g.quality.reset();
+  wire.Clear();
+  GeneratedSphereSetToProto(g, &wire);
+  back = GeneratedSphereSetFromProto(wire);
+  ASSERT_TRUE(back.ok());
+  EXPECT_FALSE(back->dilation.has_value() || back->quality.has_value());
+  wire.mutable_spheres()->set_radii(0, -1.0);
+  EXPECT_EQ(GeneratedSphereSetFromProto(wire).status().code(),
+            absl::StatusCode::kInvalidArgument);
+}
+
+TEST(DeformedSpheres, RoundTripWithBounds) {
+  DeformedSpheres moved;
+  moved.set.spheres = {Sphere{Vector3(0, 0, 1), 0.5}};
+  moved.set.contacts = {SurfaceContact{2, Vector3(0.5, 0.5, 0)}};
+  moved.reference_index = {7};
+  moved.xi = 0.01, moved.max_protrusion = 0.005, moved.shrunk = 1, moved.dropped = 2;
+  moved.closest_point_queries = 30, moved.max_shrink_steps = 4, moved.seconds = 0.125;
+  DeformationErrorBounds bounds;
+  bounds.nerr_lower = 0.1, bounds.nerr_upper = 0.2, bounds.exact = false;
+  bounds.volume_mesh = 3, bounds.volume_union = 2, bounds.seconds = 0.5;
+  for (const bool uniform : {false, true}) {
+    bounds.uniform_xi_holds = uniform;
+    bounds.nerr_upper_uniform_xi = uniform ? 0.3 : std::numeric_limits<double>::infinity();
+    v1::UpdateDeformationResponse wire;
+    DeformedSpheresToProto(moved, &wire);
+    DeformationBoundsToProto(bounds, &wire);
+    absl::StatusOr<DeformedSpheres> back = DeformedSpheresFromProto(wire);
+    ASSERT_TRUE(back.ok()) << back.status();
+    EXPECT_EQ(back->reference_index, moved.reference_index);
+    EXPECT_EQ(back->set.contacts[0].triangle, 2);
+    EXPECT_EQ(back->xi, 0.01);
+    EXPECT_EQ(back->dropped, 2);
+    EXPECT_EQ(back->max_shrink_steps, 4);
+    const DeformationErrorBounds b = DeformationBoundsFromProto(wire);
+    EXPECT_EQ(b.nerr_upper, 0.2);
+    EXPECT_EQ(b.uniform_xi_holds, uniform);
+    EXPECT_EQ(b.nerr_upper_uniform_xi, bounds.nerr_upper_uniform_xi);
+    wire.add_reference_index(8);
+    EXPECT_EQ(DeformedSpheresFromProto(wire).status().code(), absl::StatusCode::kInvalidArgument);
+  }
+}
+
+TEST(DistanceTolerance, RoundTripsAndRefusesBadNumbers) {
+  DistanceRequest t;
+  t.abs_err = 0.1, t.rel_err = 0.2;
+  v1::DistanceTolerance wire;
+  ToleranceToProto(t, &wire);
+  EXPECT_FALSE(wire.has_closer_than());
+  t.closer_than = -0.5;
+  ToleranceToProto(t, &wire);
+  absl::StatusOr<DistanceRequest> back = ToleranceFromProto(wire);
+  ASSERT_TRUE(back.ok());
+  EXPECT_EQ(back->closer_than, -0.5);
+  EXPECT_EQ(back->rel_err, 0.2);
+  wire.set_abs_err(-1.0);
+  EXPECT_EQ(ToleranceFromProto(wire).status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(VolumeFromProto(VolumeToProto(HierarchyVolume::kRss)), HierarchyVolume::kRss);
+  EXPECT_EQ(VolumeFromProto(v1::HIERARCHY_VOLUME_UNSPECIFIED), HierarchyVolume::kSphere);
+}
+
+}  // namespace
+}  // namespace inscribe::wire

@@ -48,7 +48,7 @@ enum class BoundaryOracleBackend {
 };
 
 struct BoundaryOracleOptions {
-  // Use kRayParity for meshes whose MeshReport has self_intersecting_pairs > 0.
+  // InsideTestFor (solid.h) chooses this for a mesh from its validation report.
   InsideTest inside_test = InsideTest::kPseudonormal;
   BoundaryOracleBackend backend = BoundaryOracleBackend::kFlatBvh;
 };

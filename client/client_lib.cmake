@@ -9,7 +9,7 @@ add_library(inscribe_client STATIC
   ${CMAKE_CURRENT_LIST_DIR}/src/client/routed_connection.cpp)
 add_library(inscribe::client ALIAS inscribe_client)
 target_include_directories(inscribe_client
-  PUBLIC $<BUILD_INTERFACE:${CMAKE_CURRENT_LIST_DIR}/include>)
+  PUBLIC $<BUILD_INTERFACE:${CMAKE_CURRENT_LIST_DIR}/include> $<INSTALL_INTERFACE:include>)
 target_link_libraries(inscribe_client
   PUBLIC inscribe::core inscribe::proto absl::status absl::statusor
   PRIVATE inscribe::wire gRPC::grpc++ OpenSSL::Crypto inscribe_build_flags)

@@ -34,6 +34,19 @@ double DistanceToUnion(const Vector3& x, const std::vector<Sphere>& spheres) {
 
 }  // namespace
 
+std::vector<double> SphereProtrusions(const BoundaryOracle& oracle,
+                                      const std::vector<Sphere>& spheres) {
+  std::vector<double> protrusion(spheres.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, spheres.size(), 64),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                        protrusion[i] = std::max(
+                            0.0, spheres[i].radius + oracle.SignedDistance(spheres[i].center));
+                      }
+                    });
+  return protrusion;
+}
+
 absl::Status CheckQualityOptions(const QualityOptions& options) {
   if (options.surface_samples < 0 || options.surface_samples > 100'000'000) {
     return absl::InvalidArgumentError(
@@ -72,15 +85,7 @@ absl::StatusOr<QualityReport> EvaluateSpheres(const BoundaryOracle& oracle,
   if (!union_volume.ok()) return union_volume.status();
   report.volume_union = *union_volume;
 
-  // Protrusion per sphere.
-  std::vector<double> protrusion(spheres.size());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, spheres.size(), 64),
-                    [&](const tbb::blocked_range<std::size_t>& range) {
-                      for (std::size_t i = range.begin(); i != range.end(); ++i) {
-                        protrusion[i] = std::max(
-                            0.0, spheres[i].radius + oracle.SignedDistance(spheres[i].center));
-                      }
-                    });
+  const std::vector<double> protrusion = SphereProtrusions(oracle, spheres);
   if (!spheres.empty()) {
     double sum = 0.0;
     for (double p : protrusion) {

@@ -21,20 +21,20 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/string_view.h"
 #include "inscribe/sphere_io.h"
-#include "spherized_urdf.h"
-#include "urdf_robot.h"
+#include "inscribe/robot/spherized_urdf.h"
+#include "inscribe/robot/urdf_robot.h"
 
 namespace {
 
 using inscribe::Sphere;
 using inscribe::Vector3;
-using inscribe::cli::LinkSpherizeResult;
-using inscribe::cli::LinkStatus;
-using inscribe::cli::UrdfElement;
-using inscribe::cli::UrdfGeometry;
-using inscribe::cli::UrdfLink;
-using inscribe::cli::UrdfRobot;
-using inscribe::cli::UrdfShape;
+using inscribe::robot::LinkSpherizeResult;
+using inscribe::robot::LinkStatus;
+using inscribe::robot::UrdfElement;
+using inscribe::robot::UrdfGeometry;
+using inscribe::robot::UrdfLink;
+using inscribe::robot::UrdfRobot;
+using inscribe::robot::UrdfShape;
 
 [[noreturn]] void Fail(const std::string& what) {
   std::fprintf(stderr, "fuzz_urdf: %s\n", what.c_str());
@@ -118,7 +118,7 @@ void CheckSpherizedLink(const UrdfLink& link, const LinkSpherizeResult& result) 
 
 void CheckCuroboYaml(const std::vector<LinkSpherizeResult>& results, const UrdfRobot& robot) {
   std::vector<std::string> left_out;
-  const std::string yaml = inscribe::cli::SpherizedCuroboYaml(results, robot.name, &left_out);
+  const std::string yaml = inscribe::robot::SpherizedCuroboYaml(results, robot.name, &left_out);
   const std::set<std::string> left(left_out.begin(), left_out.end());
   std::vector<const LinkSpherizeResult*> kept;
   for (const LinkSpherizeResult& result : results) {
@@ -150,7 +150,7 @@ void CheckCuroboYaml(const std::vector<LinkSpherizeResult>& results, const UrdfR
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const absl::string_view bytes(reinterpret_cast<const char*>(data), size);
-  absl::StatusOr<UrdfRobot> robot = inscribe::cli::ParseUrdf(bytes);
+  absl::StatusOr<UrdfRobot> robot = inscribe::robot::ParseUrdf(bytes);
   if (!robot.ok()) {
     if (robot.status().message().empty()) Fail("a refused document has an empty error message");
     return 0;
@@ -178,12 +178,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     results.push_back(std::move(result));
   }
 
-  absl::StatusOr<std::string> written = inscribe::cli::SpherizedUrdf(bytes, results);
+  absl::StatusOr<std::string> written = inscribe::robot::SpherizedUrdf(bytes, results);
   if (!written.ok()) {
     Fail(absl::StrCat("a document ParseUrdf accepted is refused by SpherizedUrdf: ",
                       written.status().message()));
   }
-  absl::StatusOr<UrdfRobot> reread = inscribe::cli::ParseUrdf(*written);
+  absl::StatusOr<UrdfRobot> reread = inscribe::robot::ParseUrdf(*written);
   if (!reread.ok()) {
     Fail(absl::StrCat("the spherized URDF does not read back: ", reread.status().message()));
   }

@@ -12,10 +12,12 @@
 #include "inscribe/sphere_io.h"
 #include "inscribe/sphere_quality.h"
 #include "remote_options.h"
-#include "report_json.h"
+#include "inscribe/view/report_json.h"
 #include "solid_loading.h"
 
 namespace inscribe::cli {
+
+using view::QualityReportJson;
 namespace {
 
 struct EvaluateCliOptions {

@@ -14,11 +14,13 @@
 #include "inscribe/sphere_set_generation.h"
 #include "progress_bar.h"
 #include "remote_options.h"
-#include "report_json.h"
+#include "inscribe/view/report_json.h"
 #include "solid_loading.h"
 #include "sphere_output.h"
 
 namespace inscribe::cli {
+
+using view::QualityReportJson;
 namespace {
 
 struct GenerateCliOptions {

@@ -12,9 +12,11 @@
 #include "inscribe/mesh_io.h"
 #include "inscribe/mesh_validation.h"
 #include "remote_options.h"
-#include "report_json.h"
+#include "inscribe/view/report_json.h"
 
 namespace inscribe::cli {
+
+using view::MeshReportJson;
 namespace {
 
 struct InfoOptions {

@@ -17,11 +17,23 @@
 #include "exit_codes.h"
 #include "inscribe/atomic_file.h"
 #include "nlohmann/json.hpp"
-#include "spherized_urdf.h"
-#include "urdf_robot.h"
-#include "urdf_spherize.h"
+#include "inscribe/robot/spherized_urdf.h"
+#include "inscribe/robot/urdf_robot.h"
+#include "inscribe/robot/urdf_spherize.h"
 
 namespace inscribe::cli {
+
+using robot::LinkSpherizeResult;
+using robot::PackageSearchFromEnvironment;
+using robot::LinkStatus;
+using robot::LinkStatusName;
+using robot::ParseUrdf;
+using robot::SpherizeLink;
+using robot::SpherizedCuroboYaml;
+using robot::SpherizedUrdf;
+using robot::UrdfLink;
+using robot::UrdfRobot;
+using robot::UrdfSpherizeOptions;
 namespace {
 
 namespace fs = std::filesystem;

@@ -21,11 +21,16 @@
 #include "inscribe/envelope_distances.h"
 #include "inscribe/sphere_io.h"
 #include "inscribe/sphere_quality.h"
-#include "signed_histogram.h"
+#include "inscribe/view/signed_histogram.h"
 #include "solid_loading.h"
-#include "view_report_html.h"
+#include "inscribe/view/view_report_html.h"
 
 namespace inscribe::cli {
+
+using view::MakeSignedHistogram;
+using view::ViewPageData;
+using view::ViewPageFacts;
+using view::ViewPageHtml;
 namespace {
 
 namespace fs = std::filesystem;
@@ -128,11 +133,7 @@ int RunView(const ViewCliOptions& options) {
     return report.status().code() == absl::StatusCode::kInvalidArgument ? kExitBadInput
                                                                         : kExitUnusableMesh;
   }
-  Vertices centre_rows(static_cast<std::int64_t>(spheres.size()), 3);
-  for (std::size_t i = 0; i < spheres.size(); ++i) {
-    centre_rows.row(static_cast<std::int64_t>(i)) = spheres[i].center.transpose();
-  }
-  const std::vector<double> centre_distances = solid->solid.oracle.SignedDistances(centre_rows);
+  std::vector<double> protrusion = SphereProtrusions(solid->solid.oracle, spheres);
   const double evaluate_seconds = SecondsSince(evaluate_start);
 
   EnvelopeDistanceRequest request;
@@ -159,10 +160,7 @@ int RunView(const ViewCliOptions& options) {
       !options.title.empty() ? options.title : facts.mesh_name + " \u00b7 " + facts.spheres_name;
   facts.mesh_sha256 = solid->solid.sha256;
   facts.quality = *report;
-  facts.protrusion.reserve(spheres.size());
-  for (std::size_t i = 0; i < spheres.size(); ++i) {
-    facts.protrusion.push_back(std::max(0.0, spheres[i].radius + centre_distances[i]));
-  }
+  facts.protrusion = std::move(protrusion);
   // Histograms at least 1e-9 of the diagonal wide: the rounding of exact-distance radii.
   const double min_range = std::max(1e-9 * report->bbox_diagonal, 1e-300);
   facts.boundary_to_envelope =

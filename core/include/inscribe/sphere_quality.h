@@ -70,6 +70,12 @@ struct QualityReport {
   double seconds = 0.0;
 };
 
+// How far each sphere reaches outside the solid, in order: max(0, r + signed distance of its
+// centre), mesh units (what QualityReport's protrusion figures summarise). Parallel (TBB);
+// one closest-point query per sphere.
+std::vector<double> SphereProtrusions(const BoundaryOracle& oracle,
+                                      const std::vector<Sphere>& spheres);
+
 // OK, or INVALID_ARGUMENT for surface samples outside [0, 1e8] or a negative or non-finite
 // voxel size. O(1).
 absl::Status CheckQualityOptions(const QualityOptions& options);

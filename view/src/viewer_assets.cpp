@@ -3,7 +3,7 @@
 #include <cstddef>
 
 // Defined in the sources that inscribe_embed_files generates (client/CMakeLists.txt).
-namespace inscribe::cli::embedded {
+namespace inscribe::view::embedded {
 extern const unsigned char kThreeMinJs[];
 extern const std::size_t kThreeMinJsSize;
 extern const unsigned char kOrbitControlsJs[];
@@ -14,9 +14,9 @@ extern const unsigned char kViewPageJs[];
 extern const std::size_t kViewPageJsSize;
 extern const unsigned char kViewPageCss[];
 extern const std::size_t kViewPageCssSize;
-}  // namespace inscribe::cli::embedded
+}  // namespace inscribe::view::embedded
 
-namespace inscribe::cli {
+namespace inscribe::view {
 namespace {
 
 absl::string_view View(const unsigned char* bytes, std::size_t size) {
@@ -35,4 +35,4 @@ absl::string_view ThreeJsLicense() {
 absl::string_view ViewPageJs() { return View(embedded::kViewPageJs, embedded::kViewPageJsSize); }
 absl::string_view ViewPageCss() { return View(embedded::kViewPageCss, embedded::kViewPageCssSize); }
 
-}  // namespace inscribe::cli
+}  // namespace inscribe::view

@@ -1,4 +1,4 @@
-#include "urdf_robot.h"
+#include "inscribe/robot/urdf_robot.h"
 
 #include <tinyxml2.h>
 
@@ -19,7 +19,7 @@
 #include "absl/strings/str_split.h"
 #include "absl/strings/strip.h"
 
-namespace inscribe::cli {
+namespace inscribe::robot {
 namespace {
 
 namespace fs = std::filesystem;
@@ -421,4 +421,4 @@ absl::StatusOr<std::string> ResolveMeshFilename(const std::string& filename,
   return ExistingFile(path.is_absolute() ? path : fs::path(urdf_dir) / path, filename);
 }
 
-}  // namespace inscribe::cli
+}  // namespace inscribe::robot

@@ -1,6 +1,6 @@
 // URDF parsing, rpy rotations, mesh filename resolution and the primitive meshes of
 // `inscribe urdf` (client/src/cli/urdf_robot.h, primitive_meshes.h).
-#include "urdf_robot.h"
+#include "inscribe/robot/urdf_robot.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -13,9 +13,9 @@
 #include <string>
 
 #include "inscribe/mesh_validation.h"
-#include "primitive_meshes.h"
+#include "inscribe/robot/primitive_meshes.h"
 
-namespace inscribe::cli {
+namespace inscribe::robot {
 namespace {
 
 using ::testing::HasSubstr;
@@ -301,4 +301,4 @@ TEST(PrimitiveMeshes, CylinderIsAValidPrismInsideTheCylinder) {
 }
 
 }  // namespace
-}  // namespace inscribe::cli
+}  // namespace inscribe::robot

@@ -1,4 +1,4 @@
-#include "signed_histogram.h"
+#include "inscribe/view/signed_histogram.h"
 
 #include <gtest/gtest.h>
 
@@ -6,7 +6,7 @@
 #include <random>
 #include <vector>
 
-namespace inscribe::cli {
+namespace inscribe::view {
 namespace {
 
 TEST(SignedHistogram, BinsAreSymmetricAboutZero) {
@@ -89,4 +89,4 @@ TEST(SignedHistogram, MatchesBruteForceOnRandomValues) {
 }
 
 }  // namespace
-}  // namespace inscribe::cli
+}  // namespace inscribe::view

@@ -1,9 +1,9 @@
-#include "primitive_meshes.h"
+#include "inscribe/robot/primitive_meshes.h"
 
 #include <cassert>
 #include <cmath>
 
-namespace inscribe::cli {
+namespace inscribe::robot {
 
 Mesh BoxMesh(const Vector3& size) {
   assert((size.array() > 0.0).all());
@@ -52,4 +52,4 @@ Mesh CylinderMesh(double radius, double length, int sides) {
   return mesh;
 }
 
-}  // namespace inscribe::cli
+}  // namespace inscribe::robot

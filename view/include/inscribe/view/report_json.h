@@ -7,7 +7,7 @@
 #include "inscribe/mesh_validation.h"
 #include "inscribe/sphere_quality.h"
 
-namespace inscribe::cli {
+namespace inscribe::view {
 
 // The `inscribe info --json` object: mesh_sha256, vertices, triangles, closed, usable,
 // volume, bbox {min, max, diagonal}, counts {...}, issues [...].
@@ -21,4 +21,4 @@ nlohmann::json MeshReportJson(const MeshReport& report, const std::string& sha25
 // fraction_radius_over_sqrt3_sigma.
 nlohmann::json QualityReportJson(const QualityReport& report);
 
-}  // namespace inscribe::cli
+}  // namespace inscribe::view

@@ -1,6 +1,6 @@
-#include "report_json.h"
+#include "inscribe/view/report_json.h"
 
-namespace inscribe::cli {
+namespace inscribe::view {
 
 nlohmann::json MeshReportJson(const MeshReport& report, const std::string& sha256) {
   nlohmann::json issues = nlohmann::json::array();
@@ -38,9 +38,9 @@ nlohmann::json MeshReportJson(const MeshReport& report, const std::string& sha25
   return j;
 }
 
-}  // namespace inscribe::cli
+}  // namespace inscribe::view
 
-namespace inscribe::cli {
+namespace inscribe::view {
 
 nlohmann::json QualityReportJson(const QualityReport& r) {
   nlohmann::json j;
@@ -74,4 +74,4 @@ nlohmann::json QualityReportJson(const QualityReport& r) {
   return j;
 }
 
-}  // namespace inscribe::cli
+}  // namespace inscribe::view

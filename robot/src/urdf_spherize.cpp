@@ -1,4 +1,4 @@
-#include "urdf_spherize.h"
+#include "inscribe/robot/urdf_spherize.h"
 
 #include <algorithm>
 #include <chrono>
@@ -15,9 +15,9 @@
 #include "inscribe/mesh_io.h"
 #include "inscribe/solid.h"
 #include "inscribe/sphere_set_generation.h"
-#include "primitive_meshes.h"
+#include "inscribe/robot/primitive_meshes.h"
 
-namespace inscribe::cli {
+namespace inscribe::robot {
 namespace {
 
 // An element ready for generation: a validated solid, or a sphere kept as it is.
@@ -241,4 +241,4 @@ LinkSpherizeResult SpherizeLink(const UrdfLink& link, const UrdfSpherizeOptions&
   return result;
 }
 
-}  // namespace inscribe::cli
+}  // namespace inscribe::robot

@@ -1,6 +1,6 @@
 // Per-link spherization of `inscribe urdf` (client/src/cli/urdf_spherize.h) and its writers
 // (spherized_urdf.h), on geometry built in code.
-#include "urdf_spherize.h"
+#include "inscribe/robot/urdf_spherize.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -10,11 +10,11 @@
 #include <string>
 
 #include "inscribe/mesh_validation.h"
-#include "primitive_meshes.h"
-#include "spherized_urdf.h"
+#include "inscribe/robot/primitive_meshes.h"
+#include "inscribe/robot/spherized_urdf.h"
 #include "support/synthetic_meshes.h"
 
-namespace inscribe::cli {
+namespace inscribe::robot {
 namespace {
 
 using ::testing::ElementsAre;
@@ -193,4 +193,4 @@ TEST(SpherizedUrdf, ReplacesCollisionsOfSpherizedLinksAndAnnotatesSkippedOnes) {
 }
 
 }  // namespace
-}  // namespace inscribe::cli
+}  // namespace inscribe::robot

@@ -1,4 +1,4 @@
-#include "spherized_urdf.h"
+#include "inscribe/robot/spherized_urdf.h"
 
 #include <tinyxml2.h>
 
@@ -11,7 +11,7 @@
 #include "absl/strings/str_replace.h"
 #include "inscribe/sphere_io.h"
 
-namespace inscribe::cli {
+namespace inscribe::robot {
 namespace {
 
 using tinyxml2::XMLDocument;
@@ -132,4 +132,4 @@ std::string SpherizedCuroboYaml(const std::vector<LinkSpherizeResult>& links,
   return *std::move(yaml);
 }
 
-}  // namespace inscribe::cli
+}  // namespace inscribe::robot

@@ -1,4 +1,4 @@
-#include "view_report_html.h"
+#include "inscribe/view/view_report_html.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -9,7 +9,7 @@
 #include "support/synthetic_meshes.h"
 #include "viewer_assets.h"
 
-namespace inscribe::cli {
+namespace inscribe::view {
 namespace {
 
 using ::testing::HasSubstr;
@@ -124,4 +124,4 @@ TEST(ViewReportHtml, InvalidUtf8InNamesIsReplacedNotFatal) {
 }
 
 }  // namespace
-}  // namespace inscribe::cli
+}  // namespace inscribe::view

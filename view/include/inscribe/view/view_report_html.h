@@ -12,9 +12,9 @@
 #include "inscribe/mesh.h"
 #include "inscribe/sphere.h"
 #include "inscribe/sphere_quality.h"
-#include "signed_histogram.h"
+#include "inscribe/view/signed_histogram.h"
 
-namespace inscribe::cli {
+namespace inscribe::view {
 
 // What the panel shows besides the geometry. Lengths in mesh units, times in seconds.
 struct ViewPageFacts {
@@ -47,4 +47,4 @@ nlohmann::json ViewPageData(const Mesh& mesh, const std::vector<Sphere>& spheres
 // early (a script containing "</script", a licence containing "-->"): a build problem.
 absl::StatusOr<std::string> ViewPageHtml(const nlohmann::json& data, const std::string& title);
 
-}  // namespace inscribe::cli
+}  // namespace inscribe::view

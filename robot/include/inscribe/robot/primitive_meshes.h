@@ -5,7 +5,7 @@
 
 #include "inscribe/mesh.h"
 
-namespace inscribe::cli {
+namespace inscribe::robot {
 
 // URDF's <box size="x y z">: the axis-aligned box [-x/2, x/2] x [-y/2, y/2] x [-z/2, z/2],
 // exact. 8 vertices, 12 triangles. `size` > 0 per axis.
@@ -22,4 +22,4 @@ inline constexpr int kCylinderSides = 64;
 // sides >= 3.
 Mesh CylinderMesh(double radius, double length, int sides = kCylinderSides);
 
-}  // namespace inscribe::cli
+}  // namespace inscribe::robot

@@ -1,4 +1,4 @@
-#include "view_report_html.h"
+#include "inscribe/view/view_report_html.h"
 
 #include <cmath>
 #include <cstdio>
@@ -8,10 +8,10 @@
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_replace.h"
-#include "report_json.h"
+#include "inscribe/view/report_json.h"
 #include "viewer_assets.h"
 
-namespace inscribe::cli {
+namespace inscribe::view {
 namespace {
 
 // x rounded to `digits` significant decimal digits, as the double whose shortest form (which
@@ -142,4 +142,4 @@ absl::StatusOr<std::string> ViewPageHtml(const nlohmann::json& data, const std::
   return html;
 }
 
-}  // namespace inscribe::cli
+}  // namespace inscribe::view

@@ -16,9 +16,9 @@
 #include "inscribe/medial_spheres.h"
 #include "inscribe/mesh.h"
 #include "inscribe/sphere.h"
-#include "urdf_robot.h"
+#include "inscribe/robot/urdf_robot.h"
 
-namespace inscribe::cli {
+namespace inscribe::robot {
 
 struct UrdfSpherizeOptions {
   // Exactly one of the two is > 0. max_spheres_per_link: at most this many spheres per link
@@ -85,4 +85,4 @@ struct LinkSpherizeResult {
 // such a problem. Sequential across elements; the generation itself is parallel (TBB).
 LinkSpherizeResult SpherizeLink(const UrdfLink& link, const UrdfSpherizeOptions& options);
 
-}  // namespace inscribe::cli
+}  // namespace inscribe::robot

@@ -13,7 +13,7 @@
 #include "absl/strings/string_view.h"
 #include "inscribe/mesh.h"
 
-namespace inscribe::cli {
+namespace inscribe::robot {
 
 // <origin xyz="x y z" rpy="roll pitch yaw">: the pose of an element's frame in its link's
 // frame. Metres and radians; both default to zero.
@@ -106,4 +106,4 @@ absl::StatusOr<std::string> ResolveMeshFilename(const std::string& filename,
                                                 const std::string& urdf_dir,
                                                 const PackageSearch& search);
 
-}  // namespace inscribe::cli
+}  // namespace inscribe::robot

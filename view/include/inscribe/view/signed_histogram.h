@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <vector>
 
-namespace inscribe::cli {
+namespace inscribe::view {
 
 // `bins` equal bins over [-range, range], symmetric about 0 so that the sign reads at a
 // glance: range = max |value|, at least min_range (> 0). Bin k holds the values in
@@ -22,4 +22,4 @@ struct SignedHistogram {
 // bins >= 1, min_range > 0 (asserted). Cost O(#values).
 SignedHistogram MakeSignedHistogram(const std::vector<double>& values, int bins, double min_range);
 
-}  // namespace inscribe::cli
+}  // namespace inscribe::view

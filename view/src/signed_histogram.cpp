@@ -1,10 +1,10 @@
-#include "signed_histogram.h"
+#include "inscribe/view/signed_histogram.h"
 
 #include <algorithm>
 #include <cassert>
 #include <cmath>
 
-namespace inscribe::cli {
+namespace inscribe::view {
 
 SignedHistogram MakeSignedHistogram(const std::vector<double>& values, int bins, double min_range) {
   assert(bins >= 1 && min_range > 0.0);
@@ -35,4 +35,4 @@ SignedHistogram MakeSignedHistogram(const std::vector<double>& values, int bins,
   return h;
 }
 
-}  // namespace inscribe::cli
+}  // namespace inscribe::view

@@ -6,7 +6,7 @@
 
 #include "absl/strings/string_view.h"
 
-namespace inscribe::cli {
+namespace inscribe::view {
 
 absl::string_view ThreeJs();          // build/three.min.js: defines the global THREE
 absl::string_view OrbitControlsJs();  // examples/js/controls/OrbitControls.js: THREE.OrbitControls
@@ -14,4 +14,4 @@ absl::string_view ThreeJsLicense();   // three's LICENSE file (MIT)
 absl::string_view ViewPageJs();       // view_page.js
 absl::string_view ViewPageCss();      // view_page.css
 
-}  // namespace inscribe::cli
+}  // namespace inscribe::view

@@ -7,9 +7,9 @@
 
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
-#include "urdf_spherize.h"
+#include "inscribe/robot/urdf_spherize.h"
 
-namespace inscribe::cli {
+namespace inscribe::robot {
 
 // `urdf_bytes` (a document ParseUrdf accepted) edited with tinyxml2: in every link whose
 // result is kSpherized, all <collision> elements are replaced, where the first of them was
@@ -33,4 +33,4 @@ std::string SpherizedCuroboYaml(const std::vector<LinkSpherizeResult>& links,
 // The shortest decimal that std::from_chars reads back as exactly `value` (finite).
 std::string ShortestDecimal(double value);
 
-}  // namespace inscribe::cli
+}  // namespace inscribe::robot

@@ -69,9 +69,12 @@ class FailoverTest : public ::testing::Test {
     }
     absl::StatusOr<std::shared_ptr<Connection>> routed = MakeRoutedConnection(std::move(endpoints));
     ASSERT_TRUE(routed.ok()) << routed.status();
-    // One attempt per call: the routing's failover alone must hide the dead replica.
+    // One attempt per replica and no time for a backoff: failing over (each attempt at once,
+    // to the next replica) must hide the dead replica.
     ClientOptions options;
-    options.retry.max_attempts = 1;
+    options.retry.max_attempts = 3;
+    options.retry.initial_backoff = std::chrono::milliseconds(600'000);
+    options.retry.max_backoff = std::chrono::milliseconds(600'000);
     routed_ = std::make_unique<Client>(*std::move(routed), options);
     meshes_ = SmallMeshes();
   }

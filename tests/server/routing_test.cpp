@@ -17,6 +17,7 @@
 #include <thread>
 
 #include "client_test_support.h"
+#include "absl/strings/str_cat.h"
 #include "inscribe/mesh_hash.h"
 
 namespace inscribe::client {
@@ -46,6 +47,17 @@ std::string SetKeyOf(const std::string& mesh_key, std::mt19937_64& bits) {
 std::string HashOf(const Mesh& mesh) { return FormatSha256(MeshSha256(mesh)); }
 
 Deadline In(milliseconds ms) { return std::chrono::system_clock::now() + ms; }
+
+// Client options with `attempts` RPCs per call and a backoff longer than any test waits: a
+// call that succeeds within its 5 s timeout failed over without waiting.
+ClientOptions Attempts(int attempts) {
+  ClientOptions options;
+  options.default_timeout = milliseconds(5000);
+  options.retry.max_attempts = attempts;
+  options.retry.initial_backoff = milliseconds(60'000);
+  options.retry.max_backoff = milliseconds(60'000);
+  return options;
+}
 
 // `n` mock replicas ("replica-0", ...) behind one routed connection. Every RPC answers OK by
 // default and records which replica it reached (thread-safe). Not movable: the default
@@ -217,22 +229,19 @@ TEST(RoutedConnection, FailsOverInRendezvousOrderAndTriesADownReplicaLast) {
         fleet.Record(order[0]);
         return absl::UnavailableError("connection refused");
       });
-  v1::GetSphereSetRequest request;
-  request.set_sphere_set_key(key);
-  absl::StatusOr<v1::GetSphereSetResponse> got =
-      fleet.routed->GetSphereSet(request, In(milliseconds(5000)));
+  const Client client(fleet.routed, Attempts(3));
+  absl::StatusOr<StoredSphereSet> got = client.GetSphereSet(key);
   ASSERT_TRUE(got.ok()) << got.status();
   EXPECT_THAT(fleet.TakeCalls(), ElementsAre(order[0], order[1]));
 
   // The failed replica is now tried last: straight to the second.
-  ASSERT_TRUE(fleet.routed->GetSphereSet(request, In(milliseconds(5000))).ok());
+  ASSERT_TRUE(client.GetSphereSet(key).ok());
   EXPECT_THAT(fleet.TakeCalls(), ElementsAre(order[1]));
   // Also for other keys it owns; keys it does not own are unaffected.
   for (int k = 0; k < 50; ++k) {
-    v1::GetSphereSetRequest other;
-    other.set_sphere_set_key(SetKeyOf(MeshKey(bits), bits));
-    const std::vector<int> o = RendezvousOrder(wire::RouteKey(other.sphere_set_key()), fleet.names);
-    ASSERT_TRUE(fleet.routed->GetSphereSet(other, In(milliseconds(5000))).ok());
+    const std::string other = SetKeyOf(MeshKey(bits), bits);
+    const std::vector<int> o = RendezvousOrder(wire::RouteKey(other), fleet.names);
+    ASSERT_TRUE(client.GetSphereSet(other).ok());
     EXPECT_THAT(fleet.TakeCalls(), ElementsAre(o[0] == order[0] ? o[1] : o[0]));
   }
 
@@ -244,12 +253,59 @@ TEST(RoutedConnection, FailsOverInRendezvousOrderAndTriesADownReplicaLast) {
           return absl::UnavailableError("down " + std::to_string(i));
         });
   }
-  got = fleet.routed->GetSphereSet(request, In(milliseconds(5000)));
+  got = client.GetSphereSet(key);
   EXPECT_EQ(got.status().code(), absl::StatusCode::kUnavailable);
   // order[0] was marked down first, so it goes last.
   EXPECT_THAT(fleet.TakeCalls(), ElementsAre(order[1], order[2], order[0]));
   EXPECT_THAT(got.status().message(), HasSubstr("down " + std::to_string(order[0])));
-  for (const std::string& name : fleet.names) EXPECT_THAT(got.status().message(), HasSubstr(name));
+  EXPECT_THAT(got.status().message(), HasSubstr(fleet.names[order[0]]));
+  EXPECT_THAT(got.status().message(), HasSubstr("gave up after 3 attempts"));
+  EXPECT_FALSE(got.status().GetPayload(kRetryElsewherePayload).has_value());
+}
+
+// The retry and failover policy has one layer (connection.h): a call makes exactly
+// max_attempts RPCs however many replicas there are, each to a replica not yet tried while one
+// is left, failing over at once; a single server gets the backoff between attempts.
+TEST(RoutedConnection, ACallMakesMaxAttemptsRpcsInAll) {
+  for (const int replicas : {1, 2, 3, 5}) {
+    for (const int attempts : {1, 2, 3, 7}) {
+      SCOPED_TRACE(absl::StrCat(replicas, " replicas, ", attempts, " attempts"));
+      RoutingOptions routing;
+      routing.down_for = std::chrono::hours(1);
+      Fleet fleet(replicas, routing);
+      for (int i = 0; i < replicas; ++i) {
+        ON_CALL(*fleet.replicas[i], GetSphereSet(_, _))
+            .WillByDefault([&fleet, i](const v1::GetSphereSetRequest&, Deadline) {
+              fleet.Record(i);
+              return absl::StatusOr<v1::GetSphereSetResponse>(absl::UnavailableError("down"));
+            });
+      }
+      ClientOptions options;
+      options.retry.max_attempts = attempts;
+      options.retry.initial_backoff = milliseconds(40);
+      options.retry.max_backoff = milliseconds(40);
+      const Client client(fleet.routed, options);
+      const auto start = std::chrono::steady_clock::now();
+      const absl::StatusOr<StoredSphereSet> got =
+          client.GetSphereSet("spheres/v1/" + std::string(64, 'b'));
+      const double seconds =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      EXPECT_EQ(got.status().code(), absl::StatusCode::kUnavailable);
+      const std::vector<int> calls = fleet.TakeCalls();
+      EXPECT_EQ(static_cast<int>(calls.size()), attempts);
+      // Every replica is reached before any is tried twice.
+      for (int k = 0; k < static_cast<int>(calls.size()); ++k) {
+        EXPECT_EQ(calls[k], calls[k % replicas]) << k;
+        if (k < replicas) {
+          for (int j = 0; j < k; ++j) EXPECT_NE(calls[j], calls[k]);
+        }
+      }
+      if (replicas == 1) {
+        // A lone server: the backoff (jittered to 20-40 ms) before each further attempt.
+        EXPECT_GE(seconds, 0.02 * (attempts - 1));
+      }
+    }
+  }
 }
 
 TEST(RoutedConnection, ADownReplicaIsTriedFirstAgainAfterDownFor) {
@@ -266,12 +322,11 @@ TEST(RoutedConnection, ADownReplicaIsTriedFirstAgainAfterDownFor) {
             fleet.Record(owner);
             return absl::StatusOr<v1::GenerateResult>(GenerateOk());
           });
-  v1::GenerateRequest request;
-  request.set_mesh_sha256(key);
-  ASSERT_TRUE(fleet.routed->Generate(request, In(milliseconds(5000)), nullptr).ok());
+  const Client client(fleet.routed, Attempts(2));
+  ASSERT_TRUE(client.Generate(key, GenerateSettings{}).ok());
   EXPECT_THAT(fleet.TakeCalls(), ElementsAre(second));
   std::this_thread::sleep_for(milliseconds(200));  // > down_for
-  ASSERT_TRUE(fleet.routed->Generate(request, In(milliseconds(5000)), nullptr).ok());
+  ASSERT_TRUE(client.Generate(key, GenerateSettings{}).ok());
   EXPECT_THAT(fleet.TakeCalls(), ElementsAre(owner));
 }
 
@@ -462,11 +517,11 @@ TEST(RoutedConnection, RoundRobinSpreadsEvenlyAndFailsOver) {
   options.policy = RoutingPolicy::kRoundRobin;
   options.down_for = std::chrono::hours(1);
   Fleet fleet(3, options);
-  v1::GetSphereSetRequest request;
-  request.set_sphere_set_key("spheres/v1/" + std::string(64, 'a'));
+  const std::string key = "spheres/v1/" + std::string(64, 'a');
+  const Client client(fleet.routed, Attempts(3));
   std::vector<int> count(3, 0);
   for (int k = 0; k < 300; ++k) {
-    ASSERT_TRUE(fleet.routed->GetSphereSet(request, In(milliseconds(5000))).ok());
+    ASSERT_TRUE(client.GetSphereSet(key).ok());
     for (int i : fleet.TakeCalls()) ++count[i];
   }
   EXPECT_THAT(count, ElementsAre(100, 100, 100));
@@ -476,7 +531,7 @@ TEST(RoutedConnection, RoundRobinSpreadsEvenlyAndFailsOver) {
       .WillRepeatedly(Return(absl::UnavailableError("down")));
   std::fill(count.begin(), count.end(), 0);
   for (int k = 0; k < 300; ++k) {
-    ASSERT_TRUE(fleet.routed->GetSphereSet(request, In(milliseconds(5000))).ok());
+    ASSERT_TRUE(client.GetSphereSet(key).ok());
     for (int i : fleet.TakeCalls()) ++count[i];
   }
   EXPECT_EQ(count[1], 0);
@@ -497,26 +552,25 @@ TEST(RoutedConnection, ConcurrentCallsLoseNothingWhileAReplicaGoesDown) {
             return response;
           });
   constexpr int kThreads = 4, kCalls = 500;
+  const Client client(fleet.routed, Attempts(3));
   std::atomic<int> failed{0}, misrouted{0}, done{0}, moved{0};
   std::vector<std::thread> threads;
   for (int t = 0; t < kThreads; ++t) {
     threads.emplace_back([&, t] {
       std::mt19937_64 bits(100 + t);
       for (int c = 0; c < kCalls; ++c) {
-        v1::DistanceRequest request;
-        request.set_sphere_set_a(SetKeyOf(MeshKey(bits), bits));
-        const std::vector<int> order =
-            RendezvousOrder(wire::RouteKey(request.sphere_set_a()), fleet.names);
+        const std::string set_a = SetKeyOf(MeshKey(bits), bits);
+        const std::vector<int> order = RendezvousOrder(wire::RouteKey(set_a), fleet.names);
         const bool down_before = down.load();
-        absl::StatusOr<v1::DistanceResponse> answer =
-            fleet.routed->Distance(request, In(milliseconds(10'000)));
+        absl::StatusOr<DistanceBatchResult> answer =
+            client.Distance(set_a, set_a, {RigidPose{}}, {RigidPose{}});
         const bool down_after = down.load();
         if (!answer.ok()) {
           ++failed;
           continue;
         }
         // The owner answers, or (while it is down) its second choice; nobody else.
-        const int by = static_cast<int>(answer->seconds());
+        const int by = static_cast<int>(answer->server_seconds);
         const bool owner_ok = by == order[0] && !(down_before && order[0] == kDown);
         const bool second_ok = by == order[1] && order[0] == kDown && down_after;
         if (!owner_ok && !second_ok) ++misrouted;

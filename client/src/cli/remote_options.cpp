@@ -1,5 +1,6 @@
 #include "remote_options.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <iostream>
@@ -79,6 +80,9 @@ absl::StatusOr<client::Client> MakeClient(const RemoteOptions& options) {
     return client::Client(client::MakeGrpcConnection(targets[0], connection_options),
                           client_options);
   }
+  // Every replica can be reached within one call (each attempt fails over to the next).
+  client_options.retry.max_attempts =
+      std::max(client_options.retry.max_attempts, static_cast<int>(targets.size()));
   std::vector<client::Endpoint> endpoints;
   for (const std::string& target : targets) {
     endpoints.push_back({target, client::MakeGrpcConnection(target, connection_options)});

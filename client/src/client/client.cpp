@@ -24,16 +24,21 @@ std::chrono::milliseconds Backoff(const RetryPolicy& policy, int attempt) {
   return std::chrono::milliseconds(static_cast<std::int64_t>(ms));
 }
 
-// Runs `attempt` until it succeeds, fails with a code other than UNAVAILABLE, the attempts run
-// out, or the next wait would end past `deadline`. For idempotent calls only. Every attempt
-// gets the same (overall) deadline.
+// The retry and failover loop (see connection.h): runs `attempt` until it succeeds, fails with
+// a code other than UNAVAILABLE, the attempts run out, or the next wait would end past
+// `deadline`. An UNAVAILABLE carrying kRetryElsewherePayload (another replica can take the
+// call) is retried at once. For idempotent calls only. Every attempt gets the same (overall)
+// deadline.
 absl::Status RetryIdempotent(const RetryPolicy& policy, Deadline deadline,
                              const std::function<absl::Status(Deadline)>& attempt) {
   const int max_attempts = std::max(1, policy.max_attempts);
   for (int n = 1;; ++n) {
     absl::Status status = attempt(deadline);
     if (status.code() != absl::StatusCode::kUnavailable) return status;
-    const std::chrono::milliseconds wait = Backoff(policy, n);
+    const bool elsewhere = status.GetPayload(kRetryElsewherePayload).has_value();
+    status.ErasePayload(kRetryElsewherePayload);
+    const std::chrono::milliseconds wait =
+        elsewhere ? std::chrono::milliseconds(0) : Backoff(policy, n);
     if (n == max_attempts || std::chrono::system_clock::now() + wait >= deadline) {
       if (n == 1) return status;
       return absl::UnavailableError(

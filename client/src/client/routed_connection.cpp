@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "absl/strings/ascii.h"
+#include "absl/strings/cord.h"
 #include "absl/strings/escaping.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
@@ -95,13 +96,16 @@ class Replicas {
     return order;
   }
 
-  // Moves the replicas marked down to the end of `order`; returns how many are up.
+  // Moves the replicas marked down to the end of `order`, the one marked down longest ago
+  // first (so that attempts on a fleet that is all down go round it); returns how many are up.
   int LiveFirst(std::vector<int>& order) {
     const auto now = std::chrono::steady_clock::now();
     std::lock_guard<std::mutex> lock(mutex_);
-    return static_cast<int>(std::stable_partition(order.begin(), order.end(),
-                                                  [&](int i) { return down_until_[i] <= now; }) -
-                            order.begin());
+    const auto live_end = std::stable_partition(order.begin(), order.end(),
+                                                [&](int i) { return down_until_[i] <= now; });
+    std::stable_sort(live_end, order.end(),
+                     [&](int a, int b) { return down_until_[a] < down_until_[b]; });
+    return static_cast<int>(live_end - order.begin());
   }
 
   const std::vector<Endpoint> endpoints_;
@@ -119,7 +123,28 @@ struct Answer {
   int replica = -1;
 };
 
-// Runs `call` on the replicas of `order` until one answers with anything but UNAVAILABLE, the
+// One attempt of a unary call (see connection.h): `call` on the first replica of `order`. An
+// UNAVAILABLE answer marks that replica down and, when there is another replica, carries
+// kRetryElsewherePayload: the Client's next attempt goes to the next replica at once.
+template <typename Response>
+Answer<Response> CallFirst(Replicas& replicas, const std::vector<int>& order,
+                           const std::function<absl::StatusOr<Response>(Connection&)>& call) {
+  const int i = order.front();
+  Answer<Response> answer{call(replicas.connection(i)), i};
+  if (answer.response.status().code() != absl::StatusCode::kUnavailable) {
+    replicas.MarkUp(i);
+    return answer;
+  }
+  replicas.MarkDown(i);
+  absl::Status down(absl::StatusCode::kUnavailable,
+                    absl::StrCat(answer.response.status().message(), " (replica ",
+                                 replicas.name(i), ", one of ", replicas.size(), ")"));
+  if (replicas.size() > 1) down.SetPayload(kRetryElsewherePayload, absl::Cord());
+  return Answer<Response>{std::move(down), -1};
+}
+
+// For a DistanceStream, which the Client does not retry: runs `call` on the replicas of
+// `order` until one answers with anything but UNAVAILABLE, the
 // deadline passes (checked before each further replica; the first is always tried), or every
 // replica was tried; then returns the last replica's error, naming the replicas tried.
 template <typename Response>
@@ -293,8 +318,8 @@ class RoutedConnection final : public Connection {
   // One replica's counters: the first endpoint listed, or the next listed when it is down.
   absl::StatusOr<v1::CacheStatsResponse> CacheStats(const v1::CacheStatsRequest& request,
                                                     Deadline deadline) override {
-    return CallInOrder<v1::CacheStatsResponse>(
-               *replicas_, replicas_->ListedOrder(), deadline,
+    return CallFirst<v1::CacheStatsResponse>(
+               *replicas_, replicas_->ListedOrder(),
                [&](Connection& c) { return c.CacheStats(request, deadline); })
         .response;
   }
@@ -309,7 +334,8 @@ class RoutedConnection final : public Connection {
   template <typename Response>
   absl::StatusOr<Response> Call(absl::string_view route_key, Deadline deadline,
                                 const std::function<absl::StatusOr<Response>(Connection&)>& call) {
-    return CallInOrder<Response>(*replicas_, replicas_->Order(route_key), deadline, call).response;
+    static_cast<void>(deadline);  // the call itself carries it
+    return CallFirst<Response>(*replicas_, replicas_->Order(route_key), call).response;
   }
 
   // Puts on the replicas of `route_key`; when the key the answer names (`stored_key`) routes to
@@ -320,8 +346,8 @@ class RoutedConnection final : public Connection {
       const std::string& route_key, Deadline deadline,
       const std::function<absl::StatusOr<Response>(Connection&)>& put,
       const std::function<std::string(const Response&)>& stored_key) {
-    Answer<Response> first =
-        CallInOrder<Response>(*replicas_, replicas_->Order(route_key), deadline, put);
+    static_cast<void>(deadline);  // `put` carries it
+    Answer<Response> first = CallFirst<Response>(*replicas_, replicas_->Order(route_key), put);
     if (!first.response.ok() || replicas_->policy() != RoutingPolicy::kRendezvous) {
       return std::move(first.response);
     }
@@ -329,7 +355,7 @@ class RoutedConnection final : public Connection {
     if (stored_route == route_key) return std::move(first.response);
     const std::vector<int> order = replicas_->Order(stored_route);
     if (order.front() == first.replica) return std::move(first.response);
-    return CallInOrder<Response>(*replicas_, order, deadline, put).response;
+    return CallFirst<Response>(*replicas_, order, put).response;
   }
 
   const std::shared_ptr<Replicas> replicas_;

@@ -23,10 +23,14 @@
 
 namespace inscribe::client {
 
-// Retries of idempotent calls. Only UNAVAILABLE (server unreachable, restarting or shedding
-// connections) is retried: every other error would come back the same.
+// Retries and failover of idempotent calls: the one place they happen (see connection.h). Only
+// UNAVAILABLE (server unreachable, restarting or shedding connections) is retried: every other
+// error would come back the same. Each attempt is one RPC; over a routed connection each goes
+// to the best replica not known to be down, so failing over to the next replica is the next
+// attempt, made at once (no backoff) when the connection says another replica can take it.
 struct RetryPolicy {
-  // Attempts in total, the first included; 1 disables retries.
+  // RPCs in total for one call, the first included; 1 disables retries and failover. Give at
+  // least the number of replicas to let a call reach every one of them.
   int max_attempts = 3;
   // Wait before the second attempt; each further wait is `multiplier` times longer, capped at
   // max_backoff. Every wait is drawn uniformly from [50%, 100%] of that value (jitter), so that
@@ -210,8 +214,9 @@ class DistanceSession {
 };
 
 // Calls the service through a Connection, adding a deadline to every call and retrying
-// idempotent calls on UNAVAILABLE with exponential backoff. Thread-safe; cheap to copy (shares
-// the connection).
+// idempotent calls on UNAVAILABLE (RetryPolicy: exponential backoff, or at once when the
+// connection fails over to another replica). Thread-safe; cheap to copy (shares the
+// connection).
 class Client {
  public:
   explicit Client(std::shared_ptr<Connection> connection, ClientOptions options = {});

@@ -1,4 +1,12 @@
 // The transport under inscribe::client::Client: one attempt of each RPC, nothing more.
+//
+// Retry and failover policy, in one layer: the Client retries idempotent unary calls
+// (RetryPolicy) and every Connection call is exactly one RPC to one server. A routed connection
+// (routing.h) picks the server for each call; when it answers UNAVAILABLE the routed
+// connection marks it down and returns the error with kRetryElsewherePayload, so the Client's
+// next attempt goes to the next replica at once. The one exception is a DistanceStream, which
+// the Client does not retry: a routed stream that breaks is reopened on the next replica and
+// its frame resent (a frame is a pure query).
 #pragma once
 
 #include <chrono>
@@ -14,6 +22,11 @@ class ChannelCredentials;
 }  // namespace grpc
 
 namespace inscribe::client {
+
+// Type URL of the payload an UNAVAILABLE status carries when another server can take the call
+// now (a routed connection has marked the unreachable one down): the Client then makes its
+// next attempt without waiting for the backoff.
+inline constexpr char kRetryElsewherePayload[] = "type.inscribe.dev/retry-elsewhere";
 
 // Absolute time by which a call must be answered (the clock gRPC deadlines use).
 using Deadline = std::chrono::system_clock::time_point;
@@ -35,8 +48,8 @@ class DistanceStreamConnection {
   virtual absl::Status Finish() = 0;
 };
 
-// One method per RPC of inscribe.v1.Inscribe. Each call is a single attempt with the given
-// deadline: retries, backoff and default deadlines belong to Client. Errors carry the gRPC code
+// One method per RPC of inscribe.v1.Inscribe. Each call is a single attempt (one RPC) with the
+// given deadline: retries, backoff and default deadlines belong to Client. Errors carry the gRPC code
 // unchanged (UNAVAILABLE when the server cannot be reached, DEADLINE_EXCEEDED, the server's
 // INVALID_ARGUMENT / RESOURCE_EXHAUSTED, ...). Implementations are thread-safe.
 //

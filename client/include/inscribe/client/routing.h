@@ -1,7 +1,8 @@
 // Several inscribed replicas behind one Connection: each call goes to the replica that owns its
 // mesh (rendezvous hashing on the mesh hash), so a mesh's generation, hierarchies and distance
-// queries all land where they are cached; when that replica is down, the call fails over to
-// the next replica in the key's rendezvous order, without the caller seeing an error.
+// queries all land where they are cached; when that replica is down, the Client's next attempt
+// goes to the next replica in the key's rendezvous order (connection.h: retry and failover
+// policy), without the caller seeing an error.
 #pragma once
 
 #include <chrono>
@@ -43,9 +44,11 @@ struct RoutingOptions {
 std::vector<int> RendezvousOrder(absl::string_view route_key,
                                  const std::vector<std::string>& names);
 
-// A Connection routing each call over `endpoints` (at least one; names distinct). Idempotent
-// calls that get UNAVAILABLE from one replica go to the next before the deadline; the error
-// of the last replica tried is returned when none answered. A DistanceStream is routed by its
+// A Connection routing each call over `endpoints` (at least one; names distinct). Each unary
+// call is one RPC, to the first replica of the key's order that is not marked down (those
+// marked down go last, the one marked longest ago first); an UNAVAILABLE answer marks the
+// replica down for RoutingOptions::down_for and carries kRetryElsewherePayload, so that the
+// Client retries on the next replica at once. A DistanceStream is routed by its
 // first frame's first pair (set A), and reopened on the next replica, resending the frame, when
 // it breaks. Calls naming two sets (Distance, DistanceStream) need the others on the same
 // replica: sets of one mesh are, other meshes' only with a shared cache tier (inscribed

@@ -28,8 +28,8 @@
 
 #include "absl/strings/str_format.h"
 #include "inscribe/client/client.h"
-#include "inscribe/wire/convert.h"
 #include "inscribe/v1/service.grpc.pb.h"
+#include "inscribe/wire/convert.h"
 #include "support/inscribed_process.h"
 #include "support/synthetic_meshes.h"
 

@@ -27,9 +27,9 @@
 #include "absl/strings/str_join.h"
 #include "inscribe/client/client.h"
 #include "inscribe/client/routing.h"
-#include "inscribe/wire/keys.h"
 #include "inscribe/mesh_io.h"
 #include "inscribe/mesh_validation.h"
+#include "inscribe/wire/keys.h"
 #include "support/inscribed_process.h"
 #include "support/redis_process.h"
 

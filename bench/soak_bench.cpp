@@ -83,7 +83,8 @@ void Report(Record& record, Rpc rpc, const std::string& what, const absl::Status
 
 client::GenerateSettings Settings(const Model& model, int variant) {
   client::GenerateSettings settings;
-  settings.parameters.voxel_size = model.extent / (16.0 + 2.0 * variant);  // 16..30 voxels along the side
+  settings.parameters.voxel_size =
+      model.extent / (16.0 + 2.0 * variant);  // 16..30 voxels along the side
   settings.parameters.evaluate = false;
   return settings;
 }

@@ -305,7 +305,6 @@ class VoxelSearch {
   SearchParams params_;
 };
 
-
 }  // namespace
 
 absl::Status CheckMedialSphereOptions(const MedialSphereOptions& options, bool need_voxel_size) {
@@ -344,7 +343,8 @@ absl::StatusOr<MedialSphereResult> GenerateMedialSpheres(const BoundaryOracle& o
                                                          const MedialSphereOptions& options,
                                                          const GenerationControl& control) {
   const Clock::time_point start = Clock::now();
-  if (absl::Status status = CheckMedialSphereOptions(options, /*need_voxel_size=*/true); !status.ok()) {
+  if (absl::Status status = CheckMedialSphereOptions(options, /*need_voxel_size=*/true);
+      !status.ok()) {
     return status;
   }
   const Mesh& mesh = oracle.mesh();

@@ -13,18 +13,18 @@
 #include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
 #include "inscribe/mesh_io.h"
+#include "inscribe/robot/primitive_meshes.h"
 #include "inscribe/solid.h"
 #include "inscribe/sphere_set_generation.h"
-#include "inscribe/robot/primitive_meshes.h"
 
 namespace inscribe::robot {
 namespace {
 
 // An element ready for generation: a validated solid, or a sphere kept as it is.
 struct PreparedElement {
-  std::optional<Solid> solid;            // mesh elements
-  std::optional<Sphere> sphere;          // <sphere> elements, in the link frame
-  double volume = -1.0;                  // of the mesh (m^3); -1 for a sphere
+  std::optional<Solid> solid;    // mesh elements
+  std::optional<Sphere> sphere;  // <sphere> elements, in the link frame
+  double volume = -1.0;          // of the mesh (m^3); -1 for a sphere
 };
 
 // "line 12 (<collision> 'tool')", to start a skipped link's reason.

@@ -60,7 +60,6 @@ class BearerAuthenticator {
   using Digest = Sha256Digest;
   explicit BearerAuthenticator(std::vector<Digest> digests) : digests_(std::move(digests)) {}
 
-
   std::vector<Digest> digests_;
 };
 

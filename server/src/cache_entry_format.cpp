@@ -1,6 +1,5 @@
 #include "cache_entry_format.h"
 
-
 namespace inscribe::server {
 namespace {
 

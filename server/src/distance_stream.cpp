@@ -13,8 +13,8 @@
 
 #include "absl/strings/str_cat.h"
 #include "inscribe/separation_distance.h"
-#include "inscribe/wire/convert.h"
 #include "inscribe/server/inscribe_service.h"
+#include "inscribe/wire/convert.h"
 #include "memory_budget.h"
 #include "result_store.h"
 #include "service_checks.h"

@@ -26,6 +26,7 @@ absl::Status RunInspectMesh(const v1::InspectMeshRequest& request,
   if (!mesh.ok()) return mesh.status();
   ValidateOptions options;
   options.check_self_intersections = !request.skip_self_intersections();
+  options.fill_holes = request.fill_holes();
   const ValidatedMesh validated = ValidateMesh(*std::move(mesh), options);
   const MeshReport& report = validated.report;
   // As the CLI does: a hash over NaNs or dangling indices would key nothing usable.
@@ -166,8 +167,8 @@ absl::Status InscribeService::CheckMesh(const v1::Mesh& mesh) const {
   if (absl::Status shape = wire::CheckMeshShape(mesh); !shape.ok()) return shape;
   if (wire::TriangleCount(mesh) > limits_.max_triangles) {
     return absl::ResourceExhaustedError(absl::StrCat(
-        "mesh has ", wire::TriangleCount(mesh), " triangles; this server's limit (--max-triangles) is ",
-        limits_.max_triangles));
+        "mesh has ", wire::TriangleCount(mesh),
+        " triangles; this server's limit (--max-triangles) is ", limits_.max_triangles));
   }
   return absl::OkStatus();
 }
@@ -175,10 +176,11 @@ absl::Status InscribeService::CheckMesh(const v1::Mesh& mesh) const {
 grpc::ServerUnaryReactor* InscribeService::InspectMesh(grpc::CallbackServerContext* context,
                                                        const v1::InspectMeshRequest* request,
                                                        v1::InspectMeshResponse* response) {
-  return RunUnary(context, "InspectMesh", wire::TriangleCount(request->mesh()),
-                  CheckMesh(request->mesh()), MeshWorkBytes(request->mesh()),
-                  absl::StrCat("InspectMesh of ", wire::TriangleCount(request->mesh()), " triangles"),
-                  [request, response] { return RunInspectMesh(*request, response); });
+  return RunUnary(
+      context, "InspectMesh", wire::TriangleCount(request->mesh()), CheckMesh(request->mesh()),
+      MeshWorkBytes(request->mesh()),
+      absl::StrCat("InspectMesh of ", wire::TriangleCount(request->mesh()), " triangles"),
+      [request, response] { return RunInspectMesh(*request, response); });
 }
 
 }  // namespace inscribe::server

@@ -10,10 +10,10 @@
 
 #include "absl/strings/str_cat.h"
 #include "inscribe/mesh_hash.h"
-#include "inscribe/wire/convert.h"
 #include "inscribe/server/inscribe_service.h"
 #include "inscribe/sphere_deformation.h"
 #include "inscribe/sphere_quality.h"
+#include "inscribe/wire/convert.h"
 #include "memory_budget.h"
 #include "result_store.h"
 #include "service_checks.h"
@@ -24,7 +24,6 @@ namespace {
 // Boundary samples Evaluate takes at most: ~100 ms per million samples and 1,000 spheres on
 // one core, so this bounds a call to seconds, not hours.
 constexpr std::int64_t kMaxEvaluateSamples = 10'000'000;
-constexpr std::int64_t kDefaultEvaluateSamples = 100'000;
 
 // The mesh a call is about: the request's, else the one the set names. INVALID_ARGUMENT when
 // neither names one, or when they differ (contacts index one mesh's triangles).
@@ -143,8 +142,8 @@ grpc::ServerUnaryReactor* InscribeService::UpdateDeformation(
         options.direction = request->interpolated_normal() ? ContactDirection::kInterpolatedNormal
                                                            : ContactDirection::kCarriedFrame;
         // As the stored mesh's own oracle, unless the caller asks for ray parity.
-        options.oracle.inside_test = request->ray_parity() ? InsideTest::kRayParity
-                                                           : InsideTestFor((*mesh)->solid.report);
+        options.oracle.inside_test =
+            request->ray_parity() ? InsideTest::kRayParity : InsideTestFor((*mesh)->solid.report);
         absl::StatusOr<std::shared_ptr<const DeformerEntry>> entry =
             store_->GetDeformer(*mesh_key, request->sphere_set_key(), options);
         if (!entry.ok()) return entry.status();
@@ -201,30 +200,24 @@ grpc::ServerUnaryReactor* InscribeService::Evaluate(grpc::CallbackServerContext*
     precheck = absl::InvalidArgumentError(absl::StrCat(
         "samples is ", request->samples(), "; at most ", kMaxEvaluateSamples, " are taken"));
   }
-  if (precheck.ok() &&
-      !(std::isfinite(request->voxel_size()) && request->voxel_size() >= 0.0 &&
-        std::isfinite(request->coverage_tolerance()) && request->coverage_tolerance() >= 0.0)) {
-    precheck = absl::InvalidArgumentError(
-        absl::StrCat("voxel_size and coverage_tolerance must be finite and >= 0, got ",
-                     request->voxel_size(), " and ", request->coverage_tolerance()));
-  }
+  absl::StatusOr<QualityOptions> quality = wire::QualityOptionsFromProto(*request);
+  if (precheck.ok()) precheck = quality.status();
   // Samples and an inline set are in the request; a cached set's size is reserved on the pool.
-  const std::int64_t samples = request->samples() == 0
-                                   ? kDefaultEvaluateSamples
-                                   : std::max<std::int64_t>(request->samples(), 0);
+  const std::int64_t samples = quality.ok() ? quality->surface_samples : 0;
   const std::int64_t inline_spheres = request->sphere_set().radii_size();
   return RunUnary(
       context, "Evaluate", 0, precheck,
       std::min(samples, kMaxEvaluateSamples) * MemoryCosts::kPerSample +
           inline_spheres * MemoryCosts::kPerSphere + MemoryCosts::kSmallCall,
       absl::StrCat("Evaluate with ", samples, " samples and ", inline_spheres, " inline spheres"),
-      [this, request, response]() -> absl::Status {
+      [this, request, response, options = quality.value_or(QualityOptions())]() -> absl::Status {
         std::string mesh_key = request->mesh_sha256();
         std::shared_ptr<const SphereSetEntry> cached;
         MemoryBudget::Reservation cached_reservation;  // held until the report is made
         SphereSet inline_set;
         if (request->has_sphere_set()) {
-          absl::StatusOr<SphereSet> set = wire::SphereSetFromProto(request->sphere_set(), "sphere_set");
+          absl::StatusOr<SphereSet> set =
+              wire::SphereSetFromProto(request->sphere_set(), "sphere_set");
           if (!set.ok()) return set.status();
           inline_set = *std::move(set);
         } else {
@@ -244,16 +237,9 @@ grpc::ServerUnaryReactor* InscribeService::Evaluate(grpc::CallbackServerContext*
         }
         absl::StatusOr<std::shared_ptr<const StoredMeshEntry>> mesh = store_->GetMesh(mesh_key);
         if (!mesh.ok()) return mesh.status();
-        QualityOptions options;
-        options.surface_samples = request->samples() == 0  ? kDefaultEvaluateSamples
-                                  : request->samples() < 0 ? 0
-                                                           : request->samples();
-        options.voxel_size = request->voxel_size();
-        if (request->coverage_tolerance() > 0.0) {
-          options.coverage_tolerance = request->coverage_tolerance();
-        }
         const std::vector<Sphere>& spheres = cached ? cached->set.spheres : inline_set.spheres;
-        absl::StatusOr<QualityReport> report = EvaluateSpheres((*mesh)->solid.oracle, spheres, options);
+        absl::StatusOr<QualityReport> report =
+            EvaluateSpheres((*mesh)->solid.oracle, spheres, options);
         if (!report.ok()) return report.status();
         wire::QualityReportToProto(*report, response->mutable_quality());
         return absl::OkStatus();

@@ -14,8 +14,8 @@
 #include "absl/strings/str_format.h"
 #include "inscribe/medial_spheres.h"
 #include "inscribe/separation_distance.h"
-#include "inscribe/wire/convert.h"
 #include "inscribe/server/inscribe_service.h"
+#include "inscribe/wire/convert.h"
 #include "memory_budget.h"
 #include "mesh_sizes.h"
 #include "result_store.h"
@@ -26,8 +26,8 @@ namespace inscribe::server {
 grpc::ServerUnaryReactor* InscribeService::PutMesh(grpc::CallbackServerContext* context,
                                                    const v1::PutMeshRequest* request,
                                                    v1::PutMeshResponse* response) {
-  return RunUnary(context, "PutMesh", wire::TriangleCount(request->mesh()), CheckMesh(request->mesh()),
-                  MeshWorkBytes(request->mesh()),
+  return RunUnary(context, "PutMesh", wire::TriangleCount(request->mesh()),
+                  CheckMesh(request->mesh()), MeshWorkBytes(request->mesh()),
                   absl::StrCat("PutMesh of ", wire::TriangleCount(request->mesh()), " triangles"),
                   [this, request, response]() -> absl::Status {
                     absl::StatusOr<Mesh> mesh = wire::MeshFromProto(request->mesh());
@@ -241,8 +241,9 @@ absl::StatusOr<std::int64_t> InscribeService::GenerateWorkBytes(
     // A sphere budget N: the search starts at voxels of side ~diagonal / (2 sqrt N) (sphere
     // counts grow as (diagonal / sigma)^2 / 4) and refines from there; half that side, 8x the
     // voxels, bounds where it ends on the meshes measured (at most the --max-voxels grid).
-    const double sigma = 0.5 * size->extent.norm() /
-                         std::sqrt(std::max(static_cast<double>(*EffectiveMaxSpheres(parameters)), 1.0));
+    const double sigma =
+        0.5 * size->extent.norm() /
+        std::sqrt(std::max(static_cast<double>(*EffectiveMaxSpheres(parameters)), 1.0));
     if (sigma > 0.0) voxels = std::min(max_voxels, size->GridVoxels(0.5 * sigma));
   }
   // Subdivided boundary voxels hold up to 8 candidates each.
@@ -279,15 +280,52 @@ grpc::ServerUnaryReactor* InscribeService::GetSphereSet(grpc::CallbackServerCont
 grpc::ServerUnaryReactor* InscribeService::GetHierarchy(grpc::CallbackServerContext* context,
                                                         const v1::GetHierarchyRequest* request,
                                                         v1::GetHierarchyResponse* response) {
-  return RunUnary(
-      context, "GetHierarchy", 0, CheckKey(request->sphere_set_key(), "sphere_set_key"),
-      MemoryCosts::kSmallCall, "GetHierarchy", [this, request, response]() -> absl::Status {
-        absl::StatusOr<std::shared_ptr<const SphereHierarchy>> h =
-            store_->GetHierarchy(request->sphere_set_key(), wire::VolumeFromProto(request->volume()));
-        if (!h.ok()) return h.status();
-        response->set_hierarchy((*h)->Serialize());
-        return absl::OkStatus();
-      });
+  return RunUnary(context, "GetHierarchy", 0, CheckKey(request->sphere_set_key(), "sphere_set_key"),
+                  MemoryCosts::kSmallCall, "GetHierarchy",
+                  [this, request, response]() -> absl::Status {
+                    absl::StatusOr<std::shared_ptr<const SphereHierarchy>> h = store_->GetHierarchy(
+                        request->sphere_set_key(), wire::VolumeFromProto(request->volume()));
+                    if (!h.ok()) return h.status();
+                    response->set_hierarchy((*h)->Serialize());
+                    return absl::OkStatus();
+                  });
+}
+
+absl::Status InscribeService::BruteForceDistances(const v1::DistanceRequest& request,
+                                                  const std::vector<RigidPose>& poses_a,
+                                                  const std::vector<RigidPose>& poses_b,
+                                                  const DistanceRequest& tolerance,
+                                                  v1::DistanceResponse* response) {
+  // Every sphere pair of every pose pair: bounded, so that one call cannot occupy a worker for
+  // hours (10^10 pairs are about a minute).
+  constexpr double kMaxSpherePairs = 1e10;
+  absl::StatusOr<std::shared_ptr<const SphereSetEntry>> a =
+      store_->GetSphereSet(request.sphere_set_a());
+  if (!a.ok()) return a.status();
+  absl::StatusOr<std::shared_ptr<const SphereSetEntry>> b =
+      store_->GetSphereSet(request.sphere_set_b());
+  if (!b.ok()) return b.status();
+  const std::vector<Sphere>& sa = (*a)->set.spheres;
+  const std::vector<Sphere>& sb = (*b)->set.spheres;
+  const double work = static_cast<double>(sa.size()) * static_cast<double>(sb.size()) *
+                      static_cast<double>(poses_b.size());
+  if (work > kMaxSpherePairs) {
+    return absl::ResourceExhaustedError(
+        absl::StrCat("brute_force: ", work, " sphere pairs (", sa.size(), " x ", sb.size(), " x ",
+                     poses_b.size(), " poses); at most ", kMaxSpherePairs, " per call"));
+  }
+  const ServiceClock::time_point start = ServiceClock::now();
+  std::vector<DistanceResult> results(poses_b.size());
+  for (std::size_t i = 0; i < poses_b.size(); ++i) {
+    absl::StatusOr<DistanceResult> r = BruteForceSeparationDistance(
+        sa, poses_a[poses_a.size() == 1 ? 0 : i], sb, poses_b[i], tolerance);
+    if (!r.ok())
+      return absl::Status(r.status().code(), absl::StrCat("pose ", i, ": ", r.status().message()));
+    results[i] = *r;
+  }
+  wire::AppendDistanceResults(results, response->mutable_results());
+  response->set_seconds(SecondsSince(start));
+  return absl::OkStatus();
 }
 
 grpc::ServerUnaryReactor* InscribeService::Distance(grpc::CallbackServerContext* context,
@@ -331,6 +369,9 @@ grpc::ServerUnaryReactor* InscribeService::Distance(grpc::CallbackServerContext*
           return absl::InvalidArgumentError(
               absl::StrCat("poses_a has ", poses_a->size(), " poses and poses_b ", poses_b->size(),
                            "; poses_a must have one pose or as many as poses_b"));
+        }
+        if (request->brute_force()) {
+          return BruteForceDistances(*request, *poses_a, *poses_b, *tolerance, response);
         }
         const HierarchyVolume volume = wire::VolumeFromProto(request->volume());
         absl::StatusOr<std::shared_ptr<const SphereHierarchy>> a =

@@ -14,7 +14,7 @@ namespace {
 // error naming it, never a cast to the wrong type.
 template <typename T>
 absl::StatusOr<std::shared_ptr<const T>> ObjectOf(const CacheLookup& found,
-                                                 const std::string& key) {
+                                                  const std::string& key) {
   std::shared_ptr<const T> object = found.value->Get<T>();
   if (object == nullptr) {
     return absl::InternalError(
@@ -149,9 +149,9 @@ absl::StatusOr<std::pair<std::shared_ptr<const SphereSetEntry>, CacheSource>> Re
     const GenerationControl& control) {
   if (const std::optional<std::int64_t> budget = EffectiveMaxSpheres(parameters);
       budget && *budget > limits_.max_spheres) {
-    return absl::ResourceExhaustedError(
-        absl::StrCat("parameters.max_spheres is ", *budget,
-                     "; this server's limit (--max-spheres) is ", limits_.max_spheres));
+    return absl::ResourceExhaustedError(absl::StrCat("parameters.max_spheres is ", *budget,
+                                                     "; this server's limit (--max-spheres) is ",
+                                                     limits_.max_spheres));
   }
   const std::string key = wire::GeneratedSphereSetKey(mesh_key, parameters, fill_holes);
   // The mesh is looked up only when the result is not cached.

@@ -16,10 +16,10 @@
 #include "inscribe/mesh_validation.h"
 #include "inscribe/server/result_cache.h"
 #include "inscribe/solid.h"
-#include "inscribe/sphere_set_generation.h"
 #include "inscribe/sphere.h"
 #include "inscribe/sphere_deformation.h"
 #include "inscribe/sphere_hierarchy.h"
+#include "inscribe/sphere_set_generation.h"
 #include "inscribe/v1/service.pb.h"
 
 namespace inscribe::server {

@@ -10,10 +10,10 @@
 #include "absl/status/statusor.h"
 #include "absl/strings/str_cat.h"
 #include "inscribe/separation_distance.h"
-#include "inscribe/wire/convert.h"
 #include "inscribe/server/result_cache.h"
 #include "inscribe/sphere_hierarchy.h"
 #include "inscribe/v1/service.pb.h"
+#include "inscribe/wire/convert.h"
 #include "memory_budget.h"
 
 namespace inscribe::server {

@@ -169,8 +169,7 @@ class CliRemote : public ::testing::Test {
 };
 
 // What the server does not send (see generate_command.cpp) and what it adds.
-const Keys kGenerateTimings = {"seconds", "load_seconds", "evaluate_seconds",
-                               "dilation_seconds"};
+const Keys kGenerateTimings = {"seconds", "load_seconds", "evaluate_seconds", "dilation_seconds"};
 
 TEST_F(CliRemote, InfoPrintsTheSameReport) {
   RunBothJson("info --json " + Eight(), {"seconds"});
@@ -190,7 +189,7 @@ TEST_F(CliRemote, InfoOfAnUnusableMeshIsTheSameReportAndExitOne) {
   const nlohmann::json j = nlohmann::json::parse(remote.out);
   EXPECT_FALSE(j.at("usable").get<bool>());
   ExpectSameJson(nlohmann::json::parse(embedded.out), j, {"seconds"});
-  // --fill-holes is computed locally either way: the same repaired report.
+  // --fill-holes goes to the server too (InspectMesh fill_holes): the same repaired report.
   RunBothJson("info --json --fill-holes " + open_cube, {"seconds"});
 }
 
@@ -224,6 +223,9 @@ TEST_F(CliRemote, GenerateWritesTheSameSphereFile) {
 TEST_F(CliRemote, EvaluateGivesTheSameReport) {
   RunBothJson("evaluate --json " + Eight() + " " + Spheres(), {"evaluate_seconds"});
   RunBothJson("evaluate --json --samples 0 --voxel-size 0.05 " + Eight() + " " + Spheres(),
+              {"evaluate_seconds"});
+  // Exact coverage (tolerance 0) goes over the wire like any other tolerance.
+  RunBothJson("evaluate --json --samples 3000 --coverage-tolerance 0 " + Eight() + " " + Spheres(),
               {"evaluate_seconds"});
   auto [embedded, remote] = RunBoth("evaluate " + Eight() + " " + Spheres());
   auto drop_time = [](const std::string& text) {
@@ -288,17 +290,24 @@ TEST_F(CliRemote, DistanceGivesTheSameAnswers) {
   }
 }
 
-TEST_F(CliRemote, BruteForceDistanceWithAServerIsAUsageError) {
-  const CliRun run = RunCli("distance " + Spheres() + " " + Spheres() + " --poses " +
-                            Path("none.txt") + " --hierarchy none" + Server());
-  EXPECT_EQ(run.exit_code, 64);
-  EXPECT_THAT(run.err, HasSubstr("--hierarchy none"));
-  EXPECT_THAT(run.err, HasSubstr("--server"));
+TEST_F(CliRemote, BruteForceDistanceGoesOverTheWire) {
+  const std::string b = Path("eight_30.csv");
+  ASSERT_EQ(RunCli("generate " + Eight() + " --max-spheres 30 -o " + b).exit_code, 0);
+  const std::string poses = Path("poses_brute.txt");
+  std::ofstream(poses) << "1 0 0 0 0 0 0\n0.7071 0.7071 0 0 1.5 0 0\n1 0 0 0 -4 0 0\n";
+  const std::string args =
+      "distance " + Spheres() + " " + b + " --poses " + poses + " --hierarchy none";
+  const auto [embedded, remote] = RunBoth(args);
+  // Every sphere pair either way: the same rows to the bit.
+  EXPECT_EQ(embedded.out, remote.out);
+  RunBothJson(args + " --json", {"seconds", "us_per_query"},
+              {"threads", "build_seconds", "mean_volume_tests", "mean_sphere_tests"});
 }
 
 TEST_F(CliRemote, BadGenerateOptionsAreUsageErrorsEitherWay) {
-  for (const std::string bad : {"--screen-samples 5000", "--samples 1", "--dilate --dilation-growth 2",
-                                "--quality-samples -1", "--max-voxels 10 --voxel-size 0.01"}) {
+  for (const std::string bad :
+       {"--screen-samples 5000", "--samples 1", "--dilate --dilation-growth 2",
+        "--quality-samples -1", "--max-voxels 10 --voxel-size 0.01"}) {
     SCOPED_TRACE(bad);
     const auto [embedded, remote] = RunBoth("generate " + bad + " " + Eight(), 64);
     EXPECT_EQ(embedded.out, "");

@@ -243,8 +243,7 @@ TEST(PairSeparationDistances, EveryPairMatchesBruteForce) {
           sets[which[i].first], p.pose_a, sets[which[i].second], p.pose_b);
       ASSERT_TRUE(brute.ok());
       EXPECT_NEAR((*batch)[i].distance, brute->distance, 1e-12) << i;
-      ExpectWitnesses((*batch)[i], sets[which[i].first], p.pose_a, sets[which[i].second],
-                      p.pose_b);
+      ExpectWitnesses((*batch)[i], sets[which[i].first], p.pose_a, sets[which[i].second], p.pose_b);
     }
   }
 }

@@ -76,8 +76,8 @@ TEST(Solid, RealMeshesKeepTheirHash) {
   absl::StatusOr<Solid> solid = PrepareSolid(cow);
   ASSERT_TRUE(solid.ok()) << solid.status();
   EXPECT_EQ(InsideTestFor(solid->report), solid->report.self_intersecting_pairs > 0
-                                                ? InsideTest::kRayParity
-                                                : InsideTest::kPseudonormal);
+                                              ? InsideTest::kRayParity
+                                              : InsideTest::kPseudonormal);
   absl::StatusOr<Solid> again = MakeSolid(ValidateMesh(cow));
   ASSERT_TRUE(again.ok());
   EXPECT_EQ(again->sha256, solid->sha256);

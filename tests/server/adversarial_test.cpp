@@ -19,8 +19,8 @@
 #include <thread>
 #include <vector>
 
-#include "inscribe/wire/convert.h"
 #include "inscribe/v1/service.grpc.pb.h"
+#include "inscribe/wire/convert.h"
 #include "support/inscribed_process.h"
 #include "support/synthetic_meshes.h"
 

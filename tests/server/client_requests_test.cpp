@@ -250,7 +250,8 @@ TEST(Client, PutSphereSetAndEvaluateSendTheSetTheKeyAndTheSettings) {
       .WillOnce([](const v1::EvaluateRequest& request, Deadline) {
         EXPECT_EQ(request.spheres_case(), v1::EvaluateRequest::kSphereSetKey);
         EXPECT_EQ(request.sphere_set_key(), "spheres/v1/two");
-        EXPECT_EQ(request.samples(), -1);
+        EXPECT_TRUE(request.has_samples());
+        EXPECT_EQ(request.samples(), 0);
         EXPECT_EQ(request.voxel_size(), 0.25);
         EXPECT_EQ(request.coverage_tolerance(), 0.001);
         return EvaluateOk();
@@ -259,6 +260,8 @@ TEST(Client, PutSphereSetAndEvaluateSendTheSetTheKeyAndTheSettings) {
         EXPECT_EQ(request.spheres_case(), v1::EvaluateRequest::kSphereSet);
         EXPECT_THAT(request.sphere_set().radii(), ElementsAre(0.5));
         EXPECT_EQ(request.mesh_sha256(), "sha256:cube");
+        // Core's defaults stay off the wire.
+        EXPECT_FALSE(request.has_samples() || request.has_coverage_tolerance());
         return EvaluateOk();
       });
   Client client(connection);
@@ -268,7 +271,7 @@ TEST(Client, PutSphereSetAndEvaluateSendTheSetTheKeyAndTheSettings) {
   EXPECT_TRUE(put->already_stored);
 
   EvaluateSettings settings;
-  settings.samples = -1;
+  settings.surface_samples = 0;
   settings.voxel_size = 0.25;
   settings.coverage_tolerance = 0.001;
   absl::StatusOr<QualityReport> by_key = client.Evaluate("sha256:cube", "spheres/v1/two", settings);

@@ -319,7 +319,7 @@ TEST_F(ClientRpcTest, EvaluateByKeyAndInlineMatchesTheLibrary) {
   const Mesh mesh = testing::Icosphere(2);
   const GenerateResult generated = Generated(mesh, 0.2);
   EvaluateSettings settings;
-  settings.samples = 2000;
+  settings.surface_samples = 2000;
   settings.voxel_size = 0.2;
   settings.coverage_tolerance = 0.01;
   QualityOptions options;

@@ -11,8 +11,8 @@
 #include "inscribe/client/client.h"
 #include "inscribe/client/connection.h"
 #include "inscribe/mesh_validation.h"
-#include "inscribe/wire/convert.h"
 #include "inscribe/sphere_hierarchy.h"
+#include "inscribe/wire/convert.h"
 #include "support/synthetic_meshes.h"
 
 namespace inscribe::client {

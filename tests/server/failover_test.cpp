@@ -17,8 +17,8 @@
 
 #include "inscribe/client/client.h"
 #include "inscribe/client/routing.h"
-#include "inscribe/wire/keys.h"
 #include "inscribe/mesh_hash.h"
+#include "inscribe/wire/keys.h"
 #include "support/inscribed_process.h"
 #include "support/test_meshes.h"
 
@@ -143,8 +143,7 @@ TEST_F(FailoverTest, EachMeshComputesOnItsOwnReplicaAndItsKeysRouteTogether) {
   absl::StatusOr<GenerateResult> made = routed_->Generate(mesh, CoarseFor(mesh));
   ASSERT_TRUE(made.ok()) << made.status();
   const std::string route = made->mesh_sha256.substr(7, 16);
-  absl::StatusOr<PutSphereSetResult> uploaded =
-      routed_->PutSphereSet(made->set, made->mesh_sha256);
+  absl::StatusOr<PutSphereSetResult> uploaded = routed_->PutSphereSet(made->set, made->mesh_sha256);
   ASSERT_TRUE(uploaded.ok()) << uploaded.status();
   EXPECT_EQ(uploaded->sphere_set_key.substr(11, 16), route);
   DeformationSettings store;

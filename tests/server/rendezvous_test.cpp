@@ -30,7 +30,8 @@ TEST(RouteKey, IsTheMeshDigitsOfMeshAndSetKeys) {
   const std::string hex = "0123456789abcdef" + std::string(48, 'e');
   EXPECT_EQ(wire::RouteKey("sha256:" + hex), "0123456789abcdef");
   EXPECT_EQ(wire::RouteKey("spheres/v1/" + hex), "0123456789abcdef");
-  EXPECT_EQ(wire::RouteKey("spheres/v1/0123456789abcdef" + std::string(48, '7')), "0123456789abcdef");
+  EXPECT_EQ(wire::RouteKey("spheres/v1/0123456789abcdef" + std::string(48, '7')),
+            "0123456789abcdef");
   // Anything else routes as a whole.
   EXPECT_EQ(wire::RouteKey("sha256:0123456789ABCDEF" + std::string(48, 'e')),
             "sha256:0123456789ABCDEF" + std::string(48, 'e'));

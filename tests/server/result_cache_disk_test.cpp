@@ -127,8 +127,7 @@ TEST(ResultCacheDisk, EntrySurvivesRestartAndIsDecoded) {
   EXPECT_EQ(stats.disk_hits, 1);
   EXPECT_EQ(stats.memory_hits, 1);
   EXPECT_EQ(stats.misses + stats.computations + stats.disk_errors, 0);
-  EXPECT_EQ(stats.bytes,
-            static_cast<std::int64_t>(key.size() + payload.size()));
+  EXPECT_EQ(stats.bytes, static_cast<std::int64_t>(key.size() + payload.size()));
 
   auto other = OpenCache(1 << 20, dir.cache());  // Get reads the disk tier too
   auto got = other->Get(key, CountingDecode(&decodes));

@@ -3,7 +3,6 @@
 // of a moved key, DistanceStream failover, round robin, and concurrent calls while a replica
 // goes down. RouteKey and RendezvousOrder themselves: rendezvous_test.cpp.
 #include "inscribe/client/routing.h"
-#include "inscribe/wire/keys.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -16,9 +15,10 @@
 #include <set>
 #include <thread>
 
-#include "client_test_support.h"
 #include "absl/strings/str_cat.h"
+#include "client_test_support.h"
 #include "inscribe/mesh_hash.h"
+#include "inscribe/wire/keys.h"
 
 namespace inscribe::client {
 namespace {
@@ -82,7 +82,9 @@ class Fleet {
 
   // The replica rendezvous hashing gives `key` first, and the one after it.
   int Owner(const std::string& key) const { return RendezvousOrder(wire::RouteKey(key), names)[0]; }
-  int Second(const std::string& key) const { return RendezvousOrder(wire::RouteKey(key), names)[1]; }
+  int Second(const std::string& key) const {
+    return RendezvousOrder(wire::RouteKey(key), names)[1];
+  }
 
   // Replicas reached since the last call, in order.
   std::vector<int> TakeCalls() {

@@ -10,9 +10,9 @@
 #include "inscribe/client/client.h"
 #include "inscribe/mesh_hash.h"
 #include "inscribe/mesh_validation.h"
-#include "inscribe/wire/convert.h"
 #include "inscribe/server/inscribe_server.h"
 #include "inscribe/v1/service.grpc.pb.h"
+#include "inscribe/wire/convert.h"
 #include "support/synthetic_meshes.h"
 
 namespace inscribe::server {

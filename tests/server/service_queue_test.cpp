@@ -14,9 +14,9 @@
 #include "grpcpp/security/server_credentials.h"
 #include "grpcpp/server.h"
 #include "grpcpp/server_builder.h"
-#include "inscribe/wire/convert.h"
 #include "inscribe/server/inscribe_service.h"
 #include "inscribe/server/job_pool.h"
+#include "inscribe/wire/convert.h"
 #include "support/synthetic_meshes.h"
 
 namespace inscribe::server {

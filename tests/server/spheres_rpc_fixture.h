@@ -14,9 +14,9 @@
 
 #include "grpcpp/create_channel.h"
 #include "grpcpp/security/credentials.h"
-#include "inscribe/wire/convert.h"
 #include "inscribe/server/inscribe_server.h"
 #include "inscribe/v1/service.grpc.pb.h"
+#include "inscribe/wire/convert.h"
 
 namespace inscribe::server {
 

@@ -18,10 +18,10 @@
 #include "inscribe/mesh_hash.h"
 #include "inscribe/mesh_validation.h"
 #include "inscribe/separation_distance.h"
-#include "inscribe/wire/convert.h"
 #include "inscribe/server/inscribe_server.h"
 #include "inscribe/sphere_hierarchy.h"
 #include "inscribe/v1/service.grpc.pb.h"
+#include "inscribe/wire/convert.h"
 #include "spheres_rpc_fixture.h"
 #include "support/synthetic_meshes.h"
 

@@ -368,7 +368,7 @@ TEST_F(StreamRpcTest, DistanceStreamErrorEndsTheStreamNamingThePair) {
       pair->set_sphere_set_b(a.first);
       wire::PoseToProto(RigidPose{}, pair->mutable_pose_a());
       wire::PoseToProto(RigidPose{Eigen::Quaterniond::Identity(), Vector3(3, 0, 0)},
-                  pair->mutable_pose_b());
+                        pair->mutable_pose_b());
     }
     v1::DistanceFrameResult result;
     ASSERT_TRUE(stream->Write(frame));  // a good frame first

@@ -90,6 +90,24 @@ TEST(MeshReportConvert, RoundTripOfAnInvertedOpenMesh) {
   }
 }
 
+// Found by the CLI's remote --fill-holes: the repair's counts were not on the wire, so a
+// repaired mesh's report came back "not closed".
+TEST(MeshReportConvert, AHoleFilledReportStaysClosed) {
+  ValidateOptions fill;
+  fill.fill_holes = true;
+  const MeshReport report = ValidateMesh(testing::OpenUnitCube(), fill).report;
+  ASSERT_GT(report.holes_filled, 0);
+  ASSERT_TRUE(report.closed());
+  v1::MeshReport wire;
+  wire::MeshReportToProto(report, &wire);
+  absl::StatusOr<MeshReport> back = wire::MeshReportFromProto(wire);
+  ASSERT_TRUE(back.ok()) << back.status();
+  EXPECT_EQ(back->holes_filled, report.holes_filled);
+  EXPECT_EQ(back->hole_triangles_added, report.hole_triangles_added);
+  EXPECT_TRUE(back->closed());
+  EXPECT_EQ(back->usable(), report.usable());
+}
+
 TEST(MeshReportConvert, FixedSeverityRoundTrips) {
   const MeshReport report = ValidateMesh(testing::Inverted(testing::UnitCube())).report;
   v1::MeshReport wire;
@@ -223,8 +241,7 @@ TEST(GenerateParameters, BadRequestsNameTheProblem) {
 TEST(GeneratedSphereSet, RoundTripsEveryFigure) {
   GeneratedSphereSet g;
   g.set.spheres = {Sphere{Vector3(1, 2, 3), 0.5}, Sphere{Vector3(-1, 0, 0.25), 0.125}};
-  g.set.contacts = {SurfaceContact{3, Vector3(0.2, 0.3, 0.5)},
-                    SurfaceContact{0, Vector3(1, 0, 0)}};
+  g.set.contacts = {SurfaceContact{3, Vector3(0.2, 0.3, 0.5)}, SurfaceContact{0, Vector3(1, 0, 0)}};
   g.voxel_size = 0.0625;
   g.epsilon = 1e-4;
   g.runs = 6;
@@ -269,8 +286,7 @@ TEST(GeneratedSphereSet, RoundTripsEveryFigure) {
   ASSERT_TRUE(back.ok());
   EXPECT_FALSE(back->dilation.has_value() || back->quality.has_value());
   wire.mutable_spheres()->set_radii(0, -1.0);
-  EXPECT_EQ(GeneratedSphereSetFromProto(wire).status().code(),
-            absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(GeneratedSphereSetFromProto(wire).status().code(), absl::StatusCode::kInvalidArgument);
 }
 
 TEST(DeformedSpheres, RoundTripWithBounds) {

@@ -11,8 +11,9 @@
 namespace inscribe::wire {
 namespace {
 
-const std::string kMesh = "sha256:"
-                          "0123456789abcdef0123456789abcdef0123456789abcdef0123456789abcdef";
+const std::string kMesh =
+    "sha256:"
+    "0123456789abcdef0123456789abcdef0123456789abcdef0123456789abcdef";
 
 TEST(Keys, GeneratedKeysMatchVersionOneText) {
   SphereSetParameters by_size;

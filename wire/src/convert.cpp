@@ -1,8 +1,6 @@
 #include "inscribe/wire/convert.h"
 
-#include <algorithm>
 #include <cmath>
-#include <limits>
 
 #include "absl/strings/str_cat.h"
 
@@ -109,6 +107,8 @@ void MeshReportToProto(const MeshReport& report, v1::MeshReport* out) {
   out->set_flipped_triangles(report.flipped_triangles);
   out->set_self_intersections_checked(report.self_intersections_checked);
   out->set_self_intersecting_pairs(report.self_intersecting_pairs);
+  out->set_holes_filled(report.holes_filled);
+  out->set_hole_triangles_added(report.hole_triangles_added);
   out->set_volume(report.volume);
   out->clear_bbox_min();
   out->clear_bbox_max();
@@ -146,6 +146,8 @@ absl::StatusOr<MeshReport> MeshReportFromProto(const v1::MeshReport& report) {
   out.flipped_triangles = report.flipped_triangles();
   out.self_intersections_checked = report.self_intersections_checked();
   out.self_intersecting_pairs = report.self_intersecting_pairs();
+  out.holes_filled = report.holes_filled();
+  out.hole_triangles_added = report.hole_triangles_added();
   out.volume = report.volume();
   out.bbox.min = *lo;
   out.bbox.max = *hi;
@@ -378,247 +380,6 @@ absl::StatusOr<std::vector<DistanceResult>> DistanceResultsFromProto(
     r.closer = in.closer(i);
   }
   return out;
-}
-
-}  // namespace inscribe::wire
-
-namespace inscribe::wire {
-
-v1::HierarchyVolume VolumeToProto(HierarchyVolume volume) {
-  return volume == HierarchyVolume::kRss ? v1::RSS : v1::SPHERE;
-}
-
-HierarchyVolume VolumeFromProto(v1::HierarchyVolume volume) {
-  return volume == v1::RSS ? HierarchyVolume::kRss : HierarchyVolume::kSphere;
-}
-
-void ToleranceToProto(const DistanceRequest& tolerance, v1::DistanceTolerance* out) {
-  out->set_abs_err(tolerance.abs_err);
-  out->set_rel_err(tolerance.rel_err);
-  if (tolerance.closer_than != std::numeric_limits<double>::infinity()) {
-    out->set_closer_than(tolerance.closer_than);
-  }
-}
-
-absl::StatusOr<DistanceRequest> ToleranceFromProto(const v1::DistanceTolerance& t) {
-  DistanceRequest request;
-  request.abs_err = t.abs_err();
-  request.rel_err = t.rel_err();
-  if (t.has_closer_than()) request.closer_than = t.closer_than();
-  if (!(std::isfinite(request.abs_err) && request.abs_err >= 0.0 &&
-        std::isfinite(request.rel_err) && request.rel_err >= 0.0) ||
-      std::isnan(request.closer_than)) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "tolerance: abs_err and rel_err must be finite and >= 0 and closer_than a number, got ",
-        request.abs_err, ", ", request.rel_err, ", ", request.closer_than));
-  }
-  return request;
-}
-
-void GenerateRequestToProto(const std::string& mesh_sha256, const SphereSetParameters& p,
-                            bool fill_holes, v1::GenerateRequest* out) {
-  const SphereSetParameters defaults;
-  out->set_mesh_sha256(mesh_sha256);
-  v1::GenerateParameters* wire = out->mutable_parameters();
-  wire->Clear();
-  // The wire has no "neither": core's default budget goes as a budget.
-  if (p.voxel_size) {
-    wire->set_voxel_size(*p.voxel_size);
-  } else {
-    wire->set_max_spheres(*EffectiveMaxSpheres(p));
-  }
-  const MedialSphereOptions& m = p.medial;
-  const MedialSphereOptions& d = defaults.medial;
-  if (m.object_angle != d.object_angle) wire->set_object_angle(m.object_angle);
-  wire->set_epsilon(m.epsilon);
-  if (m.samples != d.samples) wire->set_samples(m.samples);
-  wire->set_subdivide_boundary(m.subdivide_boundary);
-  if (m.screen_samples != d.screen_samples) wire->set_screen_samples(m.screen_samples);
-  if (m.corner_screen != d.corner_screen) wire->set_corner_screen(m.corner_screen);
-  if (m.pair_angle_margin != d.pair_angle_margin) wire->set_pair_angle_margin(m.pair_angle_margin);
-  if (m.max_voxels != d.max_voxels) wire->set_max_voxels(m.max_voxels);
-  wire->set_dilate(p.dilate);
-  if (p.dilate && p.dilation.growth != defaults.dilation.growth) {
-    wire->set_dilation_growth(p.dilation.growth);
-  }
-  if (p.evaluate && p.quality.surface_samples != defaults.quality.surface_samples) {
-    wire->set_quality_samples(p.quality.surface_samples);
-  }
-  wire->set_fill_holes(fill_holes);
-  out->set_skip_quality(!p.evaluate);
-}
-
-absl::StatusOr<SphereSetParameters> SphereSetParametersFromProto(const v1::GenerateRequest& request,
-                                                                 std::int64_t max_voxels_limit) {
-  const v1::GenerateParameters& wire = request.parameters();
-  const bool by_size = wire.voxel_size() != 0.0, by_budget = wire.max_spheres() != 0;
-  if (by_size == by_budget) {
-    return absl::InvalidArgumentError(
-        "parameters: set exactly one of voxel_size (> 0) and max_spheres (> 0)");
-  }
-  SphereSetParameters p;
-  if (by_size) p.voxel_size = wire.voxel_size();
-  if (by_budget) p.max_spheres = wire.max_spheres();
-  MedialSphereOptions& m = p.medial;
-  // 0 means core's default for these three (proto3 scalars without presence).
-  if (wire.object_angle() != 0.0) m.object_angle = wire.object_angle();
-  m.epsilon = wire.epsilon();
-  if (wire.samples() != 0) m.samples = wire.samples();
-  m.subdivide_boundary = wire.subdivide_boundary();
-  if (wire.has_screen_samples()) m.screen_samples = wire.screen_samples();
-  if (wire.has_corner_screen()) m.corner_screen = wire.corner_screen();
-  if (wire.has_pair_angle_margin()) m.pair_angle_margin = wire.pair_angle_margin();
-  m.max_voxels = wire.max_voxels() > 0 ? std::min(wire.max_voxels(), max_voxels_limit)
-                                       : max_voxels_limit;
-  if (wire.max_voxels() < 0) m.max_voxels = wire.max_voxels();  // refused below
-  p.dilate = wire.dilate();
-  if (p.dilate && wire.has_dilation_growth()) p.dilation.growth = wire.dilation_growth();
-  p.evaluate = !request.skip_quality();
-  if (wire.has_quality_samples()) p.quality.surface_samples = wire.quality_samples();
-  if (absl::Status s = CheckSphereSetParameters(p); !s.ok()) {
-    return absl::InvalidArgumentError(absl::StrCat("parameters: ", s.message()));
-  }
-  return p;
-}
-
-namespace {
-
-void StatsToProto(const MedialSphereStats& s, v1::GenerationStats* out) {
-  out->set_grid_voxels(s.grid_voxels);
-  out->set_visited_voxels(s.visited_voxels);
-  out->set_boundary_voxels(s.boundary_voxels);
-  out->set_screened_voxels(s.screened_voxels);
-  out->set_crossing_pairs(s.crossing_pairs);
-  out->set_searched_pairs(s.searched_pairs);
-  out->set_candidates(s.candidates);
-  out->set_closest_point_queries(s.closest_point_queries);
-  out->set_seconds(s.seconds);
-}
-
-MedialSphereStats StatsFromProto(const v1::GenerationStats& s) {
-  MedialSphereStats out;
-  out.grid_voxels = s.grid_voxels();
-  out.visited_voxels = s.visited_voxels();
-  out.boundary_voxels = s.boundary_voxels();
-  out.screened_voxels = s.screened_voxels();
-  out.crossing_pairs = s.crossing_pairs();
-  out.searched_pairs = s.searched_pairs();
-  out.candidates = s.candidates();
-  out.closest_point_queries = s.closest_point_queries();
-  out.seconds = s.seconds();
-  return out;
-}
-
-void DilationToProto(const DilationResult& d, v1::DilationStats* out) {
-  out->set_v_points(d.v_points);
-  out->set_edge_points(d.edge_points);
-  out->set_degenerate(d.degenerate);
-  out->set_grown(d.grown);
-  out->set_max_growth(d.max_growth);
-  out->set_seconds(d.seconds);
-}
-
-DilationResult DilationFromProto(const v1::DilationStats& d) {
-  DilationResult out;
-  out.v_points = d.v_points();
-  out.edge_points = d.edge_points();
-  out.degenerate = d.degenerate();
-  out.grown = d.grown();
-  out.max_growth = d.max_growth();
-  out.seconds = d.seconds();
-  return out;
-}
-
-}  // namespace
-
-void GeneratedSphereSetToProto(const GeneratedSphereSet& g, v1::GenerateResult* out) {
-  SphereSetToProto(g.set, out->mutable_spheres());
-  out->set_voxel_size(g.voxel_size);
-  out->set_epsilon(g.epsilon);
-  out->set_search_runs(g.runs);
-  StatsToProto(g.stats, out->mutable_stats());
-  if (g.dilation) DilationToProto(*g.dilation, out->mutable_dilation());
-  if (g.quality) QualityReportToProto(*g.quality, out->mutable_quality());
-  out->set_generation_seconds(g.generation_seconds);
-  out->set_seconds(g.seconds);
-}
-
-absl::StatusOr<GeneratedSphereSet> GeneratedSphereSetFromProto(const v1::GenerateResult& result) {
-  absl::StatusOr<SphereSet> set = SphereSetFromProto(result.spheres());
-  if (!set.ok()) return set.status();
-  GeneratedSphereSet g;
-  g.set = *std::move(set);
-  g.voxel_size = result.voxel_size();
-  g.epsilon = result.epsilon();
-  g.runs = result.search_runs();
-  g.stats = StatsFromProto(result.stats());
-  if (result.has_dilation()) g.dilation = DilationFromProto(result.dilation());
-  if (result.has_quality()) g.quality = QualityReportFromProto(result.quality());
-  g.generation_seconds = result.generation_seconds();
-  g.seconds = result.seconds();
-  return g;
-}
-
-void DeformedSpheresToProto(const DeformedSpheres& moved, v1::UpdateDeformationResponse* out) {
-  SphereSetToProto(moved.set, out->mutable_spheres());
-  out->mutable_reference_index()->Assign(moved.reference_index.begin(),
-                                         moved.reference_index.end());
-  out->set_xi(moved.xi);
-  out->set_max_protrusion(moved.max_protrusion);
-  out->set_shrunk(moved.shrunk);
-  out->set_dropped(moved.dropped);
-  out->set_closest_point_queries(moved.closest_point_queries);
-  out->set_max_shrink_steps(moved.max_shrink_steps);
-  out->set_seconds(moved.seconds);
-}
-
-absl::StatusOr<DeformedSpheres> DeformedSpheresFromProto(
-    const v1::UpdateDeformationResponse& response) {
-  absl::StatusOr<SphereSet> set = SphereSetFromProto(response.spheres());
-  if (!set.ok()) return set.status();
-  if (static_cast<std::size_t>(response.reference_index_size()) != set->size()) {
-    return absl::InvalidArgumentError(absl::StrCat("reference_index has ",
-                                                   response.reference_index_size(),
-                                                   " entries for ", set->size(), " spheres"));
-  }
-  DeformedSpheres moved;
-  moved.set = *std::move(set);
-  moved.reference_index.assign(response.reference_index().begin(),
-                               response.reference_index().end());
-  moved.xi = response.xi();
-  moved.max_protrusion = response.max_protrusion();
-  moved.shrunk = response.shrunk();
-  moved.dropped = response.dropped();
-  moved.closest_point_queries = response.closest_point_queries();
-  moved.max_shrink_steps = response.max_shrink_steps();
-  moved.seconds = response.seconds();
-  return moved;
-}
-
-void DeformationBoundsToProto(const DeformationErrorBounds& bounds,
-                              v1::UpdateDeformationResponse* out) {
-  out->set_nerr_lower(bounds.nerr_lower);
-  out->set_nerr_upper(bounds.nerr_upper);
-  out->set_nerr_is_exact(bounds.exact);
-  out->set_volume_mesh(bounds.volume_mesh);
-  out->set_volume_union(bounds.volume_union);
-  if (bounds.uniform_xi_holds) out->set_nerr_upper_uniform_xi(bounds.nerr_upper_uniform_xi);
-  out->set_bounds_seconds(bounds.seconds);
-}
-
-DeformationErrorBounds DeformationBoundsFromProto(const v1::UpdateDeformationResponse& response) {
-  DeformationErrorBounds bounds;
-  bounds.nerr_lower = response.nerr_lower();
-  bounds.nerr_upper = response.nerr_upper();
-  bounds.exact = response.nerr_is_exact();
-  bounds.volume_mesh = response.volume_mesh();
-  bounds.volume_union = response.volume_union();
-  bounds.uniform_xi_holds = response.has_nerr_upper_uniform_xi();
-  bounds.nerr_upper_uniform_xi = bounds.uniform_xi_holds
-                                     ? response.nerr_upper_uniform_xi()
-                                     : std::numeric_limits<double>::infinity();
-  bounds.seconds = response.bounds_seconds();
-  return bounds;
 }
 
 }  // namespace inscribe::wire

@@ -84,9 +84,8 @@ std::string GeneratedSphereSetKey(const std::string& mesh_key, const SphereSetPa
 std::string UploadedSphereSetKey(const std::string& mesh_key, const std::string& derived_from,
                                  absl::string_view spheres_bytes) {
   const std::string prefix = RoutePrefix(mesh_key.empty() ? derived_from : mesh_key);
-  return "spheres/v1/" +
-         DerivedKeyHex(prefix, absl::StrCat(kUploadedSetVersion, "\n", mesh_key, "\n",
-                                            spheres_bytes));
+  return "spheres/v1/" + DerivedKeyHex(prefix, absl::StrCat(kUploadedSetVersion, "\n", mesh_key,
+                                                            "\n", spheres_bytes));
 }
 
 std::string DeformerKey(const std::string& mesh_key, const std::string& set_key,

@@ -245,14 +245,13 @@ void PrintText(const DeformCliOptions& options, const client::DeformationResult&
   const DeformationErrorBounds& bounds = *result.bounds;
   line("reference", options.reference_path);
   line("deformed", options.deformed_path);
-  line("spheres", absl::StrFormat("%d (%d shrunk, %d dropped)", result.set.size(),
-                                  result.shrunk, result.dropped));
+  line("spheres", absl::StrFormat("%d (%d shrunk, %d dropped)", result.set.size(), result.shrunk,
+                                  result.dropped));
   line("xi", absl::StrFormat("%.6g", result.xi));
   line("max protrusion", absl::StrFormat("%.6g", result.max_protrusion));
   line(bounds.exact ? "nerr (exact)" : "nerr bounds (Lemmas 1, 2)",
-       bounds.exact
-           ? absl::StrFormat("%.6f", bounds.nerr_lower)
-           : absl::StrFormat("%.6f .. %.6f", bounds.nerr_lower, bounds.nerr_upper));
+       bounds.exact ? absl::StrFormat("%.6f", bounds.nerr_lower)
+                    : absl::StrFormat("%.6f .. %.6f", bounds.nerr_lower, bounds.nerr_upper));
   line("update", absl::StrFormat("%.4f s (%d closest-point queries)", result.seconds,
                                  result.closest_point_queries));
   line("bounds", absl::StrFormat("%.4f s", bounds.seconds));
@@ -320,16 +319,11 @@ int RunDeform(const DeformCliOptions& options) {
        std::string(options.interpolated_normal ? "interpolated_normal" : "carried_frame")},
   };
   out.stats = {
-      {"seconds", result->seconds},
-      {"bounds_seconds", bounds.seconds},
-      {"volume_mesh", bounds.volume_mesh},
-      {"volume_union", bounds.volume_union},
-      {"nerr_lower", bounds.nerr_lower},
-      {"nerr_upper", bounds.nerr_upper},
-      {"nerr_is_exact", bounds.exact},
-      {"max_protrusion", result->max_protrusion},
-      {"shrunk", result->shrunk},
-      {"dropped", result->dropped},
+      {"seconds", result->seconds},        {"bounds_seconds", bounds.seconds},
+      {"volume_mesh", bounds.volume_mesh}, {"volume_union", bounds.volume_union},
+      {"nerr_lower", bounds.nerr_lower},   {"nerr_upper", bounds.nerr_upper},
+      {"nerr_is_exact", bounds.exact},     {"max_protrusion", result->max_protrusion},
+      {"shrunk", result->shrunk},          {"dropped", result->dropped},
   };
   if (const int code =
           EmitSphereFile(out, options.output_path, options.format, options.json, options.link);

@@ -131,6 +131,7 @@ std::optional<Distances> DistancesRemotely(const DistanceCliOptions& options, co
   }
   client::DistanceOptions call;
   call.volume = options.hierarchy == "sphere" ? HierarchyVolume::kSphere : HierarchyVolume::kRss;
+  call.brute_force = options.hierarchy == "none";
   call.tolerance = options.request;
   const std::vector<RigidPose> origin = {RigidPose()};
   Distances d;
@@ -192,11 +193,6 @@ void PrintSummary(const DistanceCliOptions& options, const SphereSet& a, const S
 }
 
 int RunDistance(const DistanceCliOptions& options) {
-  if (options.remote.enabled() && options.hierarchy == "none") {
-    std::cerr << "inscribe: --hierarchy none (every sphere pair, in this process) cannot be "
-                 "used with --server; the server answers with --hierarchy sphere or rss\n";
-    return kExitUsage;
-  }
   absl::StatusOr<SphereFile> a = ReadSphereFile(options.a_path, options.a_read);
   if (!a.ok()) {
     std::cerr << "inscribe: " << a.status().message() << "\n";
@@ -265,7 +261,7 @@ void AddDistanceCommand(CLI::App& app, int* exit_code) {
       ->required();
   cmd->add_option("--hierarchy", options->hierarchy,
                   "Bounding volumes: sphere (default: the fastest on the Table II benchmark), "
-                  "rss (the paper's), or none (every sphere pair; not with --server)")
+                  "rss (the paper's), or none (every sphere pair)")
       ->check(CLI::IsMember({"rss", "sphere", "none"}));
   cmd->add_option("--abs-err", options->request.abs_err,
                   "Answers may exceed the true distance by this much (mesh units)")

@@ -11,8 +11,8 @@
 #include "exit_codes.h"
 #include "inscribe/sphere_io.h"
 #include "inscribe/sphere_quality.h"
-#include "remote_options.h"
 #include "inscribe/view/report_json.h"
+#include "remote_options.h"
 #include "solid_loading.h"
 
 namespace inscribe::cli {
@@ -76,7 +76,8 @@ std::optional<Evaluated> EvaluateHere(const EvaluateCliOptions& options, const S
   std::optional<LoadedSolid> solid =
       LoadSolid(options.mesh_path, exit_code, LoadSolidOptions{options.fill_holes});
   if (!solid) return std::nullopt;
-  absl::StatusOr<QualityReport> report = EvaluateSpheres(solid->solid.oracle, file.set.spheres, quality);
+  absl::StatusOr<QualityReport> report =
+      EvaluateSpheres(solid->solid.oracle, file.set.spheres, quality);
   if (!report.ok()) {
     std::cerr << "inscribe: " << report.status().message() << "\n";
     *exit_code = report.status().code() == absl::StatusCode::kInvalidArgument ? kExitBadInput
@@ -95,12 +96,7 @@ std::optional<Evaluated> EvaluateRemotely(const EvaluateCliOptions& options, con
   std::optional<UploadedSolid> solid =
       UploadSolid(client, options.remote, options.mesh_path, exit_code, {options.fill_holes});
   if (!solid) return std::nullopt;
-  client::EvaluateSettings settings;
-  // The wire's 0 means the default; "no samples" is negative there.
-  settings.samples = quality.surface_samples > 0 ? quality.surface_samples : -1;
-  settings.voxel_size = quality.voxel_size;
-  settings.coverage_tolerance = std::max(quality.coverage_tolerance, 0.0);
-  absl::StatusOr<QualityReport> report = client.Evaluate(solid->sha256, file.set, settings);
+  absl::StatusOr<QualityReport> report = client.Evaluate(solid->sha256, file.set, quality);
   if (!report.ok()) {
     *exit_code = ReportRemoteError(report.status(), options.remote);
     return std::nullopt;
@@ -109,11 +105,6 @@ std::optional<Evaluated> EvaluateRemotely(const EvaluateCliOptions& options, con
 }
 
 int RunEvaluate(const EvaluateCliOptions& options) {
-  if (options.remote.enabled() && options.quality.coverage_tolerance == 0.0) {
-    // On the wire 0 asks for the default (1e-3 of the diagonal), not for exact coverage.
-    std::cerr << "inscribe: --coverage-tolerance 0 cannot be used with --server\n";
-    return kExitUsage;
-  }
   int exit_code = kExitOk;
   SphereFileReadOptions read;
   if (!options.format.empty()) read.format = *ParseSphereFileFormat(options.format);

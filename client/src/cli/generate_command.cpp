@@ -12,9 +12,9 @@
 #include "exit_codes.h"
 #include "inscribe/sphere_io.h"
 #include "inscribe/sphere_set_generation.h"
+#include "inscribe/view/report_json.h"
 #include "progress_bar.h"
 #include "remote_options.h"
-#include "inscribe/view/report_json.h"
 #include "solid_loading.h"
 #include "sphere_output.h"
 
@@ -236,8 +236,8 @@ void AddGenerateCommand(CLI::App& app, int* exit_code) {
       "Approximate a closed mesh by internal medial spheres (at most one per voxel); prints "
       "the sphere-set JSON unless -o or --json says otherwise");
   cmd->add_option("MESH", options->mesh_path, "Mesh file (.off, .obj, .stl, .ply)")->required();
-  CLI::Option* voxel =
-      cmd->add_option("--voxel-size", options->parameters.voxel_size, "Voxel side sigma, mesh units");
+  CLI::Option* voxel = cmd->add_option("--voxel-size", options->parameters.voxel_size,
+                                       "Voxel side sigma, mesh units");
   CLI::Option* budget = cmd->add_option(
       "--max-spheres", options->parameters.max_spheres,
       "Finest voxel grid giving at most N spheres (default mode, N = 500); the search's runs "

@@ -11,8 +11,8 @@
 #include "inscribe/mesh_hash.h"
 #include "inscribe/mesh_io.h"
 #include "inscribe/mesh_validation.h"
-#include "remote_options.h"
 #include "inscribe/view/report_json.h"
+#include "remote_options.h"
 
 namespace inscribe::cli {
 
@@ -102,11 +102,10 @@ int RunInfo(const InfoOptions& options) {
     return kExitBadInput;
   }
   InfoResult result;
-  // The server's InspectMesh does not fill holes, so --fill-holes validates here even with
-  // --server (its output is then exactly the embedded one).
-  if (options.remote.enabled() && !options.fill_holes) {
+  if (options.remote.enabled()) {
     client::InspectMeshOptions inspect;
     inspect.skip_self_intersections = options.skip_self_intersections;
+    inspect.fill_holes = options.fill_holes;
     absl::StatusOr<client::Client> client = MakeClient(options.remote);
     if (!client.ok()) return ReportRemoteError(client.status(), options.remote);
     absl::StatusOr<client::InspectMeshResult> inspected = client->InspectMesh(*mesh, inspect);
@@ -130,7 +129,7 @@ int RunInfo(const InfoOptions& options) {
       j["hole_triangles_added"] = report.hole_triangles_added;
     }
     j["seconds"] = result.seconds;
-    if (options.remote.enabled() && !options.fill_holes) j["server"] = options.remote.server;
+    if (options.remote.enabled()) j["server"] = options.remote.server;
     std::cout << j.dump() << "\n";
   } else {
     PrintText(options.path, result);
@@ -154,8 +153,7 @@ void AddInfoCommand(CLI::App& app, int* exit_code) {
                 "Skip the exact self-intersection test (faster on huge meshes)");
   cmd->add_flag("--fill-holes", options->fill_holes,
                 "Close every hole (border loop) with triangles between its border vertices, "
-                "then validate, hash and describe the repaired mesh (done in this process even "
-                "with --server: the server's InspectMesh does not fill holes)");
+                "then validate, hash and describe the repaired mesh");
   AddRemoteOptions(cmd, &options->remote, 60.0);
   cmd->callback([options, exit_code] { *exit_code = RunInfo(*options); });
 }

@@ -16,21 +16,21 @@
 #include "absl/strings/str_format.h"
 #include "exit_codes.h"
 #include "inscribe/atomic_file.h"
-#include "nlohmann/json.hpp"
 #include "inscribe/robot/spherized_urdf.h"
 #include "inscribe/robot/urdf_robot.h"
 #include "inscribe/robot/urdf_spherize.h"
+#include "nlohmann/json.hpp"
 
 namespace inscribe::cli {
 
 using robot::LinkSpherizeResult;
-using robot::PackageSearchFromEnvironment;
 using robot::LinkStatus;
 using robot::LinkStatusName;
+using robot::PackageSearchFromEnvironment;
 using robot::ParseUrdf;
-using robot::SpherizeLink;
 using robot::SpherizedCuroboYaml;
 using robot::SpherizedUrdf;
+using robot::SpherizeLink;
 using robot::UrdfLink;
 using robot::UrdfRobot;
 using robot::UrdfSpherizeOptions;

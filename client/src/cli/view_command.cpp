@@ -18,25 +18,16 @@
 #include "absl/strings/str_format.h"
 #include "exit_codes.h"
 #include "inscribe/atomic_file.h"
-#include "inscribe/envelope_distances.h"
 #include "inscribe/sphere_io.h"
 #include "inscribe/sphere_quality.h"
-#include "inscribe/view/signed_histogram.h"
+#include "inscribe/view/view_report.h"
 #include "solid_loading.h"
-#include "inscribe/view/view_report_html.h"
 
 namespace inscribe::cli {
 
-using view::MakeSignedHistogram;
-using view::ViewPageData;
-using view::ViewPageFacts;
-using view::ViewPageHtml;
 namespace {
 
 namespace fs = std::filesystem;
-
-// Bins per histogram: Fig. 7's resolution, fine enough to see both tails.
-constexpr int kHistogramBins = 60;
 
 struct ViewCliOptions {
   std::string mesh_path;
@@ -122,61 +113,25 @@ int RunView(const ViewCliOptions& options) {
               << file->mesh_sha256 << ", not " << solid->solid.sha256 << "\n";
   }
 
-  const auto evaluate_start = std::chrono::steady_clock::now();
-  QualityOptions quality;
-  quality.surface_samples = options.samples;
-  quality.seed = options.seed;
-  quality.voxel_size = FileVoxelSize(*file);
-  absl::StatusOr<QualityReport> report = EvaluateSpheres(solid->solid.oracle, spheres, quality);
-  if (!report.ok()) {
-    std::cerr << "inscribe: " << report.status().message() << "\n";
-    return report.status().code() == absl::StatusCode::kInvalidArgument ? kExitBadInput
-                                                                        : kExitUnusableMesh;
-  }
-  std::vector<double> protrusion = SphereProtrusions(solid->solid.oracle, spheres);
-  const double evaluate_seconds = SecondsSince(evaluate_start);
-
-  EnvelopeDistanceRequest request;
-  request.boundary_samples = options.samples;
-  request.envelope_samples = options.samples;
-  request.seed = options.seed;
-  absl::StatusOr<EnvelopeDistanceResult> envelope =
-      ComputeEnvelopeDistances(solid->solid.oracle, spheres, request);
-  if (!envelope.ok()) {
+  view::ViewReportOptions report;
+  report.samples = options.samples;
+  report.seed = options.seed;
+  report.voxel_size = FileVoxelSize(*file);
+  report.mesh_name = fs::path(options.mesh_path).filename().string();
+  report.spheres_name = fs::path(options.spheres_path).filename().string();
+  report.title =
+      !options.title.empty() ? options.title : report.mesh_name + " \u00b7 " + report.spheres_name;
+  report.load_seconds = solid->seconds;
+  const absl::StatusOr<std::string> page = view::MakeViewReportPage(solid->solid, spheres, report);
+  if (!page.ok()) {
     // INVALID_ARGUMENT and RESOURCE_EXHAUSTED (an envelope too small to sample: thousands of
     // copies of one ball) are the sphere set's; anything else is a bug.
-    const absl::StatusCode code = envelope.status().code();
+    const absl::StatusCode code = page.status().code();
     const bool bad_input =
         code == absl::StatusCode::kInvalidArgument || code == absl::StatusCode::kResourceExhausted;
     std::cerr << "inscribe: " << (bad_input ? options.spheres_path + ": " : "internal error: ")
-              << envelope.status().message() << "\n";
+              << page.status().message() << "\n";
     return bad_input ? kExitBadInput : kExitInternal;
-  }
-
-  ViewPageFacts facts;
-  facts.mesh_name = fs::path(options.mesh_path).filename().string();
-  facts.spheres_name = fs::path(options.spheres_path).filename().string();
-  facts.title =
-      !options.title.empty() ? options.title : facts.mesh_name + " \u00b7 " + facts.spheres_name;
-  facts.mesh_sha256 = solid->solid.sha256;
-  facts.quality = *report;
-  facts.protrusion = std::move(protrusion);
-  // Histograms at least 1e-9 of the diagonal wide: the rounding of exact-distance radii.
-  const double min_range = std::max(1e-9 * report->bbox_diagonal, 1e-300);
-  facts.boundary_to_envelope =
-      MakeSignedHistogram(envelope->boundary_to_envelope, kHistogramBins, min_range);
-  facts.envelope_to_boundary =
-      MakeSignedHistogram(envelope->envelope_to_boundary, kHistogramBins, min_range);
-  facts.envelope_area = envelope->envelope_area;
-  facts.load_seconds = solid->seconds;
-  facts.evaluate_seconds = evaluate_seconds;
-  facts.envelope_seconds = envelope->seconds;
-
-  const absl::StatusOr<std::string> page =
-      ViewPageHtml(ViewPageData(solid->solid.oracle.mesh(), spheres, facts), facts.title);
-  if (!page.ok()) {
-    std::cerr << "inscribe: internal error: " << page.status().message() << "\n";
-    return kExitInternal;
   }
   if (absl::Status written = WriteFileAtomically(output, *page); !written.ok()) {
     std::cerr << "inscribe: " << written.message() << "\n";

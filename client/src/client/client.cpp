@@ -9,7 +9,6 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/string_view.h"
 #include "inscribe/wire/convert.h"
-#include "inscribe/wire/convert.h"
 
 namespace inscribe::client {
 namespace {
@@ -113,9 +112,7 @@ absl::StatusOr<GenerateResult> GenerateUntil(Connection& connection, const Retry
 absl::StatusOr<QualityReport> EvaluateUntil(Connection& connection, const RetryPolicy& retry,
                                             v1::EvaluateRequest& request,
                                             const EvaluateSettings& settings, Deadline deadline) {
-  request.set_samples(settings.samples);
-  request.set_voxel_size(settings.voxel_size);
-  request.set_coverage_tolerance(settings.coverage_tolerance);
+  wire::QualityOptionsToProto(settings, &request);
   absl::StatusOr<v1::EvaluateResponse> response =
       Retried(retry, deadline, [&](Deadline d) { return connection.Evaluate(request, d); });
   if (!response.ok()) return response.status();
@@ -133,6 +130,7 @@ absl::StatusOr<InspectMeshResult> Client::InspectMesh(const Mesh& mesh,
   v1::InspectMeshRequest request;
   wire::MeshToProto(mesh, request.mutable_mesh());
   request.set_skip_self_intersections(options.skip_self_intersections);
+  request.set_fill_holes(options.fill_holes);
   absl::StatusOr<v1::InspectMeshResponse> response =
       Retried(options_.retry, DeadlineAfter(options.timeout, options_),
               [&](Deadline d) { return connection_->InspectMesh(request, d); });
@@ -275,6 +273,7 @@ absl::StatusOr<DistanceBatchResult> Client::Distance(const std::string& sphere_s
   wire::PosesToProto(poses_a, request.mutable_poses_a());
   wire::PosesToProto(poses_b, request.mutable_poses_b());
   wire::ToleranceToProto(options.tolerance, request.mutable_tolerance());
+  request.set_brute_force(options.brute_force);
   absl::StatusOr<v1::DistanceResponse> response =
       Retried(options_.retry, DeadlineAfter(options.timeout, options_),
               [&](Deadline d) { return connection_->Distance(request, d); });

@@ -3,7 +3,6 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
-#include "inscribe/wire/convert.h"
 #include "inscribe/client/client.h"
 #include "inscribe/wire/convert.h"
 

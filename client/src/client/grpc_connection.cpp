@@ -20,8 +20,8 @@
 #include "grpcpp/support/channel_arguments.h"
 #include "grpcpp/support/sync_stream.h"
 #include "inscribe/client/connection.h"
-#include "inscribe/wire/convert.h"
 #include "inscribe/v1/service.grpc.pb.h"
+#include "inscribe/wire/convert.h"
 
 namespace inscribe::client {
 namespace {

@@ -29,7 +29,6 @@
 namespace inscribe::client {
 namespace {
 
-
 // The route key of a mesh as sent: the hash the server stores it under unless it fixes the
 // orientation or fills holes (PutMesh then puts it twice, see RoutedConnection::PutMesh).
 // O(#V + #T): a copy and one SHA-256 pass, small beside sending the mesh. A malformed mesh
@@ -137,8 +136,8 @@ Answer<Response> CallFirst(Replicas& replicas, const std::vector<int>& order,
   }
   replicas.MarkDown(i);
   absl::Status down(absl::StatusCode::kUnavailable,
-                    absl::StrCat(answer.response.status().message(), " (replica ",
-                                 replicas.name(i), ", one of ", replicas.size(), ")"));
+                    absl::StrCat(answer.response.status().message(), " (replica ", replicas.name(i),
+                                 ", one of ", replicas.size(), ")"));
   if (replicas.size() > 1) down.SetPayload(kRetryElsewherePayload, absl::Cord());
   return Answer<Response>{std::move(down), -1};
 }
@@ -261,17 +260,18 @@ class RoutedConnection final : public Connection {
       const v1::GenerateRequest& request, Deadline deadline,
       const std::function<void(double fraction)>& on_progress) override {
     // After a failover the progress starts again from the next replica's.
-    return Call<v1::GenerateResult>(wire::RouteKey(request.mesh_sha256()), deadline, [&](Connection& c) {
-      return c.Generate(request, deadline, on_progress);
-    });
+    return Call<v1::GenerateResult>(
+        wire::RouteKey(request.mesh_sha256()), deadline,
+        [&](Connection& c) { return c.Generate(request, deadline, on_progress); });
   }
 
   // Routed by the mesh key, else by a hash of the numbers; a set without a mesh is then put on
   // its key's replica too (as PutMesh does), a second upload for (n-1)/n of such sets.
   absl::StatusOr<v1::PutSphereSetResponse> PutSphereSet(const v1::PutSphereSetRequest& request,
                                                         Deadline deadline) override {
-    const std::string route = request.mesh_sha256().empty() ? wire::ContentRouteKey(request.spheres().SerializeAsString())
-                                                            : wire::RouteKey(request.mesh_sha256());
+    const std::string route = request.mesh_sha256().empty()
+                                  ? wire::ContentRouteKey(request.spheres().SerializeAsString())
+                                  : wire::RouteKey(request.mesh_sha256());
     return PutTwiceIfKeyMoved<v1::PutSphereSetResponse>(
         route, deadline, [&](Connection& c) { return c.PutSphereSet(request, deadline); },
         [](const v1::PutSphereSetResponse& r) { return r.sphere_set_key(); });
@@ -369,7 +369,8 @@ std::vector<int> RendezvousOrder(absl::string_view route_key,
   // keeps ("ab", "c") and ("a", "bc") apart.
   std::vector<std::uint64_t> score(names.size());
   for (std::size_t i = 0; i < names.size(); ++i) {
-    const Sha256Digest digest = Sha256(absl::StrCat(route_key, absl::string_view("\0", 1), names[i]));
+    const Sha256Digest digest =
+        Sha256(absl::StrCat(route_key, absl::string_view("\0", 1), names[i]));
     for (int b = 0; b < 8; ++b) score[i] = (score[i] << 8) | digest[b];
   }
   std::vector<int> order(names.size());

@@ -75,7 +75,6 @@ absl::StatusOr<std::vector<DistanceResult>> PairSeparationDistances(
     const std::vector<PosedPair>& pairs, const DistanceRequest& request = {},
     const std::atomic<bool>* cancel = nullptr);
 
-
 // The same answer by comparing every sphere pair: O(#a #b), the reference the hierarchies are
 // tested against, and the `--hierarchy none` of the CLI. Tolerances are ignored (exact);
 // closer_than is honoured.

@@ -47,11 +47,11 @@ absl::Status CheckSphereSetParameters(const SphereSetParameters& parameters);
 std::optional<std::int64_t> EffectiveMaxSpheres(const SphereSetParameters& parameters);
 
 struct GeneratedSphereSet {
-  SphereSet set;             // S_D with contacts, or S_D+ (no contacts) when dilated
-  double voxel_size = 0.0;   // sigma used (the search's choice for a budget)
-  double epsilon = 0.0;      // epsilon used, mesh units (the default resolved)
-  int runs = 0;              // medial-sphere runs (1 for a fixed sigma)
-  MedialSphereStats stats;   // of the run that made the set
+  SphereSet set;            // S_D with contacts, or S_D+ (no contacts) when dilated
+  double voxel_size = 0.0;  // sigma used (the search's choice for a budget)
+  double epsilon = 0.0;     // epsilon used, mesh units (the default resolved)
+  int runs = 0;             // medial-sphere runs (1 for a fixed sigma)
+  MedialSphereStats stats;  // of the run that made the set
   // When dilated: the dilation's figures (its `set` is left empty: the result is `set`).
   std::optional<DilationResult> dilation;
   std::optional<QualityReport> quality;  // when parameters.evaluate

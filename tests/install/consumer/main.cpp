@@ -15,8 +15,8 @@ int main() {
     box.vertices.row(i) << (i & 1) * 2.0, ((i >> 1) & 1) * 1.0, ((i >> 2) & 1) * 0.5;
   }
   box.triangles.resize(12, 3);
-  box.triangles << 0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4,
-                   2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6, 1, 3, 5, 3, 7, 5;
+  box.triangles << 0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4, 2, 6, 3, 3, 6, 7, 0, 4, 2,
+      2, 4, 6, 1, 3, 5, 3, 7, 5;
   absl::StatusOr<inscribe::Solid> solid = inscribe::PrepareSolid(box);
   if (!solid.ok()) {
     std::printf("PrepareSolid: %s\n", std::string(solid.status().message()).c_str());

@@ -16,8 +16,8 @@
 #include "inscribe/rigid_pose.h"
 #include "inscribe/separation_distance.h"
 #include "inscribe/sphere.h"
-#include "inscribe/sphere_hierarchy.h"
 #include "inscribe/sphere_deformation.h"
+#include "inscribe/sphere_hierarchy.h"
 #include "inscribe/sphere_quality.h"
 #include "inscribe/sphere_set_generation.h"
 
@@ -50,6 +50,8 @@ struct ClientOptions {
 struct InspectMeshOptions {
   // Skip the exact self-intersection test (O(#T log #T) on the server).
   bool skip_self_intersections = false;
+  // Close the mesh's holes first; the report and hash are the repaired mesh's.
+  bool fill_holes = false;
   // Overrides ClientOptions::default_timeout for this call.
   std::optional<std::chrono::milliseconds> timeout;
 };
@@ -128,6 +130,8 @@ struct DeformationResult : DeformedSpheres {
 struct DistanceOptions : CallOptions {
   HierarchyVolume volume = HierarchyVolume::kSphere;
   DistanceRequest tolerance;  // abs_err, rel_err, closer_than
+  // Every sphere pair instead of a hierarchy (BruteForceSeparationDistance on the server).
+  bool brute_force = false;
 };
 
 struct DistanceBatchResult {
@@ -135,11 +139,9 @@ struct DistanceBatchResult {
   double server_seconds = 0.0;          // the server's time on the queries
 };
 
-struct EvaluateSettings {
-  std::int64_t samples = 0;         // boundary samples; 0 = 100,000; negative = none
-  double voxel_size = 0.0;          // for the fatness test; 0 = unknown
-  double coverage_tolerance = 0.0;  // mesh units; 0 = 1e-3 of the bbox diagonal
-};
+// Evaluation options are core's (surface_samples, voxel_size and coverage_tolerance go on the
+// wire; the seed and protrusion tolerance are the server's defaults).
+using EvaluateSettings = QualityOptions;
 
 // CacheStats as the server reports it (see CacheStatsResponse in service.proto).
 struct ServerCacheStats {

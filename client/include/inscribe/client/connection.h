@@ -49,8 +49,8 @@ class DistanceStreamConnection {
 };
 
 // One method per RPC of inscribe.v1.Inscribe. Each call is a single attempt (one RPC) with the
-// given deadline: retries, backoff and default deadlines belong to Client. Errors carry the gRPC code
-// unchanged (UNAVAILABLE when the server cannot be reached, DEADLINE_EXCEEDED, the server's
+// given deadline: retries, backoff and default deadlines belong to Client. Errors carry the gRPC
+// code unchanged (UNAVAILABLE when the server cannot be reached, DEADLINE_EXCEEDED, the server's
 // INVALID_ARGUMENT / RESOURCE_EXHAUSTED, ...). Implementations are thread-safe.
 //
 // An interface so that code using Client can be tested against a mock (gmock) Connection.

@@ -15,8 +15,8 @@
 #include "absl/status/statusor.h"
 #include "inscribe/medial_spheres.h"
 #include "inscribe/mesh.h"
-#include "inscribe/sphere.h"
 #include "inscribe/robot/urdf_robot.h"
+#include "inscribe/sphere.h"
 
 namespace inscribe::robot {
 

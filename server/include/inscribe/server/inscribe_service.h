@@ -10,9 +10,12 @@
 #include <mutex>
 #include <set>
 #include <string>
+#include <vector>
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "inscribe/rigid_pose.h"
+#include "inscribe/separation_distance.h"
 #include "inscribe/server/job_pool.h"
 #include "inscribe/server/result_cache.h"
 #include "inscribe/sphere_set_generation.h"
@@ -145,6 +148,13 @@ class InscribeService final : public v1::Inscribe::CallbackService {
                                      std::int64_t triangles, const absl::Status& precheck,
                                      std::int64_t memory_bytes, std::string what,
                                      std::function<absl::Status()> body);
+
+  // Distance with brute_force: every sphere pair of the two cached sets per pose pair.
+  absl::Status BruteForceDistances(const v1::DistanceRequest& request,
+                                   const std::vector<RigidPose>& poses_a,
+                                   const std::vector<RigidPose>& poses_b,
+                                   const DistanceRequest& tolerance,
+                                   v1::DistanceResponse* response);
 
   // Remembers a stored mesh's size, for GenerateWorkBytes.
   void RecordMeshSize(const StoredMeshEntry& entry);

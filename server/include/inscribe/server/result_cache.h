@@ -106,8 +106,8 @@ std::string RedactRedisUrl(absl::string_view url);
 // costs no parsing. Immutable once cached; shared by every caller holding it.
 struct CachedValue {
   std::string bytes;
-  CachedObject object;             // may be empty (std::monostate)
-  std::int64_t object_bytes = 0;   // memory the object holds, for the LRU budget
+  CachedObject object;            // may be empty (std::monostate)
+  std::int64_t object_bytes = 0;  // memory the object holds, for the LRU budget
   // False for values that only make sense in this process (e.g. a deformer holding a refit
   // oracle): kept in memory only, never written to the disk or Redis tier.
   bool persist = true;

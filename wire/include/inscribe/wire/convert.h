@@ -109,6 +109,13 @@ void GeneratedSphereSetToProto(const GeneratedSphereSet& generated, v1::Generate
 // The inverse; INVALID_ARGUMENT as SphereSetFromProto for bad spheres.
 absl::StatusOr<GeneratedSphereSet> GeneratedSphereSetFromProto(const v1::GenerateResult& result);
 
+// Evaluation options (Evaluate): the sample count, the voxel size and the coverage tolerance go
+// on the wire, each left unset at core's default; the seed and protrusion tolerance are core's.
+void QualityOptionsToProto(const QualityOptions& options, v1::EvaluateRequest* out);
+// Core's defaults where the wire leaves a field unset (a negative sample count is none), then
+// CheckQualityOptions and a finite coverage tolerance: INVALID_ARGUMENT otherwise.
+absl::StatusOr<QualityOptions> QualityOptionsFromProto(const v1::EvaluateRequest& request);
+
 // A deformation update's spheres and figures, and its error bounds.
 void DeformedSpheresToProto(const DeformedSpheres& moved, v1::UpdateDeformationResponse* out);
 // INVALID_ARGUMENT for bad spheres or a reference_index of another length than the spheres.

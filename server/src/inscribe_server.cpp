@@ -18,11 +18,13 @@
 #include "absl/strings/str_cat.h"
 #include "bearer_auth.h"
 #include "grpc/grpc.h"
+#include "grpcpp/channel.h"
 #include "grpcpp/ext/proto_server_reflection_plugin.h"
 #include "grpcpp/health_check_service_interface.h"
 #include "grpcpp/security/server_credentials.h"
 #include "grpcpp/server.h"
 #include "grpcpp/server_builder.h"
+#include "grpcpp/support/channel_arguments.h"
 #include "service_metrics.h"
 
 namespace inscribe::server {
@@ -31,7 +33,7 @@ namespace {
 constexpr char kServiceName[] = "inscribe.v1.Inscribe";
 
 absl::Status CheckOptions(const ServerOptions& options) {
-  if (options.listen.rfind(':') == std::string::npos) {
+  if (!options.listen.empty() && options.listen.rfind(':') == std::string::npos) {
     return absl::InvalidArgumentError(
         absl::StrCat("--listen must be HOST:PORT, got \"", options.listen, "\""));
   }
@@ -161,7 +163,8 @@ struct InscribeServer::Parts {
 
   JobPool pool;
   std::unique_ptr<ResultCache> cache;
-  int metrics_port = 0;  // 0: no metrics endpoint
+  int metrics_port = 0;       // 0: no metrics endpoint
+  int max_message_bytes = 0;  // --max-message-bytes, for in-process channels too
   InscribeService service;
   std::unique_ptr<grpc::Server> server;
 
@@ -208,22 +211,26 @@ absl::StatusOr<std::unique_ptr<InscribeServer>> InscribeServer::Start(
 
   grpc::ServerBuilder builder;
   int port = 0;
-  builder.AddListeningPort(options.listen, *std::move(credentials), &port);
+  if (!options.listen.empty())
+    builder.AddListeningPort(options.listen, *std::move(credentials), &port);
   builder.RegisterService(&parts->service);
   builder.SetMaxReceiveMessageSize(options.max_message_bytes);
   // gRPC sets SO_REUSEPORT by default on Linux, which would let a second server silently share
   // (and steal calls from) a port that is in use; an occupied port must be an error instead.
   builder.AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);
   parts->server = builder.BuildAndStart();
-  if (parts->server == nullptr || port == 0) {
+  if (parts->server == nullptr || (port == 0 && !options.listen.empty())) {
     return absl::UnavailableError(absl::StrCat("cannot listen on ", options.listen,
                                                " (address in use, or not a local address?)"));
   }
   parts->server->GetHealthCheckService()->SetServingStatus(kServiceName, true);
 
-  const std::string host = options.listen.substr(0, options.listen.rfind(':'));
-  return std::unique_ptr<InscribeServer>(
-      new InscribeServer(std::move(parts), port, absl::StrCat(host, ":", port), jobs));
+  parts->max_message_bytes = options.max_message_bytes;
+  const std::string address =
+      options.listen.empty()
+          ? std::string()
+          : absl::StrCat(options.listen.substr(0, options.listen.rfind(':')), ":", port);
+  return std::unique_ptr<InscribeServer>(new InscribeServer(std::move(parts), port, address, jobs));
 }
 
 InscribeServer::InscribeServer(std::unique_ptr<Parts> parts, int port, std::string address,
@@ -259,6 +266,13 @@ void InscribeServer::Shutdown(std::chrono::system_clock::time_point deadline) {
 }
 
 int InscribeServer::metrics_port() const { return parts_->metrics_port; }
+
+std::shared_ptr<grpc::Channel> InscribeServer::InProcessChannel() const {
+  grpc::ChannelArguments args;
+  args.SetMaxReceiveMessageSize(parts_->max_message_bytes);
+  args.SetMaxSendMessageSize(parts_->max_message_bytes);
+  return parts_->server->InProcessChannel(args);
+}
 
 std::int64_t InscribeServer::jobs_in_flight() const { return parts_->pool.jobs_in_flight(); }
 

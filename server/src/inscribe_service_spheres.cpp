@@ -9,6 +9,7 @@
 #include <new>
 #include <optional>
 #include <utility>
+#include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
@@ -18,10 +19,25 @@
 #include "inscribe/wire/convert.h"
 #include "memory_budget.h"
 #include "mesh_sizes.h"
+#include "oneapi/tbb/task_arena.h"
 #include "result_store.h"
 #include "service_checks.h"
 
 namespace inscribe::server {
+namespace {
+
+// Adds the work counts of `results` (their tests, summed) to a Distance answer.
+void AddWork(const std::vector<DistanceResult>& results, v1::DistanceResponse* response) {
+  std::int64_t volume_tests = 0, sphere_tests = 0;
+  for (const DistanceResult& r : results) {
+    volume_tests += r.volume_tests;
+    sphere_tests += r.sphere_tests;
+  }
+  response->set_volume_tests(response->volume_tests() + volume_tests);
+  response->set_sphere_tests(response->sphere_tests() + sphere_tests);
+}
+
+}  // namespace
 
 grpc::ServerUnaryReactor* InscribeService::PutMesh(grpc::CallbackServerContext* context,
                                                    const v1::PutMeshRequest* request,
@@ -223,10 +239,14 @@ void InscribeService::RecordMeshSize(const StoredMeshEntry& entry) {
 absl::StatusOr<std::int64_t> InscribeService::GenerateWorkBytes(
     const std::string& mesh_key, const SphereSetParameters& parameters) const {
   const std::optional<MeshSize> size = mesh_sizes_->Find(mesh_key);
-  const double max_voxels = static_cast<double>(limits_.max_voxels);
+  // The request's grid limit, already capped by this server's.
+  const double max_voxels = static_cast<double>(parameters.medial.max_voxels);
+  const bool server_limit_binds = parameters.medial.max_voxels >= limits_.max_voxels;
   double voxels = max_voxels;  // unknown mesh (stored by another process): the worst case
   if (size && parameters.voxel_size) {
     voxels = size->GridVoxels(*parameters.voxel_size);
+    // Over the caller's own limit: core refuses it at once, naming that limit.
+    if (voxels > max_voxels && !server_limit_binds) voxels = max_voxels;
     if (voxels > max_voxels) {
       // Refused here, before the call is queued; core would refuse it too (MakeGrid), but
       // only after a pool thread and a cache lookup.
@@ -325,6 +345,8 @@ absl::Status InscribeService::BruteForceDistances(const v1::DistanceRequest& req
   }
   wire::AppendDistanceResults(results, response->mutable_results());
   response->set_seconds(SecondsSince(start));
+  response->set_threads(1);
+  AddWork(results, response);
   return absl::OkStatus();
 }
 
@@ -374,23 +396,35 @@ grpc::ServerUnaryReactor* InscribeService::Distance(grpc::CallbackServerContext*
           return BruteForceDistances(*request, *poses_a, *poses_b, *tolerance, response);
         }
         const HierarchyVolume volume = wire::VolumeFromProto(request->volume());
+        const ServiceClock::time_point hierarchies_start = ServiceClock::now();
         absl::StatusOr<std::shared_ptr<const SphereHierarchy>> a =
             store_->GetHierarchy(request->sphere_set_a(), volume);
         if (!a.ok()) return a.status();
         absl::StatusOr<std::shared_ptr<const SphereHierarchy>> b =
             store_->GetHierarchy(request->sphere_set_b(), volume);
         if (!b.ok()) return b.status();
+        response->set_hierarchy_seconds(SecondsSince(hierarchies_start));
         const ServiceClock::time_point start = ServiceClock::now();
-        std::vector<PosedPair> posed(poses_b->size());
-        for (std::size_t i = 0; i < posed.size(); ++i) {
-          posed[i] = PosedPair{a->get(), b->get(), (*poses_a)[poses_a->size() == 1 ? 0 : i],
-                               (*poses_b)[i]};
+        // The pairs in blocks: a block's posed pairs (128 bytes each) are all the memory the
+        // query adds to the poses and the results.
+        constexpr std::size_t kBlock = 16'384;
+        std::vector<PosedPair> posed;
+        posed.reserve(std::min(kBlock, poses_b->size()));
+        for (std::size_t first = 0; first < poses_b->size(); first += kBlock) {
+          const std::size_t end = std::min(poses_b->size(), first + kBlock);
+          posed.clear();
+          for (std::size_t i = first; i < end; ++i) {
+            posed.push_back(PosedPair{a->get(), b->get(), (*poses_a)[poses_a->size() == 1 ? 0 : i],
+                                      (*poses_b)[i]});
+          }
+          absl::StatusOr<std::vector<DistanceResult>> results =
+              PairSeparationDistances(posed, *tolerance);
+          if (!results.ok()) return results.status();  // poses and tolerance checked above
+          wire::AppendDistanceResults(*results, response->mutable_results());
+          AddWork(*results, response);
         }
-        absl::StatusOr<std::vector<DistanceResult>> results =
-            PairSeparationDistances(posed, *tolerance);
-        if (!results.ok()) return results.status();
-        wire::AppendDistanceResults(*results, response->mutable_results());
         response->set_seconds(SecondsSince(start));
+        response->set_threads(tbb::this_task_arena::max_concurrency());
         return absl::OkStatus();
       });
 }

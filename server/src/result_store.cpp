@@ -33,15 +33,6 @@ std::int64_t MeshObjectBytes(const Mesh& mesh) {
 // Builds the cache value of a validated mesh: bytes = StoredMesh, object = StoredMeshEntry.
 absl::StatusOr<CachedValue> MeshValue(const std::string& key, ValidatedMesh validated,
                                       std::string bytes) {
-  if (!validated.report.usable()) {
-    for (const MeshIssue& issue : validated.report.issues) {
-      if (issue.severity == Severity::kError) {
-        return absl::FailedPreconditionError(
-            absl::StrCat("mesh cannot be used: ", issue.code, ": ", issue.message));
-      }
-    }
-    return absl::FailedPreconditionError("mesh cannot be used");
-  }
   absl::StatusOr<Solid> solid = MakeSolid(std::move(validated), key);
   if (!solid.ok()) return solid.status();
   auto entry = std::make_shared<const StoredMeshEntry>(StoredMeshEntry{key, *std::move(solid)});
@@ -102,10 +93,8 @@ absl::StatusOr<std::shared_ptr<const StoredMeshEntry>> ResultStore::PutMesh(Mesh
   options.fill_holes = fill_holes;
   ValidatedMesh validated = ValidateMesh(std::move(mesh), options);
   if (validated.report.non_finite_vertices > 0 || validated.report.out_of_range_indices > 0) {
-    return absl::FailedPreconditionError(
-        absl::StrCat("mesh cannot be used: ", validated.report.non_finite_vertices,
-                     " vertices with non-finite coordinates, ",
-                     validated.report.out_of_range_indices, " out-of-range indices"));
+    // Not hashable; refused before hashing, with the error MakeSolid would give.
+    return absl::FailedPreconditionError(validated.report.first_error());
   }
   const std::string key = FormatSha256(MeshSha256(validated.mesh));
   absl::StatusOr<CacheLookup> found = cache_->GetOrCompute(

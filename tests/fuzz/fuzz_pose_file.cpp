@@ -1,6 +1,7 @@
 // libFuzzer target: the pose-file reader of `inscribe distance --poses` (ParsePoses, which
 // ReadPoseFile uses on the file's bytes). A file that parses must give at least one pose and
-// only poses CheckPose accepts (finite, unit quaternion); anything else aborts.
+// only poses NormalizedPose accepts (finite, a quaternion within 1e-3 of unit length, which the
+// service normalises); anything else aborts.
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
@@ -27,8 +28,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     std::abort();
   }
   for (const inscribe::RigidPose& pose : *poses) {
-    if (const absl::Status valid = inscribe::CheckPose(pose); !valid.ok()) {
-      std::fprintf(stderr, "fuzz_pose_file: a parsed pose fails CheckPose: %s\n",
+    if (const absl::Status valid = inscribe::NormalizedPose(pose).status(); !valid.ok()) {
+      std::fprintf(stderr, "fuzz_pose_file: a parsed pose fails NormalizedPose: %s\n",
                    std::string(valid.message()).c_str());
       std::abort();
     }

@@ -45,7 +45,7 @@ TEST_F(SpheresRpcTest, PutMeshKeysByContentAndRefusesUnusableMeshes) {
   wire::MeshToProto(testing::OpenUnitCube(), open.mutable_mesh());
   const grpc::Status refused = stub_->PutMesh(Context().get(), open, &response);
   EXPECT_EQ(refused.error_code(), grpc::StatusCode::FAILED_PRECONDITION);
-  EXPECT_THAT(refused.error_message(), HasSubstr("not_closed"));
+  EXPECT_THAT(refused.error_message(), HasSubstr("not closed"));
 
   v1::PutMeshRequest ragged;
   ragged.mutable_mesh()->add_vertices(1.0);

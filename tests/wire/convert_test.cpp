@@ -3,6 +3,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "inscribe/mesh_validation.h"
 #include "support/synthetic_meshes.h"
 
@@ -191,7 +193,7 @@ TEST(GenerateParameters, EveryOptionSurvivesTheWire) {
     ASSERT_TRUE(back.ok()) << back.status();
     SphereSetParameters expected = p;
     if (!expected.voxel_size) expected.max_spheres = EffectiveMaxSpheres(p);
-    if (p.medial.max_voxels == MedialSphereOptions().max_voxels) expected.medial.max_voxels = limit;
+    expected.medial.max_voxels = std::min(p.medial.max_voxels, limit);
     EXPECT_TRUE(SameParameters(*back, expected));
   }
   // Defaults are never restated on the wire.
@@ -203,7 +205,9 @@ TEST(GenerateParameters, EveryOptionSurvivesTheWire) {
                wire.has_quality_samples());
   EXPECT_EQ(wire.object_angle(), 0.0);
   EXPECT_EQ(wire.samples(), 0);
-  EXPECT_EQ(wire.max_voxels(), 0);
+  // The caller's grid limit always travels: a server with a larger --max-voxels must not
+  // lift it (0 would mean "the server's limit").
+  EXPECT_EQ(wire.max_voxels(), MedialSphereOptions().max_voxels);
 }
 
 TEST(GenerateParameters, TheServersVoxelLimitCapsTheRequest) {

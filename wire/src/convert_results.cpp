@@ -61,7 +61,7 @@ void GenerateRequestToProto(const std::string& mesh_sha256, const SphereSetParam
   if (m.screen_samples != d.screen_samples) wire->set_screen_samples(m.screen_samples);
   if (m.corner_screen != d.corner_screen) wire->set_corner_screen(m.corner_screen);
   if (m.pair_angle_margin != d.pair_angle_margin) wire->set_pair_angle_margin(m.pair_angle_margin);
-  if (m.max_voxels != d.max_voxels) wire->set_max_voxels(m.max_voxels);
+  wire->set_max_voxels(m.max_voxels);  // the caller's limit, which the server's caps
   wire->set_dilate(p.dilate);
   if (p.dilate && p.dilation.growth != defaults.dilation.growth) {
     wire->set_dilation_growth(p.dilation.growth);

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "absl/strings/str_join.h"
-#include "exit_codes.h"
+#include "command_outcome.h"
 #include "inscribe/sphere_io.h"
 #include "sphere_output.h"
 
@@ -37,10 +37,9 @@ std::vector<std::string> DroppedParts(const SphereFile& file, SphereFileFormat t
   return dropped;
 }
 
-int RunConvert(const ConvertCliOptions& options) {
+absl::Status RunConvert(const ConvertCliOptions& options) {
   if (options.json && options.output_path.empty()) {
-    std::cerr << "inscribe: --json prints a summary on stdout, so it needs -o for the file\n";
-    return kExitUsage;
+    return UsageError("--json prints a summary on stdout, so it needs -o for the file");
   }
   // The output format, settled before anything is read: an unknown extension is a usage error.
   SphereFileFormat to = SphereFileFormat::kJson;
@@ -49,9 +48,8 @@ int RunConvert(const ConvertCliOptions& options) {
   } else if (!options.output_path.empty()) {
     absl::StatusOr<SphereFileFormat> by_extension = SphereFileFormatFromPath(options.output_path);
     if (!by_extension.ok()) {
-      std::cerr << "inscribe: " << by_extension.status().message()
-                << "; name the format with --to\n";
-      return kExitUsage;
+      return UsageError(std::string(by_extension.status().message()) +
+                        "; name the format with --to");
     }
     to = *by_extension;
   }
@@ -60,8 +58,7 @@ int RunConvert(const ConvertCliOptions& options) {
   const std::string yaml_link = !options.yaml_link.empty() ? options.yaml_link : options.link;
   if (to == SphereFileFormat::kYaml && !yaml_link.empty()) {
     if (absl::Status name = FormatCuroboYaml({LinkSpheres{yaml_link, {}}}).status(); !name.ok()) {
-      std::cerr << "inscribe: " << name.message() << "\n";
-      return kExitUsage;
+      return UsageError(name.message());
     }
   }
 
@@ -70,14 +67,13 @@ int RunConvert(const ConvertCliOptions& options) {
   read.sph_level = options.sph_level;
   read.yaml_link = options.link;
   absl::StatusOr<SphereFile> file = ReadSphereFile(options.input_path, read);
-  if (!file.ok()) {
-    std::cerr << "inscribe: " << file.status().message() << "\n";
-    return kExitBadInput;
+  if (!file.ok()) return BadInputError(file.status().message());
+  if (absl::Status written =
+          EmitSphereFile(*file, options.output_path, std::string(SphereFileFormatName(to)),
+                         /*json_summary=*/false, yaml_link);
+      !written.ok()) {
+    return written;
   }
-  const int written =
-      EmitSphereFile(*file, options.output_path, std::string(SphereFileFormatName(to)),
-                     /*json_summary=*/false, yaml_link);
-  if (written != kExitOk) return written;
 
   const std::vector<std::string> dropped = DroppedParts(*file, to);
   if (!dropped.empty()) {
@@ -97,12 +93,12 @@ int RunConvert(const ConvertCliOptions& options) {
     std::cout << "wrote " << file->set.spheres.size() << " spheres to " << options.output_path
               << " (" << SphereFileFormatName(to) << ")\n";
   }
-  return kExitOk;
+  return absl::OkStatus();
 }
 
 }  // namespace
 
-void AddConvertCommand(CLI::App& app, int* exit_code) {
+void AddConvertCommand(CLI::App& app, CommandOutcome* outcome) {
   auto options = std::make_shared<ConvertCliOptions>();
   CLI::App* cmd = app.add_subcommand(
       "convert",
@@ -125,7 +121,7 @@ void AddConvertCommand(CLI::App& app, int* exit_code) {
                   "Link name the spheres are listed under in YAML output (default: --link, "
                   "else mesh)");
   cmd->add_flag("--json", options->json, "Print one JSON summary on stdout (needs -o)");
-  cmd->callback([options, exit_code] { *exit_code = RunConvert(*options); });
+  cmd->callback([options, outcome] { outcome->status = RunConvert(*options); });
 }
 
 }  // namespace inscribe::cli

@@ -6,8 +6,9 @@
 #include <optional>
 #include <string>
 
+#include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
-#include "exit_codes.h"
+#include "command_outcome.h"
 #include "inscribe/mesh_hash.h"
 #include "inscribe/mesh_io.h"
 #include "inscribe/mesh_validation.h"
@@ -16,6 +17,7 @@
 #include "inscribe/sphere_io.h"
 #include "nlohmann/json.hpp"
 #include "remote_options.h"
+#include "service_session.h"
 #include "sphere_output.h"
 
 namespace inscribe::cli {
@@ -58,12 +60,12 @@ std::string DescribeTopologyDifference(const Mesh& reference, const Mesh& deform
   return "";
 }
 
-// The local half of deform, the same in both modes: the three files read and checked against
-// each other, the reference validated and hashed, the deformed solid checked.
+// What deform checks here before calling the service: the three files read and checked
+// against each other, the reference validated and hashed (to match the sphere file's hash),
+// the deformed solid checked.
 struct DeformInputs {
   SphereFile file;
-  Mesh reference_file;      // as read: what remote mode uploads (the server validates it itself)
-  ValidatedMesh reference;  // orientation fixed, holes filled when asked
+  Mesh reference_file;  // as read: what is stored in the service (which validates it itself)
   std::string reference_sha256;
   Mesh deformed;  // the validated reference's triangles on the moved vertices
   std::string deformed_sha256;
@@ -73,40 +75,28 @@ struct DeformInputs {
   bool ray_parity = false;
 };
 
-// Prints why and sets *exit_code when it returns nothing.
-std::optional<DeformInputs> ReadInputs(const DeformCliOptions& options, int* exit_code) {
-  *exit_code = kExitBadInput;
+absl::StatusOr<DeformInputs> ReadInputs(const DeformCliOptions& options) {
   SphereFileReadOptions read;
   if (!options.format.empty()) read.format = *ParseSphereFileFormat(options.format);
   read.yaml_link = options.link;
   absl::StatusOr<SphereFile> file = ReadSphereFile(options.spheres_path, read);
-  if (!file.ok()) {
-    std::cerr << "inscribe: " << file.status().message() << "\n";
-    return std::nullopt;
-  }
+  if (!file.ok()) return BadInputError(file.status().message());
   if (!file->set.has_contacts()) {
-    std::cerr << "inscribe: " << options.spheres_path
-              << ": no contact points; deform needs the JSON sphere file inscribe generate "
-                 "writes (contacts are where each sphere touches the reference mesh)\n";
-    return std::nullopt;
+    return BadInputError(options.spheres_path +
+                         ": no contact points; deform needs the JSON sphere file inscribe "
+                         "generate writes (contacts are where each sphere touches the reference "
+                         "mesh)");
   }
   absl::StatusOr<Mesh> reference = ReadMesh(options.reference_path);
-  if (!reference.ok()) {
-    std::cerr << "inscribe: " << reference.status().message() << "\n";
-    return std::nullopt;
-  }
+  if (!reference.ok()) return BadInputError(reference.status().message());
   absl::StatusOr<Mesh> deformed_file = ReadMesh(options.deformed_path);
-  if (!deformed_file.ok()) {
-    std::cerr << "inscribe: " << deformed_file.status().message() << "\n";
-    return std::nullopt;
-  }
+  if (!deformed_file.ok()) return BadInputError(deformed_file.status().message());
   if (const std::string why = DescribeTopologyDifference(*reference, *deformed_file);
       !why.empty()) {
-    std::cerr << "inscribe: " << options.deformed_path << " is not a deformation of "
-              << options.reference_path << ": " << why
-              << " (a deformed mesh keeps the reference's vertices and triangles, in order, "
-                 "and only moves the vertices)\n";
-    return std::nullopt;
+    return BadInputError(options.deformed_path + " is not a deformation of " +
+                         options.reference_path + ": " + why +
+                         " (a deformed mesh keeps the reference's vertices and triangles, in "
+                         "order, and only moves the vertices)");
   }
   DeformInputs in;
   in.reference_file = *reference;
@@ -114,19 +104,15 @@ std::optional<DeformInputs> ReadInputs(const DeformCliOptions& options, int* exi
   validate.fill_holes = options.fill_holes;
   absl::StatusOr<ValidatedMesh> solid = PrepareMesh(*std::move(reference), validate);
   if (!solid.ok()) {
-    std::cerr << "inscribe: " << options.reference_path << ": " << solid.status().message() << "\n";
-    *exit_code = kExitUnusableMesh;
-    return std::nullopt;
+    return UnusableMeshError(options.reference_path + ": " + std::string(solid.status().message()));
   }
   in.reference_sha256 = FormatSha256(MeshSha256(solid->mesh));
   if (!file->mesh_sha256.empty() && file->mesh_sha256 != in.reference_sha256) {
-    std::cerr << "inscribe: " << options.spheres_path << " was made for mesh " << file->mesh_sha256
-              << ", but " << options.reference_path << " is " << in.reference_sha256
-              << (options.fill_holes ? ""
-                                     : " (if the spheres were made with --fill-holes, "
-                                       "pass it here too)")
-              << "\n";
-    return std::nullopt;
+    return BadInputError(options.spheres_path + " was made for mesh " + file->mesh_sha256 +
+                         ", but " + options.reference_path + " is " + in.reference_sha256 +
+                         (options.fill_holes ? ""
+                                             : " (if the spheres were made with --fill-holes, "
+                                               "pass it here too)"));
   }
   // The deformed solid is that of the reference, deformed.
   in.deformed = Mesh{deformed_file->vertices, solid->mesh.triangles};
@@ -141,76 +127,24 @@ std::optional<DeformInputs> ReadInputs(const DeformCliOptions& options, int* exi
   in.ray_parity = InsideTestFor(solid->report) == InsideTest::kRayParity ||
                   InsideTestFor(deformed_report) == InsideTest::kRayParity;
   in.file = *std::move(file);
-  in.reference = *std::move(solid);
-  *exit_code = kExitOk;
   return in;
 }
 
-// Embedded mode: the core's deformer and bounds, in the client library's result type (which
-// both modes print from). Prints why and sets *exit_code on failure.
-std::optional<client::DeformationResult> DeformHere(const DeformCliOptions& options,
-                                                    DeformInputs in, int* exit_code) {
-  DeformationOptions deform;
-  deform.xi = options.xi;
-  deform.strict = options.strict;
-  deform.direction = options.interpolated_normal ? ContactDirection::kInterpolatedNormal
-                                                 : ContactDirection::kCarriedFrame;
-  if (in.ray_parity) deform.oracle.inside_test = InsideTest::kRayParity;
-  absl::StatusOr<SphereDeformer> deformer =
-      SphereDeformer::Create(std::move(in.reference.mesh), std::move(in.file.set), deform);
-  if (!deformer.ok()) {
-    std::cerr << "inscribe: " << options.spheres_path << ": " << deformer.status().message()
-              << "\n";
-    *exit_code = kExitBadInput;
-    return std::nullopt;
-  }
-  absl::StatusOr<DeformedSpheres> moved = deformer->Update(in.deformed.vertices);
-  if (!moved.ok()) {
-    std::cerr << "inscribe: " << options.deformed_path << ": " << moved.status().message() << "\n";
-    *exit_code = kExitUnusableMesh;
-    return std::nullopt;
-  }
-  absl::StatusOr<DeformationErrorBounds> bounds =
-      BoundDeformationError(deformer->oracle(), moved->set.spheres, moved->xi);
-  if (!bounds.ok()) {
-    std::cerr << "inscribe: bounding the error: " << bounds.status().message() << "\n";
-    *exit_code = kExitUnusableMesh;
-    return std::nullopt;
-  }
-  client::DeformationResult r;
-  static_cast<DeformedSpheres&>(r) = *std::move(moved);
-  r.reference_spheres = static_cast<std::int64_t>(deformer->reference_spheres().size());
-  r.deformed_mesh_sha256 = in.deformed_sha256;
-  r.bounds = *std::move(bounds);
-  return r;
-}
-
-// Remote mode: the reference and the spheres are stored on the server, which keeps a deformer
-// for them; the moved vertices go in one UpdateDeformation call.
-std::optional<client::DeformationResult> DeformRemotely(const DeformCliOptions& options,
-                                                        const DeformInputs& in, int* exit_code) {
-  const std::optional<client::Client> made = MakeClientOrReport(options.remote, exit_code);
-  if (!made) return std::nullopt;
-  const client::Client& client = *made;
+// The reference and the spheres are stored in the service, which keeps a deformer for them;
+// the moved vertices go in one UpdateDeformation call.
+absl::StatusOr<client::DeformationResult> Deform(const client::Client& client,
+                                                 const DeformCliOptions& options,
+                                                 const DeformInputs& in) {
   absl::StatusOr<client::PutMeshResult> mesh =
       client.PutMesh(in.reference_file, options.fill_holes);
-  if (!mesh.ok()) {
-    *exit_code = ReportRemoteError(mesh.status(), options.remote);
-    return std::nullopt;
-  }
+  if (!mesh.ok()) return mesh.status();
   if (mesh->mesh_sha256 != in.reference_sha256) {
-    std::cerr << "inscribe: the server stored " << options.reference_path << " as "
-              << mesh->mesh_sha256 << ", not " << in.reference_sha256 << " (server "
-              << options.remote.server << ")\n";
-    *exit_code = kExitInternal;
-    return std::nullopt;
+    return absl::InternalError(absl::StrCat("the service stored ", options.reference_path, " as ",
+                                            mesh->mesh_sha256, ", not ", in.reference_sha256));
   }
   absl::StatusOr<client::PutSphereSetResult> set =
       client.PutSphereSet(in.file.set, mesh->mesh_sha256);
-  if (!set.ok()) {
-    *exit_code = ReportRemoteError(set.status(), options.remote);
-    return std::nullopt;
-  }
+  if (!set.ok()) return set.status();
   client::DeformationSettings settings;
   settings.xi = options.xi;
   settings.strict = options.strict;
@@ -220,21 +154,18 @@ std::optional<client::DeformationResult> DeformRemotely(const DeformCliOptions& 
   absl::StatusOr<client::DeformationResult> result = client.UpdateDeformation(
       mesh->mesh_sha256, set->sphere_set_key, in.deformed.vertices, settings);
   if (!result.ok()) {
-    *exit_code = ReportRemoteError(result.status(), options.remote);
-    // As in embedded mode: contacts that do not fit are the sphere file's fault, a degenerate
-    // deformed solid (the vertex count was checked here) is the deformed mesh's.
-    if (result.status().code() == absl::StatusCode::kFailedPrecondition) *exit_code = kExitBadInput;
-    if (result.status().code() == absl::StatusCode::kInvalidArgument) {
-      *exit_code = kExitUnusableMesh;
+    // Contacts that do not fit are the sphere file's fault, a degenerate deformed solid (the
+    // vertex count was checked here) is the deformed mesh's.
+    switch (result.status().code()) {
+      case absl::StatusCode::kFailedPrecondition:
+        return WithExitCode(WithContext(options.spheres_path, result.status()), kExitBadInput);
+      case absl::StatusCode::kInvalidArgument:
+        return WithExitCode(WithContext(options.deformed_path, result.status()), kExitUnusableMesh);
+      default:
+        return result.status();
     }
-    return std::nullopt;
   }
-  if (!result->bounds) {
-    std::cerr << "inscribe: the server sent no error bounds (server " << options.remote.server
-              << ")\n";
-    *exit_code = kExitInternal;
-    return std::nullopt;
-  }
+  if (!result->bounds) return absl::InternalError("the service sent no error bounds");
   return *std::move(result);
 }
 
@@ -292,20 +223,16 @@ void PrintSummary(const DeformCliOptions& options, const DeformInputs& in,
   std::cout << summary.dump() << "\n";
 }
 
-int RunDeform(const DeformCliOptions& options) {
+absl::Status RunDeform(const DeformCliOptions& options) {
   const auto load_start = std::chrono::steady_clock::now();
-  int exit_code = kExitOk;
-  std::optional<DeformInputs> in = ReadInputs(options, &exit_code);
-  if (!in) return exit_code;
+  absl::StatusOr<DeformInputs> in = ReadInputs(options);
+  if (!in.ok()) return in.status();
   const double load_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - load_start).count();
-  std::optional<client::DeformationResult> result;
-  if (options.remote.enabled()) {
-    result = DeformRemotely(options, *in, &exit_code);
-  } else {
-    result = DeformHere(options, *in, &exit_code);
-  }
-  if (!result) return exit_code;
+  absl::StatusOr<std::unique_ptr<ServiceSession>> session = ServiceSession::Open(options.remote);
+  if (!session.ok()) return session.status();
+  absl::StatusOr<client::DeformationResult> result = Deform((*session)->client(), options, *in);
+  if (!result.ok()) return result.status();
   const DeformationErrorBounds& bounds = *result->bounds;
 
   SphereFile out;
@@ -325,22 +252,22 @@ int RunDeform(const DeformCliOptions& options) {
       {"nerr_is_exact", bounds.exact},     {"max_protrusion", result->max_protrusion},
       {"shrunk", result->shrunk},          {"dropped", result->dropped},
   };
-  if (const int code =
+  if (absl::Status written =
           EmitSphereFile(out, options.output_path, options.format, options.json, options.link);
-      code != kExitOk) {
-    return code;
+      !written.ok()) {
+    return written;
   }
   if (options.json) {
     PrintSummary(options, *in, *result, load_seconds);
   } else if (!options.output_path.empty()) {
     PrintText(options, *result);
   }
-  return kExitOk;
+  return absl::OkStatus();
 }
 
 }  // namespace
 
-void AddDeformCommand(CLI::App& app, int* exit_code) {
+void AddDeformCommand(CLI::App& app, CommandOutcome* outcome) {
   auto options = std::make_shared<DeformCliOptions>();
   CLI::App* cmd = app.add_subcommand(
       "deform",
@@ -378,7 +305,9 @@ void AddDeformCommand(CLI::App& app, int* exit_code) {
                 "Print one JSON summary on stdout (spheres, seconds, nerr_lower, nerr_upper, "
                 "max_protrusion, ...)");
   AddRemoteOptions(cmd, &options->remote, 60.0);
-  cmd->callback([options, exit_code] { *exit_code = RunDeform(*options); });
+  cmd->callback([options, outcome] {
+    *outcome = CommandOutcome{RunDeform(*options), options->remote.server};
+  });
 }
 
 }  // namespace inscribe::cli

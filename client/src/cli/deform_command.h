@@ -4,8 +4,10 @@
 
 #include <CLI/CLI.hpp>
 
+#include "command_outcome.h"
+
 namespace inscribe::cli {
 
-void AddDeformCommand(CLI::App& app, int* exit_code);
+void AddDeformCommand(CLI::App& app, CommandOutcome* outcome);
 
 }  // namespace inscribe::cli

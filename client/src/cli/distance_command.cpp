@@ -1,9 +1,6 @@
 #include "distance_command.h"
 
-#include <tbb/info.h>
-
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <fstream>
 #include <iostream>
@@ -15,13 +12,13 @@
 #include <vector>
 
 #include "absl/strings/str_format.h"
-#include "exit_codes.h"
+#include "command_outcome.h"
 #include "inscribe/separation_distance.h"
-#include "inscribe/sphere_hierarchy.h"
 #include "inscribe/sphere_io.h"
 #include "nlohmann/json.hpp"
 #include "pose_file.h"
 #include "remote_options.h"
+#include "service_session.h"
 
 namespace inscribe::cli {
 namespace {
@@ -36,12 +33,6 @@ struct DistanceCliOptions {
   RemoteOptions remote;
 };
 
-using Clock = std::chrono::steady_clock;
-
-double SecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
 std::string FormatCsv(const std::vector<DistanceResult>& results) {
   std::ostringstream out;
   out << "pose,distance,sphere_a,sphere_b,ax,ay,az,bx,by,bz\n";
@@ -54,79 +45,30 @@ std::string FormatCsv(const std::vector<DistanceResult>& results) {
   return out.str();
 }
 
-// Poses per Distance call in remote mode: 100,000 poses are a 5.6 MB request and a 6.5 MB
-// answer, far below gRPC's and the server's message limits (--max-message-bytes, --max-poses),
-// and large enough that the round trips cost nothing next to the queries.
+// Poses per Distance call: 100,000 poses are a 5.6 MB request and a 6.5 MB answer, far below
+// gRPC's and a server's message limits (--max-message-bytes, --max-poses), and large enough
+// that the round trips cost nothing next to the queries.
 constexpr std::size_t kPosesPerCall = 100'000;
 
-// What distance reports, computed here or by the server. The server sends neither the work
-// counts nor its hierarchy build time and thread count: those stay empty in remote mode.
+// What distance reports: the service's answers and figures, summed over the calls.
 struct Distances {
   std::vector<DistanceResult> results;  // entry i answers pose i
-  double seconds = 0.0;                 // the queries (remote: the server's time on them)
-  std::optional<double> build_seconds;  // both hierarchies
-  std::optional<int> threads;
-  bool work_counted = false;  // volume_tests and sphere_tests are filled in
+  double seconds = 0.0;                 // the service's time on the queries
+  double build_seconds = 0.0;           // ... and on both hierarchies
+  int threads = 0;
+  std::int64_t volume_tests = 0, sphere_tests = 0;
 };
 
-// Embedded mode. Prints why and returns nothing on failure (kExitBadInput).
-std::optional<Distances> DistancesHere(const DistanceCliOptions& options, const SphereSet& a,
-                                       const SphereSet& b, const std::vector<RigidPose>& poses) {
-  Distances d;
-  d.results.resize(poses.size());
-  d.work_counted = true;
-  const auto start = Clock::now();
-  if (options.hierarchy == "none") {
-    const RigidPose identity;
-    for (std::size_t i = 0; i < poses.size(); ++i) {
-      absl::StatusOr<DistanceResult> r =
-          BruteForceSeparationDistance(a.spheres, identity, b.spheres, poses[i], options.request);
-      if (!r.ok()) {
-        std::cerr << "inscribe: pose " << i << ": " << r.status().message() << "\n";
-        return std::nullopt;
-      }
-      d.results[i] = *r;
-    }
-    d.build_seconds = 0.0;
-    d.threads = 1;
-  } else {
-    const HierarchyVolume volume =
-        options.hierarchy == "sphere" ? HierarchyVolume::kSphere : HierarchyVolume::kRss;
-    absl::StatusOr<SphereHierarchy> ha = SphereHierarchy::Build(a.spheres, volume);
-    absl::StatusOr<SphereHierarchy> hb = SphereHierarchy::Build(b.spheres, volume);
-    if (!ha.ok() || !hb.ok()) {
-      std::cerr << "inscribe: " << (ha.ok() ? hb.status() : ha.status()).message() << "\n";
-      return std::nullopt;
-    }
-    d.build_seconds = SecondsSince(start);
-    absl::StatusOr<std::vector<DistanceResult>> batch =
-        SeparationDistances(*ha, *hb, poses, options.request);
-    if (!batch.ok()) {
-      std::cerr << "inscribe: " << batch.status().message() << "\n";
-      return std::nullopt;
-    }
-    d.results = *std::move(batch);
-    d.threads = tbb::info::default_concurrency();
-  }
-  d.seconds = SecondsSince(start) - d.build_seconds.value_or(0.0);
-  return d;
-}
-
-// Remote mode: both sets stored on the server (PutSphereSet), then the poses in batches of
-// kPosesPerCall, A at the origin. Prints why and sets *exit_code on failure.
-std::optional<Distances> DistancesRemotely(const DistanceCliOptions& options, const SphereSet& a,
-                                           const SphereSet& b, const std::vector<RigidPose>& poses,
-                                           int* exit_code) {
-  const std::optional<client::Client> made = MakeClientOrReport(options.remote, exit_code);
-  if (!made) return std::nullopt;
-  const client::Client& client = *made;
+// Both sets stored in the service (PutSphereSet), then the poses in calls of kPosesPerCall,
+// A at the origin.
+absl::StatusOr<Distances> ComputeDistances(const client::Client& client,
+                                           const DistanceCliOptions& options, const SphereSet& a,
+                                           const SphereSet& b,
+                                           const std::vector<RigidPose>& poses) {
   std::string keys[2];
   for (int k = 0; k < 2; ++k) {
     absl::StatusOr<client::PutSphereSetResult> stored = client.PutSphereSet(k == 0 ? a : b);
-    if (!stored.ok()) {
-      *exit_code = ReportRemoteError(stored.status(), options.remote);
-      return std::nullopt;
-    }
+    if (!stored.ok()) return stored.status();
     keys[k] = stored->sphere_set_key;
   }
   client::DistanceOptions call;
@@ -142,11 +84,12 @@ std::optional<Distances> DistancesRemotely(const DistanceCliOptions& options, co
         poses.begin() + static_cast<std::ptrdiff_t>(std::min(poses.size(), first + kPosesPerCall)));
     absl::StatusOr<client::DistanceBatchResult> answer =
         client.Distance(keys[0], keys[1], origin, batch, call);
-    if (!answer.ok()) {
-      *exit_code = ReportRemoteError(answer.status(), options.remote);
-      return std::nullopt;
-    }
+    if (!answer.ok()) return answer.status();
     d.seconds += answer->server_seconds;
+    d.build_seconds += answer->hierarchy_seconds;
+    d.threads = std::max(d.threads, answer->threads);
+    d.volume_tests += answer->volume_tests;
+    d.sphere_tests += answer->sphere_tests;
     for (DistanceResult& r : answer->results) d.results.push_back(std::move(r));
   }
   return d;
@@ -155,13 +98,11 @@ std::optional<Distances> DistancesRemotely(const DistanceCliOptions& options, co
 void PrintSummary(const DistanceCliOptions& options, const SphereSet& a, const SphereSet& b,
                   const Distances& d) {
   double min_distance = std::numeric_limits<double>::infinity();
-  std::int64_t touching = 0, closer = 0, volume_tests = 0, sphere_tests = 0;
+  std::int64_t touching = 0, closer = 0;
   for (const DistanceResult& r : d.results) {
     min_distance = std::min(min_distance, r.distance);
     touching += r.distance <= 0.0;
     closer += r.closer;
-    volume_tests += r.volume_tests;
-    sphere_tests += r.sphere_tests;
   }
   const auto n = static_cast<double>(d.results.size());
   nlohmann::json j;
@@ -173,8 +114,8 @@ void PrintSummary(const DistanceCliOptions& options, const SphereSet& a, const S
   j["queries"] = d.results.size();
   j["seconds"] = d.seconds;
   j["us_per_query"] = 1e6 * d.seconds / n;
-  if (d.threads) j["threads"] = *d.threads;
-  if (d.build_seconds) j["build_seconds"] = *d.build_seconds;
+  j["threads"] = d.threads;
+  j["build_seconds"] = d.build_seconds;
   j["min_distance"] = min_distance;
   j["touching"] = touching;
   if (std::isfinite(options.request.closer_than)) {
@@ -183,62 +124,46 @@ void PrintSummary(const DistanceCliOptions& options, const SphereSet& a, const S
   }
   j["abs_err"] = options.request.abs_err;
   j["rel_err"] = options.request.rel_err;
-  if (d.work_counted) {
-    j["mean_volume_tests"] = static_cast<double>(volume_tests) / n;
-    j["mean_sphere_tests"] = static_cast<double>(sphere_tests) / n;
-  }
+  j["mean_volume_tests"] = static_cast<double>(d.volume_tests) / n;
+  j["mean_sphere_tests"] = static_cast<double>(d.sphere_tests) / n;
   if (options.remote.enabled()) j["server"] = options.remote.server;
   if (!options.output_path.empty()) j["output"] = options.output_path;
   std::cout << j.dump() << "\n";
 }
 
-int RunDistance(const DistanceCliOptions& options) {
+absl::Status RunDistance(const DistanceCliOptions& options) {
   absl::StatusOr<SphereFile> a = ReadSphereFile(options.a_path, options.a_read);
-  if (!a.ok()) {
-    std::cerr << "inscribe: " << a.status().message() << "\n";
-    return kExitBadInput;
-  }
+  if (!a.ok()) return BadInputError(a.status().message());
   absl::StatusOr<SphereFile> b = ReadSphereFile(options.b_path, options.b_read);
-  if (!b.ok()) {
-    std::cerr << "inscribe: " << b.status().message() << "\n";
-    return kExitBadInput;
-  }
+  if (!b.ok()) return BadInputError(b.status().message());
   for (const auto* file : {&*a, &*b}) {
     if (file->set.spheres.empty()) {
-      std::cerr << "inscribe: " << (file == &*a ? options.a_path : options.b_path)
-                << ": no spheres\n";
-      return kExitBadInput;
+      return BadInputError((file == &*a ? options.a_path : options.b_path) + ": no spheres");
     }
   }
   absl::StatusOr<std::vector<RigidPose>> poses = ReadPoseFile(options.poses_path);
-  if (!poses.ok()) {
-    std::cerr << "inscribe: " << poses.status().message() << "\n";
-    return kExitBadInput;
-  }
+  if (!poses.ok()) return BadInputError(poses.status().message());
 
-  int exit_code = kExitBadInput;
-  const std::optional<Distances> d =
-      options.remote.enabled() ? DistancesRemotely(options, a->set, b->set, *poses, &exit_code)
-                               : DistancesHere(options, a->set, b->set, *poses);
-  if (!d) return exit_code;
+  absl::StatusOr<std::unique_ptr<ServiceSession>> session = ServiceSession::Open(options.remote);
+  if (!session.ok()) return session.status();
+  const absl::StatusOr<Distances> d =
+      ComputeDistances((*session)->client(), options, a->set, b->set, *poses);
+  if (!d.ok()) return d.status();
 
   if (!options.output_path.empty()) {
     std::ofstream out(options.output_path, std::ios::binary | std::ios::trunc);
     out << FormatCsv(d->results);
-    if (!out.flush()) {
-      std::cerr << "inscribe: " << options.output_path << ": cannot write\n";
-      return kExitBadInput;
-    }
+    if (!out.flush()) return BadInputError(options.output_path + ": cannot write");
   } else if (!options.json) {
     std::cout << FormatCsv(d->results);
   }
   if (options.json) PrintSummary(options, a->set, b->set, *d);
-  return kExitOk;
+  return absl::OkStatus();
 }
 
 }  // namespace
 
-void AddDistanceCommand(CLI::App& app, int* exit_code) {
+void AddDistanceCommand(CLI::App& app, CommandOutcome* outcome) {
   auto options = std::make_shared<DistanceCliOptions>();
   CLI::App* cmd = app.add_subcommand(
       "distance",
@@ -276,7 +201,9 @@ void AddDistanceCommand(CLI::App& app, int* exit_code) {
   cmd->add_flag("--json", options->json,
                 "Print one JSON summary (queries, seconds, us_per_query, ...) on stdout");
   AddRemoteOptions(cmd, &options->remote, 60.0);
-  cmd->callback([options, exit_code] { *exit_code = RunDistance(*options); });
+  cmd->callback([options, outcome] {
+    *outcome = CommandOutcome{RunDistance(*options), options->remote.server};
+  });
 }
 
 }  // namespace inscribe::cli

@@ -4,8 +4,10 @@
 
 #include <CLI/CLI.hpp>
 
+#include "command_outcome.h"
+
 namespace inscribe::cli {
 
-void AddDistanceCommand(CLI::App& app, int* exit_code);
+void AddDistanceCommand(CLI::App& app, CommandOutcome* outcome);
 
 }  // namespace inscribe::cli

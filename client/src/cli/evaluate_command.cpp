@@ -8,11 +8,12 @@
 #include <variant>
 
 #include "absl/strings/str_format.h"
-#include "exit_codes.h"
+#include "command_outcome.h"
 #include "inscribe/sphere_io.h"
 #include "inscribe/sphere_quality.h"
 #include "inscribe/view/report_json.h"
 #include "remote_options.h"
+#include "service_session.h"
 #include "solid_loading.h"
 
 namespace inscribe::cli {
@@ -32,7 +33,7 @@ struct EvaluateCliOptions {
   RemoteOptions remote;
 };
 
-// The mesh's key and the report, from this process or from the server.
+// The mesh's key in the service and the service's report.
 struct Evaluated {
   std::string mesh_sha256;
   QualityReport report;
@@ -70,51 +71,23 @@ void PrintText(const EvaluateCliOptions& options, const QualityReport& r) {
   line("evaluated in", absl::StrFormat("%.3f s", r.seconds));
 }
 
-// Embedded mode. Prints why and sets *exit_code on failure.
-std::optional<Evaluated> EvaluateHere(const EvaluateCliOptions& options, const SphereFile& file,
-                                      const QualityOptions& quality, int* exit_code) {
-  std::optional<LoadedSolid> solid =
-      LoadSolid(options.mesh_path, exit_code, LoadSolidOptions{options.fill_holes});
-  if (!solid) return std::nullopt;
-  absl::StatusOr<QualityReport> report =
-      EvaluateSpheres(solid->solid.oracle, file.set.spheres, quality);
-  if (!report.ok()) {
-    std::cerr << "inscribe: " << report.status().message() << "\n";
-    *exit_code = report.status().code() == absl::StatusCode::kInvalidArgument ? kExitBadInput
-                                                                              : kExitUnusableMesh;
-    return std::nullopt;
-  }
-  return Evaluated{solid->solid.sha256, *std::move(report)};
-}
-
-// Remote mode: PutMesh, then Evaluate with the spheres sent inline.
-std::optional<Evaluated> EvaluateRemotely(const EvaluateCliOptions& options, const SphereFile& file,
-                                          const QualityOptions& quality, int* exit_code) {
-  const std::optional<client::Client> made = MakeClientOrReport(options.remote, exit_code);
-  if (!made) return std::nullopt;
-  const client::Client& client = *made;
-  std::optional<UploadedSolid> solid =
-      UploadSolid(client, options.remote, options.mesh_path, exit_code, {options.fill_holes});
-  if (!solid) return std::nullopt;
+// PutMesh, then Evaluate with the spheres sent inline.
+absl::StatusOr<Evaluated> Evaluate(const client::Client& client, const EvaluateCliOptions& options,
+                                   const SphereFile& file, const QualityOptions& quality) {
+  absl::StatusOr<StoredSolid> solid = StoreSolid(client, options.mesh_path, {options.fill_holes});
+  if (!solid.ok()) return solid.status();
   absl::StatusOr<QualityReport> report = client.Evaluate(solid->sha256, file.set, quality);
-  if (!report.ok()) {
-    *exit_code = ReportRemoteError(report.status(), options.remote);
-    return std::nullopt;
-  }
+  if (!report.ok()) return report.status();
   return Evaluated{solid->sha256, *std::move(report)};
 }
 
-int RunEvaluate(const EvaluateCliOptions& options) {
-  int exit_code = kExitOk;
+absl::Status RunEvaluate(const EvaluateCliOptions& options) {
   SphereFileReadOptions read;
   if (!options.format.empty()) read.format = *ParseSphereFileFormat(options.format);
   read.sph_level = options.sph_level;
   read.yaml_link = options.link;
   absl::StatusOr<SphereFile> file = ReadSphereFile(options.spheres_path, read);
-  if (!file.ok()) {
-    std::cerr << "inscribe: " << file.status().message() << "\n";
-    return kExitBadInput;
-  }
+  if (!file.ok()) return BadInputError(file.status().message());
   QualityOptions quality = options.quality;
   if (quality.voxel_size == 0.0) {
     for (const auto& [key, value] : file->params) {
@@ -123,10 +96,11 @@ int RunEvaluate(const EvaluateCliOptions& options) {
       }
     }
   }
-  const std::optional<Evaluated> evaluated =
-      options.remote.enabled() ? EvaluateRemotely(options, *file, quality, &exit_code)
-                               : EvaluateHere(options, *file, quality, &exit_code);
-  if (!evaluated) return exit_code;
+  absl::StatusOr<std::unique_ptr<ServiceSession>> session = ServiceSession::Open(options.remote);
+  if (!session.ok()) return session.status();
+  const absl::StatusOr<Evaluated> evaluated =
+      Evaluate((*session)->client(), options, *file, quality);
+  if (!evaluated.ok()) return evaluated.status();
   if (!file->mesh_sha256.empty() && file->mesh_sha256 != evaluated->mesh_sha256) {
     std::cerr << "inscribe: warning: " << options.spheres_path << " was made for mesh "
               << file->mesh_sha256 << ", not " << evaluated->mesh_sha256 << "\n";
@@ -141,12 +115,12 @@ int RunEvaluate(const EvaluateCliOptions& options) {
   } else {
     PrintText(options, evaluated->report);
   }
-  return kExitOk;
+  return absl::OkStatus();
 }
 
 }  // namespace
 
-void AddEvaluateCommand(CLI::App& app, int* exit_code) {
+void AddEvaluateCommand(CLI::App& app, CommandOutcome* outcome) {
   auto options = std::make_shared<EvaluateCliOptions>();
   CLI::App* cmd = app.add_subcommand(
       "evaluate",
@@ -175,7 +149,9 @@ void AddEvaluateCommand(CLI::App& app, int* exit_code) {
                 "Close the mesh's holes first (see inscribe info --fill-holes)");
   cmd->add_flag("--json", options->json, "Print one JSON object on stdout");
   AddRemoteOptions(cmd, &options->remote, 60.0);
-  cmd->callback([options, exit_code] { *exit_code = RunEvaluate(*options); });
+  cmd->callback([options, outcome] {
+    *outcome = CommandOutcome{RunEvaluate(*options), options->remote.server};
+  });
 }
 
 }  // namespace inscribe::cli

@@ -9,12 +9,13 @@
 #include <variant>
 
 #include "absl/strings/str_format.h"
-#include "exit_codes.h"
+#include "command_outcome.h"
 #include "inscribe/sphere_io.h"
 #include "inscribe/sphere_set_generation.h"
 #include "inscribe/view/report_json.h"
 #include "progress_bar.h"
 #include "remote_options.h"
+#include "service_session.h"
 #include "solid_loading.h"
 #include "sphere_output.h"
 
@@ -34,12 +35,12 @@ struct GenerateCliOptions {
   RemoteOptions remote;
 };
 
-// What generate reports, made here or by the server: the same figures either way.
+// What generate reports: the service's figures, in either mode.
 struct Generated {
   GeneratedSphereSet result;  // S_D, or S_D+ with --dilate
   std::string mesh_sha256;
   std::int64_t triangles = 0;  // of the validated mesh
-  double load_seconds = 0.0;   // reading and validation (remote: and the upload)
+  double load_seconds = 0.0;   // reading, storing and validation
   // Remote mode only: the server's key of the set and where it came from ("computed",
   // "memory", "disk", "joined").
   std::string sphere_set_key, cache;
@@ -101,40 +102,11 @@ SphereFile MakeSphereFile(const GenerateCliOptions& options, const Generated& g)
   return file;
 }
 
-// Embedded mode: the core in this process. Prints why and sets *exit_code on failure.
-std::optional<Generated> GenerateHere(const GenerateCliOptions& options, int* exit_code) {
-  std::optional<LoadedSolid> solid =
-      LoadSolid(options.mesh_path, exit_code, LoadSolidOptions{options.fill_holes});
-  if (!solid) return std::nullopt;
-
-  ProgressBar progress("generating");
-  GenerationControl control;
-  control.on_progress = [&progress](double fraction) { progress.Update(fraction); };
-  absl::StatusOr<GeneratedSphereSet> generated =
-      GenerateSphereSet(solid->solid, options.parameters, control);
-  if (!generated.ok()) {
-    std::cerr << "inscribe: " << generated.status().message() << "\n";
-    *exit_code = generated.status().code() == absl::StatusCode::kInvalidArgument
-                     ? kExitUsage
-                     : kExitUnusableMesh;
-    return std::nullopt;
-  }
-  Generated g;
-  g.result = *std::move(generated);
-  g.mesh_sha256 = solid->solid.sha256;
-  g.triangles = solid->solid.report.triangles;
-  g.load_seconds = solid->seconds;
-  return g;
-}
-
-// Remote mode: PutMesh, then Generate with the progress bar fed by the server's messages.
-std::optional<Generated> GenerateRemotely(const GenerateCliOptions& options, int* exit_code) {
-  const std::optional<client::Client> made = MakeClientOrReport(options.remote, exit_code);
-  if (!made) return std::nullopt;
-  const client::Client& client = *made;
-  std::optional<UploadedSolid> solid =
-      UploadSolid(client, options.remote, options.mesh_path, exit_code, {options.fill_holes});
-  if (!solid) return std::nullopt;
+// PutMesh, then Generate with the progress bar fed by the service's messages.
+absl::StatusOr<Generated> Generate(const client::Client& client,
+                                   const GenerateCliOptions& options) {
+  absl::StatusOr<StoredSolid> solid = StoreSolid(client, options.mesh_path, {options.fill_holes});
+  if (!solid.ok()) return solid.status();
 
   client::GenerateSettings settings;
   settings.parameters = options.parameters;
@@ -148,16 +120,14 @@ std::optional<Generated> GenerateRemotely(const GenerateCliOptions& options, int
     result = client.Generate(solid->mesh, settings, call);
   }
   if (!result.ok()) {
-    const int code = ReportRemoteError(result.status(), options.remote);
-    // Bad parameters are a usage error, as in embedded mode.
-    *exit_code = result.status().code() == absl::StatusCode::kInvalidArgument ? kExitUsage : code;
-    return std::nullopt;
+    // Parameters the service refuses are a bad command line.
+    if (result.status().code() == absl::StatusCode::kInvalidArgument) {
+      return WithExitCode(result.status(), kExitUsage);
+    }
+    return result.status();
   }
   if (options.parameters.evaluate && !result->quality) {
-    std::cerr << "inscribe: the server sent no quality report (server " << options.remote.server
-              << ")\n";
-    *exit_code = kExitInternal;
-    return std::nullopt;
+    return absl::InternalError("the service sent no quality report");
   }
   Generated g;
   g.mesh_sha256 = std::move(result->mesh_sha256);
@@ -205,31 +175,27 @@ void PrintSummary(const GenerateCliOptions& options, const Generated& g) {
   std::cout << summary.dump() << "\n";
 }
 
-int RunGenerate(const GenerateCliOptions& options) {
-  int exit_code = kExitOk;
-  std::optional<Generated> generated;
-  if (options.remote.enabled()) {
-    generated = GenerateRemotely(options, &exit_code);
-  } else {
-    generated = GenerateHere(options, &exit_code);
-  }
-  if (!generated) return exit_code;
+absl::Status RunGenerate(const GenerateCliOptions& options) {
+  absl::StatusOr<std::unique_ptr<ServiceSession>> session = ServiceSession::Open(options.remote);
+  if (!session.ok()) return session.status();
+  absl::StatusOr<Generated> generated = Generate((*session)->client(), options);
+  if (!generated.ok()) return generated.status();
 
   // The sphere file goes to -o, else to stdout unless --json claims stdout for the summary
   // (as with deform).
   const SphereFile file = MakeSphereFile(options, *generated);
-  if (const int code =
+  if (absl::Status written =
           EmitSphereFile(file, options.output_path, options.format, options.json, options.link);
-      code != kExitOk) {
-    return code;
+      !written.ok()) {
+    return written;
   }
   if (options.json) PrintSummary(options, *generated);
-  return kExitOk;
+  return absl::OkStatus();
 }
 
 }  // namespace
 
-void AddGenerateCommand(CLI::App& app, int* exit_code) {
+void AddGenerateCommand(CLI::App& app, CommandOutcome* outcome) {
   auto options = std::make_shared<GenerateCliOptions>();
   CLI::App* cmd = app.add_subcommand(
       "generate",
@@ -291,7 +257,9 @@ void AddGenerateCommand(CLI::App& app, int* exit_code) {
                 "Print one JSON summary on stdout (spheres, voxel_size, seconds, volumes, nerr, "
                 "quality figures)");
   AddRemoteOptions(cmd, &options->remote, 600.0);
-  cmd->callback([options, exit_code] { *exit_code = RunGenerate(*options); });
+  cmd->callback([options, outcome] {
+    *outcome = CommandOutcome{RunGenerate(*options), options->remote.server};
+  });
 }
 
 }  // namespace inscribe::cli

@@ -3,9 +3,11 @@
 
 #include <CLI/CLI.hpp>
 
+#include "command_outcome.h"
+
 namespace inscribe::cli {
 
-// Registers the subcommand on `app`; when it runs, its exit status is written to *exit_code.
-void AddGenerateCommand(CLI::App& app, int* exit_code);
+// Registers the subcommand on `app`; when it runs, it leaves its outcome in *outcome.
+void AddGenerateCommand(CLI::App& app, CommandOutcome* outcome);
 
 }  // namespace inscribe::cli

@@ -4,9 +4,10 @@
 #include <iostream>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "absl/strings/str_format.h"
-#include "exit_codes.h"
+#include "command_outcome.h"
 #include "grpc/health/v1/health.grpc.pb.h"
 #include "grpcpp/client_context.h"
 #include "grpcpp/create_channel.h"
@@ -48,11 +49,12 @@ absl::StatusOr<HealthCheckResponse::ServingStatus> Check(const std::string& targ
   return response.status();
 }
 
-int RunHealth(const HealthCliOptions& options) {
+absl::Status RunHealth(const HealthCliOptions& options) {
   absl::StatusOr<client::ConnectionOptions> channel = ConnectionOptionsFor(options.remote);
-  if (!channel.ok()) return ReportRemoteError(channel.status(), options.remote);
-  int exit_code = kExitOk;
-  for (const std::string& target : options.remote.servers()) {
+  if (!channel.ok()) return channel.status();
+  const std::vector<std::string> targets = options.remote.servers();
+  std::size_t not_serving = 0;
+  for (const std::string& target : targets) {
     absl::StatusOr<HealthCheckResponse::ServingStatus> status = Check(target, *channel, options);
     if (!status.ok()) {
       const absl::StatusCode code = status.status().code();
@@ -61,19 +63,25 @@ int RunHealth(const HealthCliOptions& options) {
       std::cout << absl::StrFormat("%s %s (%s: %s)\n", target,
                                    unreachable ? "UNREACHABLE" : "ERROR",
                                    absl::StatusCodeToString(code), status.status().message());
-      exit_code = kExitServerUnavailable;
+      ++not_serving;
       continue;
     }
     std::cout << absl::StrFormat("%s %s\n", target,
                                  HealthCheckResponse::ServingStatus_Name(*status));
-    if (*status != HealthCheckResponse::SERVING) exit_code = kExitServerUnavailable;
+    if (*status != HealthCheckResponse::SERVING) ++not_serving;
   }
-  return exit_code;
+  if (not_serving > 0) {
+    return CommandError(
+        absl::StatusCode::kUnavailable,
+        absl::StrFormat("%d of %d servers not serving", not_serving, targets.size()),
+        kExitServerUnavailable);
+  }
+  return absl::OkStatus();
 }
 
 }  // namespace
 
-void AddHealthCommand(CLI::App& app, int* exit_code) {
+void AddHealthCommand(CLI::App& app, CommandOutcome* outcome) {
   auto options = std::make_shared<HealthCliOptions>();
   CLI::App* cmd = app.add_subcommand(
       "health",
@@ -83,7 +91,9 @@ void AddHealthCommand(CLI::App& app, int* exit_code) {
                   "Service to ask about; empty = the server as a whole")
       ->capture_default_str();
   AddRemoteOptions(cmd, &options->remote, 5.0, /*server_required=*/true);
-  cmd->callback([options, exit_code] { *exit_code = RunHealth(*options); });
+  cmd->callback([options, outcome] {
+    *outcome = CommandOutcome{RunHealth(*options), options->remote.server};
+  });
 }
 
 }  // namespace inscribe::cli

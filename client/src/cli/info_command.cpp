@@ -7,12 +7,12 @@
 #include <string>
 
 #include "absl/strings/str_format.h"
-#include "exit_codes.h"
-#include "inscribe/mesh_hash.h"
+#include "command_outcome.h"
 #include "inscribe/mesh_io.h"
 #include "inscribe/mesh_validation.h"
 #include "inscribe/view/report_json.h"
 #include "remote_options.h"
+#include "service_session.h"
 
 namespace inscribe::cli {
 
@@ -27,27 +27,13 @@ struct InfoOptions {
   RemoteOptions remote;
 };
 
-// What info prints, from this process's validation or the server's.
+// What info prints: the service's report of the mesh, and how the file was read here.
 struct InfoResult {
   MeshReport report;
   std::string sha256;  // "" when the mesh's indices or coordinates cannot be trusted
-  ReadMeshInfo read;   // always local: the file is parsed here
+  ReadMeshInfo read;
   double seconds = 0.0;
 };
-
-InfoResult ValidateHere(Mesh mesh, const InfoOptions& options) {
-  ValidateOptions validate;
-  validate.check_self_intersections = !options.skip_self_intersections;
-  validate.fill_holes = options.fill_holes;
-  ValidatedMesh validated = ValidateMesh(std::move(mesh), validate);
-  InfoResult result;
-  // The hash is only meaningful for a mesh whose indices and coordinates can be trusted.
-  if (validated.report.non_finite_vertices == 0 && validated.report.out_of_range_indices == 0) {
-    result.sha256 = FormatSha256(MeshSha256(validated.mesh));
-  }
-  result.report = std::move(validated.report);
-  return result;
-}
 
 void PrintText(const std::string& path, const InfoResult& result) {
   const MeshReport& report = result.report;
@@ -93,35 +79,27 @@ void PrintText(const std::string& path, const InfoResult& result) {
   line("verdict", report.usable() ? "usable" : "NOT usable: " + report.first_error());
 }
 
-int RunInfo(const InfoOptions& options) {
+absl::Status RunInfo(const InfoOptions& options) {
   const auto start = std::chrono::steady_clock::now();
-  ReadMeshInfo read;
-  absl::StatusOr<Mesh> mesh = ReadMesh(options.path, &read);
-  if (!mesh.ok()) {
-    std::cerr << "inscribe: " << mesh.status().message() << "\n";
-    return kExitBadInput;
-  }
   InfoResult result;
-  if (options.remote.enabled()) {
-    client::InspectMeshOptions inspect;
-    inspect.skip_self_intersections = options.skip_self_intersections;
-    inspect.fill_holes = options.fill_holes;
-    absl::StatusOr<client::Client> client = MakeClient(options.remote);
-    if (!client.ok()) return ReportRemoteError(client.status(), options.remote);
-    absl::StatusOr<client::InspectMeshResult> inspected = client->InspectMesh(*mesh, inspect);
-    if (!inspected.ok()) return ReportRemoteError(inspected.status(), options.remote);
-    result.report = std::move(inspected->report);
-    result.sha256 = std::move(inspected->mesh_sha256);
-  } else {
-    result = ValidateHere(*std::move(mesh), options);
-  }
-  result.read = read;
+  absl::StatusOr<Mesh> mesh = ReadMesh(options.path, &result.read);
+  if (!mesh.ok()) return BadInputError(mesh.status().message());
+  absl::StatusOr<std::unique_ptr<ServiceSession>> session = ServiceSession::Open(options.remote);
+  if (!session.ok()) return session.status();
+  client::InspectMeshOptions inspect;
+  inspect.skip_self_intersections = options.skip_self_intersections;
+  inspect.fill_holes = options.fill_holes;
+  absl::StatusOr<client::InspectMeshResult> inspected =
+      (*session)->client().InspectMesh(*mesh, inspect);
+  if (!inspected.ok()) return inspected.status();
+  result.report = std::move(inspected->report);
+  result.sha256 = std::move(inspected->mesh_sha256);
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const MeshReport& report = result.report;
   if (options.json) {
     nlohmann::json j = MeshReportJson(report, result.sha256);
     j["path"] = options.path;
-    j["polygons_triangulated"] = read.polygons_triangulated;
+    j["polygons_triangulated"] = result.read.polygons_triangulated;
     // With --fill-holes the hash, volume and self-intersections describe the repaired mesh;
     // these two say how it was repaired.
     if (options.fill_holes) {
@@ -134,16 +112,13 @@ int RunInfo(const InfoOptions& options) {
   } else {
     PrintText(options.path, result);
   }
-  if (!report.usable()) {
-    std::cerr << "inscribe: " << options.path << ": " << report.first_error() << "\n";
-    return kExitUnusableMesh;
-  }
-  return kExitOk;
+  if (!report.usable()) return UnusableMeshError(options.path + ": " + report.first_error());
+  return absl::OkStatus();
 }
 
 }  // namespace
 
-void AddInfoCommand(CLI::App& app, int* exit_code) {
+void AddInfoCommand(CLI::App& app, CommandOutcome* outcome) {
   auto options = std::make_shared<InfoOptions>();
   CLI::App* cmd = app.add_subcommand(
       "info", "Validate a mesh and print its report, content hash, volume and bounding box");
@@ -155,7 +130,9 @@ void AddInfoCommand(CLI::App& app, int* exit_code) {
                 "Close every hole (border loop) with triangles between its border vertices, "
                 "then validate, hash and describe the repaired mesh");
   AddRemoteOptions(cmd, &options->remote, 60.0);
-  cmd->callback([options, exit_code] { *exit_code = RunInfo(*options); });
+  cmd->callback([options, outcome] {
+    *outcome = CommandOutcome{RunInfo(*options), options->remote.server};
+  });
 }
 
 }  // namespace inscribe::cli

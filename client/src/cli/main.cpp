@@ -1,14 +1,16 @@
-// The `inscribe` command line. Each subcommand lives in its own *_command.cpp; each runs in this
-// process, or on an inscribed server with --server ADDR (see remote_options.h).
+// The `inscribe` command line. Each subcommand lives in its own *_command.cpp and returns an
+// absl::Status; this prints a failure once and maps it to the exit status once
+// (command_outcome.h). The service commands run on an inscribed server with --server ADDR, or
+// on the same service in this process (service_session.h).
 #include <CLI/CLI.hpp>
 #include <exception>
 #include <iostream>
 
+#include "command_outcome.h"
 #include "convert_command.h"
 #include "deform_command.h"
 #include "distance_command.h"
 #include "evaluate_command.h"
-#include "exit_codes.h"
 #include "generate_command.h"
 #include "health_command.h"
 #include "info_command.h"
@@ -25,17 +27,17 @@ int main(int argc, char** argv) {
       "input; 64 bad command line; 69 the --server could not be reached or did not answer "
       "within --timeout; 70 internal error; 77 the --server refused the call (missing or wrong "
       "--token-file, UNAUTHENTICATED or PERMISSION_DENIED).");
-  int exit_code = inscribe::cli::kExitOk;
-  inscribe::cli::AddInfoCommand(app, &exit_code);
-  inscribe::cli::AddGenerateCommand(app, &exit_code);
-  inscribe::cli::AddEvaluateCommand(app, &exit_code);
-  inscribe::cli::AddDeformCommand(app, &exit_code);
-  inscribe::cli::AddDistanceCommand(app, &exit_code);
-  inscribe::cli::AddStatsCommand(app, &exit_code);
-  inscribe::cli::AddHealthCommand(app, &exit_code);
-  inscribe::cli::AddUrdfCommand(app, &exit_code);
-  inscribe::cli::AddViewCommand(app, &exit_code);
-  inscribe::cli::AddConvertCommand(app, &exit_code);
+  inscribe::cli::CommandOutcome outcome;
+  inscribe::cli::AddInfoCommand(app, &outcome);
+  inscribe::cli::AddGenerateCommand(app, &outcome);
+  inscribe::cli::AddEvaluateCommand(app, &outcome);
+  inscribe::cli::AddDeformCommand(app, &outcome);
+  inscribe::cli::AddDistanceCommand(app, &outcome);
+  inscribe::cli::AddStatsCommand(app, &outcome);
+  inscribe::cli::AddHealthCommand(app, &outcome);
+  inscribe::cli::AddUrdfCommand(app, &outcome);
+  inscribe::cli::AddViewCommand(app, &outcome);
+  inscribe::cli::AddConvertCommand(app, &outcome);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -49,5 +51,5 @@ int main(int argc, char** argv) {
     std::cerr << "inscribe: internal error: " << e.what() << "\n";
     return inscribe::cli::kExitInternal;
   }
-  return exit_code;
+  return inscribe::cli::ReportOutcome(outcome);
 }

@@ -40,9 +40,12 @@ absl::StatusOr<std::vector<RigidPose>> ParsePoses(absl::string_view bytes,
       return fail(absl::StrCat("more than ", kMaxPoses, " poses; split the file"));
     }
     RigidPose pose{Eigen::Quaterniond(v[0], v[1], v[2], v[3]), Vector3(v[4], v[5], v[6])};
-    absl::StatusOr<RigidPose> normalized = NormalizedPose(pose);
-    if (!normalized.ok()) return fail(std::string(normalized.status().message()));
-    poses.push_back(*normalized);
+    // Checked here, normalised once, by the service that uses it (normalising twice can move
+    // the last bit).
+    if (absl::Status usable = NormalizedPose(pose).status(); !usable.ok()) {
+      return fail(std::string(usable.message()));
+    }
+    poses.push_back(pose);
   }
   if (poses.empty()) {
     return absl::InvalidArgumentError(

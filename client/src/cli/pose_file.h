@@ -16,8 +16,9 @@ namespace inscribe::cli {
 inline constexpr std::int64_t kMaxPoses = 2'000'000;
 
 // Parses the bytes of a whole pose file; `name` (the path) starts every error message.
-// Quaternions are normalised when within 1e-3 of unit length (rounded values such as 0.7071),
-// refused otherwise; every pose returned passes CheckPose. INVALID_ARGUMENT naming the line:
+// Quaternions within 1e-3 of unit length (rounded values such as 0.7071) are returned as
+// written, for the service to normalise (NormalizedPose accepts each); others are refused.
+// INVALID_ARGUMENT naming the line:
 // `poses.txt: line 4: expected 7 numbers qw qx qy qz tx ty tz, found 6`. Cost O(bytes); no
 // memory is sized from the input beyond the poses it holds.
 absl::StatusOr<std::vector<RigidPose>> ParsePoses(absl::string_view bytes, const std::string& name);

@@ -3,14 +3,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <iostream>
 
 #include "absl/strings/ascii.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_split.h"
-#include "exit_codes.h"
 #include "inscribe/client/connection.h"
-#include "inscribe/client/routing.h"
 
 namespace inscribe::cli {
 
@@ -65,67 +62,6 @@ absl::StatusOr<client::ConnectionOptions> ConnectionOptionsFor(const RemoteOptio
     connection_options.bearer_token = *std::move(token);
   }
   return connection_options;
-}
-
-absl::StatusOr<client::Client> MakeClient(const RemoteOptions& options) {
-  absl::StatusOr<client::ConnectionOptions> made = ConnectionOptionsFor(options);
-  if (!made.ok()) return made.status();
-  const client::ConnectionOptions& connection_options = *made;
-  client::ClientOptions client_options;
-  client_options.default_timeout = std::chrono::duration_cast<std::chrono::milliseconds>(
-      std::chrono::duration<double>(options.timeout_seconds));
-
-  const std::vector<std::string> targets = options.servers();
-  if (targets.size() == 1) {
-    return client::Client(client::MakeGrpcConnection(targets[0], connection_options),
-                          client_options);
-  }
-  // Every replica can be reached within one call (each attempt fails over to the next).
-  client_options.retry.max_attempts =
-      std::max(client_options.retry.max_attempts, static_cast<int>(targets.size()));
-  std::vector<client::Endpoint> endpoints;
-  for (const std::string& target : targets) {
-    endpoints.push_back({target, client::MakeGrpcConnection(target, connection_options)});
-  }
-  absl::StatusOr<std::shared_ptr<client::Connection>> routed =
-      client::MakeRoutedConnection(std::move(endpoints));
-  if (!routed.ok()) return routed.status();
-  return client::Client(*std::move(routed), client_options);
-}
-
-std::optional<client::Client> MakeClientOrReport(const RemoteOptions& options, int* exit_code) {
-  absl::StatusOr<client::Client> made = MakeClient(options);
-  if (!made.ok()) {
-    *exit_code = ReportRemoteError(made.status(), options);
-    return std::nullopt;
-  }
-  return *std::move(made);
-}
-
-int RemoteExitCode(absl::StatusCode code) {
-  switch (code) {
-    case absl::StatusCode::kUnavailable:
-    case absl::StatusCode::kDeadlineExceeded:
-      return kExitServerUnavailable;
-    case absl::StatusCode::kInvalidArgument:
-    case absl::StatusCode::kNotFound:
-    case absl::StatusCode::kOutOfRange:
-    case absl::StatusCode::kResourceExhausted:
-      return kExitBadInput;
-    case absl::StatusCode::kFailedPrecondition:
-      return kExitUnusableMesh;
-    case absl::StatusCode::kUnauthenticated:
-    case absl::StatusCode::kPermissionDenied:
-      return kExitNotAuthorized;
-    default:
-      return kExitInternal;
-  }
-}
-
-int ReportRemoteError(const absl::Status& status, const RemoteOptions& options) {
-  std::cerr << absl::StrFormat("inscribe: %s (server %s: %s)\n", status.message(), options.server,
-                               absl::StatusCodeToString(status.code()));
-  return RemoteExitCode(status.code());
 }
 
 }  // namespace inscribe::cli

@@ -1,7 +1,7 @@
 // `--server ADDR[,ADDR...]`, `--timeout SECONDS` and the TLS and token flags: the option group
-// that switches any subcommand from embedded mode (the core library in this process) to remote
-// mode (inscribed, through the typed client library). Both modes print the same thing; only
-// timings may differ.
+// that switches a subcommand from embedded mode (the service in this process) to remote mode
+// (inscribed at --server); service_session.h opens either. Both modes print the same thing;
+// only timings and the remote-only figures (server, cache) differ.
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -46,20 +46,5 @@ void AddRemoteOptions(CLI::App* cmd, RemoteOptions* options, double default_time
 // The channel settings of `options`: TLS credentials and the bearer token, read from their
 // files (INVALID_ARGUMENT naming a file that cannot be read or used).
 absl::StatusOr<client::ConnectionOptions> ConnectionOptionsFor(const RemoteOptions& options);
-
-// A client for options.server (routed over the replicas when there are several) whose calls
-// default to options.timeout_seconds. The channels connect on the first call, so an
-// unreachable server shows up as UNAVAILABLE there; this fails only for unreadable TLS or
-// token files (INVALID_ARGUMENT naming the file).
-absl::StatusOr<client::Client> MakeClient(const RemoteOptions& options);
-// MakeClient for a subcommand: on failure, reports it (ReportRemoteError), sets *exit_code and
-// returns nullopt.
-std::optional<client::Client> MakeClientOrReport(const RemoteOptions& options, int* exit_code);
-
-int RemoteExitCode(absl::StatusCode code);
-
-// Prints `inscribe: <server's message> (server ADDR: CODE)` on stderr and returns
-// RemoteExitCode(status.code()). `status` must not be OK.
-int ReportRemoteError(const absl::Status& status, const RemoteOptions& options);
 
 }  // namespace inscribe::cli

@@ -2,9 +2,9 @@
 
 #include <chrono>
 #include <iostream>
+#include <utility>
 
-#include "exit_codes.h"
-#include "inscribe/mesh_hash.h"
+#include "command_outcome.h"
 #include "inscribe/mesh_io.h"
 
 namespace inscribe::cli {
@@ -19,50 +19,39 @@ void NoteRepairs(const std::string& path, const MeshReport& report) {
   }
 }
 
+double SecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
 }  // namespace
 
-std::optional<LoadedSolid> LoadSolid(const std::string& path, int* exit_code,
-                                     const LoadSolidOptions& options) {
+absl::StatusOr<LoadedSolid> LoadSolid(const std::string& path, const SolidLoadOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   absl::StatusOr<Mesh> mesh = ReadMesh(path, nullptr);
-  if (!mesh.ok()) {
-    std::cerr << "inscribe: " << mesh.status().message() << "\n";
-    *exit_code = kExitBadInput;
-    return std::nullopt;
-  }
+  if (!mesh.ok()) return BadInputError(mesh.status().message());
   SolidOptions solid_options;
   solid_options.validate.fill_holes = options.fill_holes;
   absl::StatusOr<Solid> solid = PrepareSolid(*std::move(mesh), solid_options);
-  if (!solid.ok()) {
-    std::cerr << "inscribe: " << path << ": " << solid.status().message() << "\n";
-    *exit_code = kExitUnusableMesh;
-    return std::nullopt;
-  }
+  if (!solid.ok()) return UnusableMeshError(path + ": " + std::string(solid.status().message()));
   NoteRepairs(path, solid->report);
-  return LoadedSolid{
-      *std::move(solid),
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()};
+  return LoadedSolid{*std::move(solid), SecondsSince(start)};
 }
 
-std::optional<UploadedSolid> UploadSolid(const client::Client& client, const RemoteOptions& remote,
-                                         const std::string& path, int* exit_code,
-                                         const LoadSolidOptions& options) {
+absl::StatusOr<StoredSolid> StoreSolid(const client::Client& client, const std::string& path,
+                                       const SolidLoadOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   absl::StatusOr<Mesh> mesh = ReadMesh(path, nullptr);
-  if (!mesh.ok()) {
-    std::cerr << "inscribe: " << mesh.status().message() << "\n";
-    *exit_code = kExitBadInput;
-    return std::nullopt;
-  }
+  if (!mesh.ok()) return BadInputError(mesh.status().message());
   absl::StatusOr<client::PutMeshResult> stored = client.PutMesh(*mesh, options.fill_holes);
   if (!stored.ok()) {
-    *exit_code = ReportRemoteError(stored.status(), remote);
-    return std::nullopt;
+    if (stored.status().code() == absl::StatusCode::kFailedPrecondition) {
+      return WithContext(path, stored.status());
+    }
+    return stored.status();
   }
   NoteRepairs(path, stored->report);
-  return UploadedSolid{
-      *std::move(mesh), std::move(stored->report), std::move(stored->mesh_sha256),
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()};
+  return StoredSolid{*std::move(mesh), std::move(stored->report), std::move(stored->mesh_sha256),
+                     SecondsSince(start)};
 }
 
 }  // namespace inscribe::cli

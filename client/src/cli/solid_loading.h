@@ -1,50 +1,45 @@
-// Loading a mesh for sphere work: read, validate (fix orientation), hash, build the oracle;
-// or, with --server, read here and store on the server, which validates it. Shared by the
-// subcommands that need a usable solid (generate, evaluate).
+// Loading a mesh for sphere work. view, which works locally, reads and validates it here
+// (LoadSolid); the commands that call the service read it here and store it there
+// (StoreSolid), where it is validated.
 #pragma once
 
-#include <optional>
 #include <string>
 
-#include "inscribe/boundary_oracle.h"
+#include "absl/status/statusor.h"
 #include "inscribe/client/client.h"
 #include "inscribe/mesh_validation.h"
 #include "inscribe/solid.h"
-#include "remote_options.h"
 
 namespace inscribe::cli {
+
+struct SolidLoadOptions {
+  // Close the mesh's holes before use (ValidateOptions::fill_holes, `--fill-holes`); the hash
+  // and the oracle are then those of the repaired mesh, and one line on stderr says so.
+  bool fill_holes = false;
+};
 
 struct LoadedSolid {
   Solid solid;
   double seconds = 0.0;  // reading + validation + oracle build
 };
 
-struct LoadSolidOptions {
-  // Close the mesh's holes before use (ValidateOptions::fill_holes, `--fill-holes`); the hash
-  // and the oracle are then those of the repaired mesh, and one line on stderr says so.
-  bool fill_holes = false;
-};
+// core's PrepareSolid on the file at `path`. BadInputError for an unreadable file,
+// UnusableMeshError ("PATH: why") for a mesh that is not a closed solid.
+absl::StatusOr<LoadedSolid> LoadSolid(const std::string& path,
+                                      const SolidLoadOptions& options = {});
 
-// Prints the reason on stderr and sets *exit_code (kExitBadInput for unreadable files,
-// kExitUnusableMesh for meshes that are not closed solids) when it returns nothing. The solid
-// is core's PrepareSolid (its inside-test rule included).
-std::optional<LoadedSolid> LoadSolid(const std::string& path, int* exit_code,
-                                     const LoadSolidOptions& options = {});
-
-// A mesh stored on the server (PutMesh): the file as read here, and the server's key and
+// A mesh stored in the service (PutMesh): the file as read here, and the service's key and
 // report of it after its fixes.
-struct UploadedSolid {
-  Mesh mesh;             // as read (to upload again if the server evicts it)
-  MeshReport report;     // the server's, as LoadSolid's
-  std::string sha256;    // the server's key: "sha256:<hex>" of the validated mesh
-  double seconds = 0.0;  // reading + upload + the server's validation
+struct StoredSolid {
+  Mesh mesh;             // as read (to store again if the service evicts it)
+  MeshReport report;     // the service's
+  std::string sha256;    // the service's key: "sha256:<hex>" of the validated mesh
+  double seconds = 0.0;  // reading + storing + the service's validation
 };
 
-// The remote LoadSolid: reads the file here (kExitBadInput on stderr if it cannot), then
-// PutMesh; a refusal (an unusable mesh is FAILED_PRECONDITION) is reported as
-// ReportRemoteError does. Prints the same note as LoadSolid when holes were filled.
-std::optional<UploadedSolid> UploadSolid(const client::Client& client, const RemoteOptions& remote,
-                                         const std::string& path, int* exit_code,
-                                         const LoadSolidOptions& options = {});
+// Reads the file here (BadInputError if it cannot), then PutMesh; the service's refusal of an
+// unusable mesh (FAILED_PRECONDITION) comes back as "PATH: why".
+absl::StatusOr<StoredSolid> StoreSolid(const client::Client& client, const std::string& path,
+                                       const SolidLoadOptions& options = {});
 
 }  // namespace inscribe::cli

@@ -7,9 +7,10 @@
 #include <vector>
 
 #include "absl/strings/str_format.h"
-#include "exit_codes.h"
+#include "command_outcome.h"
 #include "nlohmann/json.hpp"
 #include "remote_options.h"
+#include "service_session.h"
 
 namespace inscribe::cli {
 namespace {
@@ -46,28 +47,28 @@ std::vector<std::pair<const char*, std::int64_t>> Counters(const client::ServerC
           {"disk_available", s.disk_available}};
 }
 
-int RunStats(const StatsCliOptions& options) {
-  absl::StatusOr<client::Client> client = MakeClient(options.remote);
-  if (!client.ok()) return ReportRemoteError(client.status(), options.remote);
-  absl::StatusOr<client::ServerCacheStats> stats = client->CacheStats();
-  if (!stats.ok()) return ReportRemoteError(stats.status(), options.remote);
+absl::Status RunStats(const StatsCliOptions& options) {
+  absl::StatusOr<std::unique_ptr<ServiceSession>> session = ServiceSession::Open(options.remote);
+  if (!session.ok()) return session.status();
+  absl::StatusOr<client::ServerCacheStats> stats = (*session)->client().CacheStats();
+  if (!stats.ok()) return stats.status();
   if (options.json) {
     nlohmann::json j;
     j["server"] = options.remote.server;
     for (const auto& [name, value] : Counters(*stats)) j[name] = value;
     std::cout << j.dump() << "\n";
-    return kExitOk;
+    return absl::OkStatus();
   }
   std::cout << absl::StrFormat("%-20s %s\n", "server", options.remote.server);
   for (const auto& [name, value] : Counters(*stats)) {
     std::cout << absl::StrFormat("%-20s %d\n", name, value);
   }
-  return kExitOk;
+  return absl::OkStatus();
 }
 
 }  // namespace
 
-void AddStatsCommand(CLI::App& app, int* exit_code) {
+void AddStatsCommand(CLI::App& app, CommandOutcome* outcome) {
   auto options = std::make_shared<StatsCliOptions>();
   CLI::App* cmd = app.add_subcommand(
       "stats",
@@ -77,7 +78,9 @@ void AddStatsCommand(CLI::App& app, int* exit_code) {
       "skips (while it is down), corrupt values and availability");
   cmd->add_flag("--json", options->json, "Print one JSON object on stdout");
   AddRemoteOptions(cmd, &options->remote, 60.0, /*server_required=*/true);
-  cmd->callback([options, exit_code] { *exit_code = RunStats(*options); });
+  cmd->callback([options, outcome] {
+    *outcome = CommandOutcome{RunStats(*options), options->remote.server};
+  });
 }
 
 }  // namespace inscribe::cli

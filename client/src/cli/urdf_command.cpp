@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "absl/strings/str_format.h"
-#include "exit_codes.h"
+#include "command_outcome.h"
 #include "inscribe/atomic_file.h"
 #include "inscribe/robot/spherized_urdf.h"
 #include "inscribe/robot/urdf_robot.h"
@@ -146,24 +146,21 @@ void PrintTable(const std::vector<LinkSpherizeResult>& results, const std::strin
   std::cout << "\n";
 }
 
-int RunUrdf(UrdfCliOptions options) {
+absl::Status RunUrdf(UrdfCliOptions options) {
   const auto start = std::chrono::steady_clock::now();
   if (!options.voxel_size && !options.max_spheres_per_link) {
     options.max_spheres_per_link = kDefaultMaxSpheresPerLink;
   }
   if (options.voxel_size && !(*options.voxel_size > 0.0 && std::isfinite(*options.voxel_size))) {
-    std::cerr << "inscribe: --voxel-size must be a positive number of metres\n";
-    return kExitUsage;
+    return UsageError("--voxel-size must be a positive number of metres");
   }
   if (options.max_spheres_per_link && *options.max_spheres_per_link <= 0) {
-    std::cerr << "inscribe: --max-spheres-per-link must be at least 1\n";
-    return kExitUsage;
+    return UsageError("--max-spheres-per-link must be at least 1");
   }
   const std::string yaml_path = YamlPath(options);
   if (SameFile(yaml_path, options.output_path)) {
-    std::cerr << "inscribe: the YAML would overwrite -o " << options.output_path
-              << "; give --yaml PATH or an -o ending in .urdf\n";
-    return kExitUsage;
+    return UsageError("the YAML would overwrite -o " + options.output_path +
+                      "; give --yaml PATH or an -o ending in .urdf");
   }
 
   // Before any work: a missing output directory would otherwise only show at the end.
@@ -171,20 +168,15 @@ int RunUrdf(UrdfCliOptions options) {
     const fs::path directory = fs::absolute(path).parent_path();
     std::error_code error;
     if (!fs::is_directory(directory, error)) {
-      std::cerr << "inscribe: cannot write " << path << ": directory " << directory.string()
-                << " does not exist\n";
-      return kExitBadInput;
+      return BadInputError("cannot write " + path + ": directory " + directory.string() +
+                           " does not exist");
     }
   }
   absl::StatusOr<std::string> bytes = ReadWholeFile(options.urdf_path);
-  if (!bytes.ok()) {
-    std::cerr << "inscribe: " << bytes.status().message() << "\n";
-    return kExitBadInput;
-  }
+  if (!bytes.ok()) return BadInputError(bytes.status().message());
   absl::StatusOr<UrdfRobot> robot = ParseUrdf(*bytes);
   if (!robot.ok()) {
-    std::cerr << "inscribe: " << options.urdf_path << ": " << robot.status().message() << "\n";
-    return kExitBadInput;
+    return BadInputError(options.urdf_path + ": " + std::string(robot.status().message()));
   }
 
   UrdfSpherizeOptions spherize;
@@ -203,10 +195,7 @@ int RunUrdf(UrdfCliOptions options) {
   }
 
   absl::StatusOr<std::string> urdf = SpherizedUrdf(*bytes, results);
-  if (!urdf.ok()) {
-    std::cerr << "inscribe: " << urdf.status().message() << "\n";
-    return kExitInternal;  // ParseUrdf accepted these bytes
-  }
+  if (!urdf.ok()) return BugError(urdf.status().message());  // ParseUrdf accepted them
   std::vector<std::string> left_out;
   const std::string yaml = SpherizedCuroboYaml(results, robot->name, &left_out);
   for (const std::string& link : left_out) {
@@ -214,12 +203,12 @@ int RunUrdf(UrdfCliOptions options) {
               << " but left out of " << yaml_path
               << ": cuRobo YAML link names are letters, digits and _ - . /\n";
   }
-  const auto write = [](const std::string& path, const std::string& contents) {
-    const absl::Status written = WriteFileAtomically(path, contents);
-    if (!written.ok()) std::cerr << "inscribe: " << written.message() << "\n";
-    return written.ok();
-  };
-  if (!write(options.output_path, *urdf) || !write(yaml_path, yaml)) return kExitBadInput;
+  for (const auto& [path, contents] :
+       {std::pair{options.output_path, *urdf}, std::pair{yaml_path, yaml}}) {
+    if (absl::Status written = WriteFileAtomically(path, contents); !written.ok()) {
+      return BadInputError(written.message());
+    }
+  }
 
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -228,15 +217,23 @@ int RunUrdf(UrdfCliOptions options) {
   } else {
     PrintTable(results, options.output_path, yaml_path, left_out, seconds);
   }
-  for (const LinkSpherizeResult& result : results) {
-    if (result.status == LinkStatus::kSkipped) return kExitUnusableMesh;
+  const auto skipped = std::count_if(results.begin(), results.end(), [](const auto& result) {
+    return result.status == LinkStatus::kSkipped;
+  });
+  if (skipped > 0) {
+    return UnusableMeshError(
+        absl::StrFormat("%d of %d links skipped (see above)", skipped, results.size()));
   }
-  return left_out.empty() ? kExitOk : kExitUnusableMesh;
+  if (!left_out.empty()) {
+    return UnusableMeshError(
+        absl::StrFormat("%d links left out of %s (see above)", left_out.size(), yaml_path));
+  }
+  return absl::OkStatus();
 }
 
 }  // namespace
 
-void AddUrdfCommand(CLI::App& app, int* exit_code) {
+void AddUrdfCommand(CLI::App& app, CommandOutcome* outcome) {
   auto options = std::make_shared<UrdfCliOptions>();
   CLI::App* cmd = app.add_subcommand(
       "urdf",
@@ -261,7 +258,7 @@ void AddUrdfCommand(CLI::App& app, int* exit_code) {
                   "cuRobo collision_spheres YAML to write (default: -o with extension .yml)");
   cmd->add_flag("--json", options->json,
                 "Print one JSON report on stdout: per link status, spheres, seconds, error");
-  cmd->callback([options, exit_code] { *exit_code = RunUrdf(*options); });
+  cmd->callback([options, outcome] { outcome->status = RunUrdf(*options); });
 }
 
 }  // namespace inscribe::cli

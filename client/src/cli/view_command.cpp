@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "absl/strings/str_format.h"
-#include "exit_codes.h"
+#include "command_outcome.h"
 #include "inscribe/atomic_file.h"
 #include "inscribe/sphere_io.h"
 #include "inscribe/sphere_quality.h"
@@ -71,22 +71,16 @@ std::string OutputPathProblem(const std::string& path) {
   return "";
 }
 
-int RunView(const ViewCliOptions& options) {
+absl::Status RunView(const ViewCliOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   SphereFileReadOptions read;
   if (!options.format.empty()) read.format = *ParseSphereFileFormat(options.format);
   read.sph_level = options.sph_level;
   read.yaml_link = options.link;
   absl::StatusOr<SphereFile> file = ReadSphereFile(options.spheres_path, read);
-  if (!file.ok()) {
-    std::cerr << "inscribe: " << file.status().message() << "\n";
-    return kExitBadInput;
-  }
+  if (!file.ok()) return BadInputError(file.status().message());
   const std::vector<Sphere>& spheres = file->set.spheres;
-  if (spheres.empty()) {
-    std::cerr << "inscribe: " << options.spheres_path << ": no spheres to show\n";
-    return kExitBadInput;
-  }
+  if (spheres.empty()) return BadInputError(options.spheres_path + ": no spheres to show");
   const std::string output =
       !options.output_path.empty()
           ? options.output_path
@@ -95,19 +89,15 @@ int RunView(const ViewCliOptions& options) {
   const fs::path output_canonical = fs::weakly_canonical(output, output_error);
   const fs::path spheres_canonical = fs::weakly_canonical(options.spheres_path, spheres_error);
   if (!output_error && !spheres_error && output_canonical == spheres_canonical) {
-    std::cerr << "inscribe: the page would overwrite the sphere file " << options.spheres_path
-              << "; choose another path with -o\n";
-    return kExitUsage;
+    return UsageError("the page would overwrite the sphere file " + options.spheres_path +
+                      "; choose another path with -o");
   }
   if (const std::string problem = OutputPathProblem(output); !problem.empty()) {
-    std::cerr << "inscribe: cannot write the page to " << output << ": " << problem << "\n";
-    return kExitBadInput;
+    return BadInputError("cannot write the page to " + output + ": " + problem);
   }
 
-  int exit_code = kExitOk;
-  std::optional<LoadedSolid> solid =
-      LoadSolid(options.mesh_path, &exit_code, LoadSolidOptions{options.fill_holes});
-  if (!solid) return exit_code;
+  absl::StatusOr<LoadedSolid> solid = LoadSolid(options.mesh_path, {options.fill_holes});
+  if (!solid.ok()) return solid.status();
   if (!file->mesh_sha256.empty() && file->mesh_sha256 != solid->solid.sha256) {
     std::cerr << "inscribe: warning: " << options.spheres_path << " was made for mesh "
               << file->mesh_sha256 << ", not " << solid->solid.sha256 << "\n";
@@ -129,23 +119,22 @@ int RunView(const ViewCliOptions& options) {
     const absl::StatusCode code = page.status().code();
     const bool bad_input =
         code == absl::StatusCode::kInvalidArgument || code == absl::StatusCode::kResourceExhausted;
-    std::cerr << "inscribe: " << (bad_input ? options.spheres_path + ": " : "internal error: ")
-              << page.status().message() << "\n";
-    return bad_input ? kExitBadInput : kExitInternal;
+    return bad_input
+               ? BadInputError(options.spheres_path + ": " + std::string(page.status().message()))
+               : BugError(page.status().message());
   }
   if (absl::Status written = WriteFileAtomically(output, *page); !written.ok()) {
-    std::cerr << "inscribe: " << written.message() << "\n";
-    return kExitBadInput;
+    return BadInputError(written.message());
   }
   std::cout << output << "\n";
   std::cerr << absl::StrFormat("inscribe: %d spheres, %.0f KB page, %.2f s\n", spheres.size(),
                                page->size() / 1024.0, SecondsSince(start));
-  return kExitOk;
+  return absl::OkStatus();
 }
 
 }  // namespace
 
-void AddViewCommand(CLI::App& app, int* exit_code) {
+void AddViewCommand(CLI::App& app, CommandOutcome* outcome) {
   auto options = std::make_shared<ViewCliOptions>();
   CLI::App* cmd = app.add_subcommand(
       "view",
@@ -174,7 +163,7 @@ void AddViewCommand(CLI::App& app, int* exit_code) {
                 "Close the mesh's holes first (see inscribe info --fill-holes)");
   cmd->add_option("--title", options->title,
                   "Heading of the page (default: the mesh and sphere file names)");
-  cmd->callback([options, exit_code] { *exit_code = RunView(*options); });
+  cmd->callback([options, outcome] { outcome->status = RunView(*options); });
 }
 
 }  // namespace inscribe::cli

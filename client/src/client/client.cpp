@@ -152,6 +152,11 @@ absl::StatusOr<PutMeshResult> Client::PutMesh(const Mesh& mesh, bool fill_holes,
 absl::StatusOr<GenerateResult> Client::Generate(const std::string& mesh_sha256,
                                                 const GenerateSettings& settings,
                                                 const GenerateOptions& options) const {
+  // Checked before sending: the wire cannot carry some bad values (a voxel size of 0 reads as
+  // unset), and core's message is the one to give.
+  if (absl::Status checked = CheckSphereSetParameters(settings.parameters); !checked.ok()) {
+    return checked;
+  }
   return GenerateUntil(*connection_, options_.retry,
                        GenerateRequestFor(mesh_sha256, settings, options), options.on_progress,
                        DeadlineAfter(options.timeout, options_));
@@ -159,6 +164,9 @@ absl::StatusOr<GenerateResult> Client::Generate(const std::string& mesh_sha256,
 
 absl::StatusOr<GenerateResult> Client::Generate(const Mesh& mesh, const GenerateSettings& settings,
                                                 const GenerateOptions& options) const {
+  if (absl::Status checked = CheckSphereSetParameters(settings.parameters); !checked.ok()) {
+    return checked;
+  }
   // One deadline for the uploads and generations together; the mesh is converted once.
   const Deadline deadline = DeadlineAfter(options.timeout, options_);
   v1::PutMeshRequest put;
@@ -285,7 +293,14 @@ absl::StatusOr<DistanceBatchResult> Client::Distance(const std::string& sphere_s
     return Malformed("Distance", absl::StrCat("results has ", results->size(), " entries for ",
                                               poses_b.size(), " pose pairs"));
   }
-  return DistanceBatchResult{*std::move(results), response->seconds()};
+  DistanceBatchResult batch;
+  batch.results = *std::move(results);
+  batch.server_seconds = response->seconds();
+  batch.hierarchy_seconds = response->hierarchy_seconds();
+  batch.threads = response->threads();
+  batch.volume_tests = response->volume_tests();
+  batch.sphere_tests = response->sphere_tests();
+  return batch;
 }
 
 absl::StatusOr<QualityReport> Client::Evaluate(const std::string& mesh_sha256,

@@ -331,8 +331,13 @@ std::shared_ptr<Connection> MakeGrpcConnection(const std::string& target,
   arguments.SetMaxSendMessageSize(options.max_message_bytes);
   std::shared_ptr<grpc::ChannelCredentials> credentials =
       options.credentials ? options.credentials : grpc::InsecureChannelCredentials();
-  return std::make_shared<GrpcConnection>(grpc::CreateCustomChannel(target, credentials, arguments),
-                                          options.bearer_token);
+  return MakeGrpcConnection(grpc::CreateCustomChannel(target, credentials, arguments),
+                            options.bearer_token);
+}
+
+std::shared_ptr<Connection> MakeGrpcConnection(std::shared_ptr<grpc::Channel> channel,
+                                               const std::string& bearer_token) {
+  return std::make_shared<GrpcConnection>(std::move(channel), bearer_token);
 }
 
 absl::StatusOr<std::shared_ptr<grpc::ChannelCredentials>> MakeTlsCredentials(

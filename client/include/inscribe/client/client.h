@@ -137,6 +137,10 @@ struct DistanceOptions : CallOptions {
 struct DistanceBatchResult {
   std::vector<DistanceResult> results;  // entry i answers pose pair i; witnesses in world frame
   double server_seconds = 0.0;          // the server's time on the queries
+  double hierarchy_seconds = 0.0;       // ... and on getting both hierarchies (built or cached)
+  int threads = 0;                      // threads the queries ran on
+  // Bounding-volume and sphere-pair tests over all the queries.
+  std::int64_t volume_tests = 0, sphere_tests = 0;
 };
 
 // Evaluation options are core's (surface_samples, voxel_size and coverage_tolerance go on the

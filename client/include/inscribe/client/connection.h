@@ -18,6 +18,7 @@
 #include "inscribe/v1/service.pb.h"
 
 namespace grpc {
+class Channel;
 class ChannelCredentials;
 }  // namespace grpc
 
@@ -125,5 +126,9 @@ absl::StatusOr<std::string> ReadBearerToken(const std::string& path);
 // unreachable server shows up as UNAVAILABLE from the calls.
 std::shared_ptr<Connection> MakeGrpcConnection(const std::string& target,
                                                const ConnectionOptions& options = {});
+// A Connection over an existing channel, e.g. an in-process one
+// (inscribe::server::InscribeServer::InProcessChannel), sending `bearer_token` when not empty.
+std::shared_ptr<Connection> MakeGrpcConnection(std::shared_ptr<grpc::Channel> channel,
+                                               const std::string& bearer_token = "");
 
 }  // namespace inscribe::client

@@ -9,6 +9,10 @@
 #include "absl/status/statusor.h"
 #include "inscribe/server/inscribe_service.h"
 
+namespace grpc {
+class Channel;
+}  // namespace grpc
+
 namespace inscribe::server {
 
 // TLS on the listening port. PEM files, read once at start.
@@ -26,7 +30,8 @@ struct ServerTlsOptions {
 
 struct ServerOptions {
   // --listen: HOST:PORT to bind (plaintext unless `tls` is enabled). Loopback by default; port
-  // 0 picks a free port (read it back from InscribeServer::port()).
+  // 0 picks a free port (read it back from InscribeServer::port()). Empty: no port at all, the
+  // server is reached only through InProcessChannel (the CLI's embedded mode).
   std::string listen = "127.0.0.1:50051";
   // --jobs: requests computed at the same time. 0 = one per hardware thread.
   int jobs = 0;
@@ -69,8 +74,12 @@ class InscribeServer {
 
   // The port actually bound (the one asked for, or the one picked for port 0).
   int port() const { return port_; }
-  // HOST:PORT with the bound port, e.g. "127.0.0.1:50051"; suitable as a client target.
+  // HOST:PORT with the bound port, e.g. "127.0.0.1:50051"; suitable as a client target. Empty
+  // when there is no port (ServerOptions::listen empty).
   const std::string& address() const { return address_; }
+  // A channel to this server inside this process, with no socket and no TLS (--auth-tokens
+  // still apply). The server must outlive it.
+  std::shared_ptr<grpc::Channel> InProcessChannel() const;
   // The port of the Prometheus endpoint (--metrics-listen), 0 when there is none.
   int metrics_port() const;
   // Jobs (requests) used by the pool after resolving jobs = 0.

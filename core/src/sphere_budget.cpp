@@ -13,6 +13,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "inscribe/medial_spheres.h"
+#include "voxel_grid.h"
 
 namespace inscribe {
 namespace {
@@ -59,8 +60,9 @@ absl::StatusOr<SphereBudgetResult> GenerateWithSphereBudget(const BoundaryOracle
   const double target = static_cast<double>(options.max_spheres);
   // The finest sigma the voxel limit allows: below it runs would be refused.
   const Vector3 extent = box.extent().cwiseMax(Vector3::Constant(1e-12 * diagonal));
-  const double finest =
-      std::cbrt(extent.prod() / static_cast<double>(options.base.max_voxels)) * 1.0001;
+  // From the volume's estimate up until the grid, whose sides round up to whole voxels, fits.
+  double finest = std::cbrt(extent.prod() / static_cast<double>(options.base.max_voxels));
+  while (!internal::MakeGrid(box, finest, options.base.max_voxels).ok()) finest *= 1.001;
 
   SphereBudgetResult result;
   std::optional<MedialSphereResult> accepted;  // smallest sigma with n <= N

@@ -1,14 +1,17 @@
 // The InscribeService RPCs on sphere sets made elsewhere or moved: PutSphereSet,
-// UpdateDeformation (paper Section V) and Evaluate (Section IV-B measures). O(1) checks on
-// the gRPC thread, the rest on the pool through ResultStore.
+// UpdateDeformation (paper Section V), Evaluate (Section IV-B measures) and CertifyCover. O(1)
+// checks on the gRPC thread, the rest on the pool through ResultStore.
 #include <algorithm>
 #include <cstdint>
 #include <memory>
 #include <mutex>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/string_view.h"
+#include "inscribe/cover_certificate.h"
 #include "inscribe/mesh_hash.h"
 #include "inscribe/server/inscribe_service.h"
 #include "inscribe/sphere_deformation.h"
@@ -65,6 +68,64 @@ absl::StatusOr<Vertices> DeformedVertices(const v1::UpdateDeformationRequest& re
     vertices(i / 3, i % 3) = x;
   }
   return vertices;
+}
+
+// The O(1) checks of a call on "a set, cached by key or sent inline, against a mesh"
+// (Evaluate, CertifyCover): an inline set within --max-spheres and a mesh key, or a set key.
+template <class Request>
+absl::Status CheckSpheresRequest(const Request& request, std::int64_t max_spheres) {
+  if (request.has_sphere_set()) {
+    if (request.sphere_set().radii_size() > max_spheres) {
+      return absl::ResourceExhaustedError(
+          absl::StrCat("sphere_set has ", request.sphere_set().radii_size(),
+                       " spheres; this server's limit (--max-spheres) is ", max_spheres));
+    }
+    return CheckKey(request.mesh_sha256(), "mesh_sha256");
+  }
+  return CheckKey(request.sphere_set_key(), "sphere_set_key (or an inline sphere_set)");
+}
+
+// The spheres and the mesh such a call names, on the pool: an inline set and the request's
+// mesh, or a cached set (its memory reserved while this lives) and the mesh it names.
+struct NamedSpheres {
+  std::shared_ptr<const StoredMeshEntry> mesh;
+  std::shared_ptr<const SphereSetEntry> cached;
+  SphereSet inline_set;
+  MemoryBudget::Reservation reservation;
+
+  const std::vector<Sphere>& spheres() const {
+    return cached ? cached->set.spheres : inline_set.spheres;
+  }
+};
+
+template <class Request>
+absl::StatusOr<NamedSpheres> ResolveSpheres(const Request& request, ResultStore& store,
+                                            MemoryBudget& memory, absl::string_view call) {
+  NamedSpheres out;
+  std::string mesh_key = request.mesh_sha256();
+  if (request.has_sphere_set()) {
+    absl::StatusOr<SphereSet> set = wire::SphereSetFromProto(request.sphere_set(), "sphere_set");
+    if (!set.ok()) return set.status();
+    out.inline_set = *std::move(set);
+  } else {
+    absl::StatusOr<std::shared_ptr<const SphereSetEntry>> set =
+        store.GetSphereSet(request.sphere_set_key());
+    if (!set.ok()) return set.status();
+    out.cached = *std::move(set);
+    absl::StatusOr<MemoryBudget::Reservation> more = memory.Reserve(
+        static_cast<std::int64_t>(out.cached->set.spheres.size()) * MemoryCosts::kPerSphere,
+        absl::StrCat(call, " of ", out.cached->set.spheres.size(), " cached spheres"));
+    if (!more.ok()) return more.status();
+    out.reservation = *std::move(more);
+    absl::StatusOr<std::string> key =
+        MeshKeyFor(request.mesh_sha256(), *out.cached, request.sphere_set_key());
+    if (!key.ok()) return key.status();
+    mesh_key = *std::move(key);
+  }
+  absl::StatusOr<std::shared_ptr<const StoredMeshEntry>> mesh = store.GetMesh(mesh_key);
+  if (!mesh.ok()) return mesh.status();
+  out.mesh = *std::move(mesh);
+  return out;
 }
 
 }  // namespace
@@ -184,18 +245,7 @@ grpc::ServerUnaryReactor* InscribeService::UpdateDeformation(
 grpc::ServerUnaryReactor* InscribeService::Evaluate(grpc::CallbackServerContext* context,
                                                     const v1::EvaluateRequest* request,
                                                     v1::EvaluateResponse* response) {
-  absl::Status precheck;
-  if (request->has_sphere_set()) {
-    if (request->sphere_set().radii_size() > limits_.max_spheres) {
-      precheck = absl::ResourceExhaustedError(
-          absl::StrCat("sphere_set has ", request->sphere_set().radii_size(),
-                       " spheres; this server's limit (--max-spheres) is ", limits_.max_spheres));
-    } else {
-      precheck = CheckKey(request->mesh_sha256(), "mesh_sha256");
-    }
-  } else {
-    precheck = CheckKey(request->sphere_set_key(), "sphere_set_key (or an inline sphere_set)");
-  }
+  absl::Status precheck = CheckSpheresRequest(*request, limits_.max_spheres);
   if (precheck.ok() && request->samples() > kMaxEvaluateSamples) {
     precheck = absl::InvalidArgumentError(absl::StrCat(
         "samples is ", request->samples(), "; at most ", kMaxEvaluateSamples, " are taken"));
@@ -211,39 +261,39 @@ grpc::ServerUnaryReactor* InscribeService::Evaluate(grpc::CallbackServerContext*
           inline_spheres * MemoryCosts::kPerSphere + MemoryCosts::kSmallCall,
       absl::StrCat("Evaluate with ", samples, " samples and ", inline_spheres, " inline spheres"),
       [this, request, response, options = quality.value_or(QualityOptions())]() -> absl::Status {
-        std::string mesh_key = request->mesh_sha256();
-        std::shared_ptr<const SphereSetEntry> cached;
-        MemoryBudget::Reservation cached_reservation;  // held until the report is made
-        SphereSet inline_set;
-        if (request->has_sphere_set()) {
-          absl::StatusOr<SphereSet> set =
-              wire::SphereSetFromProto(request->sphere_set(), "sphere_set");
-          if (!set.ok()) return set.status();
-          inline_set = *std::move(set);
-        } else {
-          absl::StatusOr<std::shared_ptr<const SphereSetEntry>> set =
-              store_->GetSphereSet(request->sphere_set_key());
-          if (!set.ok()) return set.status();
-          cached = *std::move(set);
-          absl::StatusOr<MemoryBudget::Reservation> more = memory_->Reserve(
-              static_cast<std::int64_t>(cached->set.spheres.size()) * MemoryCosts::kPerSphere,
-              absl::StrCat("Evaluate of ", cached->set.spheres.size(), " cached spheres"));
-          if (!more.ok()) return more.status();
-          cached_reservation = *std::move(more);
-          absl::StatusOr<std::string> key =
-              MeshKeyFor(request->mesh_sha256(), *cached, request->sphere_set_key());
-          if (!key.ok()) return key.status();
-          mesh_key = *std::move(key);
-        }
-        absl::StatusOr<std::shared_ptr<const StoredMeshEntry>> mesh = store_->GetMesh(mesh_key);
-        if (!mesh.ok()) return mesh.status();
-        const std::vector<Sphere>& spheres = cached ? cached->set.spheres : inline_set.spheres;
+        absl::StatusOr<NamedSpheres> named =
+            ResolveSpheres(*request, *store_, *memory_, "Evaluate");
+        if (!named.ok()) return named.status();
         absl::StatusOr<QualityReport> report =
-            EvaluateSpheres((*mesh)->solid.oracle, spheres, options);
+            EvaluateSpheres(named->mesh->solid.oracle, named->spheres(), options);
         if (!report.ok()) return report.status();
         wire::QualityReportToProto(*report, response->mutable_quality());
         return absl::OkStatus();
       });
+}
+
+grpc::ServerUnaryReactor* InscribeService::CertifyCover(grpc::CallbackServerContext* context,
+                                                        const v1::CertifyCoverRequest* request,
+                                                        v1::CertifyCoverResponse* response) {
+  absl::Status precheck = CheckSpheresRequest(*request, limits_.max_spheres);
+  absl::StatusOr<CoverCertifyOptions> options = wire::CoverCertifyOptionsFromProto(*request);
+  if (precheck.ok()) precheck = options.status();
+  // The octree holds one candidate list per level on each thread; the spheres dominate.
+  const std::int64_t inline_spheres = request->sphere_set().radii_size();
+  return RunUnary(context, "CertifyCover", 0, precheck,
+                  inline_spheres * MemoryCosts::kPerSphere * 4 + MemoryCosts::kSmallCall,
+                  absl::StrCat("CertifyCover of ", inline_spheres, " inline spheres"),
+                  [this, request, response,
+                   options = options.value_or(CoverCertifyOptions())]() -> absl::Status {
+                    absl::StatusOr<NamedSpheres> named =
+                        ResolveSpheres(*request, *store_, *memory_, "CertifyCover");
+                    if (!named.ok()) return named.status();
+                    absl::StatusOr<CoverCertificate> certificate =
+                        inscribe::CertifyCover(named->mesh->solid, named->spheres(), options);
+                    if (!certificate.ok()) return certificate.status();
+                    wire::CoverCertificateToProto(*certificate, response->mutable_certificate());
+                    return absl::OkStatus();
+                  });
 }
 
 }  // namespace inscribe::server

@@ -1,6 +1,5 @@
 // inscribed: the inscribe gRPC server. Logs go to stderr as key=value pairs; the one plain line
 // "inscribed listening on HOST:PORT" says the server is ready (scripts and tests read it).
-#include <malloc.h>
 #include <pthread.h>
 #include <signal.h>
 
@@ -24,21 +23,6 @@ namespace {
 using inscribe::server::CallRecord;
 using inscribe::server::InscribeServer;
 using inscribe::server::ServerOptions;
-
-// glibc gives threads that contend arenas of their own, up to 8 per core, and each keeps what
-// is freed in it; under --memory-budget the RSS then drifts far past what the calls hold
-// (Adversarial.MemoryStaysUnderTheBudgetUnderConcurrentAbuse: peak 424-566 MiB with glibc's
-// default, 324-346 MiB with 2 arenas, on 2 cores). One arena per job, at least 2, unless
-// MALLOC_ARENA_MAX says otherwise. Must run before the server starts its threads.
-void LimitMallocArenas(int jobs) {
-#ifdef M_ARENA_MAX
-  if (std::getenv("MALLOC_ARENA_MAX") != nullptr) return;
-  if (jobs <= 0) jobs = static_cast<int>(std::thread::hardware_concurrency());
-  mallopt(M_ARENA_MAX, std::max(jobs, 2));
-#else
-  (void)jobs;
-#endif
-}
 
 void LogCall(const CallRecord& call) {
   const auto level = call.status.ok() ? spdlog::level::info : spdlog::level::warn;
@@ -191,7 +175,6 @@ int main(int argc, char** argv) {
   options.cache.on_shared_tier_event = LogSharedTier;
   options.cache.on_disk_tier_event = LogDiskTier;
 
-  LimitMallocArenas(options.jobs);
   absl::StatusOr<std::unique_ptr<InscribeServer>> server = InscribeServer::Start(options);
   if (!server.ok()) {
     spdlog::critical("event=start_failed listen={} error=\"{}\"", options.listen,

@@ -4,10 +4,12 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <memory>
 #include <string>
 
 #include "command_outcome.h"
+#include "inscribe/cover_certificate.h"
 #include "inscribe/solid.h"
 #include "inscribe/sphere_set_generation.h"
 #include "service_session.h"
@@ -134,6 +136,42 @@ TEST(ServiceSession, EmbeddedTakesCoresGridLimitInBothDirections) {
             absl::StatusCode::kInvalidArgument);
   settings.parameters.medial.max_voxels = 30'000'000;
   EXPECT_TRUE((*session)->client().Generate(cube, settings).ok());
+}
+
+// CertifyCover through the in-process service gives core's certificate, figure for figure.
+TEST(ServiceSession, CertifiesAsCoreDoes) {
+  const Mesh cube = testing::UnitCube();
+  absl::StatusOr<std::unique_ptr<ServiceSession>> session = ServiceSession::Open(RemoteOptions{});
+  ASSERT_TRUE(session.ok()) << session.status();
+  absl::StatusOr<client::PutMeshResult> stored = (*session)->client().PutMesh(cube);
+  ASSERT_TRUE(stored.ok()) << stored.status();
+  absl::StatusOr<Solid> solid = PrepareSolid(cube);
+  ASSERT_TRUE(solid.ok()) << solid.status();
+  CoverCertifyOptions options;
+  options.resolution = 1.0 / 64;
+  for (const double radius : {0.8, 0.9}) {  // short of the corners, then past them
+    SCOPED_TRACE(radius);
+    SphereSet set;
+    set.spheres = {Sphere{Vector3::Constant(0.5), radius}};
+    absl::StatusOr<CoverCertificate> served =
+        (*session)->client().CertifyCover(stored->mesh_sha256, set, options);
+    ASSERT_TRUE(served.ok()) << served.status();
+    absl::StatusOr<CoverCertificate> core = CertifyCover(*solid, set.spheres, options);
+    ASSERT_TRUE(core.ok()) << core.status();
+    EXPECT_EQ(served->certified, radius > std::sqrt(0.75));
+    EXPECT_EQ(served->certified, core->certified);
+    EXPECT_EQ(served->delta, core->delta);
+    EXPECT_EQ(served->cells, core->cells);
+    EXPECT_EQ(served->failed_cells, core->failed_cells);
+    EXPECT_EQ(served->uncovered_point, core->uncovered_point);
+    EXPECT_EQ(served->uncovered_depth, core->uncovered_depth);
+    EXPECT_TRUE(served->failures.empty());  // counted, not sent
+  }
+  // A resolution outside (0, 1] is the caller's mistake.
+  options.resolution = 0.0;
+  EXPECT_EQ(
+      (*session)->client().CertifyCover(stored->mesh_sha256, SphereSet{}, options).status().code(),
+      absl::StatusCode::kInvalidArgument);
 }
 
 }  // namespace

@@ -340,5 +340,24 @@ TEST(SphereBudget, FinestGridWithinTheBudget) {
   }
 }
 
+// A ball's medial axis is one point: no grid reaches the budget, and the search must stop at
+// the finest grid the voxel limit allows (whose sides round up to whole voxels) instead of
+// asking for one just past it.
+TEST(SphereBudget, AnUnreachableBudgetGivesTheFinestGridsSet) {
+  const BoundaryOracle oracle = MakeOracle(testing::Icosphere(3));
+  for (const std::int64_t max_voxels : {100'000, 250'047, 1'000'000}) {
+    SCOPED_TRACE(max_voxels);
+    SphereBudgetOptions options;
+    options.max_spheres = 500;
+    options.base.max_voxels = max_voxels;
+    const absl::StatusOr<SphereBudgetResult> found = GenerateWithSphereBudget(oracle, options);
+    ASSERT_TRUE(found.ok()) << found.status();
+    EXPECT_LT(static_cast<std::int64_t>(found->best.set.size()), 500);
+    EXPECT_GE(found->best.set.size(), 1u);
+    EXPECT_LE(found->best.stats.grid_voxels, max_voxels);
+    EXPECT_GT(found->best.stats.grid_voxels, max_voxels * 9 / 10);
+  }
+}
+
 }  // namespace
 }  // namespace inscribe

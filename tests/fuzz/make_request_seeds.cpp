@@ -155,6 +155,14 @@ int main(int argc, char** argv) {
   Seed(dir, RequestKind::kEvaluate, evaluate, "inline");
 
   Seed(dir, RequestKind::kCacheStats, v1::CacheStatsRequest(), "empty");
+
+  v1::CertifyCoverRequest certify;
+  certify.set_mesh_sha256(server.mesh_key);
+  certify.set_sphere_set_key(server.sphere_set_key);
+  certify.set_resolution(1.0 / 64);
+  Seed(dir, RequestKind::kCertifyCover, certify, "key");
+  *certify.mutable_sphere_set() = put_set.spheres();
+  Seed(dir, RequestKind::kCertifyCover, certify, "inline");
   std::printf("%d seeds in %s\n", written, dir.c_str());
   std::fflush(stdout);
   std::_Exit(0);  // the fuzzing server is never stopped (see TheFuzzServer)

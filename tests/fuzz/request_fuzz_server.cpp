@@ -148,7 +148,7 @@ const char* RequestKindName(RequestKind kind) {
   static const char* const kNames[kRequestKinds] = {
       "InspectMesh",    "PutMesh",      "Generate",          "PutSphereSet",
       "GetSphereSet",   "GetHierarchy", "UpdateDeformation", "Distance",
-      "DistanceStream", "Evaluate",     "CacheStats"};
+      "DistanceStream", "Evaluate",     "CacheStats",        "CertifyCover"};
   return kNames[static_cast<int>(kind) % kRequestKinds];
 }
 
@@ -191,6 +191,8 @@ std::optional<grpc::Status> SendRequest(FuzzServer& server, RequestKind kind,
       return Unary(bytes, &Stub::Evaluate, stub);
     case RequestKind::kCacheStats:
       return Unary(bytes, &Stub::CacheStats, stub);
+    case RequestKind::kCertifyCover:
+      return Unary(bytes, &Stub::CertifyCover, stub);
   }
   return std::nullopt;
 }

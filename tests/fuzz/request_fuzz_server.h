@@ -30,8 +30,9 @@ enum class RequestKind : std::uint8_t {
   kDistanceStream,  // the bytes are one DistanceFrame, sent twice on one stream
   kEvaluate,
   kCacheStats,
+  kCertifyCover,
 };
-inline constexpr int kRequestKinds = 11;
+inline constexpr int kRequestKinds = 12;
 
 const char* RequestKindName(RequestKind kind);
 

@@ -456,7 +456,7 @@ TEST(Adversarial, GarbageAndOversizedBytesGetAStatusFromEveryMethod) {
   const std::vector<std::string> methods = {"InspectMesh",  "PutMesh",           "Generate",
                                             "PutSphereSet", "GetSphereSet",      "GetHierarchy",
                                             "Distance",     "UpdateDeformation", "DistanceStream",
-                                            "Evaluate",     "CacheStats"};
+                                            "Evaluate",     "CacheStats",        "CertifyCover"};
   for (const std::string& name : methods) {
     const std::string method = "/inscribe.v1.Inscribe/" + name;
     for (const std::string* garbage :

@@ -39,6 +39,8 @@ class MockConnection : public Connection {
               (const v1::DistanceRequest& request, Deadline deadline), (override));
   MOCK_METHOD(absl::StatusOr<v1::EvaluateResponse>, Evaluate,
               (const v1::EvaluateRequest& request, Deadline deadline), (override));
+  MOCK_METHOD(absl::StatusOr<v1::CertifyCoverResponse>, CertifyCover,
+              (const v1::CertifyCoverRequest& request, Deadline deadline), (override));
   MOCK_METHOD(absl::StatusOr<v1::CacheStatsResponse>, CacheStats,
               (const v1::CacheStatsRequest& request, Deadline deadline), (override));
   MOCK_METHOD(absl::StatusOr<std::unique_ptr<DistanceStreamConnection>>, OpenDistanceStream,

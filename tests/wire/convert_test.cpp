@@ -210,6 +210,53 @@ TEST(GenerateParameters, EveryOptionSurvivesTheWire) {
   EXPECT_EQ(wire.max_voxels(), MedialSphereOptions().max_voxels);
 }
 
+TEST(CoverCertificate, RoundTripsWithoutItsCellList) {
+  CoverCertificate c;
+  c.certified = false;
+  c.delta = 0.125;
+  c.resolution = 1.0 / 1024;
+  c.cells = 1000;
+  c.cells_in_sphere = 600;
+  c.cells_outside = 300;
+  c.failed_cells = 100;
+  c.failures.push_back(CoverCell{Vector3(1, 2, 3), 0.5});
+  c.uncovered_point = Vector3(0.1, -0.2, 0.3);
+  c.uncovered_depth = 0.01;
+  c.uncovered_gap = 0.002;
+  c.seconds = 1.5;
+  v1::CoverCertificate wire;
+  CoverCertificateToProto(c, &wire);
+  absl::StatusOr<CoverCertificate> back = CoverCertificateFromProto(wire);
+  ASSERT_TRUE(back.ok()) << back.status();
+  EXPECT_EQ(back->certified, c.certified);
+  EXPECT_EQ(back->delta, c.delta);
+  EXPECT_EQ(back->resolution, c.resolution);
+  EXPECT_EQ(back->cells, c.cells);
+  EXPECT_EQ(back->cells_in_sphere, c.cells_in_sphere);
+  EXPECT_EQ(back->cells_outside, c.cells_outside);
+  EXPECT_EQ(back->failed_cells, c.failed_cells);
+  EXPECT_TRUE(back->failures.empty());
+  EXPECT_EQ(back->uncovered_point, c.uncovered_point);
+  EXPECT_EQ(back->uncovered_depth, c.uncovered_depth);
+  EXPECT_EQ(back->uncovered_gap, c.uncovered_gap);
+  EXPECT_EQ(back->seconds, c.seconds);
+  // A certified set has no witness; a malformed one is refused.
+  c.uncovered_point.reset();
+  wire.Clear();
+  CoverCertificateToProto(c, &wire);
+  EXPECT_EQ(wire.uncovered_point_size(), 0);
+  EXPECT_FALSE(CoverCertificateFromProto(wire)->uncovered_point);
+  wire.add_uncovered_point(1.0);
+  EXPECT_THAT(CoverCertificateFromProto(wire).status().message(), HasSubstr("uncovered_point"));
+  // Options: unset resolution is core's default; outside (0, 1] is refused.
+  v1::CertifyCoverRequest request;
+  EXPECT_EQ(CoverCertifyOptionsFromProto(request)->resolution, CoverCertifyOptions().resolution);
+  request.set_resolution(0.25);
+  EXPECT_EQ(CoverCertifyOptionsFromProto(request)->resolution, 0.25);
+  request.set_resolution(1.5);
+  EXPECT_FALSE(CoverCertifyOptionsFromProto(request).ok());
+}
+
 TEST(GenerateParameters, TheServersVoxelLimitCapsTheRequest) {
   v1::GenerateRequest request;
   request.mutable_parameters()->set_voxel_size(0.1);

@@ -271,4 +271,58 @@ DeformationErrorBounds DeformationBoundsFromProto(const v1::UpdateDeformationRes
   return bounds;
 }
 
+void CoverCertificateToProto(const CoverCertificate& c, v1::CoverCertificate* out) {
+  out->set_certified(c.certified);
+  out->set_delta(c.delta);
+  out->set_resolution(c.resolution);
+  out->set_cells(c.cells);
+  out->set_cells_in_sphere(c.cells_in_sphere);
+  out->set_cells_outside(c.cells_outside);
+  out->set_failed_cells(c.failed_cells);
+  if (c.uncovered_point) {
+    for (int k = 0; k < 3; ++k) out->add_uncovered_point((*c.uncovered_point)[k]);
+  }
+  out->set_uncovered_depth(c.uncovered_depth);
+  out->set_uncovered_gap(c.uncovered_gap);
+  out->set_seconds(c.seconds);
+}
+
+absl::StatusOr<CoverCertificate> CoverCertificateFromProto(const v1::CoverCertificate& c) {
+  if (c.uncovered_point_size() != 0 && c.uncovered_point_size() != 3) {
+    return absl::InvalidArgumentError(absl::StrCat("certificate: uncovered_point has ",
+                                                   c.uncovered_point_size(),
+                                                   " numbers; expected 0 or 3"));
+  }
+  CoverCertificate out;
+  out.certified = c.certified();
+  out.delta = c.delta();
+  out.resolution = c.resolution();
+  out.cells = c.cells();
+  out.cells_in_sphere = c.cells_in_sphere();
+  out.cells_outside = c.cells_outside();
+  out.failed_cells = c.failed_cells();
+  if (c.uncovered_point_size() == 3) {
+    out.uncovered_point = Vector3(c.uncovered_point(0), c.uncovered_point(1), c.uncovered_point(2));
+  }
+  out.uncovered_depth = c.uncovered_depth();
+  out.uncovered_gap = c.uncovered_gap();
+  out.seconds = c.seconds();
+  return out;
+}
+
+absl::StatusOr<CoverCertifyOptions> CoverCertifyOptionsFromProto(
+    const v1::CertifyCoverRequest& request) {
+  CoverCertifyOptions options;
+  if (request.has_resolution()) {
+    if (!(request.resolution() > 0.0 && request.resolution() <= 1.0)) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("resolution must lie in (0, 1], got ", request.resolution()));
+    }
+    options.resolution = request.resolution();
+  }
+  // The failed cells are not sent: keep none.
+  options.max_failures_kept = 0;
+  return options;
+}
+
 }  // namespace inscribe::wire

@@ -9,6 +9,7 @@
 
 #include "absl/strings/str_format.h"
 #include "command_outcome.h"
+#include "inscribe/cover_certificate.h"
 #include "inscribe/sphere_io.h"
 #include "inscribe/sphere_quality.h"
 #include "inscribe/view/report_json.h"
@@ -28,6 +29,8 @@ struct EvaluateCliOptions {
   int sph_level = -1;
   std::string link;
   QualityOptions quality;
+  bool certify = false;
+  CoverCertifyOptions certify_options;
   bool json = false;
   bool fill_holes = false;
   RemoteOptions remote;
@@ -81,6 +84,75 @@ absl::StatusOr<Evaluated> Evaluate(const client::Client& client, const EvaluateC
   return Evaluated{solid->sha256, *std::move(report)};
 }
 
+void PrintCertificate(const EvaluateCliOptions& options, const SphereFile& file,
+                      const std::string& mesh_sha256, const CoverCertificate& c) {
+  if (options.json) {
+    nlohmann::json j;
+    j["mesh"] = options.mesh_path;
+    j["mesh_sha256"] = mesh_sha256;
+    j["spheres_path"] = options.spheres_path;
+    j["spheres"] = file.set.size();
+    j["certified"] = c.certified;
+    j["delta"] = c.delta;
+    j["resolution"] = c.resolution;
+    j["cells"] = c.cells;
+    j["cells_in_sphere"] = c.cells_in_sphere;
+    j["cells_outside"] = c.cells_outside;
+    j["failed_cells"] = c.failed_cells;
+    if (c.uncovered_point) {
+      const Vector3& p = *c.uncovered_point;
+      j["uncovered_point"] = {p.x(), p.y(), p.z()};
+      j["uncovered_depth"] = c.uncovered_depth;
+      j["uncovered_gap"] = c.uncovered_gap;
+    }
+    j["seconds"] = c.seconds;
+    if (options.remote.enabled()) j["server"] = options.remote.server;
+    std::cout << j.dump() << "\n";
+    return;
+  }
+  auto line = [](const char* key, const std::string& value) {
+    std::cout << absl::StrFormat("%-26s %s\n", key, value);
+  };
+  line("mesh", options.mesh_path);
+  line("spheres", absl::StrFormat("%s (%d)", options.spheres_path, file.set.size()));
+  if (c.certified) {
+    line("cover", "certified: every point of the solid is in a sphere");
+  } else if (c.uncovered_point) {
+    const Vector3& p = *c.uncovered_point;
+    line("cover", absl::StrFormat("NOT certified: the point (%.10g %.10g %.10g), %.6g deep in the "
+                                  "solid, is %.6g from the nearest sphere",
+                                  p.x(), p.y(), p.z(), c.uncovered_depth, c.uncovered_gap));
+  } else {
+    line("cover", absl::StrFormat("NOT certified: %d cells of side %.6g near the boundary are "
+                                  "in no single sphere (no uncovered point found; a finer "
+                                  "--certify-resolution may settle them)",
+                                  c.failed_cells, c.resolution));
+  }
+  line("delta (reach outside)", absl::StrFormat("%.6g", c.delta));
+  line("proof",
+       absl::StrFormat("%d cells: %d in one sphere, %d outside the solid, %d failed; "
+                       "finest side %.6g",
+                       c.cells, c.cells_in_sphere, c.cells_outside, c.failed_cells, c.resolution));
+  line("certified in", absl::StrFormat("%.3f s", c.seconds));
+}
+
+// --certify: PutMesh, then CertifyCover with the spheres sent inline. Not a cover is exit 1.
+absl::Status RunCertify(const client::Client& client, const EvaluateCliOptions& options,
+                        const SphereFile& file) {
+  absl::StatusOr<StoredSolid> solid = StoreSolid(client, options.mesh_path, {options.fill_holes});
+  if (!solid.ok()) return solid.status();
+  absl::StatusOr<CoverCertificate> certificate =
+      client.CertifyCover(solid->sha256, file.set, options.certify_options);
+  if (!certificate.ok()) return certificate.status();
+  PrintCertificate(options, file, solid->sha256, *certificate);
+  if (!certificate->certified) {
+    return CommandError(absl::StatusCode::kFailedPrecondition,
+                        options.spheres_path + " is not a certified cover of " + options.mesh_path,
+                        kExitUnusableMesh);
+  }
+  return absl::OkStatus();
+}
+
 absl::Status RunEvaluate(const EvaluateCliOptions& options) {
   SphereFileReadOptions read;
   if (!options.format.empty()) read.format = *ParseSphereFileFormat(options.format);
@@ -98,6 +170,7 @@ absl::Status RunEvaluate(const EvaluateCliOptions& options) {
   }
   absl::StatusOr<std::unique_ptr<ServiceSession>> session = ServiceSession::Open(options.remote);
   if (!session.ok()) return session.status();
+  if (options.certify) return RunCertify((*session)->client(), options, *file);
   const absl::StatusOr<Evaluated> evaluated =
       Evaluate((*session)->client(), options, *file, quality);
   if (!evaluated.ok()) return evaluated.status();
@@ -147,6 +220,15 @@ void AddEvaluateCommand(CLI::App& app, CommandOutcome* outcome) {
                   "Voxel size for the fatness test (default: the file's, if it has one)");
   cmd->add_flag("--fill-holes", options->fill_holes,
                 "Close the mesh's holes first (see inscribe info --fill-holes)");
+  cmd->add_flag("--certify", options->certify,
+                "Instead of the quality report: prove that the spheres contain the whole solid "
+                "(a cover), or give a point of the solid in no sphere; with delta, a sound bound "
+                "on how far they reach outside it. Exit 1 when not certified");
+  cmd->add_option("--certify-resolution", options->certify_options.resolution,
+                  "With --certify: the proof's finest cell side, as a fraction of the largest "
+                  "bounding-box side")
+      ->check(CLI::Range(1e-6, 1.0))
+      ->capture_default_str();
   cmd->add_flag("--json", options->json, "Print one JSON object on stdout");
   AddRemoteOptions(cmd, &options->remote, 60.0);
   cmd->callback([options, outcome] {

@@ -120,6 +120,21 @@ absl::StatusOr<QualityReport> EvaluateUntil(Connection& connection, const RetryP
   return wire::QualityReportFromProto(response->quality());
 }
 
+absl::StatusOr<CoverCertificate> CertifyUntil(Connection& connection, const RetryPolicy& retry,
+                                              v1::CertifyCoverRequest& request,
+                                              const CoverCertifyOptions& settings,
+                                              Deadline deadline) {
+  request.set_resolution(settings.resolution);
+  absl::StatusOr<v1::CertifyCoverResponse> response =
+      Retried(retry, deadline, [&](Deadline d) { return connection.CertifyCover(request, d); });
+  if (!response.ok()) return response.status();
+  if (!response->has_certificate()) return Malformed("CertifyCover", "no certificate");
+  absl::StatusOr<CoverCertificate> certificate =
+      wire::CoverCertificateFromProto(response->certificate());
+  if (!certificate.ok()) return Malformed("CertifyCover", certificate.status().message());
+  return certificate;
+}
+
 }  // namespace
 
 Client::Client(std::shared_ptr<Connection> connection, ClientOptions options)
@@ -323,6 +338,28 @@ absl::StatusOr<QualityReport> Client::Evaluate(const std::string& mesh_sha256,
   wire::SphereSetToProto(spheres, request.mutable_sphere_set());
   return EvaluateUntil(*connection_, options_.retry, request, settings,
                        DeadlineAfter(options.timeout, options_));
+}
+
+absl::StatusOr<CoverCertificate> Client::CertifyCover(const std::string& mesh_sha256,
+                                                      const std::string& sphere_set_key,
+                                                      const CoverCertifyOptions& settings,
+                                                      const CallOptions& options) const {
+  v1::CertifyCoverRequest request;
+  request.set_mesh_sha256(mesh_sha256);
+  request.set_sphere_set_key(sphere_set_key);
+  return CertifyUntil(*connection_, options_.retry, request, settings,
+                      DeadlineAfter(options.timeout, options_));
+}
+
+absl::StatusOr<CoverCertificate> Client::CertifyCover(const std::string& mesh_sha256,
+                                                      const SphereSet& spheres,
+                                                      const CoverCertifyOptions& settings,
+                                                      const CallOptions& options) const {
+  v1::CertifyCoverRequest request;
+  request.set_mesh_sha256(mesh_sha256);
+  wire::SphereSetToProto(spheres, request.mutable_sphere_set());
+  return CertifyUntil(*connection_, options_.retry, request, settings,
+                      DeadlineAfter(options.timeout, options_));
 }
 
 absl::StatusOr<ServerCacheStats> Client::CacheStats(const CallOptions& options) const {

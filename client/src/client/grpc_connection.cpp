@@ -265,6 +265,11 @@ class GrpcConnection final : public Connection {
     return CallUnary(*stub_, token_, &Stub::Evaluate, request, deadline);
   }
 
+  absl::StatusOr<v1::CertifyCoverResponse> CertifyCover(const v1::CertifyCoverRequest& request,
+                                                        Deadline deadline) override {
+    return CallUnary(*stub_, token_, &Stub::CertifyCover, request, deadline);
+  }
+
   absl::StatusOr<v1::CacheStatsResponse> CacheStats(const v1::CacheStatsRequest& request,
                                                     Deadline deadline) override {
     return CallUnary(*stub_, token_, &Stub::CacheStats, request, deadline);

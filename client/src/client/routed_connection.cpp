@@ -315,6 +315,16 @@ class RoutedConnection final : public Connection {
                                       [&](Connection& c) { return c.Evaluate(request, deadline); });
   }
 
+  absl::StatusOr<v1::CertifyCoverResponse> CertifyCover(const v1::CertifyCoverRequest& request,
+                                                        Deadline deadline) override {
+    const std::string& key = request.spheres_case() == v1::CertifyCoverRequest::kSphereSetKey
+                                 ? request.sphere_set_key()
+                                 : request.mesh_sha256();
+    return Call<v1::CertifyCoverResponse>(wire::RouteKey(key), deadline, [&](Connection& c) {
+      return c.CertifyCover(request, deadline);
+    });
+  }
+
   // One replica's counters: the first endpoint listed, or the next listed when it is down.
   absl::StatusOr<v1::CacheStatsResponse> CacheStats(const v1::CacheStatsRequest& request,
                                                     Deadline deadline) override {

@@ -11,6 +11,7 @@
 
 #include "absl/status/statusor.h"
 #include "inscribe/client/connection.h"
+#include "inscribe/cover_certificate.h"
 #include "inscribe/mesh.h"
 #include "inscribe/mesh_validation.h"
 #include "inscribe/rigid_pose.h"
@@ -283,6 +284,18 @@ class Client {
   absl::StatusOr<QualityReport> Evaluate(const std::string& mesh_sha256, const SphereSet& spheres,
                                          const EvaluateSettings& settings = {},
                                          const CallOptions& options = {}) const;
+
+  // Whether a cached set, or `spheres` sent inline, provably contains the whole solid of a
+  // stored mesh (cover_certificate.h); the certificate's resolution is settings.resolution
+  // (the failed cells are not sent, only counted).
+  absl::StatusOr<CoverCertificate> CertifyCover(const std::string& mesh_sha256,
+                                                const std::string& sphere_set_key,
+                                                const CoverCertifyOptions& settings = {},
+                                                const CallOptions& options = {}) const;
+  absl::StatusOr<CoverCertificate> CertifyCover(const std::string& mesh_sha256,
+                                                const SphereSet& spheres,
+                                                const CoverCertifyOptions& settings = {},
+                                                const CallOptions& options = {}) const;
 
   absl::StatusOr<ServerCacheStats> CacheStats(const CallOptions& options = {}) const;
 

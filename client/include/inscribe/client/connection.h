@@ -81,6 +81,8 @@ class Connection {
                                                         Deadline deadline) = 0;
   virtual absl::StatusOr<v1::EvaluateResponse> Evaluate(const v1::EvaluateRequest& request,
                                                         Deadline deadline) = 0;
+  virtual absl::StatusOr<v1::CertifyCoverResponse> CertifyCover(
+      const v1::CertifyCoverRequest& request, Deadline deadline) = 0;
   virtual absl::StatusOr<v1::CacheStatsResponse> CacheStats(const v1::CacheStatsRequest& request,
                                                             Deadline deadline) = 0;
   // Opens a DistanceStream call that must end by `deadline` (Deadline::max() for none). Never

@@ -116,6 +116,9 @@ class InscribeService final : public v1::Inscribe::CallbackService {
   grpc::ServerUnaryReactor* Evaluate(grpc::CallbackServerContext* context,
                                      const v1::EvaluateRequest* request,
                                      v1::EvaluateResponse* response) override;
+  grpc::ServerUnaryReactor* CertifyCover(grpc::CallbackServerContext* context,
+                                         const v1::CertifyCoverRequest* request,
+                                         v1::CertifyCoverResponse* response) override;
   grpc::ServerUnaryReactor* CacheStats(grpc::CallbackServerContext* context,
                                        const v1::CacheStatsRequest* request,
                                        v1::CacheStatsResponse* response) override;

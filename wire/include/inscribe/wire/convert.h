@@ -12,6 +12,7 @@
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
 #include "grpcpp/support/status.h"
+#include "inscribe/cover_certificate.h"
 #include "inscribe/mesh.h"
 #include "inscribe/mesh_validation.h"
 #include "inscribe/rigid_pose.h"
@@ -65,6 +66,15 @@ absl::StatusOr<SphereSet> SphereSetFromProto(const v1::SphereSet& set,
 void QualityReportToProto(const QualityReport& report, v1::QualityReport* out);
 // The inverse: every field, unchecked (a report is numbers only).
 QualityReport QualityReportFromProto(const v1::QualityReport& report);
+
+// A cover certificate, without its list of failed cells (counted in failed_cells).
+void CoverCertificateToProto(const CoverCertificate& certificate, v1::CoverCertificate* out);
+// INVALID_ARGUMENT when uncovered_point has other than 0 or 3 numbers.
+absl::StatusOr<CoverCertificate> CoverCertificateFromProto(const v1::CoverCertificate& certificate);
+// Certification options of a request (resolution unset: core's default); INVALID_ARGUMENT for
+// a resolution outside (0, 1].
+absl::StatusOr<CoverCertifyOptions> CoverCertifyOptionsFromProto(
+    const v1::CertifyCoverRequest& request);
 
 void PoseToProto(const RigidPose& pose, v1::Pose* out);
 // The pose with its quaternion normalised (NormalizedPose); INVALID_ARGUMENT naming `field`.

@@ -1,0 +1,86 @@
+// Certified covers: a proof that a solid lies inside a union of spheres, and a sound bound on
+// how far the union reaches outside it.
+//
+// The proof is an octree over the solid's bounding cube. A cell is settled when one sphere
+// contains it (a ball is convex, so it contains the cube when it contains the cube's farthest
+// corner), or when it provably misses the solid (its centre is outside and farther from the
+// boundary than the cell's half-diagonal). Other cells split in 8, down to a finest size; a
+// finest cell still unsettled is a failure. Every cell corner is an exact dyadic number (the
+// cube's side is a power of two and its origin a multiple of the finest side), so the cells
+// tile the cube exactly, and each test carries a relative margin far above the rounding of the
+// few operations it makes. Certified means: every point of the solid (boundary included) lies
+// in some sphere.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "inscribe/medial_spheres.h"
+#include "inscribe/solid.h"
+#include "inscribe/sphere.h"
+
+namespace inscribe {
+
+struct CoverCertifyOptions {
+  // Side of the finest cells, as a fraction of the largest side of the mesh's bounding box
+  // (rounded down to a power-of-two division of the cube, at most 2^20 cells per side). A
+  // sphere set that protrudes less than about this near the boundary cannot be certified.
+  double resolution = 1.0 / 512;
+  // Failing cells kept in CoverCertificate::failures (all are counted).
+  std::int64_t max_failures_kept = 1 << 20;
+  // A cell whose centre is inside the solid and in no sphere already disproves the cover: stop
+  // there rather than split it down to the finest cells (a set that misses a large part of
+  // the solid is refused in milliseconds). Off for repairs, which grow a sphere around each
+  // failed cell and want them small.
+  bool stop_at_witness = true;
+};
+
+// One axis-aligned cube of the octree: [min, min + side] on each axis, exact dyadic numbers.
+struct CoverCell {
+  Vector3 min = Vector3::Zero();
+  double side = 0.0;
+};
+
+struct CoverCertificate {
+  // Every point of the solid lies in some sphere (a proof, see above).
+  bool certified = false;
+  // No point of any sphere lies farther than this outside the solid: the maximum over spheres
+  // of radius - depth(centre) (depth: distance to the boundary, negative outside), at least 0,
+  // rounded up. Holds whether or not the set is certified. Mesh units.
+  double delta = 0.0;
+  // Finest cell side used, mesh units.
+  double resolution = 0.0;
+  // The octree: cells examined, settled inside one sphere, settled outside the solid, and the
+  // failed cells: finest cells left unsettled, and (with stop_at_witness) cells whose centre
+  // is a point of the solid in no sphere (0 when certified).
+  std::int64_t cells = 0, cells_in_sphere = 0, cells_outside = 0, failed_cells = 0;
+  // Up to CoverCertifyOptions::max_failures_kept of the failed cells, sorted (coarse first,
+  // then x, y, z); all of them when fewer failed (which are kept of more may vary between
+  // runs).
+  std::vector<CoverCell> failures;
+  // A point of the solid in no sphere, when a failed cell's centre is one (the deepest such
+  // centre): the proof that the set is not a cover. Its depth inside the solid
+  // (0 on the boundary) and its distance to the nearest sphere.
+  std::optional<Vector3> uncovered_point;
+  double uncovered_depth = 0.0;
+  double uncovered_gap = 0.0;
+  double seconds = 0.0;
+};
+
+// Certifies `spheres` (each passing CheckSphere) as a cover of `solid`. INVALID_ARGUMENT for a
+// bad sphere or resolution (in (0, 1]); CANCELLED when control.cancel is set. Parallel (TBB)
+// and deterministic: the verdict, the counts, the failures and the witness depend only on the
+// input. Progress goes to control.on_progress in [0, 1].
+absl::StatusOr<CoverCertificate> CertifyCover(const Solid& solid,
+                                              const std::vector<Sphere>& spheres,
+                                              const CoverCertifyOptions& options = {},
+                                              const GenerationControl& control = {});
+
+// The protrusion bound of CoverCertificate::delta alone: max over spheres of radius -
+// depth(centre), at least 0, rounded up. Spheres must pass CheckSphere. O(N) oracle queries.
+absl::StatusOr<double> SphereProtrusionBound(const Solid& solid,
+                                             const std::vector<Sphere>& spheres);
+
+}  // namespace inscribe

@@ -1,0 +1,278 @@
+#include "inscribe/cover_certificate.h"
+
+#include <tbb/combinable.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <mutex>
+#include <optional>
+#include <tuple>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+
+namespace inscribe {
+namespace {
+
+// Levels of the octree at most: 2^20 cells per side keeps every corner an exact double.
+constexpr int kMaxLevel = 20;
+// Levels below which children are visited in parallel (8^3 = 512 subtrees).
+constexpr int kParallelLevels = 3;
+// Relative margins, far above the rounding of the few operations each test makes (a dozen
+// roundings of 2^-53 each), so that a settled cell is settled in exact arithmetic too.
+constexpr double kContainMargin = 1e-12;  // on squared distances
+constexpr double kOutsideMargin = 1e-9;   // on the distance to the boundary
+const double kHalfDiagonalPerSide = std::sqrt(3.0) / 2.0 * (1.0 + 1e-12);
+
+using Index = std::array<std::int64_t, 3>;
+
+// A finest cell left unsettled, and whether its centre shows the set is not a cover.
+struct Failure {
+  int level = 0;
+  Index index;
+  Vector3 min = Vector3::Zero(), centre = Vector3::Zero();
+  double side = 0.0;
+  double depth = 0.0;  // of the centre, when it is a witness
+};
+
+// Cells in a fixed order: by level, then x, y, z index.
+bool Before(const Failure& a, const Failure& b) {
+  return std::tie(a.level, a.index) < std::tie(b.level, b.index);
+}
+
+struct Counts {
+  std::int64_t cells = 0, in_sphere = 0, outside = 0, failed = 0;
+  std::vector<Failure> failures;
+  std::optional<Failure> deepest;  // the deepest witness
+};
+
+// The deeper witness; of two as deep, the one with the smaller index (so the choice does not
+// depend on which thread found which).
+bool Deeper(const Failure& a, const Failure& b) {
+  return a.depth > b.depth || (a.depth == b.depth && Before(a, b));
+}
+
+class Certifier {
+ public:
+  Certifier(const Solid& solid, const std::vector<Sphere>& spheres,
+            const CoverCertifyOptions& options, const GenerationControl& control)
+      : oracle_(solid.oracle), spheres_(spheres), options_(options), control_(control) {
+    const BoundingBox box = ComputeBoundingBox(solid.mesh().vertices);
+    scale_ = std::max(box.extent().maxCoeff(), std::numeric_limits<double>::min());
+    // A power-of-two side a little over the box's largest side, and an origin on the grid of
+    // the finest possible cells: every corner o + i * side / 2^level is then exact.
+    side_ = std::exp2(std::ceil(std::log2(scale_ * (1.0 + 1e-6))));
+    const double unit = std::ldexp(side_, -kMaxLevel);
+    for (int k = 0; k < 3; ++k) origin_[k] = std::floor(box.min[k] / unit) * unit;
+    // The origin moved down by less than one unit; the side covers that (side >= scale (1 +
+    // 1e-6) and unit <= 2 scale 2^-20 < 1e-6 scale).
+    finest_ = 0;
+    while (finest_ < kMaxLevel && std::ldexp(side_, -finest_) > options.resolution * scale_) {
+      ++finest_;
+    }
+  }
+
+  double finest_side() const { return std::ldexp(side_, -finest_); }
+  double scale() const { return scale_; }
+
+  absl::Status Run(Counts* total) {
+    std::vector<std::int32_t> all(spheres_.size());
+    for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<std::int32_t>(i);
+    Visit(0, {0, 0, 0}, all, std::numeric_limits<double>::infinity());
+    if (Cancelled()) return absl::CancelledError("cover certification cancelled");
+    counts_.combine_each([total](const Counts& c) {
+      total->cells += c.cells;
+      total->in_sphere += c.in_sphere;
+      total->outside += c.outside;
+      total->failed += c.failed;
+      total->failures.insert(total->failures.end(), c.failures.begin(), c.failures.end());
+      if (c.deepest && (!total->deepest || Deeper(*c.deepest, *total->deepest))) {
+        total->deepest = c.deepest;
+      }
+    });
+    std::sort(total->failures.begin(), total->failures.end(), Before);
+    if (static_cast<std::int64_t>(total->failures.size()) > options_.max_failures_kept) {
+      total->failures.resize(static_cast<std::size_t>(options_.max_failures_kept));
+    }
+    return absl::OkStatus();
+  }
+
+ private:
+  bool Cancelled() const { return control_.cancel != nullptr && control_.cancel->load(); }
+
+  void Visit(int level, const Index& index, const std::vector<std::int32_t>& candidates,
+             double distance_bound) {
+    if (Cancelled()) return;
+    Counts& counts = counts_.local();
+    ++counts.cells;
+    const double side = std::ldexp(side_, -level);
+    Vector3 lo, hi;
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = origin_[k] + static_cast<double>(index[k]) * side;
+      hi[k] = lo[k] + side;
+    }
+    // The spheres that reach into the cell; one containing it settles it.
+    std::vector<std::int32_t> near;
+    near.reserve(candidates.size());
+    for (const std::int32_t i : candidates) {
+      const Sphere& s = spheres_[static_cast<std::size_t>(i)];
+      double inside2 = 0.0, far2 = 0.0;
+      for (int k = 0; k < 3; ++k) {
+        const double below = lo[k] - s.center[k], above = s.center[k] - hi[k];
+        const double gap = std::max({below, above, 0.0});
+        inside2 += gap * gap;
+        const double reach = std::max(std::abs(s.center[k] - lo[k]), std::abs(s.center[k] - hi[k]));
+        far2 += reach * reach;
+      }
+      const double r2 = s.radius * s.radius;
+      if (far2 * (1.0 + kContainMargin) <= r2) {
+        ++counts.in_sphere;
+        Settled(level);
+        return;
+      }
+      if (inside2 < r2) near.push_back(i);
+    }
+    const Vector3 centre = lo + Vector3::Constant(0.5 * side);
+    const BoundaryPoint closest = std::isfinite(distance_bound)
+                                      ? oracle_.ClosestPoint(centre, distance_bound)
+                                      : oracle_.ClosestPoint(centre);
+    const double half_diagonal = side * kHalfDiagonalPerSide;
+    const Side centre_side = oracle_.Classify(centre, closest);
+    if (closest.distance > half_diagonal * (1.0 + kOutsideMargin) + 1e-12 * scale_ &&
+        centre_side == Side::kOutside) {
+      ++counts.outside;
+      Settled(level);
+      return;
+    }
+    const bool witness = centre_side == Side::kInside && !InAny(centre, near);
+    if (level == finest_ || (witness && options_.stop_at_witness)) {
+      ++counts.failed;
+      Failure failure{level, index, lo, centre, side, 0.0};
+      if (witness) {
+        failure.depth = closest.distance;
+        if (!counts.deepest || Deeper(failure, *counts.deepest)) counts.deepest = failure;
+      }
+      if (static_cast<std::int64_t>(counts.failures.size()) < options_.max_failures_kept) {
+        counts.failures.push_back(failure);
+      }
+      Settled(level);
+      return;
+    }
+    const double child_bound = closest.distance + half_diagonal;
+    const auto child = [&](int c) {
+      const Index sub = {2 * index[0] + (c & 1), 2 * index[1] + ((c >> 1) & 1),
+                         2 * index[2] + ((c >> 2) & 1)};
+      Visit(level + 1, sub, near, child_bound);
+    };
+    if (level < kParallelLevels) {
+      tbb::parallel_for(0, 8, child);
+    } else {
+      for (int c = 0; c < 8; ++c) child(c);
+    }
+    if (level == kParallelLevels) Settled(level);
+  }
+
+  // Strictly outside every sphere listed, with margin.
+  bool InAny(const Vector3& p, const std::vector<std::int32_t>& listed) const {
+    for (const std::int32_t i : listed) {
+      const Sphere& s = spheres_[static_cast<std::size_t>(i)];
+      if ((p - s.center).squaredNorm() <= s.radius * s.radius * (1.0 + kContainMargin)) {
+        return true;
+      }
+    }
+    return false;
+  }
+
+  // Progress: the share of the level-3 subtrees done.
+  void Settled(int level) {
+    if (level > kParallelLevels || !control_.on_progress) return;
+    const std::int64_t weight = std::int64_t{1} << (3 * (kParallelLevels - level));
+    const std::int64_t done = settled_.fetch_add(weight) + weight;
+    std::lock_guard<std::mutex> lock(progress_mutex_);
+    control_.on_progress(static_cast<double>(done) / (1 << (3 * kParallelLevels)));
+  }
+
+  const BoundaryOracle& oracle_;
+  const std::vector<Sphere>& spheres_;
+  const CoverCertifyOptions& options_;
+  const GenerationControl& control_;
+  double scale_ = 1.0, side_ = 1.0;
+  Vector3 origin_ = Vector3::Zero();
+  int finest_ = 0;
+  tbb::combinable<Counts> counts_;
+  std::atomic<std::int64_t> settled_{0};
+  std::mutex progress_mutex_;
+};
+
+}  // namespace
+
+absl::StatusOr<double> SphereProtrusionBound(const Solid& solid,
+                                             const std::vector<Sphere>& spheres) {
+  if (absl::Status s = CheckSpheres(spheres); !s.ok()) return s;
+  const double scale = ComputeBoundingBox(solid.mesh().vertices).extent().maxCoeff();
+  std::vector<double> reach(spheres.size());
+  tbb::parallel_for(std::size_t{0}, spheres.size(), [&](std::size_t i) {
+    const Sphere& s = spheres[i];
+    const BoundaryPoint closest = solid.oracle.ClosestPoint(s.center);
+    // Depth of the centre: + inside, - outside. A centre too close to the boundary for its
+    // side to matter counts as outside (the larger reach).
+    const bool inside = solid.oracle.Classify(s.center, closest) == Side::kInside &&
+                        closest.distance > 1e-9 * scale;
+    const double depth = inside ? closest.distance : -closest.distance;
+    // Rounded up: the distance and the subtraction are each within a few ulps.
+    reach[i] = (s.radius - depth) * (1.0 + 1e-12) + 1e-12 * scale;
+  });
+  double delta = 0.0;
+  for (const double r : reach) delta = std::max(delta, r);
+  return delta;
+}
+
+absl::StatusOr<CoverCertificate> CertifyCover(const Solid& solid,
+                                              const std::vector<Sphere>& spheres,
+                                              const CoverCertifyOptions& options,
+                                              const GenerationControl& control) {
+  const auto start = std::chrono::steady_clock::now();
+  if (!(options.resolution > 0.0 && options.resolution <= 1.0)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("cover resolution must lie in (0, 1], got ", options.resolution));
+  }
+  if (options.max_failures_kept < 0) {
+    return absl::InvalidArgumentError("max_failures_kept must be >= 0");
+  }
+  absl::StatusOr<double> delta = SphereProtrusionBound(solid, spheres);
+  if (!delta.ok()) return delta.status();
+
+  Certifier certifier(solid, spheres, options, control);
+  Counts counts;
+  if (absl::Status s = certifier.Run(&counts); !s.ok()) return s;
+
+  CoverCertificate out;
+  out.certified = counts.failed == 0;
+  out.delta = *delta;
+  out.resolution = certifier.finest_side();
+  out.cells = counts.cells;
+  out.cells_in_sphere = counts.in_sphere;
+  out.cells_outside = counts.outside;
+  out.failed_cells = counts.failed;
+  out.failures.reserve(counts.failures.size());
+  for (const Failure& f : counts.failures) {
+    out.failures.push_back(CoverCell{f.min, f.side});
+  }
+  if (const std::optional<Failure>& deepest = counts.deepest) {
+    out.uncovered_point = deepest->centre;
+    out.uncovered_depth = deepest->depth;
+    double gap = std::numeric_limits<double>::infinity();
+    for (const Sphere& s : spheres)
+      gap = std::min(gap, (deepest->centre - s.center).norm() - s.radius);
+    out.uncovered_gap = std::max(gap, 0.0);
+  }
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
+}  // namespace inscribe

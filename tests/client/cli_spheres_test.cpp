@@ -104,6 +104,35 @@ TEST(CliEvaluate, ProtrudingSpheresFromAnotherToolGetABound) {
   fs::remove_all(dir);
 }
 
+// --certify on another tool's files: one ball around the whole mesh is a cover (exit 0, delta
+// its reach); the internal spheres generate writes are not (exit 1, with a point they miss).
+TEST(CliEvaluate, CertifyProvesACoverOrShowsAPointItMisses) {
+  INSCRIBE_REQUIRE_MESH("eight.off");
+  const fs::path dir = TempDir();
+  const fs::path ball = dir / "ball.csv";
+  std::ofstream(ball) << "x,y,z,r\n0,0,0,10\n";
+  CliRun run = RunCli("evaluate --certify --json " + Eight() + " " + Quote(ball.string()));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  nlohmann::json j = nlohmann::json::parse(run.out);
+  EXPECT_TRUE(j.at("certified").get<bool>());
+  EXPECT_EQ(j.at("failed_cells"), 0);
+  EXPECT_GT(j.at("delta").get<double>(), 9.0);
+  EXPECT_FALSE(j.contains("uncovered_point"));
+
+  const fs::path internal = dir / "internal.json";
+  ASSERT_EQ(RunCli("generate " + Eight() + " --max-spheres 60 -o " + Quote(internal.string()))
+                .exit_code,
+            0);
+  run = RunCli("evaluate --certify " + Eight() + " " + Quote(internal.string()));
+  EXPECT_EQ(run.exit_code, 1) << run.err;
+  EXPECT_THAT(run.out, HasSubstr("NOT certified: the point ("));
+  EXPECT_THAT(run.err, HasSubstr("is not a certified cover of"));
+  run = RunCli("evaluate --certify --certify-resolution 0 " + Eight() + " " +
+               Quote(internal.string()));
+  EXPECT_EQ(run.exit_code, 64) << run.err;
+  fs::remove_all(dir);
+}
+
 TEST(CliGenerate, BadOptionsAreClearErrorsNotHangs) {
   INSCRIBE_REQUIRE_MESH("eight.off");
   struct Case {

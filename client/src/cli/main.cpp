@@ -23,7 +23,8 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.set_version_flag("--version", "inscribe 0.1.0");
   app.footer(
-      "Exit status: 0 done; 1 the mesh cannot be used; 2 missing, unreadable or malformed "
+      "Exit status: 0 done; 1 the mesh cannot be used (evaluate --certify: the spheres are "
+      "not a certified cover); 2 missing, unreadable or malformed "
       "input; 64 bad command line; 69 the --server could not be reached or did not answer "
       "within --timeout; 70 internal error; 77 the --server refused the call (missing or wrong "
       "--token-file, UNAUTHENTICATED or PERMISSION_DENIED).");

@@ -120,9 +120,9 @@ TEST(CliEvaluate, CertifyProvesACoverOrShowsAPointItMisses) {
   EXPECT_FALSE(j.contains("uncovered_point"));
 
   const fs::path internal = dir / "internal.json";
-  ASSERT_EQ(RunCli("generate " + Eight() + " --max-spheres 60 -o " + Quote(internal.string()))
-                .exit_code,
-            0);
+  ASSERT_EQ(
+      RunCli("generate " + Eight() + " --max-spheres 60 -o " + Quote(internal.string())).exit_code,
+      0);
   run = RunCli("evaluate --certify " + Eight() + " " + Quote(internal.string()));
   EXPECT_EQ(run.exit_code, 1) << run.err;
   EXPECT_THAT(run.out, HasSubstr("NOT certified: the point ("));

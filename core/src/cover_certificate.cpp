@@ -15,6 +15,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "cover_cells.h"
 
 namespace inscribe {
 namespace {
@@ -121,14 +122,12 @@ class Certifier {
     near.reserve(candidates.size());
     for (const std::int32_t i : candidates) {
       const Sphere& s = spheres_[static_cast<std::size_t>(i)];
-      double inside2 = 0.0, far2 = 0.0;
+      double inside2 = 0.0;
       for (int k = 0; k < 3; ++k) {
-        const double below = lo[k] - s.center[k], above = s.center[k] - hi[k];
-        const double gap = std::max({below, above, 0.0});
+        const double gap = std::max({lo[k] - s.center[k], s.center[k] - hi[k], 0.0});
         inside2 += gap * gap;
-        const double reach = std::max(std::abs(s.center[k] - lo[k]), std::abs(s.center[k] - hi[k]));
-        far2 += reach * reach;
       }
+      const double far2 = internal::FarthestCornerSquared(s.center, lo, hi);
       const double r2 = s.radius * s.radius;
       if (far2 * (1.0 + kContainMargin) <= r2) {
         ++counts.in_sphere;
@@ -232,11 +231,7 @@ absl::StatusOr<double> SphereProtrusionBound(const Solid& solid,
   return delta;
 }
 
-absl::StatusOr<CoverCertificate> CertifyCover(const Solid& solid,
-                                              const std::vector<Sphere>& spheres,
-                                              const CoverCertifyOptions& options,
-                                              const GenerationControl& control) {
-  const auto start = std::chrono::steady_clock::now();
+absl::Status CheckCoverCertifyOptions(const CoverCertifyOptions& options) {
   if (!(options.resolution > 0.0 && options.resolution <= 1.0)) {
     return absl::InvalidArgumentError(
         absl::StrCat("cover resolution must lie in (0, 1], got ", options.resolution));
@@ -244,6 +239,15 @@ absl::StatusOr<CoverCertificate> CertifyCover(const Solid& solid,
   if (options.max_failures_kept < 0) {
     return absl::InvalidArgumentError("max_failures_kept must be >= 0");
   }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<CoverCertificate> CertifyCover(const Solid& solid,
+                                              const std::vector<Sphere>& spheres,
+                                              const CoverCertifyOptions& options,
+                                              const GenerationControl& control) {
+  const auto start = std::chrono::steady_clock::now();
+  if (absl::Status s = CheckCoverCertifyOptions(options); !s.ok()) return s;
   absl::StatusOr<double> delta = SphereProtrusionBound(solid, spheres);
   if (!delta.ok()) return delta.status();
 

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "cover_cells.h"
 #include "inscribe/sphere_set_generation.h"
 #include "surface_sampling.h"
 
@@ -71,15 +72,10 @@ void GrowToContain(const std::vector<CoverCell>& cells, std::vector<Sphere>* sph
   for (const CoverCell& cell : cells) {
     std::size_t best = 0;
     double best_growth = std::numeric_limits<double>::infinity(), best_reach = 0.0;
+    const Vector3 hi = cell.min + Vector3::Constant(cell.side);  // exact: dyadic cells
     for (std::size_t i = 0; i < spheres->size(); ++i) {
       const Sphere& s = (*spheres)[i];
-      double far2 = 0.0;
-      for (int k = 0; k < 3; ++k) {
-        const double reach = std::max(std::abs(s.center[k] - cell.min[k]),
-                                      std::abs(s.center[k] - (cell.min[k] + cell.side)));
-        far2 += reach * reach;
-      }
-      const double reach = std::sqrt(far2);
+      const double reach = std::sqrt(internal::FarthestCornerSquared(s.center, cell.min, hi));
       if (reach - s.radius < best_growth) {
         best_growth = reach - s.radius;
         best = i;
@@ -110,10 +106,7 @@ absl::Status CheckCoverParameters(const CoverParameters& p) {
     return absl::InvalidArgumentError(
         absl::StrCat("cover: growth_samples must lie in 0..100,000,000, got ", p.growth_samples));
   }
-  if (!(p.certify.resolution > 0.0 && p.certify.resolution <= 1.0)) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("cover: resolution must lie in (0, 1], got ", p.certify.resolution));
-  }
+  if (absl::Status s = CheckCoverCertifyOptions(p.certify); !s.ok()) return s;
   return CheckMedialSphereOptions(p.medial, /*need_voxel_size=*/false);
 }
 

@@ -314,14 +314,11 @@ absl::StatusOr<CoverCertifyOptions> CoverCertifyOptionsFromProto(
     const v1::CertifyCoverRequest& request) {
   CoverCertifyOptions options;
   if (request.has_resolution()) {
-    if (!(request.resolution() > 0.0 && request.resolution() <= 1.0)) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("resolution must lie in (0, 1], got ", request.resolution()));
-    }
     options.resolution = request.resolution();
   }
   // The failed cells are not sent: keep none.
   options.max_failures_kept = 0;
+  if (absl::Status s = CheckCoverCertifyOptions(options); !s.ok()) return s;
   return options;
 }
 

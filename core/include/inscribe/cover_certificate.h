@@ -69,6 +69,9 @@ struct CoverCertificate {
   double seconds = 0.0;
 };
 
+// OK, or INVALID_ARGUMENT for a resolution outside (0, 1] or a negative max_failures_kept.
+absl::Status CheckCoverCertifyOptions(const CoverCertifyOptions& options);
+
 // Certifies `spheres` (each passing CheckSphere) as a cover of `solid`. INVALID_ARGUMENT for a
 // bad sphere or resolution (in (0, 1]); CANCELLED when control.cancel is set. Parallel (TBB)
 // and deterministic: the verdict, the counts, the failures and the witness depend only on the

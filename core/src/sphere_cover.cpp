@@ -102,6 +102,14 @@ absl::Status CheckCoverParameters(const CoverParameters& p) {
     return absl::InvalidArgumentError(
         absl::StrCat("cover: max_spheres must be positive, got ", *p.max_spheres));
   }
+  if (p.max_spheres && p.max_protrusion) {
+    return absl::InvalidArgumentError(
+        "cover: give max_spheres or max_protrusion, not both (a budget, or a delta to reach)");
+  }
+  if (p.max_protrusion && !(std::isfinite(*p.max_protrusion) && *p.max_protrusion > 0.0)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("cover: max_protrusion must be a finite length > 0, got ", *p.max_protrusion));
+  }
   if (p.growth_samples < 0 || p.growth_samples > 100'000'000) {
     return absl::InvalidArgumentError(
         absl::StrCat("cover: growth_samples must lie in 0..100,000,000, got ", p.growth_samples));

@@ -22,9 +22,11 @@
 namespace inscribe {
 
 struct CoverParameters {
-  // Spheres in the cover: the budget of the internal set it grows from (GenerateSphereSet's
-  // max_spheres; kDefaultMaxSpheres when unset). > 0.
+  // The two modes, at most one set: at most N spheres with the smallest delta reached (> 0),
+  // or delta at most D mesh units with the fewest spheres (finite, > 0). Neither: at most
+  // kDefaultMaxSpheres spheres.
   std::optional<std::int64_t> max_spheres;
+  std::optional<double> max_protrusion;
   // The internal set's medial options (object angle, samples, ...); core's defaults.
   MedialSphereOptions medial;
   // Boundary points drawn (uniformly by area, fixed seed) to grow the spheres before the first

@@ -1,0 +1,80 @@
+// Certified separation distance: an interval that provably holds the exact distance between two
+// solids, from each solid's internal sphere set (inside the solid) and certified cover (holding
+// the solid, reaching at most delta outside it; cover_certificate.h).
+//
+// With A ⊆ solid_A ⊆ CA and CA within delta_A of solid_A (likewise for B):
+//   lower = max(0, d(CA, CB))            the covers hold the solids, so these are no closer;
+//   upper = max(0, min(d(A, B), max(0, d(CA, CB)) + delta_A + delta_B))
+// where d is the sphere-union distance (negative when they overlap) and the exact distance is
+// the solids' separation (0 when they touch or overlap). The second term of upper: a point
+// where the covers come closest (or overlap) is within delta_A of solid_A and delta_B of
+// solid_B. Every sphere distance is computed exactly over all sphere pairs (no tolerance), and
+// lower and upper are moved outward by a margin far above the rounding of the pose and of the
+// few operations per pair (kCertifiedDistanceMargin times the pair's coordinate scale).
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "inscribe/rigid_pose.h"
+#include "inscribe/separation_distance.h"
+#include "inscribe/sphere_hierarchy.h"
+
+namespace inscribe {
+
+// Relative margin on lower and upper, times the largest |coordinate| + radius of the posed
+// spheres (bounded from the hierarchies' roots and the poses).
+inline constexpr double kCertifiedDistanceMargin = 1e-12;
+
+// One solid of a certified query. The hierarchies are not owned and must outlive the call.
+struct CertifiedObject {
+  const SphereHierarchy* internal = nullptr;  // spheres inside the solid
+  const SphereHierarchy* cover = nullptr;     // spheres holding the whole solid (certified)
+  double cover_delta = 0.0;                   // the cover's certified protrusion bound, >= 0
+};
+
+// OK, or INVALID_ARGUMENT naming the problem: a missing hierarchy, a delta that is negative or
+// not finite. O(1).
+absl::Status CheckCertifiedObject(const CertifiedObject& object);
+
+// "Are the solids closer than d?" answered without a wrong yes or no.
+enum class CloserAnswer { kYes, kNo, kUndecided };
+
+// "yes", "no", "undecided".
+const char* CloserAnswerName(CloserAnswer answer);
+
+// The answer the interval gives: yes when upper < d, no when lower >= d, else undecided.
+CloserAnswer DecideCloser(double lower, double upper, double closer_than);
+
+struct CertifiedDistanceResult {
+  // lower <= exact distance <= upper, 0 <= lower <= upper (mesh units).
+  double lower = 0.0;
+  double upper = std::numeric_limits<double>::infinity();
+  // DecideCloser(lower, upper, closer_than); kUndecided when no closer_than was asked.
+  CloserAnswer closer = CloserAnswer::kUndecided;
+  // The two sphere queries behind it: internal sets (upper) and covers (lower).
+  DistanceResult internal, cover;
+};
+
+// One posed pair: two objects (not owned) and their world poses.
+struct CertifiedPair {
+  const CertifiedObject* a = nullptr;
+  const CertifiedObject* b = nullptr;
+  RigidPose pose_a, pose_b;
+};
+
+// The interval for every pair (entry i answers pairs[i]), and the closer-than answer when
+// closer_than is finite. Poses are normalised first (NormalizedPose): the exact distance is
+// that of the solids under the rotation of the unit quaternion. Parallel (TBB) like
+// PairSeparationDistances, cancellable through `cancel` (CANCELLED). Errors: INVALID_ARGUMENT
+// naming "pairs[i]" for a missing object, a bad object (CheckCertifiedObject) or a bad pose; for a
+// closer_than that is NaN.
+absl::StatusOr<std::vector<CertifiedDistanceResult>> CertifiedDistances(
+    const std::vector<CertifiedPair>& pairs,
+    double closer_than = std::numeric_limits<double>::infinity(),
+    const std::atomic<bool>* cancel = nullptr);
+
+}  // namespace inscribe

@@ -20,8 +20,6 @@
 namespace inscribe {
 namespace {
 
-// Levels of the octree at most: 2^20 cells per side keeps every corner an exact double.
-constexpr int kMaxLevel = 20;
 // Levels below which children are visited in parallel (8^3 = 512 subtrees).
 constexpr int kParallelLevels = 3;
 // Relative margins, far above the rounding of the few operations each test makes (a dozen
@@ -63,19 +61,12 @@ class Certifier {
   Certifier(const Solid& solid, const std::vector<Sphere>& spheres,
             const CoverCertifyOptions& options, const GenerationControl& control)
       : oracle_(solid.oracle), spheres_(spheres), options_(options), control_(control) {
-    const BoundingBox box = ComputeBoundingBox(solid.mesh().vertices);
-    scale_ = std::max(box.extent().maxCoeff(), std::numeric_limits<double>::min());
-    // A power-of-two side a little over the box's largest side, and an origin on the grid of
-    // the finest possible cells: every corner o + i * side / 2^level is then exact.
-    side_ = std::exp2(std::ceil(std::log2(scale_ * (1.0 + 1e-6))));
-    const double unit = std::ldexp(side_, -kMaxLevel);
-    for (int k = 0; k < 3; ++k) origin_[k] = std::floor(box.min[k] / unit) * unit;
-    // The origin moved down by less than one unit; the side covers that (side >= scale (1 +
-    // 1e-6) and unit <= 2 scale 2^-20 < 1e-6 scale).
-    finest_ = 0;
-    while (finest_ < kMaxLevel && std::ldexp(side_, -finest_) > options.resolution * scale_) {
-      ++finest_;
-    }
+    const internal::OctreeFrame frame =
+        internal::MakeOctreeFrame(ComputeBoundingBox(solid.mesh().vertices), options.resolution);
+    scale_ = frame.scale;
+    side_ = frame.side;
+    origin_ = frame.origin;
+    finest_ = frame.finest;
   }
 
   double finest_side() const { return std::ldexp(side_, -finest_); }

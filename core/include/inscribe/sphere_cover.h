@@ -1,13 +1,19 @@
-// Cover sets: spheres that provably contain the whole solid (cover_certificate.h), grown from
-// the paper's internal medial spheres.
+// Cover sets: spheres that provably contain the whole solid (cover_certificate.h), with a
+// certified bound delta on how far they reach outside it.
 //
-// GenerateCover makes the internal set S_D for the budget, then grows spheres, never moves
-// them: first each boundary sample and mesh vertex outside the union is given to the sphere
-// that needs the least growth to reach it, then each cell the certificate could not settle to
-// the sphere that needs the least growth to contain it, and certifies again. A cell the
-// repair grew a sphere around is inside it, so the second certificate passes; the result is
-// always certified. delta is then about the largest gap between S_D and the boundary, plus at
-// most one finest cell's diagonal.
+// GenerateCover chooses internal balls and grows them. The candidates: from each of many
+// boundary points (every vertex and area samples), balls centred on the inward normal at a
+// ladder of depths up to the deepest, each with radius = the depth of its centre (so a ball
+// grown to R protrudes at most R - depth). The choice: the fewest candidates that reach every
+// boundary sample (and interior stand-ins) by growing at most a threshold t: a greedy set
+// cover, with t searched down to the least that fits the budget (or moved until delta fits
+// max_protrusion). Then every boundary triangle, cut into pieces of edge at most 1/1024 of the
+// largest side, goes whole to the chosen ball that needs the least growth to hold its corners,
+// plus a margin of one finest certificate cell's diagonal; a ball is convex, so it then holds
+// the piece and its margin, and every certificate cell meeting the boundary lies in one ball.
+// The certificate then passes (failed cells, if any, grow the ball needing the least growth
+// and it certifies again): the result is always certified. delta is about t plus the margin
+// plus the growth the boundary between samples needs.
 #pragma once
 
 #include <cstdint>
@@ -21,19 +27,22 @@
 
 namespace inscribe {
 
+// The certificate resolution covers are made at (CoverCertifyOptions::resolution).
+inline constexpr double kCoverResolution = 1.0 / 2048;
+
 struct CoverParameters {
   // The two modes, at most one set: at most N spheres with the smallest delta reached (> 0),
   // or delta at most D mesh units with the fewest spheres (finite, > 0). Neither: at most
   // kDefaultMaxSpheres spheres.
   std::optional<std::int64_t> max_spheres;
   std::optional<double> max_protrusion;
-  // The internal set's medial options (object angle, samples, ...); core's defaults.
-  MedialSphereOptions medial;
-  // Boundary points drawn (uniformly by area, fixed seed) to grow the spheres before the first
-  // certificate; every mesh vertex is used too. 0..100,000,000.
-  std::int64_t growth_samples = 200'000;
-  // The certificate's settings (its finest cell size bounds how much a repair overshoots).
-  CoverCertifyOptions certify;
+  // Boundary points drawn (uniformly by area, fixed seed) that the choice must reach; every
+  // mesh vertex is used too. 0..100,000,000; more: a tighter choice, slower.
+  std::int64_t growth_samples = 20'000;
+  // The certificate's settings. Every sphere reaches one finest cell's diagonal past the
+  // boundary (so the certificate settles the cells there), which delta includes: a finer
+  // resolution allows a smaller delta and costs more cells.
+  CoverCertifyOptions certify = {kCoverResolution};
 };
 
 // OK, or INVALID_ARGUMENT naming the first bad field. O(1).
@@ -42,8 +51,8 @@ absl::Status CheckCoverParameters(const CoverParameters& parameters);
 struct GeneratedCover {
   SphereSet set;                   // the cover (no contacts: its spheres touch nothing)
   CoverCertificate certificate;    // certified; delta is the cover's protrusion bound
-  double voxel_size = 0.0;         // of the internal set it grew from, mesh units
-  std::int64_t grown_spheres = 0;  // spheres whose radius grew
+  std::int64_t candidates = 0;     // balls the choice was made from
+  std::int64_t grown_spheres = 0;  // spheres the repairs grew (after the first certificate)
   int repair_rounds = 0;           // certificates that failed before the one that passed
   double seconds = 0.0;            // all of it, the internal set included
 };

@@ -46,17 +46,20 @@
 #include "inscribe/sphere_dilation.h"
 #include "inscribe/sphere_hierarchy.h"
 #include "inscribe/sphere_quality.h"
+#include "support/fcl_solid_distance.h"
 #include "table2_poses.h"
 
 namespace {
 
 using namespace inscribe;
 using Clock = std::chrono::steady_clock;
-using FclMesh = fcl::BVHModel<fcl::OBBRSSd>;
 using bench::kPoseSets;
 using bench::PosePair;
 using bench::PoseSetSpec;
 using bench::RandomPosePairs;
+using testing::BuildFclMesh;
+using testing::FclMesh;
+using testing::ToFcl;
 
 constexpr double kLargestSide = 10.0;      // every model is scaled to this (paper: "bbox 10")
 constexpr double kTargetSpeedup = 30.0;    // RSS median at least this many times FCL's
@@ -92,13 +95,6 @@ struct Options {
   double growth = 1.0;      // DilationOptions::growth
   DistanceRequest request;  // tolerances of the timed sphere queries
 };
-
-fcl::Transform3d ToFcl(const RigidPose& pose) {
-  fcl::Transform3d t = fcl::Transform3d::Identity();
-  t.linear() = pose.rotation.toRotationMatrix();
-  t.translation() = pose.translation;
-  return t;
-}
 
 // Per model: how S_D and S_D+ were made and what the hierarchies cost.
 struct ModelRow {
@@ -168,24 +164,6 @@ Mesh ScaledToBox(Mesh mesh) {
     mesh.vertices.row(i) = ((mesh.vertices.row(i).transpose() - centre) * scale).transpose();
   }
   return mesh;
-}
-
-std::shared_ptr<FclMesh> BuildFclMesh(const Mesh& mesh) {
-  std::vector<fcl::Vector3d> points(static_cast<std::size_t>(mesh.num_vertices()));
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    points[i] = mesh.vertices.row(static_cast<Eigen::Index>(i)).transpose();
-  }
-  std::vector<fcl::Triangle> triangles(static_cast<std::size_t>(mesh.num_triangles()));
-  for (std::size_t i = 0; i < triangles.size(); ++i) {
-    const auto t = mesh.triangles.row(static_cast<Eigen::Index>(i));
-    triangles[i] = fcl::Triangle(static_cast<std::size_t>(t(0)), static_cast<std::size_t>(t(1)),
-                                 static_cast<std::size_t>(t(2)));
-  }
-  auto model = std::make_shared<FclMesh>();
-  model->beginModel();
-  model->addSubModel(points, triangles);
-  model->endModel();
-  return model;
 }
 
 // Loads and prepares one model, generates S_D and S_D+, builds the three trees.

@@ -1,7 +1,9 @@
 # FCL, the exact mesh-mesh distance that tests and benchmarks check and measure against (never
 # linked by the libraries). Debian's libfcl-dev (scripts/install-deps), found through its
 # fcl-config.cmake, else through pkg-config (whose Cflags carry -std=c++11, hence only its
-# paths and libraries). Sets INSCRIBE_FCL_TARGET to the target to link.
+# paths and libraries). Sets INSCRIBE_FCL_TARGET to the target to link, and defines
+# inscribe_fcl_oracle: FCL's trees and the exact distance between posed solids
+# (tests/support/fcl_solid_distance.h), for the tests and the benchmarks alike.
 find_package(fcl 0.7 CONFIG QUIET)
 if(fcl_FOUND)
   set(INSCRIBE_FCL_TARGET fcl)
@@ -20,3 +22,8 @@ else()
   target_link_libraries(inscribe_fcl INTERFACE ${INSCRIBE_FCL_LINK_LIBRARIES})
   set(INSCRIBE_FCL_TARGET inscribe_fcl)
 endif()
+
+add_library(inscribe_fcl_oracle STATIC ${PROJECT_SOURCE_DIR}/tests/support/fcl_solid_distance.cpp)
+target_include_directories(inscribe_fcl_oracle PUBLIC ${PROJECT_SOURCE_DIR}/tests)
+target_link_libraries(inscribe_fcl_oracle PUBLIC inscribe::core ${INSCRIBE_FCL_TARGET}
+  PRIVATE inscribe_build_flags)

@@ -29,7 +29,6 @@
 #include <iterator>
 #include <limits>
 #include <memory>
-#include <random>
 #include <string>
 #include <utility>
 #include <vector>
@@ -47,12 +46,20 @@
 #include "inscribe/sphere_dilation.h"
 #include "inscribe/sphere_hierarchy.h"
 #include "inscribe/sphere_quality.h"
+#include "support/fcl_solid_distance.h"
+#include "table2_poses.h"
 
 namespace {
 
 using namespace inscribe;
 using Clock = std::chrono::steady_clock;
-using FclMesh = fcl::BVHModel<fcl::OBBRSSd>;
+using bench::kPoseSets;
+using bench::PosePair;
+using bench::PoseSetSpec;
+using bench::RandomPosePairs;
+using testing::BuildFclMesh;
+using testing::FclMesh;
+using testing::ToFcl;
 
 constexpr double kLargestSide = 10.0;      // every model is scaled to this (paper: "bbox 10")
 constexpr double kTargetSpeedup = 30.0;    // RSS median at least this many times FCL's
@@ -88,61 +95,6 @@ struct Options {
   double growth = 1.0;      // DilationOptions::growth
   DistanceRequest request;  // tolerances of the timed sphere queries
 };
-
-// Where copy b's centre may be: a centre distance drawn uniformly from [lo, hi] bounding-box
-// diagonals, in a uniformly random direction.
-struct PoseSetSpec {
-  const char* name;
-  double lo, hi;
-};
-constexpr PoseSetSpec kPoseSets[] = {{"near", 0.4, 0.9}, {"far", 0.6, 1.5}};
-
-// World poses of the two copies of a model (centred on its bounding box, so that the
-// translation is the distance between the boxes' centres).
-struct PosePair {
-  RigidPose a, b;
-};
-
-Eigen::Quaterniond RandomRotation(std::mt19937_64& rng) {
-  // A normalised 4D Gaussian is uniform on the unit quaternions, hence on SO(3).
-  std::normal_distribution<double> normal;
-  Eigen::Quaterniond q;
-  do {
-    q = Eigen::Quaterniond(normal(rng), normal(rng), normal(rng), normal(rng));
-  } while (q.norm() < 1e-6);
-  return q.normalized();
-}
-
-// `count` pose pairs: both copies randomly rotated, a at the origin, b at a centre distance of
-// [lo, hi] * diagonal (mesh units). The same seed gives the same draws for every model: only the
-// scale by its diagonal differs.
-std::vector<PosePair> RandomPosePairs(int count, const PoseSetSpec& spec, double diagonal,
-                                      std::uint64_t seed) {
-  std::mt19937_64 rng(seed);
-  std::normal_distribution<double> normal;
-  std::uniform_real_distribution<double> fraction(spec.lo, spec.hi);
-  std::vector<PosePair> pairs;
-  pairs.reserve(static_cast<std::size_t>(count));
-  for (int i = 0; i < count; ++i) {
-    PosePair p;
-    p.a.rotation = RandomRotation(rng);
-    p.b.rotation = RandomRotation(rng);
-    Vector3 direction;
-    do {
-      direction = Vector3(normal(rng), normal(rng), normal(rng));
-    } while (direction.norm() < 1e-6);
-    p.b.translation = direction.normalized() * (fraction(rng) * diagonal);
-    pairs.push_back(p);
-  }
-  return pairs;
-}
-
-fcl::Transform3d ToFcl(const RigidPose& pose) {
-  fcl::Transform3d t = fcl::Transform3d::Identity();
-  t.linear() = pose.rotation.toRotationMatrix();
-  t.translation() = pose.translation;
-  return t;
-}
 
 // Per model: how S_D and S_D+ were made and what the hierarchies cost.
 struct ModelRow {
@@ -212,24 +164,6 @@ Mesh ScaledToBox(Mesh mesh) {
     mesh.vertices.row(i) = ((mesh.vertices.row(i).transpose() - centre) * scale).transpose();
   }
   return mesh;
-}
-
-std::shared_ptr<FclMesh> BuildFclMesh(const Mesh& mesh) {
-  std::vector<fcl::Vector3d> points(static_cast<std::size_t>(mesh.num_vertices()));
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    points[i] = mesh.vertices.row(static_cast<Eigen::Index>(i)).transpose();
-  }
-  std::vector<fcl::Triangle> triangles(static_cast<std::size_t>(mesh.num_triangles()));
-  for (std::size_t i = 0; i < triangles.size(); ++i) {
-    const auto t = mesh.triangles.row(static_cast<Eigen::Index>(i));
-    triangles[i] = fcl::Triangle(static_cast<std::size_t>(t(0)), static_cast<std::size_t>(t(1)),
-                                 static_cast<std::size_t>(t(2)));
-  }
-  auto model = std::make_shared<FclMesh>();
-  model->beginModel();
-  model->addSubModel(points, triangles);
-  model->endModel();
-  return model;
 }
 
 // Loads and prepares one model, generates S_D and S_D+, builds the three trees.

@@ -76,9 +76,14 @@ absl::StatusOr<std::vector<CertifiedDistanceResult>> CertifiedDistances(
     if (!pose_b.ok()) return PairError(i, pose_b.status());
     internal[i] = PosedPair{p.a->internal, p.b->internal, *pose_a, *pose_b};
     cover[i] = PosedPair{p.a->cover, p.b->cover, *pose_a, *pose_b};
-    margin[i] =
-        kCertifiedDistanceMargin *
-        (Extent(*p.a) + Extent(*p.b) + pose_a->translation.norm() + pose_b->translation.norm());
+    const double scale =
+        Extent(*p.a) + Extent(*p.b) + pose_a->translation.norm() + pose_b->translation.norm();
+    if (!(scale <= kCertifiedDistanceMaxScale)) {
+      return PairError(i, absl::InvalidArgumentError(absl::StrCat(
+                              "coordinates reach ", scale, " mesh units, beyond the ",
+                              kCertifiedDistanceMaxScale, " that certified distances support")));
+    }
+    margin[i] = kCertifiedDistanceMargin * scale + kCertifiedDistanceFloor;
   }
   // Exact sphere distances (no tolerance): a bound that stopped early would not be sound.
   absl::StatusOr<std::vector<DistanceResult>> inner = PairSeparationDistances(internal, {}, cancel);

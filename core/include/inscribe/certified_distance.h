@@ -10,7 +10,8 @@
 // where the covers come closest (or overlap) is within delta_A of solid_A and delta_B of
 // solid_B. Every sphere distance is computed exactly over all sphere pairs (no tolerance), and
 // lower and upper are moved outward by a margin far above the rounding of the pose and of the
-// few operations per pair (kCertifiedDistanceMargin times the pair's coordinate scale).
+// few operations per pair (kCertifiedDistanceMargin times the pair's coordinate scale, plus
+// kCertifiedDistanceFloor for lengths whose squares underflow).
 #pragma once
 
 #include <atomic>
@@ -25,9 +26,18 @@
 
 namespace inscribe {
 
-// Relative margin on lower and upper, times the largest |coordinate| + radius of the posed
-// spheres (bounded from the hierarchies' roots and the poses).
+// Margin on lower and upper: this fraction of the pair's coordinate scale (the largest
+// |centre| + radius of either object's spheres, from the hierarchies' roots, plus the poses'
+// translations), plus kCertifiedDistanceFloor.
 inline constexpr double kCertifiedDistanceMargin = 1e-12;
+// Absolute part of the margin, mesh units. Lengths below about 1e-154 have squares below the
+// smallest normal double, whose square roots then err by up to about 1e-161 in absolute terms
+// however small the coordinates; this stays far above that and far below any mesh's lengths.
+inline constexpr double kCertifiedDistanceFloor = 1e-150;
+// Largest coordinate scale (as above) a pair may have, mesh units: beyond it squared distances
+// could overflow to infinity, which would make lower infinite for objects a finite distance
+// apart. Such pairs are refused.
+inline constexpr double kCertifiedDistanceMaxScale = 1e100;
 
 // One solid of a certified query. The hierarchies are not owned and must outlive the call.
 struct CertifiedObject {
@@ -70,8 +80,8 @@ struct CertifiedPair {
 // closer_than is finite. Poses are normalised first (NormalizedPose): the exact distance is
 // that of the solids under the rotation of the unit quaternion. Parallel (TBB) like
 // PairSeparationDistances, cancellable through `cancel` (CANCELLED). Errors: INVALID_ARGUMENT
-// naming "pairs[i]" for a missing object, a bad object (CheckCertifiedObject) or a bad pose; for a
-// closer_than that is NaN.
+// naming "pairs[i]" for a missing object, a bad object (CheckCertifiedObject), a bad pose or a
+// coordinate scale above kCertifiedDistanceMaxScale; for a closer_than that is NaN.
 absl::StatusOr<std::vector<CertifiedDistanceResult>> CertifiedDistances(
     const std::vector<CertifiedPair>& pairs,
     double closer_than = std::numeric_limits<double>::infinity(),

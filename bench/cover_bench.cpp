@@ -311,7 +311,7 @@ const char* Pass(bool ok) { return ok ? "pass" : "FAIL"; }
 
 void PrintCovers(const Options& options, const Results& results) {
   absl::PrintF(
-      "Covers: GenerateCover (default settings: certificate resolution 1/512 of the largest "
+      "Covers: GenerateCover (default settings: certificate resolution 1/2048 of the largest "
       "side) at AMAA's sphere count and at %d; certify s = CertifyCover run again on the result; "
       "delta and protrusions as %% of the bounding box's largest side. AMAA = spheretree "
       "makeTreeMedial; 'quoted' figures are issue 22's measurements, not this run's.\n\n",

@@ -27,7 +27,7 @@ struct CoverCertifyOptions {
   // Side of the finest cells, as a fraction of the largest side of the mesh's bounding box
   // (rounded down to a power-of-two division of the cube, at most 2^20 cells per side). A
   // sphere set that protrudes less than about this near the boundary cannot be certified.
-  double resolution = 1.0 / 512;
+  double resolution = 1.0 / 2048;
   // Failing cells kept in CoverCertificate::failures (all are counted).
   std::int64_t max_failures_kept = 1 << 20;
   // A cell whose centre is inside the solid and in no sphere already disproves the cover: stop

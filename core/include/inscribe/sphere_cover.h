@@ -27,9 +27,6 @@
 
 namespace inscribe {
 
-// The certificate resolution covers are made at (CoverCertifyOptions::resolution).
-inline constexpr double kCoverResolution = 1.0 / 2048;
-
 struct CoverParameters {
   // The two modes, at most one set: at most N spheres with the smallest delta reached (> 0),
   // or delta at most D mesh units with the fewest spheres (finite, > 0). Neither: at most
@@ -42,7 +39,7 @@ struct CoverParameters {
   // The certificate's settings. Every sphere reaches one finest cell's diagonal past the
   // boundary (so the certificate settles the cells there), which delta includes: a finer
   // resolution allows a smaller delta and costs more cells.
-  CoverCertifyOptions certify = {kCoverResolution};
+  CoverCertifyOptions certify;
 };
 
 // OK, or INVALID_ARGUMENT naming the first bad field. O(1).

@@ -260,10 +260,11 @@ absl::StatusOr<std::int64_t> InscribeService::GenerateWorkBytes(
   } else if (size) {
     // A sphere budget N: the search starts at voxels of side ~diagonal / (2 sqrt N) (sphere
     // counts grow as (diagonal / sigma)^2 / 4) and refines from there; half that side, 8x the
-    // voxels, bounds where it ends on the meshes measured (at most the --max-voxels grid).
+    // voxels, bounds where it ends on the meshes measured (at most the --max-voxels grid). A
+    // cover bounded by max_protrusion instead is estimated as one of the default budget.
+    const std::int64_t budget = EffectiveMaxSpheres(parameters).value_or(kDefaultMaxSpheres);
     const double sigma =
-        0.5 * size->extent.norm() /
-        std::sqrt(std::max(static_cast<double>(*EffectiveMaxSpheres(parameters)), 1.0));
+        0.5 * size->extent.norm() / std::sqrt(std::max(static_cast<double>(budget), 1.0));
     if (sigma > 0.0) voxels = std::min(max_voxels, size->GridVoxels(0.5 * sigma));
   }
   // Subdivided boundary voxels hold up to 8 candidates each.

@@ -152,6 +152,16 @@ absl::StatusOr<std::pair<std::shared_ptr<const SphereSetEntry>, CacheSource>> Re
         absl::StatusOr<GeneratedSphereSet> generated =
             GenerateSphereSet((*mesh)->solid, parameters, control);
         if (!generated.ok()) return generated.status();
+        // A budget was checked above; a cover bounded by max_protrusion is checked here.
+        if (parameters.max_protrusion &&
+            static_cast<std::int64_t>(generated->set.size()) > limits_.max_spheres) {
+          return absl::ResourceExhaustedError(
+              absl::StrCat("the cover needs ", generated->set.size(),
+                           " spheres for "
+                           "max_protrusion ",
+                           parameters.max_protrusion.value_or(0.0),
+                           "; this server's limit (--max-spheres) is ", limits_.max_spheres));
+        }
         v1::GenerateResult result;
         result.set_sphere_set_key(key);
         result.set_mesh_sha256(mesh_key);

@@ -83,6 +83,11 @@ int main(int argc, char** argv) {
   generate.mutable_parameters()->set_dilate(true);
   generate.mutable_parameters()->set_dilation_growth(0.5);
   Seed(dir, RequestKind::kGenerate, generate, "budget");
+  generate.mutable_parameters()->set_dilate(false);
+  generate.mutable_parameters()->clear_dilation_growth();
+  generate.mutable_parameters()->set_cover(true);
+  generate.mutable_parameters()->set_cover_resolution(1.0 / 64);
+  Seed(dir, RequestKind::kGenerate, generate, "cover");
 
   v1::PutSphereSetRequest put_set;
   for (double x : {0.5, 0.5, 0.5, 0.25, 0.25, 0.25}) put_set.mutable_spheres()->add_centers(x);

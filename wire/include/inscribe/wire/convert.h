@@ -108,15 +108,18 @@ absl::StatusOr<DistanceRequest> ToleranceFromProto(const v1::DistanceTolerance& 
 void GenerateRequestToProto(const std::string& mesh_sha256, const SphereSetParameters& parameters,
                             bool fill_holes, v1::GenerateRequest* out);
 // The core parameters of a request, core's defaults where the wire leaves a field unset, then
-// CheckSphereSetParameters: INVALID_ARGUMENT "parameters: <why>". Exactly one of voxel_size
-// and max_spheres must be > 0 on the wire. `max_voxels_limit` (> 0) caps the voxel limit and
+// CheckSphereSetParameters: INVALID_ARGUMENT "parameters: <why>". Exactly one of voxel_size,
+// max_spheres (> 0) and max_protrusion must be set on the wire, and at most one of dilate and
+// cover. `max_voxels_limit` (> 0) caps the voxel limit and
 // stands in for an unset one.
 absl::StatusOr<SphereSetParameters> SphereSetParametersFromProto(const v1::GenerateRequest& request,
                                                                  std::int64_t max_voxels_limit);
 
-// Everything of a generated set but its key, mesh and cache source.
+// Everything of a generated set but its key, mesh and cache source (a cover's certificate
+// without its list of failed cells).
 void GeneratedSphereSetToProto(const GeneratedSphereSet& generated, v1::GenerateResult* out);
-// The inverse; INVALID_ARGUMENT as SphereSetFromProto for bad spheres.
+// The inverse; INVALID_ARGUMENT as SphereSetFromProto for bad spheres, as
+// CoverCertificateFromProto for a malformed certificate.
 absl::StatusOr<GeneratedSphereSet> GeneratedSphereSetFromProto(const v1::GenerateResult& result);
 
 // Evaluation options (Evaluate): the sample count, the voxel size and the coverage tolerance go

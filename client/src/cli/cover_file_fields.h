@@ -1,0 +1,31 @@
+// What a sphere file says about its kind and a cover's certificate, in one place: generate
+// writes these params and stats, distance reads them back to use a file as a cover.
+#pragma once
+
+#include <optional>
+#include <string>
+
+#include "absl/status/statusor.h"
+#include "inscribe/cover_certificate.h"
+#include "inscribe/sphere_io.h"
+#include "inscribe/sphere_set_generation.h"
+
+namespace inscribe::cli {
+
+// The param naming the set's kind: SphereSetKindName ("internal", "dilated", "cover").
+inline constexpr char kKindParam[] = "kind";
+
+// The certificate's figures as stats: delta and certificate_resolution (mesh units),
+// certified, certificate_cells, cells_in_sphere, cells_outside, failed_cells, certify_seconds.
+NamedValues CoverCertificateStats(const CoverCertificate& certificate);
+
+// The kind `file` records (its kKindParam), or "" when it records none (peer formats, files
+// written before kinds were recorded).
+std::string RecordedKind(const SphereFile& file);
+
+// The certificate a cover file records: kind "cover" and the stats CoverCertificateStats
+// writes. nullopt for a file of another kind or of none; INVALID_ARGUMENT naming the stat when
+// a cover file lacks one of them or gives it another type.
+absl::StatusOr<std::optional<CoverCertificate>> RecordedCoverCertificate(const SphereFile& file);
+
+}  // namespace inscribe::cli

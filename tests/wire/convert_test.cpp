@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "inscribe/mesh_validation.h"
 #include "support/synthetic_meshes.h"
@@ -422,6 +423,60 @@ TEST(GeneratedSphereSet, ACoverRoundTripsWithItsKindAndCertificate) {
   EXPECT_EQ(GeneratedSphereSetFromProto(old)->kind, SphereSetKind::kDilated);
   wire.mutable_cover()->mutable_certificate()->add_uncovered_point(1.0);
   EXPECT_EQ(GeneratedSphereSetFromProto(wire).status().code(), absl::StatusCode::kInvalidArgument);
+}
+
+TEST(CertifiedDistanceResults, RoundTripWithAndWithoutAnswers) {
+  std::vector<CertifiedDistanceResult> results(3);
+  const CloserAnswer answers[] = {CloserAnswer::kYes, CloserAnswer::kNo, CloserAnswer::kUndecided};
+  for (int i = 0; i < 3; ++i) {
+    CertifiedDistanceResult& r = results[static_cast<std::size_t>(i)];
+    r.lower = 0.25 * i;
+    r.upper = 0.25 * i + 0.125;
+    r.closer = answers[i];
+    r.internal.distance = 0.25 * i + 0.0625;
+    r.internal.sphere_a = i;
+    r.internal.sphere_b = 2 * i;
+    r.internal.point_a = Vector3(i, 1, 2);
+    r.internal.point_b = Vector3(3, i, 4);
+    r.cover.distance = -1.0;  // not sent
+  }
+  for (const bool with_answers : {true, false}) {
+    SCOPED_TRACE(with_answers);
+    v1::DistanceResults wire;
+    AppendCertifiedDistanceResults(results, with_answers, &wire);
+    EXPECT_EQ(wire.answers_size(), with_answers ? 3 : 0);
+    absl::StatusOr<std::vector<CertifiedDistanceResult>> back =
+        CertifiedDistanceResultsFromProto(wire);
+    ASSERT_TRUE(back.ok()) << back.status();
+    ASSERT_EQ(back->size(), 3u);
+    for (std::size_t i = 0; i < 3; ++i) {
+      EXPECT_EQ((*back)[i].lower, results[i].lower);
+      EXPECT_EQ((*back)[i].upper, results[i].upper);
+      EXPECT_EQ((*back)[i].closer, with_answers ? results[i].closer : CloserAnswer::kUndecided);
+      EXPECT_EQ((*back)[i].internal.distance, results[i].internal.distance);
+      EXPECT_EQ((*back)[i].internal.sphere_b, results[i].internal.sphere_b);
+      EXPECT_EQ((*back)[i].internal.point_a, results[i].internal.point_a);
+      EXPECT_EQ((*back)[i].cover.distance, DistanceResult().distance);
+    }
+    // The plain reading of the same answers: the internal sets'.
+    absl::StatusOr<std::vector<DistanceResult>> plain = DistanceResultsFromProto(wire);
+    ASSERT_TRUE(plain.ok());
+    EXPECT_EQ((*plain)[2].distance, results[2].internal.distance);
+  }
+  v1::DistanceResults wire;
+  AppendCertifiedDistanceResults(results, true, &wire);
+  v1::DistanceResults short_upper = wire;
+  short_upper.mutable_upper()->RemoveLast();
+  EXPECT_EQ(CertifiedDistanceResultsFromProto(short_upper).status().code(),
+            absl::StatusCode::kInvalidArgument);
+  v1::DistanceResults unknown = wire;
+  unknown.set_answers(1, v1::CLOSER_ANSWER_UNSPECIFIED);
+  EXPECT_EQ(CertifiedDistanceResultsFromProto(unknown).status().code(),
+            absl::StatusCode::kInvalidArgument);
+  v1::DistanceResults plain;
+  AppendDistanceResults({results[0].internal}, &plain);
+  EXPECT_EQ(CertifiedDistanceResultsFromProto(plain).status().code(),
+            absl::StatusCode::kInvalidArgument);
 }
 
 TEST(DeformedSpheres, RoundTripWithBounds) {

@@ -133,6 +133,23 @@ TEST(Keys, UploadedAndDerivedKeys) {
   EXPECT_NE(DeformerKey(kMesh, with_mesh, options), deformer);
 
   EXPECT_EQ(HierarchyKey(with_mesh, HierarchyVolume::kRss), "hierarchy/v1/rss/" + with_mesh);
+
+  // A certificate uploaded with a set keys it apart; none keeps the key it had.
+  EXPECT_EQ(UploadedSphereSetKey(kMesh, "", "numbers", ""), with_mesh);
+  const std::string vouched = UploadedSphereSetKey(kMesh, "", "numbers", "certificate");
+  EXPECT_NE(vouched, with_mesh);
+  EXPECT_EQ(RouteKey(vouched), RouteKey(kMesh));
+  EXPECT_NE(UploadedSphereSetKey(kMesh, "", "numbers", "another certificate"), vouched);
+
+  CoverCertifyOptions certify;
+  const std::string certificate = CoverCertificateKey(with_mesh, kMesh, certify);
+  EXPECT_EQ(certificate.substr(0, 15), "certificate/v1/");
+  EXPECT_EQ(certificate.substr(15, 16), RouteKey(kMesh));
+  certify.max_failures_kept = 7;  // changes no verdict
+  EXPECT_EQ(CoverCertificateKey(with_mesh, kMesh, certify), certificate);
+  certify.resolution = 1.0 / 64;
+  EXPECT_NE(CoverCertificateKey(with_mesh, kMesh, certify), certificate);
+  EXPECT_NE(CoverCertificateKey(derived, kMesh, CoverCertifyOptions()), certificate);
   EXPECT_TRUE(IsMeshKey(kMesh));
   EXPECT_FALSE(IsMeshKey(with_mesh));
   EXPECT_TRUE(IsSphereSetKey(with_mesh));

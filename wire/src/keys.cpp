@@ -22,6 +22,8 @@ constexpr char kHierarchyVersion[] = "v1";
 // Hashed with an uploaded set's numbers: uploaded keys never collide with generated ones.
 constexpr char kUploadedSetVersion[] = "inscribe-uploaded-spheres-1";
 constexpr char kDeformerVersion[] = "inscribe-deformer-1";
+// Bumped whenever CertifyCover would give another verdict or figures for the same input.
+constexpr char kCertificateVersion[] = "inscribe-certificate-1";
 
 // `prefix` (a RoutePrefix, or "") then the SHA-256 of `canonical`, 64 hex digits in all: the
 // prefix takes the place of the digest's last digits. The 192 bits left keep collisions out
@@ -91,10 +93,19 @@ std::string GeneratedSphereSetKey(const std::string& mesh_key, const SphereSetPa
 }
 
 std::string UploadedSphereSetKey(const std::string& mesh_key, const std::string& derived_from,
-                                 absl::string_view spheres_bytes) {
+                                 absl::string_view spheres_bytes,
+                                 absl::string_view certificate_bytes) {
   const std::string prefix = RoutePrefix(mesh_key.empty() ? derived_from : mesh_key);
-  return "spheres/v1/" + DerivedKeyHex(prefix, absl::StrCat(kUploadedSetVersion, "\n", mesh_key,
-                                                            "\n", spheres_bytes));
+  std::string canonical = absl::StrCat(kUploadedSetVersion, "\n", mesh_key, "\n", spheres_bytes);
+  if (!certificate_bytes.empty()) absl::StrAppend(&canonical, "\ncertificate\n", certificate_bytes);
+  return "spheres/v1/" + DerivedKeyHex(prefix, canonical);
+}
+
+std::string CoverCertificateKey(const std::string& set_key, const std::string& mesh_key,
+                                const CoverCertifyOptions& options) {
+  const std::string canonical = absl::StrFormat(
+      "%s\n%s\n%s\nresolution=%.17g\n", kCertificateVersion, set_key, mesh_key, options.resolution);
+  return "certificate/v1/" + DerivedKeyHex(RoutePrefix(set_key), canonical);
 }
 
 std::string DeformerKey(const std::string& mesh_key, const std::string& set_key,

@@ -1,5 +1,6 @@
-// What a sphere file says about its kind and a cover's certificate, in one place: generate
-// writes these params and stats, distance reads them back to use a file as a cover.
+// A cover's certificate as the command line writes and reads it, in one place: the params and
+// stats of a sphere file (generate writes them, distance reads them back to use a file as a
+// cover) and the verdict's wording (evaluate --certify, distance).
 #pragma once
 
 #include <optional>
@@ -27,5 +28,9 @@ std::string RecordedKind(const SphereFile& file);
 // writes. nullopt for a file of another kind or of none; INVALID_ARGUMENT naming the stat when
 // a cover file lacks one of them or gives it another type.
 absl::StatusOr<std::optional<CoverCertificate>> RecordedCoverCertificate(const SphereFile& file);
+
+// The verdict in words: "certified: ...", or "NOT certified: " and the point of the solid in no
+// sphere (its depth and gap), or the unsettled cells when no such point was found.
+std::string CoverVerdict(const CoverCertificate& certificate);
 
 }  // namespace inscribe::cli

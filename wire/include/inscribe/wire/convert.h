@@ -12,6 +12,7 @@
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
 #include "grpcpp/support/status.h"
+#include "inscribe/certified_distance.h"
 #include "inscribe/cover_certificate.h"
 #include "inscribe/mesh.h"
 #include "inscribe/mesh_validation.h"
@@ -90,6 +91,17 @@ absl::StatusOr<std::vector<RigidPose>> PosesFromProto(const v1::PoseArray& poses
 void AppendDistanceResults(const std::vector<DistanceResult>& results, v1::DistanceResults* out);
 // The inverse, all queries of `results`; INVALID_ARGUMENT when the arrays' lengths disagree.
 absl::StatusOr<std::vector<DistanceResult>> DistanceResultsFromProto(
+    const v1::DistanceResults& results);
+
+// Appends certified answers: each result's internal-set answer as AppendDistanceResults does,
+// its lower and upper, and its closer answer when `answers` (closer_than was asked).
+void AppendCertifiedDistanceResults(const std::vector<CertifiedDistanceResult>& results,
+                                    bool answers, v1::DistanceResults* out);
+// The inverse, all queries of `results`: lower, upper, closer (kUndecided when no answers were
+// sent) and internal; the covers' answer is not sent (`cover` is left empty). INVALID_ARGUMENT
+// when the arrays' lengths disagree (no lower and upper: not a certified answer) or an answer
+// is unknown.
+absl::StatusOr<std::vector<CertifiedDistanceResult>> CertifiedDistanceResultsFromProto(
     const v1::DistanceResults& results);
 
 // HIERARCHY_VOLUME_UNSPECIFIED and SPHERE are the sphere hierarchy.

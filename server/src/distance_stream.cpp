@@ -202,19 +202,14 @@ class DistanceStreamReactor final
       absl::StatusOr<const SphereHierarchy*> b =
           Hierarchy(pair.sphere_set_b(), volume, "sphere_set_b");
       if (!b.ok()) return InPair(i, b.status());
-      absl::StatusOr<RigidPose> pose_a = wire::PoseFromProto(pair.pose_a(), "pose_a");
-      if (!pose_a.ok()) return InPair(i, pose_a.status());
-      absl::StatusOr<RigidPose> pose_b = wire::PoseFromProto(pair.pose_b(), "pose_b");
-      if (!pose_b.ok()) return InPair(i, pose_b.status());
-      pairs[i] = PosedPair{*a, *b, *pose_a, *pose_b};
+      pairs[i] = PosedPair{*a, *b};
+      if (absl::Status s = ReadPoses(i, pair, &pairs[i].pose_a, &pairs[i].pose_b); !s.ok()) {
+        return s;
+      }
     }
     absl::StatusOr<std::vector<DistanceResult>> results =
         PairSeparationDistances(pairs, *tolerance, &cancelled_);
-    if (cancelled_.load()) return absl::CancelledError("client went away mid-frame");
-    if (!results.ok()) {
-      return absl::Status(results.status().code(),
-                          absl::StrCat("frame ", frame_.frame(), " ", results.status().message()));
-    }
+    if (absl::Status s = Answered(results.status()); !s.ok()) return s;
     wire::AppendDistanceResults(*results, result_.mutable_results());
     return absl::OkStatus();
   }
@@ -224,6 +219,27 @@ class DistanceStreamReactor final
   absl::Status InPair(std::size_t i, const absl::Status& s) const {
     return absl::Status(s.code(),
                         absl::StrCat("frame ", frame_.frame(), " pairs[", i, "].", s.message()));
+  }
+
+  // The two poses of pair `i`, normalised; INVALID_ARGUMENT naming the pair and pose.
+  absl::Status ReadPoses(std::size_t i, const v1::DistancePair& pair, RigidPose* a,
+                         RigidPose* b) const {
+    absl::StatusOr<RigidPose> pose_a = wire::PoseFromProto(pair.pose_a(), "pose_a");
+    if (!pose_a.ok()) return InPair(i, pose_a.status());
+    absl::StatusOr<RigidPose> pose_b = wire::PoseFromProto(pair.pose_b(), "pose_b");
+    if (!pose_b.ok()) return InPair(i, pose_b.status());
+    *a = *pose_a;
+    *b = *pose_b;
+    return absl::OkStatus();
+  }
+
+  // The frame's queries ended with `status`: CANCELLED when the client went away meanwhile,
+  // else `status` naming the frame.
+  absl::Status Answered(const absl::Status& status) const {
+    if (cancelled_.load()) return absl::CancelledError("client went away mid-frame");
+    if (status.ok()) return status;
+    return absl::Status(status.code(),
+                        absl::StrCat("frame ", frame_.frame(), " ", status.message()));
   }
 
   // A frame of certified pairs (every pair names covers): intervals from core's
@@ -248,19 +264,14 @@ class DistanceStreamReactor final
       absl::StatusOr<const CertifiedObject*> b =
           Certified(pair.sphere_set_b(), pair.cover_b(), volume, "sphere_set_b");
       if (!b.ok()) return InPair(i, b.status());
-      absl::StatusOr<RigidPose> pose_a = wire::PoseFromProto(pair.pose_a(), "pose_a");
-      if (!pose_a.ok()) return InPair(i, pose_a.status());
-      absl::StatusOr<RigidPose> pose_b = wire::PoseFromProto(pair.pose_b(), "pose_b");
-      if (!pose_b.ok()) return InPair(i, pose_b.status());
-      pairs[i] = CertifiedPair{*a, *b, *pose_a, *pose_b};
+      pairs[i] = CertifiedPair{*a, *b};
+      if (absl::Status s = ReadPoses(i, pair, &pairs[i].pose_a, &pairs[i].pose_b); !s.ok()) {
+        return s;
+      }
     }
     absl::StatusOr<std::vector<CertifiedDistanceResult>> results =
         inscribe::CertifiedDistances(pairs, tolerance.closer_than, &cancelled_);
-    if (cancelled_.load()) return absl::CancelledError("client went away mid-frame");
-    if (!results.ok()) {
-      return absl::Status(results.status().code(),
-                          absl::StrCat("frame ", frame_.frame(), " ", results.status().message()));
-    }
+    if (absl::Status s = Answered(results.status()); !s.ok()) return s;
     wire::AppendCertifiedDistanceResults(*results, std::isfinite(tolerance.closer_than),
                                          result_.mutable_results());
     return absl::OkStatus();

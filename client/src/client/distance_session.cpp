@@ -3,10 +3,19 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/string_view.h"
 #include "inscribe/client/client.h"
 #include "inscribe/wire/convert.h"
 
 namespace inscribe::client {
+namespace {
+
+// A reply the server should never send: INTERNAL, with what is wrong with it.
+absl::Status Malformed(absl::string_view problem) {
+  return absl::InternalError(absl::StrCat("malformed DistanceStream response: ", problem));
+}
+
+}  // namespace
 
 DistanceSession::DistanceSession(std::unique_ptr<DistanceStreamConnection> stream,
                                  const DistanceSessionOptions& options)
@@ -43,13 +52,12 @@ absl::StatusOr<v1::DistanceFrameResult> DistanceSession::RoundTrip(
   if (!reply.ok()) return Break(reply.status());
   if (reply->frame() != next_frame_) {
     return Break(
-        absl::InternalError(absl::StrCat("malformed DistanceStream response: frame ", next_frame_,
-                                         " was answered as frame ", reply->frame())));
+        Malformed(absl::StrCat("frame ", next_frame_, " was answered as frame ", reply->frame())));
   }
   if (reply->results().distances_size() != static_cast<int>(pairs.size())) {
-    return Break(absl::InternalError(
-        absl::StrCat("malformed DistanceStream response: frame ", next_frame_, " has ",
-                     reply->results().distances_size(), " results for ", pairs.size(), " pairs")));
+    return Break(
+        Malformed(absl::StrCat("frame ", next_frame_, " has ", reply->results().distances_size(),
+                               " results for ", pairs.size(), " pairs")));
   }
   ++next_frame_;
   return reply;
@@ -67,10 +75,7 @@ absl::StatusOr<std::vector<DistanceResult>> DistanceSession::Query(
   if (!reply.ok()) return reply.status();
   absl::StatusOr<std::vector<DistanceResult>> results =
       wire::DistanceResultsFromProto(reply->results());
-  if (!results.ok()) {
-    return Break(absl::InternalError(
-        absl::StrCat("malformed DistanceStream response: ", results.status().message())));
-  }
+  if (!results.ok()) return Break(Malformed(results.status().message()));
   return results;
 }
 
@@ -80,10 +85,7 @@ absl::StatusOr<std::vector<CertifiedDistanceResult>> DistanceSession::QueryCerti
   if (!reply.ok()) return reply.status();
   absl::StatusOr<std::vector<CertifiedDistanceResult>> results =
       wire::CertifiedDistanceResultsFromProto(reply->results());
-  if (!results.ok()) {
-    return Break(absl::InternalError(
-        absl::StrCat("malformed DistanceStream response: ", results.status().message())));
-  }
+  if (!results.ok()) return Break(Malformed(results.status().message()));
   return results;
 }
 

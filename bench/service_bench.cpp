@@ -112,7 +112,7 @@ absl::StatusOr<Model> LoadModel(const client::Client& client, const Options& opt
   model.name = name;
   model.diagonal = prepared->report.bbox.diagonal();
   model.settings.parameters.max_spheres = options.max_spheres;
-  model.settings.parameters.dilate = true;
+  model.settings.parameters.kind = inscribe::SphereSetKind::kDilated;
   model.settings.parameters.evaluate = false;
   client::GenerateOptions call;
   call.timeout = std::chrono::minutes(10);

@@ -15,11 +15,59 @@ double SecondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
+// The pipeline's last step, whatever the kind: the quality report when asked, and the time.
+absl::StatusOr<GeneratedSphereSet> Evaluated(const Solid& solid,
+                                             const SphereSetParameters& parameters,
+                                             Clock::time_point start, GeneratedSphereSet out) {
+  if (parameters.evaluate) {
+    QualityOptions quality = parameters.quality;
+    quality.voxel_size = out.voxel_size;
+    absl::StatusOr<QualityReport> report = EvaluateSpheres(solid.oracle, out.set.spheres, quality);
+    if (!report.ok()) {
+      return absl::Status(report.status().code(),
+                          absl::StrCat("evaluating the result: ", report.status().message()));
+    }
+    out.quality = *std::move(report);
+  }
+  out.seconds = SecondsSince(start);
+  return out;
+}
+
 }  // namespace
+
+const char* SphereSetKindName(SphereSetKind kind) {
+  switch (kind) {
+    case SphereSetKind::kDilated:
+      return "dilated";
+    case SphereSetKind::kCover:
+      return "cover";
+    case SphereSetKind::kInternal:
+      break;
+  }
+  return "internal";
+}
+
+CoverParameters CoverParametersOf(const SphereSetParameters& parameters) {
+  CoverParameters cover;
+  cover.max_spheres = parameters.max_spheres;
+  cover.max_protrusion = parameters.max_protrusion;
+  cover.certify.resolution = parameters.cover_resolution;
+  return cover;
+}
 
 absl::Status CheckSphereSetParameters(const SphereSetParameters& p) {
   if (p.voxel_size && p.max_spheres) {
     return absl::InvalidArgumentError("give a voxel size or a sphere budget, not both");
+  }
+  const bool cover = p.kind == SphereSetKind::kCover;
+  if (cover && p.voxel_size) {
+    return absl::InvalidArgumentError(
+        "a cover takes a sphere budget or a max_protrusion, not a voxel size");
+  }
+  if (!cover && p.max_protrusion) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("max_protrusion bounds a cover's delta; it means nothing for ",
+                     SphereSetKindName(p.kind), " spheres"));
   }
   if (p.voxel_size && !(std::isfinite(*p.voxel_size) && *p.voxel_size > 0.0)) {
     return absl::InvalidArgumentError(
@@ -32,8 +80,11 @@ absl::Status CheckSphereSetParameters(const SphereSetParameters& p) {
   if (absl::Status s = CheckMedialSphereOptions(p.medial, /*need_voxel_size=*/false); !s.ok()) {
     return s;
   }
-  if (p.dilate) {
+  if (p.kind == SphereSetKind::kDilated) {
     if (absl::Status s = CheckDilationOptions(p.dilation); !s.ok()) return s;
+  }
+  if (cover) {
+    if (absl::Status s = CheckCoverParameters(CoverParametersOf(p)); !s.ok()) return s;
   }
   if (p.evaluate) {
     if (absl::Status s = CheckQualityOptions(p.quality); !s.ok()) return s;
@@ -43,7 +94,7 @@ absl::Status CheckSphereSetParameters(const SphereSetParameters& p) {
 
 std::optional<std::int64_t> EffectiveMaxSpheres(const SphereSetParameters& parameters) {
   if (parameters.max_spheres) return parameters.max_spheres;
-  if (parameters.voxel_size) return std::nullopt;
+  if (parameters.voxel_size || parameters.max_protrusion) return std::nullopt;
   return kDefaultMaxSpheres;
 }
 
@@ -53,6 +104,17 @@ absl::StatusOr<GeneratedSphereSet> GenerateSphereSet(const Solid& solid,
   const Clock::time_point start = Clock::now();
   if (absl::Status s = CheckSphereSetParameters(parameters); !s.ok()) return s;
   GeneratedSphereSet out;
+  out.kind = parameters.kind;
+  if (parameters.kind == SphereSetKind::kCover) {
+    absl::StatusOr<GeneratedCover> cover =
+        GenerateCover(solid, CoverParametersOf(parameters), control);
+    if (!cover.ok()) return cover.status();
+    out.set = std::move(cover->set);
+    cover->set = {};
+    out.cover = *std::move(cover);
+    out.generation_seconds = SecondsSince(start);
+    return Evaluated(solid, parameters, start, std::move(out));
+  }
   MedialSphereResult medial;
   if (const std::optional<std::int64_t> budget = EffectiveMaxSpheres(parameters)) {
     SphereBudgetOptions search;
@@ -78,7 +140,7 @@ absl::StatusOr<GeneratedSphereSet> GenerateSphereSet(const Solid& solid,
   out.set = std::move(medial.set);
 
   // S_D+ (Section VI-A) replaces S_D from here on: it is what gets evaluated and returned.
-  if (parameters.dilate) {
+  if (parameters.kind == SphereSetKind::kDilated) {
     absl::StatusOr<DilationResult> dilated =
         DilateSpheres(solid.oracle, out.set, parameters.dilation);
     if (!dilated.ok()) {
@@ -89,18 +151,7 @@ absl::StatusOr<GeneratedSphereSet> GenerateSphereSet(const Solid& solid,
     dilated->set = {};
     out.dilation = *std::move(dilated);
   }
-  if (parameters.evaluate) {
-    QualityOptions quality = parameters.quality;
-    quality.voxel_size = out.voxel_size;
-    absl::StatusOr<QualityReport> report = EvaluateSpheres(solid.oracle, out.set.spheres, quality);
-    if (!report.ok()) {
-      return absl::Status(report.status().code(),
-                          absl::StrCat("evaluating the result: ", report.status().message()));
-    }
-    out.quality = *std::move(report);
-  }
-  out.seconds = SecondsSince(start);
-  return out;
+  return Evaluated(solid, parameters, start, std::move(out));
 }
 
 }  // namespace inscribe

@@ -4,6 +4,7 @@
 // itself. The hierarchies a stream names are resolved once and held for the stream's life.
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -12,6 +13,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "inscribe/certified_distance.h"
 #include "inscribe/separation_distance.h"
 #include "inscribe/server/inscribe_service.h"
 #include "inscribe/wire/convert.h"
@@ -177,36 +179,127 @@ class DistanceStreamReactor final
     absl::StatusOr<DistanceRequest> tolerance = wire::ToleranceFromProto(frame_.tolerance());
     if (!tolerance.ok()) return tolerance.status();
     const HierarchyVolume volume = wire::VolumeFromProto(frame_.volume());
+    if (frame_.pairs_size() > 0 && !frame_.pairs(0).cover_a().empty()) {
+      return ComputeCertifiedFrame(*tolerance, volume);
+    }
     const std::size_t n = static_cast<std::size_t>(frame_.pairs_size());
     std::vector<PosedPair> pairs(n);
     for (std::size_t i = 0; i < n; ++i) {
       const v1::DistancePair& pair = frame_.pairs(static_cast<int>(i));
-      // Field names are built only for an error: this loop is on every frame's path.
-      auto in_pair = [&](const absl::Status& s) {
-        return absl::Status(
-            s.code(), absl::StrCat("frame ", frame_.frame(), " pairs[", i, "].", s.message()));
-      };
+      if (!pair.cover_a().empty() || !pair.cover_b().empty()) {
+        if (absl::Status s = CheckCovers(pair.cover_a(), pair.cover_b()); !s.ok()) {
+          return InPair(i, s);
+        }
+        return InPair(
+            i,
+            absl::InvalidArgumentError(
+                "cover_a, cover_b: a frame's pairs are all certified (covers named) or none, and "
+                "pairs[0] names none"));
+      }
       absl::StatusOr<const SphereHierarchy*> a =
           Hierarchy(pair.sphere_set_a(), volume, "sphere_set_a");
-      if (!a.ok()) return in_pair(a.status());
+      if (!a.ok()) return InPair(i, a.status());
       absl::StatusOr<const SphereHierarchy*> b =
           Hierarchy(pair.sphere_set_b(), volume, "sphere_set_b");
-      if (!b.ok()) return in_pair(b.status());
-      absl::StatusOr<RigidPose> pose_a = wire::PoseFromProto(pair.pose_a(), "pose_a");
-      if (!pose_a.ok()) return in_pair(pose_a.status());
-      absl::StatusOr<RigidPose> pose_b = wire::PoseFromProto(pair.pose_b(), "pose_b");
-      if (!pose_b.ok()) return in_pair(pose_b.status());
-      pairs[i] = PosedPair{*a, *b, *pose_a, *pose_b};
+      if (!b.ok()) return InPair(i, b.status());
+      pairs[i] = PosedPair{*a, *b};
+      if (absl::Status s = ReadPoses(i, pair, &pairs[i].pose_a, &pairs[i].pose_b); !s.ok()) {
+        return s;
+      }
     }
     absl::StatusOr<std::vector<DistanceResult>> results =
         PairSeparationDistances(pairs, *tolerance, &cancelled_);
-    if (cancelled_.load()) return absl::CancelledError("client went away mid-frame");
-    if (!results.ok()) {
-      return absl::Status(results.status().code(),
-                          absl::StrCat("frame ", frame_.frame(), " ", results.status().message()));
-    }
+    if (absl::Status s = Answered(results.status()); !s.ok()) return s;
     wire::AppendDistanceResults(*results, result_.mutable_results());
     return absl::OkStatus();
+  }
+
+  // `s` as an error of pair `i` of this frame. Field names are built only for an error: the
+  // frame loops are on every frame's path.
+  absl::Status InPair(std::size_t i, const absl::Status& s) const {
+    return absl::Status(s.code(),
+                        absl::StrCat("frame ", frame_.frame(), " pairs[", i, "].", s.message()));
+  }
+
+  // The two poses of pair `i`, normalised; INVALID_ARGUMENT naming the pair and pose.
+  absl::Status ReadPoses(std::size_t i, const v1::DistancePair& pair, RigidPose* a,
+                         RigidPose* b) const {
+    absl::StatusOr<RigidPose> pose_a = wire::PoseFromProto(pair.pose_a(), "pose_a");
+    if (!pose_a.ok()) return InPair(i, pose_a.status());
+    absl::StatusOr<RigidPose> pose_b = wire::PoseFromProto(pair.pose_b(), "pose_b");
+    if (!pose_b.ok()) return InPair(i, pose_b.status());
+    *a = *pose_a;
+    *b = *pose_b;
+    return absl::OkStatus();
+  }
+
+  // The frame's queries ended with `status`: CANCELLED when the client went away meanwhile,
+  // else `status` naming the frame.
+  absl::Status Answered(const absl::Status& status) const {
+    if (cancelled_.load()) return absl::CancelledError("client went away mid-frame");
+    if (status.ok()) return status;
+    return absl::Status(status.code(),
+                        absl::StrCat("frame ", frame_.frame(), " ", status.message()));
+  }
+
+  // A frame of certified pairs (every pair names covers): intervals from core's
+  // CertifiedDistances over the objects the store certifies (ResultStore::GetCertifiedObject).
+  absl::Status ComputeCertifiedFrame(const DistanceRequest& tolerance, HierarchyVolume volume) {
+    if (absl::Status s = CheckCertifiedTolerance(tolerance); !s.ok()) return s;
+    const std::size_t n = static_cast<std::size_t>(frame_.pairs_size());
+    std::vector<CertifiedPair> pairs(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const v1::DistancePair& pair = frame_.pairs(static_cast<int>(i));
+      if (pair.cover_a().empty()) {
+        return InPair(i, absl::InvalidArgumentError(
+                             "cover_a, cover_b: a frame's pairs are all certified (covers named) "
+                             "or none, and pairs[0] names covers"));
+      }
+      if (absl::Status s = CheckCovers(pair.cover_a(), pair.cover_b()); !s.ok()) {
+        return InPair(i, s);
+      }
+      absl::StatusOr<const CertifiedObject*> a =
+          Certified(pair.sphere_set_a(), pair.cover_a(), volume, "sphere_set_a");
+      if (!a.ok()) return InPair(i, a.status());
+      absl::StatusOr<const CertifiedObject*> b =
+          Certified(pair.sphere_set_b(), pair.cover_b(), volume, "sphere_set_b");
+      if (!b.ok()) return InPair(i, b.status());
+      pairs[i] = CertifiedPair{*a, *b};
+      if (absl::Status s = ReadPoses(i, pair, &pairs[i].pose_a, &pairs[i].pose_b); !s.ok()) {
+        return s;
+      }
+    }
+    absl::StatusOr<std::vector<CertifiedDistanceResult>> results =
+        inscribe::CertifiedDistances(pairs, tolerance.closer_than, &cancelled_);
+    if (absl::Status s = Answered(results.status()); !s.ok()) return s;
+    wire::AppendCertifiedDistanceResults(*results, std::isfinite(tolerance.closer_than),
+                                         result_.mutable_results());
+    return absl::OkStatus();
+  }
+
+  // The certified object of (internal set, cover) for this stream, from the stream's own table
+  // or the store; it counts against kMaxStreamSets like a hierarchy.
+  absl::StatusOr<const CertifiedObject*> Certified(const std::string& internal_key,
+                                                   const std::string& cover_key,
+                                                   HierarchyVolume volume, const char* field) {
+    const std::string slot =
+        absl::StrCat(HierarchyVolumeName(volume), "/", internal_key, "|", cover_key);
+    if (auto it = certified_.find(slot); it != certified_.end()) return &it->second->object;
+    if (absl::Status s = CheckKey(internal_key, field); !s.ok()) return s;
+    if (held_.size() + certified_.size() >= kMaxStreamSets) {
+      return absl::ResourceExhaustedError(
+          absl::StrCat(field, ": a stream may name at most ", kMaxStreamSets,
+                       " distinct sphere sets (per hierarchy volume); open another stream"));
+    }
+    absl::StatusOr<std::shared_ptr<const CertifiedObjectEntry>> entry =
+        service_->store_->GetCertifiedObject(internal_key, cover_key, volume);
+    if (!entry.ok()) {
+      return absl::Status(entry.status().code(),
+                          absl::StrCat(field, ": ", entry.status().message()));
+    }
+    const CertifiedObject* object = &(*entry)->object;
+    certified_.emplace(slot, *std::move(entry));
+    return object;
   }
 
   // The hierarchy of `key` for this stream, from the stream's own table or the store.
@@ -215,7 +308,7 @@ class DistanceStreamReactor final
     const std::string slot = absl::StrCat(HierarchyVolumeName(volume), "/", key);
     if (auto it = held_.find(slot); it != held_.end()) return it->second.get();
     if (absl::Status s = CheckKey(key, field); !s.ok()) return s;
-    if (held_.size() >= kMaxStreamSets) {
+    if (held_.size() + certified_.size() >= kMaxStreamSets) {
       return absl::ResourceExhaustedError(
           absl::StrCat(field, ": a stream may name at most ", kMaxStreamSets,
                        " distinct sphere sets (per hierarchy volume); open another stream"));
@@ -244,6 +337,8 @@ class DistanceStreamReactor final
   v1::DistanceFrameResult result_;
   MemoryBudget::Reservation frame_reservation_;  // the current frame's estimate
   std::unordered_map<std::string, std::shared_ptr<const SphereHierarchy>> held_;
+  // Certified pairs' objects by "volume/internal key|cover key".
+  std::unordered_map<std::string, std::shared_ptr<const CertifiedObjectEntry>> certified_;
   CallRecord record_;
 };
 

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -148,9 +149,17 @@ grpc::ServerUnaryReactor* InscribeService::PutSphereSet(grpc::CallbackServerCont
                   [this, request, response]() -> absl::Status {
                     absl::StatusOr<SphereSet> set = wire::SphereSetFromProto(request->spheres());
                     if (!set.ok()) return set.status();
+                    std::optional<CoverCertificate> certificate;
+                    if (request->has_certificate()) {
+                      absl::StatusOr<CoverCertificate> given =
+                          wire::CoverCertificateFromProto(request->certificate());
+                      if (!given.ok()) return given.status();
+                      certificate = *std::move(given);
+                    }
                     bool already = false;
                     absl::StatusOr<std::shared_ptr<const SphereSetEntry>> entry =
-                        store_->PutSphereSet(*std::move(set), request->mesh_sha256(), &already);
+                        store_->PutSphereSet(*std::move(set), request->mesh_sha256(), &already, "",
+                                             certificate);
                     if (!entry.ok()) return entry.status();
                     response->set_sphere_set_key((*entry)->result.sphere_set_key());
                     response->set_already_stored(already);
@@ -288,6 +297,15 @@ grpc::ServerUnaryReactor* InscribeService::CertifyCover(grpc::CallbackServerCont
                     absl::StatusOr<NamedSpheres> named =
                         ResolveSpheres(*request, *store_, *memory_, "CertifyCover");
                     if (!named.ok()) return named.status();
+                    if (named->cached) {
+                      // Cached with the set, where Distance finds it (CoverCertificateOf).
+                      absl::StatusOr<std::shared_ptr<const CoverCertificate>> certificate =
+                          store_->CertifySphereSet(request->sphere_set_key(), named->mesh->key,
+                                                   options);
+                      if (!certificate.ok()) return certificate.status();
+                      wire::CoverCertificateToProto(**certificate, response->mutable_certificate());
+                      return absl::OkStatus();
+                    }
                     absl::StatusOr<CoverCertificate> certificate =
                         inscribe::CertifyCover(named->mesh->solid, named->spheres(), options);
                     if (!certificate.ok()) return certificate.status();

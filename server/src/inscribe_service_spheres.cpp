@@ -1,6 +1,7 @@
 // The InscribeService RPCs over stored meshes and cached results: PutMesh, Generate,
-// GetSphereSet, GetHierarchy, Distance, CacheStats. Each validates on the gRPC thread what is
-// O(1), then hands the rest to the pool through ResultStore (the cache).
+// GetSphereSet, GetHierarchy, Distance (certified queries: inscribe_service_certified.cpp),
+// CacheStats. Each validates on the gRPC thread what is O(1), then hands the rest to the pool
+// through ResultStore (the cache).
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -260,10 +261,11 @@ absl::StatusOr<std::int64_t> InscribeService::GenerateWorkBytes(
   } else if (size) {
     // A sphere budget N: the search starts at voxels of side ~diagonal / (2 sqrt N) (sphere
     // counts grow as (diagonal / sigma)^2 / 4) and refines from there; half that side, 8x the
-    // voxels, bounds where it ends on the meshes measured (at most the --max-voxels grid).
+    // voxels, bounds where it ends on the meshes measured (at most the --max-voxels grid). A
+    // cover bounded by max_protrusion instead is estimated as one of the default budget.
+    const std::int64_t budget = EffectiveMaxSpheres(parameters).value_or(kDefaultMaxSpheres);
     const double sigma =
-        0.5 * size->extent.norm() /
-        std::sqrt(std::max(static_cast<double>(*EffectiveMaxSpheres(parameters)), 1.0));
+        0.5 * size->extent.norm() / std::sqrt(std::max(static_cast<double>(budget), 1.0));
     if (sigma > 0.0) voxels = std::min(max_voxels, size->GridVoxels(0.5 * sigma));
   }
   // Subdivided boundary voxels hold up to 8 candidates each.
@@ -355,6 +357,12 @@ grpc::ServerUnaryReactor* InscribeService::Distance(grpc::CallbackServerContext*
                                                     v1::DistanceResponse* response) {
   absl::Status precheck = CheckKey(request->sphere_set_a(), "sphere_set_a");
   if (precheck.ok()) precheck = CheckKey(request->sphere_set_b(), "sphere_set_b");
+  if (precheck.ok()) precheck = CheckCovers(request->cover_a(), request->cover_b());
+  const bool certified = !request->cover_a().empty();
+  if (precheck.ok() && certified && request->brute_force()) {
+    precheck = absl::InvalidArgumentError(
+        "brute_force: a certified query (covers named) is exact already; leave it unset");
+  }
   // Shapes and counts are O(1) to check here; the poses' numbers are checked on the pool.
   const int numbers_a = request->poses_a().values_size();
   const int numbers_b = request->poses_b().values_size();
@@ -378,9 +386,12 @@ grpc::ServerUnaryReactor* InscribeService::Distance(grpc::CallbackServerContext*
   return RunUnary(
       context, "Distance", 0, precheck, pairs * MemoryCosts::kPerPosePair + MemoryCosts::kSmallCall,
       absl::StrCat("Distance of ", pairs, " pose pairs"),
-      [this, request, response]() -> absl::Status {
+      [this, request, response, certified]() -> absl::Status {
         absl::StatusOr<DistanceRequest> tolerance = wire::ToleranceFromProto(request->tolerance());
         if (!tolerance.ok()) return tolerance.status();
+        if (certified) {
+          if (absl::Status s = CheckCertifiedTolerance(*tolerance); !s.ok()) return s;
+        }
         absl::StatusOr<std::vector<RigidPose>> poses_a =
             wire::PosesFromProto(request->poses_a(), "poses_a");
         if (!poses_a.ok()) return poses_a.status();
@@ -394,6 +405,9 @@ grpc::ServerUnaryReactor* InscribeService::Distance(grpc::CallbackServerContext*
         }
         if (request->brute_force()) {
           return BruteForceDistances(*request, *poses_a, *poses_b, *tolerance, response);
+        }
+        if (certified) {
+          return CertifiedDistances(*request, *poses_a, *poses_b, *tolerance, response);
         }
         const HierarchyVolume volume = wire::VolumeFromProto(request->volume());
         const ServiceClock::time_point hierarchies_start = ServiceClock::now();

@@ -69,6 +69,34 @@ absl::StatusOr<CachedValue> DecodeSphereSet(std::string bytes) {
   return value;
 }
 
+absl::StatusOr<CachedValue> DecodeCertificate(std::string bytes) {
+  v1::CoverCertificate stored;
+  if (!stored.ParseFromString(bytes))
+    return absl::DataLossError("stored certificate does not parse");
+  absl::StatusOr<CoverCertificate> certificate = wire::CoverCertificateFromProto(stored);
+  if (!certificate.ok()) return certificate.status();
+  CachedValue value;
+  value.object_bytes = static_cast<std::int64_t>(sizeof(CoverCertificate));
+  value.object = std::shared_ptr<const CoverCertificate>(
+      std::make_shared<const CoverCertificate>(*std::move(certificate)));
+  value.bytes = std::move(bytes);
+  return value;
+}
+
+// Why a certificate does not let a set serve as a cover.
+std::string NotACover(const std::string& set_key, const std::string& mesh_key,
+                      const CoverCertificate& c) {
+  if (c.uncovered_point) {
+    const Vector3& p = *c.uncovered_point;
+    return absl::StrCat("sphere set ", set_key, " is not a cover of mesh ", mesh_key,
+                        ": the point (", p.x(), ", ", p.y(), ", ", p.z(), "), ", c.uncovered_depth,
+                        " deep in the solid, is ", c.uncovered_gap, " from the nearest sphere");
+  }
+  return absl::StrCat("sphere set ", set_key, " is not a certified cover of mesh ", mesh_key, ": ",
+                      c.failed_cells, " cells of side ", c.resolution,
+                      " near the boundary are in no single sphere");
+}
+
 absl::StatusOr<CachedValue> DecodeHierarchy(std::string bytes) {
   absl::StatusOr<SphereHierarchy> h = SphereHierarchy::Deserialize(bytes);
   if (!h.ok()) return h.status();
@@ -152,6 +180,16 @@ absl::StatusOr<std::pair<std::shared_ptr<const SphereSetEntry>, CacheSource>> Re
         absl::StatusOr<GeneratedSphereSet> generated =
             GenerateSphereSet((*mesh)->solid, parameters, control);
         if (!generated.ok()) return generated.status();
+        // A budget was checked above; a cover bounded by max_protrusion is checked here.
+        if (parameters.max_protrusion &&
+            static_cast<std::int64_t>(generated->set.size()) > limits_.max_spheres) {
+          return absl::ResourceExhaustedError(
+              absl::StrCat("the cover needs ", generated->set.size(),
+                           " spheres for "
+                           "max_protrusion ",
+                           parameters.max_protrusion.value_or(0.0),
+                           "; this server's limit (--max-spheres) is ", limits_.max_spheres));
+        }
         v1::GenerateResult result;
         result.set_sphere_set_key(key);
         result.set_mesh_sha256(mesh_key);
@@ -206,7 +244,12 @@ absl::StatusOr<std::shared_ptr<const SphereHierarchy>> ResultStore::GetHierarchy
 
 absl::StatusOr<std::shared_ptr<const SphereSetEntry>> ResultStore::PutSphereSet(
     SphereSet set, const std::string& mesh_key, bool* already_stored,
-    const std::string& derived_from) {
+    const std::string& derived_from, const std::optional<CoverCertificate>& certificate) {
+  if (certificate && !certificate->certified) {
+    return absl::InvalidArgumentError(
+        "certificate: it does not certify the set (certified is false); send a certified one, "
+        "or none and let CertifyCover prove it against the set's mesh");
+  }
   if (!mesh_key.empty()) {
     absl::StatusOr<std::shared_ptr<const StoredMeshEntry>> mesh = GetMesh(mesh_key);
     if (!mesh.ok()) return mesh.status();
@@ -222,9 +265,14 @@ absl::StatusOr<std::shared_ptr<const SphereSetEntry>> ResultStore::PutSphereSet(
   }
   v1::GenerateResult result;
   wire::SphereSetToProto(set, result.mutable_spheres());
+  if (certificate) {
+    result.set_kind(v1::SPHERE_SET_KIND_COVER);
+    wire::CoverCertificateToProto(*certificate, result.mutable_cover()->mutable_certificate());
+  }
   // The packed arrays of one message serialise the same way for the same numbers.
-  const std::string key =
-      wire::UploadedSphereSetKey(mesh_key, derived_from, result.spheres().SerializeAsString());
+  const std::string key = wire::UploadedSphereSetKey(
+      mesh_key, derived_from, result.spheres().SerializeAsString(),
+      certificate ? result.cover().certificate().SerializeAsString() : "");
   result.set_sphere_set_key(key);
   result.set_mesh_sha256(mesh_key);
   absl::StatusOr<CacheLookup> found = cache_->GetOrCompute(
@@ -234,6 +282,91 @@ absl::StatusOr<std::shared_ptr<const SphereSetEntry>> ResultStore::PutSphereSet(
     *already_stored = found->source == CacheSource::kMemory || found->source == CacheSource::kDisk;
   }
   return ObjectOf<SphereSetEntry>(*found, key);
+}
+
+absl::StatusOr<std::shared_ptr<const CoverCertificate>> ResultStore::CertifySphereSet(
+    const std::string& set_key, const std::string& mesh_key, const CoverCertifyOptions& options,
+    const GenerationControl& control) {
+  absl::StatusOr<std::shared_ptr<const SphereSetEntry>> set = GetSphereSet(set_key);
+  if (!set.ok()) return set.status();
+  const std::string key = wire::CoverCertificateKey(set_key, mesh_key, options);
+  absl::StatusOr<CacheLookup> found = cache_->GetOrCompute(
+      key,
+      [&]() -> absl::StatusOr<CachedValue> {
+        absl::StatusOr<std::shared_ptr<const StoredMeshEntry>> mesh = GetMesh(mesh_key);
+        if (!mesh.ok()) return mesh.status();
+        CoverCertifyOptions unkept = options;
+        unkept.max_failures_kept = 0;  // the failed cells are neither stored nor sent
+        absl::StatusOr<CoverCertificate> certificate =
+            CertifyCover((*mesh)->solid, (*set)->set.spheres, unkept, control);
+        if (!certificate.ok()) return certificate.status();
+        v1::CoverCertificate stored;
+        wire::CoverCertificateToProto(*certificate, &stored);
+        return DecodeCertificate(stored.SerializeAsString());
+      },
+      DecodeCertificate);
+  if (!found.ok()) return found.status();
+  return ObjectOf<CoverCertificate>(*found, key);
+}
+
+absl::StatusOr<CoverCertificate> ResultStore::CoverCertificateOf(const std::string& set_key) {
+  absl::StatusOr<std::shared_ptr<const SphereSetEntry>> set = GetSphereSet(set_key);
+  if (!set.ok()) return set.status();
+  const v1::GenerateResult& result = (*set)->result;
+  CoverCertificate certificate;
+  if (result.has_cover()) {
+    absl::StatusOr<CoverCertificate> held =
+        wire::CoverCertificateFromProto(result.cover().certificate());
+    if (!held.ok()) return held.status();
+    certificate = *std::move(held);
+  } else if (!result.mesh_sha256().empty()) {
+    absl::StatusOr<std::shared_ptr<const CoverCertificate>> proved =
+        CertifySphereSet(set_key, result.mesh_sha256(), CoverCertifyOptions());
+    if (!proved.ok()) return proved.status();
+    certificate = **proved;
+  } else {
+    return absl::FailedPreconditionError(absl::StrCat(
+        "sphere set ", set_key,
+        " has no cover certificate and names no mesh to prove one against: generate it as a "
+        "cover, or upload it with its mesh or with its certificate"));
+  }
+  if (!certificate.certified) {
+    return absl::FailedPreconditionError(NotACover(set_key, result.mesh_sha256(), certificate));
+  }
+  return certificate;
+}
+
+absl::StatusOr<std::shared_ptr<const CertifiedObjectEntry>> ResultStore::GetCertifiedObject(
+    const std::string& internal_key, const std::string& cover_key, HierarchyVolume volume) {
+  absl::StatusOr<std::shared_ptr<const SphereSetEntry>> internal = GetSphereSet(internal_key);
+  if (!internal.ok()) return internal.status();
+  const v1::SphereSetKind kind = (*internal)->result.kind();
+  if (kind == v1::SPHERE_SET_KIND_COVER || kind == v1::SPHERE_SET_KIND_DILATED ||
+      (*internal)->result.has_dilation()) {
+    return absl::FailedPreconditionError(absl::StrCat(
+        "sphere set ", internal_key, " is ",
+        kind == v1::SPHERE_SET_KIND_COVER ? "a cover" : "dilated",
+        ": the upper bound of a certified distance needs spheres inside the solid (generate "
+        "them without dilate or cover)"));
+  }
+  absl::StatusOr<std::shared_ptr<const SphereSetEntry>> cover = GetSphereSet(cover_key);
+  if (!cover.ok()) return cover.status();
+  const std::string& internal_mesh = (*internal)->result.mesh_sha256();
+  const std::string& cover_mesh = (*cover)->result.mesh_sha256();
+  if (!internal_mesh.empty() && !cover_mesh.empty() && internal_mesh != cover_mesh) {
+    return absl::InvalidArgumentError(absl::StrCat("sphere set ", internal_key, " is of mesh ",
+                                                   internal_mesh, " but its cover ", cover_key,
+                                                   " of mesh ", cover_mesh));
+  }
+  absl::StatusOr<CoverCertificate> certificate = CoverCertificateOf(cover_key);
+  if (!certificate.ok()) return certificate.status();
+  absl::StatusOr<std::shared_ptr<const SphereHierarchy>> internal_h =
+      GetHierarchy(internal_key, volume);
+  if (!internal_h.ok()) return internal_h.status();
+  absl::StatusOr<std::shared_ptr<const SphereHierarchy>> cover_h = GetHierarchy(cover_key, volume);
+  if (!cover_h.ok()) return cover_h.status();
+  return std::make_shared<const CertifiedObjectEntry>(*std::move(internal_h), *std::move(cover_h),
+                                                      certificate->delta);
 }
 
 absl::StatusOr<std::shared_ptr<const DeformerEntry>> ResultStore::GetDeformer(

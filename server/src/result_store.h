@@ -6,11 +6,14 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <utility>
 
 #include "absl/status/statusor.h"
 #include "inscribe/boundary_oracle.h"
+#include "inscribe/certified_distance.h"
+#include "inscribe/cover_certificate.h"
 #include "inscribe/medial_spheres.h"
 #include "inscribe/mesh.h"
 #include "inscribe/mesh_validation.h"
@@ -33,10 +36,24 @@ struct StoredMeshEntry {
 };
 
 // A generated sphere set: the cache object under "spheres/v1/<hex>". `result` is what Generate
-// returns (its `cache` field empty).
+// returns (its `cache` field empty). An uploaded set has its spheres, mesh and key there, and
+// kind cover with the certificate it was uploaded with, if any.
 struct SphereSetEntry {
   v1::GenerateResult result;
   SphereSet set;
+};
+
+// One solid of a certified distance query: its internal set's and its cover's hierarchies
+// (held, so `object` stays valid) and the cover's certified delta.
+struct CertifiedObjectEntry {
+  CertifiedObjectEntry(std::shared_ptr<const SphereHierarchy> internal_set,
+                       std::shared_ptr<const SphereHierarchy> cover_set, double cover_delta)
+      : internal(std::move(internal_set)),
+        cover(std::move(cover_set)),
+        object{internal.get(), cover.get(), cover_delta} {}
+
+  const std::shared_ptr<const SphereHierarchy> internal, cover;
+  const CertifiedObject object;
 };
 
 // A SphereDeformer kept between UpdateDeformation calls on one (mesh, set, options): the
@@ -87,9 +104,32 @@ class ResultStore {
   // numbers; a full SHA-256 when neither names a mesh. `mesh_key` may be empty; when given the
   // mesh must be stored (NOT_FOUND) and contacts must name its triangles (INVALID_ARGUMENT).
   // *already_stored: the key was held before.
+  // With a `certificate` (which must be certified: INVALID_ARGUMENT otherwise) the set is
+  // stored as a cover holding it, under a key that includes it.
   absl::StatusOr<std::shared_ptr<const SphereSetEntry>> PutSphereSet(
       SphereSet set, const std::string& mesh_key, bool* already_stored,
-      const std::string& derived_from = "");
+      const std::string& derived_from = "",
+      const std::optional<CoverCertificate>& certificate = std::nullopt);
+
+  // The certificate of cached set `set_key` against stored mesh `mesh_key` with `options`
+  // (CertifyCover; the failed cells are not kept), computed once, then cached under
+  // CoverCertificateKey. NOT_FOUND for unknown keys; CertifyCover's errors.
+  absl::StatusOr<std::shared_ptr<const CoverCertificate>> CertifySphereSet(
+      const std::string& set_key, const std::string& mesh_key, const CoverCertifyOptions& options,
+      const GenerationControl& control = {});
+
+  // The rule for using a set as a cover, in one place: the certificate the set was generated
+  // or uploaded with, else CertifySphereSet against the mesh the set names at core's default
+  // options. FAILED_PRECONDITION naming the key when there is none (no certificate, no mesh)
+  // or it does not certify the set (naming the point of the solid in no sphere).
+  absl::StatusOr<CoverCertificate> CoverCertificateOf(const std::string& set_key);
+
+  // One solid of a certified query: internal set `internal_key` (refused, FAILED_PRECONDITION,
+  // when Generate made it a cover or dilated: it must lie inside the solid) and cover
+  // `cover_key` (CoverCertificateOf), their hierarchies of `volume`. INVALID_ARGUMENT when the
+  // two name different meshes.
+  absl::StatusOr<std::shared_ptr<const CertifiedObjectEntry>> GetCertifiedObject(
+      const std::string& internal_key, const std::string& cover_key, HierarchyVolume volume);
 
   // The deformer of (mesh, set, options), created on first use (an oracle build). FAILED_
   // PRECONDITION for a set without contacts or whose contacts do not fit the mesh.

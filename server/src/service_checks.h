@@ -33,6 +33,28 @@ inline absl::Status CheckKey(const std::string& key, const char* field) {
   return absl::OkStatus();
 }
 
+// The covers of a certified distance query (Distance, a DistanceStream pair): both or
+// neither, each a well-formed key. O(length).
+inline absl::Status CheckCovers(const std::string& cover_a, const std::string& cover_b) {
+  if (cover_a.empty() != cover_b.empty()) {
+    return absl::InvalidArgumentError(
+        "cover_a and cover_b: give both (a certified query) or neither");
+  }
+  if (cover_a.empty()) return absl::OkStatus();
+  if (absl::Status s = CheckKey(cover_a, "cover_a"); !s.ok()) return s;
+  return CheckKey(cover_b, "cover_b");
+}
+
+// A certified query computes every sphere distance exactly: a tolerance would loosen a bound
+// it promises. INVALID_ARGUMENT for abs_err or rel_err other than 0.
+inline absl::Status CheckCertifiedTolerance(const DistanceRequest& tolerance) {
+  if (tolerance.abs_err == 0.0 && tolerance.rel_err == 0.0) return absl::OkStatus();
+  return absl::InvalidArgumentError(absl::StrCat(
+      "tolerance: a certified query (covers named) computes exact distances; abs_err and "
+      "rel_err must be 0, got ",
+      tolerance.abs_err, " and ", tolerance.rel_err));
+}
+
 // Estimated working memory of validating and storing `mesh` (InspectMesh, PutMesh), bytes. O(1).
 inline std::int64_t MeshWorkBytes(const v1::Mesh& mesh) {
   return wire::TriangleCount(mesh) * MemoryCosts::kPerTriangle +

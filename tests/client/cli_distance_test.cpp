@@ -2,6 +2,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -41,18 +42,21 @@ class CliDistance : public ::testing::Test {
     std::ofstream(path) << text;
     return path;
   }
-  // Rows of a CSV answer, header dropped, split on commas.
-  static std::vector<std::vector<std::string>> Rows(const std::string& csv) {
+  // Rows of a CSV answer, header dropped (and checked: the plain columns, then `extra`), split
+  // on commas.
+  static std::vector<std::vector<std::string>> Rows(const std::string& csv,
+                                                    const std::string& extra = "") {
     std::vector<std::vector<std::string>> rows;
     std::istringstream in(csv);
     std::string line;
     std::getline(in, line);
-    EXPECT_EQ(line, "pose,distance,sphere_a,sphere_b,ax,ay,az,bx,by,bz");
+    EXPECT_EQ(line, "pose,distance,sphere_a,sphere_b,ax,ay,az,bx,by,bz" + extra);
+    const std::size_t columns = 10 + std::count(extra.begin(), extra.end(), ',');
     while (std::getline(in, line)) {
       std::vector<std::string> cells;
       std::istringstream cells_in(line);
       for (std::string cell; std::getline(cells_in, cell, ',');) cells.push_back(cell);
-      EXPECT_EQ(cells.size(), 10u) << line;
+      EXPECT_EQ(cells.size(), columns) << line;
       rows.push_back(cells);
     }
     return rows;
@@ -110,6 +114,96 @@ TEST_F(CliDistance, JsonSummaryAndCsvFile) {
                                Quote(poses) + " --closer-than 0.5 --json");
   ASSERT_EQ(closer.exit_code, 0) << closer.err;
   EXPECT_EQ(nlohmann::json::parse(closer.out).at("closer"), 2);
+}
+
+// --cover-a/--cover-b: each row gains lower,upper (and closer with --closer-than), an interval
+// that holds the exact distance: the internal sets' distance is at least upper (they lie
+// inside the solids); a cover whose file records no certificate is proved with --mesh-a/-b.
+TEST_F(CliDistance, CoversAddCertifiedIntervals) {
+  const std::string mesh = Quote(testing::TestMeshPath("eight.off"));
+  const std::string cover = (dir_ / "cover.json").string();
+  ASSERT_EQ(RunCli("generate " + mesh + " --cover --max-spheres 60 -o " + Quote(cover)).exit_code,
+            0);
+  const std::string poses = Write("poses.txt", kPoses);
+  const std::string base = "distance " + Quote(json_) + " " + Quote(json_) + " --poses " +
+                           Quote(poses) + " --cover-a " + Quote(cover) + " --cover-b ";
+  const CliRun run = RunCli(base + Quote(cover));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto rows = Rows(run.out, ",lower,upper");
+  ASSERT_EQ(rows.size(), 4u);
+  for (const auto& row : rows) {
+    const double distance = std::stod(row[1]), lower = std::stod(row[10]),
+                 upper = std::stod(row[11]);
+    EXPECT_GE(lower, 0.0) << row[0];
+    EXPECT_LE(lower, upper) << row[0];
+    EXPECT_LE(upper, std::max(0.0, distance) + 1e-9) << row[0];
+  }
+  // Poses 0 and 3 overlap: 0 is an answer; pose 2 is 5 apart along z.
+  EXPECT_EQ(std::stod(rows[0][10]), 0.0);
+  EXPECT_GT(std::stod(rows[2][10]), 0.0);
+
+  const CliRun closer = RunCli(base + Quote(cover) + " --closer-than 0.5");
+  ASSERT_EQ(closer.exit_code, 0) << closer.err;
+  const auto answered = Rows(closer.out, ",lower,upper,closer");
+  EXPECT_EQ(answered[0][12], "yes");
+  EXPECT_EQ(answered[2][12], "no");
+  const CliRun summary = RunCli(base + Quote(cover) + " --closer-than 0.5 --json");
+  ASSERT_EQ(summary.exit_code, 0) << summary.err;
+  const nlohmann::json j = nlohmann::json::parse(summary.out);
+  EXPECT_TRUE(j.at("certified").get<bool>());
+  EXPECT_EQ(j.at("closer_yes").get<int>() + j.at("closer_no").get<int>() +
+                j.at("closer_undecided").get<int>(),
+            4);
+  EXPECT_GE(j.at("mean_width").get<double>(), 0.0);
+  EXPECT_LE(j.at("mean_width").get<double>(), j.at("max_width").get<double>());
+
+  // The same cover as CSV records no certificate: refused, then proved with the mesh, giving
+  // the same intervals (the service's delta is the file's).
+  const std::string csv_cover = (dir_ / "cover.csv").string();
+  ASSERT_EQ(RunCli("convert " + Quote(cover) + " -o " + Quote(csv_cover)).exit_code, 0);
+  const CliRun unproved = RunCli(base + Quote(csv_cover));
+  EXPECT_EQ(unproved.exit_code, 64);
+  EXPECT_THAT(unproved.err, HasSubstr("records no cover certificate"));
+  EXPECT_THAT(unproved.err, HasSubstr("--mesh-b"));
+  const CliRun proved = RunCli(base + Quote(csv_cover) + " --mesh-b " + mesh);
+  ASSERT_EQ(proved.exit_code, 0) << proved.err;
+  EXPECT_EQ(proved.out, run.out);
+}
+
+TEST_F(CliDistance, CoverCombinationsThatCannotHoldAreRefused) {
+  const std::string mesh = Quote(testing::TestMeshPath("eight.off"));
+  const std::string cover = (dir_ / "cover.json").string();
+  const std::string dilated = (dir_ / "dilated.json").string();
+  ASSERT_EQ(RunCli("generate " + mesh + " --cover --max-spheres 60 -o " + Quote(cover)).exit_code,
+            0);
+  ASSERT_EQ(
+      RunCli("generate " + mesh + " --dilate --max-spheres 60 -o " + Quote(dilated)).exit_code, 0);
+  const std::string poses = " --poses " + Quote(Write("poses.txt", kPoses));
+  const std::string pair = "distance " + Quote(json_) + " " + Quote(json_) + poses;
+  const std::string covers = " --cover-a " + Quote(cover) + " --cover-b " + Quote(cover);
+  struct Case {
+    std::string command;
+    int exit_code;
+    std::string message;
+  };
+  const Case cases[] = {
+      {pair + " --cover-a " + Quote(cover), 64, "requires"},
+      {pair + " --mesh-a " + mesh, 64, "requires"},
+      {pair + covers + " --hierarchy none", 64, "exact already"},
+      {pair + covers + " --abs-err 0.01", 64, "abs_err"},
+      {"distance " + Quote(dilated) + " " + Quote(json_) + poses + covers, 64,
+       "holds dilated spheres"},
+      // Internal spheres are no cover: the service's proof gives a point they miss.
+      {pair + " --cover-a " + Quote(json_) + " --mesh-a " + mesh + " --cover-b " + Quote(cover), 1,
+       "is not a cover of"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.command);
+    const CliRun run = RunCli(c.command);
+    EXPECT_EQ(run.exit_code, c.exit_code) << run.err;
+    EXPECT_THAT(run.err, HasSubstr(c.message));
+    EXPECT_EQ(run.out, "");
+  }
 }
 
 TEST_F(CliDistance, RefusesBadInput) {

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "client/cli_run.h"
@@ -93,6 +94,49 @@ TEST_F(CliPeerFormats, ARobotYamlIsReadOneLinkAtATime) {
   const nlohmann::json empty = Evaluate(robot, "--link gripper");
   EXPECT_EQ(empty.at("spheres"), 0);
   EXPECT_EQ(empty.at("nerr").get<double>(), 1.0);
+}
+
+// evaluate --certify on a cover written as spheretree .sph, CSV and a cuRobo robot YAML (the
+// cover one link of two, picked with --link): each is certified with the JSON's delta, and the
+// internal set beside it in the same robot file is not.
+TEST_F(CliPeerFormats, CertifyReadsCoversInEveryPeerFormat) {
+  const std::string cover_json = Path("cover.json");
+  ASSERT_EQ(
+      RunCli("generate " + mesh_ + " --cover --max-spheres 60 -o " + Quote(cover_json)).exit_code,
+      0);
+  absl::StatusOr<SphereFile> cover = ReadSphereFile(cover_json);
+  ASSERT_TRUE(cover.ok()) << cover.status();
+  absl::StatusOr<SphereFile> internal = ReadSphereFile(Path("eight.json"));
+  ASSERT_TRUE(internal.ok()) << internal.status();
+  for (const char* extension : {"sph", "csv"}) {
+    ASSERT_TRUE(WriteSphereFile(Path(std::string("cover.") + extension), *cover).ok());
+  }
+  absl::StatusOr<std::string> robot =
+      FormatCuroboYaml({{"arm", internal->set.spheres}, {"arm_cover", cover->set.spheres}});
+  ASSERT_TRUE(robot.ok()) << robot.status();
+  std::ofstream(Path("robot.yml")) << *robot;
+
+  const auto certify = [&](const std::string& spheres, const std::string& extra) {
+    return RunCli("evaluate --certify --json " + mesh_ + " " + Quote(spheres) + " " + extra);
+  };
+  const CliRun reference = certify(cover_json, "");
+  ASSERT_EQ(reference.exit_code, 0) << reference.err;
+  const double delta = nlohmann::json::parse(reference.out).at("delta").get<double>();
+  for (const auto& [file, extra] :
+       std::vector<std::pair<std::string, std::string>>{{Path("cover.sph"), ""},
+                                                        {Path("cover.csv"), ""},
+                                                        {Path("robot.yml"), "--link arm_cover"}}) {
+    SCOPED_TRACE(file + " " + extra);
+    const CliRun run = certify(file, extra);
+    ASSERT_EQ(run.exit_code, 0) << run.err;
+    const nlohmann::json j = nlohmann::json::parse(run.out);
+    EXPECT_TRUE(j.at("certified").get<bool>());
+    EXPECT_EQ(j.at("delta").get<double>(), delta);
+  }
+  const CliRun arm = certify(Path("robot.yml"), "--link arm");
+  EXPECT_EQ(arm.exit_code, 1) << arm.err;
+  EXPECT_FALSE(nlohmann::json::parse(arm.out).at("certified").get<bool>());
+  EXPECT_TRUE(nlohmann::json::parse(arm.out).contains("uncovered_point"));
 }
 
 TEST_F(CliPeerFormats, DistanceReadsYamlLinksAndSphLevels) {

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -133,6 +134,47 @@ TEST(CliEvaluate, CertifyProvesACoverOrShowsAPointItMisses) {
   fs::remove_all(dir);
 }
 
+// --cover: a certified cover, whose file records its kind and certificate; evaluate --certify
+// proves it again with the same delta.
+TEST(CliGenerate, CoverIsCertifiedAndItsFileRecordsTheCertificate) {
+  INSCRIBE_REQUIRE_MESH("eight.off");
+  const fs::path dir = TempDir();
+  const fs::path path = dir / "cover.json";
+  CliRun run =
+      RunCli("generate " + Eight() + " --cover --max-spheres 60 --json -o " + Quote(path.string()));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const nlohmann::json summary = nlohmann::json::parse(run.out);
+  EXPECT_EQ(summary.at("kind"), "cover");
+  EXPECT_TRUE(summary.at("certified").get<bool>());
+  EXPECT_EQ(summary.at("coverage").get<double>(), 1.0);
+  EXPECT_FALSE(summary.contains("search_runs"));
+
+  const nlohmann::json file = nlohmann::json::parse(std::ifstream(path));
+  const nlohmann::json& params = file.at("params");
+  const nlohmann::json& stats = file.at("stats");
+  EXPECT_EQ(params.at("kind"), "cover");
+  EXPECT_EQ(params.at("max_spheres"), 60);
+  EXPECT_EQ(params.at("cover_resolution").get<double>(), 1.0 / 2048);
+  EXPECT_FALSE(params.contains("epsilon"));  // the cover generator's own internal set
+  EXPECT_TRUE(stats.at("certified").get<bool>());
+  EXPECT_EQ(stats.at("delta"), summary.at("delta"));
+  EXPECT_GT(stats.at("delta").get<double>(), 0.0);
+  EXPECT_GT(stats.at("certificate_resolution").get<double>(), 0.0);
+  EXPECT_GT(stats.at("certificate_cells").get<int>(), 0);
+  EXPECT_EQ(stats.at("failed_cells"), 0);
+  EXPECT_GE(stats.at("grown_spheres").get<int>(), 0);
+  EXPECT_GE(stats.at("cover_candidates").get<int>(), 1);
+  EXPECT_FALSE(file.contains("contacts"));
+  EXPECT_LE(file.at("spheres").size(), 60u);
+
+  run = RunCli("evaluate --certify --json " + Eight() + " " + Quote(path.string()));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const nlohmann::json certified = nlohmann::json::parse(run.out);
+  EXPECT_TRUE(certified.at("certified").get<bool>());
+  EXPECT_EQ(certified.at("delta"), stats.at("delta"));
+  fs::remove_all(dir);
+}
+
 TEST(CliGenerate, BadOptionsAreClearErrorsNotHangs) {
   INSCRIBE_REQUIRE_MESH("eight.off");
   struct Case {
@@ -151,6 +193,13 @@ TEST(CliGenerate, BadOptionsAreClearErrorsNotHangs) {
       {"--samples 1", 64, "samples per voxel"},
       {"--voxel-size 0.1 --max-spheres 10", 64, "excludes"},
       {"--format pdf", 64, "pdf"},
+      {"--cover --voxel-size 0.1", 64, "excludes"},
+      {"--cover --dilate", 64, "excludes"},
+      {"--max-protrusion 0.1", 64, "requires"},
+      {"--cover-resolution 0.01", 64, "requires"},
+      {"--cover --max-spheres 10 --max-protrusion 0.1", 64, "excludes"},
+      {"--cover --max-protrusion -1", 64, "max_protrusion must be a finite length > 0"},
+      {"--cover --cover-resolution 0", 64, "resolution"},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.args);
@@ -187,7 +236,7 @@ TEST(CliGenerate, DilateGrowsTheSpheresAndReportsABound) {
   const CliRun run = RunCli(base + "--dilate --json -o " + Quote(dilated_path.string()));
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const nlohmann::json summary = nlohmann::json::parse(run.out);
-  EXPECT_EQ(summary.at("dilated"), true);
+  EXPECT_EQ(summary.at("kind"), "dilated");
   EXPECT_EQ(summary.at("nerr_kind"), "lower_bound");
   EXPECT_GT(summary.at("v_points").get<int>(), 100);
   EXPECT_GT(summary.at("grown").get<int>(), 100);
@@ -195,8 +244,8 @@ TEST(CliGenerate, DilateGrowsTheSpheresAndReportsABound) {
 
   const nlohmann::json plain = nlohmann::json::parse(std::ifstream(plain_path));
   const nlohmann::json dilated = nlohmann::json::parse(std::ifstream(dilated_path));
-  EXPECT_FALSE(plain.at("params").contains("dilated"));
-  EXPECT_EQ(dilated.at("params").at("dilated"), true);
+  EXPECT_EQ(plain.at("params").at("kind"), "internal");
+  EXPECT_EQ(dilated.at("params").at("kind"), "dilated");
   EXPECT_FALSE(dilated.contains("contacts"));
   EXPECT_FALSE(dilated.at("stats").at("nerr_is_exact").get<bool>());
   EXPECT_GT(dilated.at("stats").at("coverage").get<double>(),

@@ -65,7 +65,7 @@ ByHand RunByHand(const Solid& solid, const SphereSetParameters& p) {
   }
   out.set = medial.set;
   out.voxel_size = medial.voxel_size;
-  if (p.dilate) {
+  if (p.kind == SphereSetKind::kDilated) {
     absl::StatusOr<DilationResult> dilated = DilateSpheres(solid.oracle, out.set, p.dilation);
     EXPECT_TRUE(dilated.ok()) << dilated.status();
     out.set = dilated->set;
@@ -85,8 +85,9 @@ void ExpectPipelineEqualsStages(const Solid& solid, const SphereSetParameters& p
   ExpectSameSet(g->set, hand.set);
   EXPECT_EQ(g->voxel_size, hand.voxel_size);
   EXPECT_EQ(g->runs, hand.runs);
-  EXPECT_EQ(g->dilation.has_value(), p.dilate);
-  EXPECT_EQ(g->set.has_contacts(), !p.dilate);
+  EXPECT_EQ(g->dilation.has_value(), p.kind == SphereSetKind::kDilated);
+  EXPECT_EQ(g->kind, p.kind);
+  EXPECT_EQ(g->set.has_contacts(), p.kind == SphereSetKind::kInternal);
   ASSERT_TRUE(g->quality.has_value());
   EXPECT_EQ(g->quality->nerr, hand.quality.nerr);
   EXPECT_EQ(g->quality->volume_union, hand.quality.volume_union);
@@ -107,7 +108,7 @@ TEST(GenerateSphereSet, EqualsItsStagesOnASphereAndABox) {
   const Solid solid = MakeSolidOf(testing::Box(Vector3::Zero(), Vector3(4, 2, 1)));
   SphereSetParameters dilated;
   dilated.max_spheres = 40;
-  dilated.dilate = true;
+  dilated.kind = SphereSetKind::kDilated;
   dilated.dilation.growth = 0.5;
   dilated.quality.surface_samples = 2000;
   ExpectPipelineEqualsStages(solid, dilated);
@@ -125,7 +126,7 @@ TEST(GenerateSphereSet, EqualsItsStagesOnRealMeshes) {
     ExpectPipelineEqualsStages(solid, budget);
     SphereSetParameters dilated;
     dilated.voxel_size = 0.1;
-    dilated.dilate = true;
+    dilated.kind = SphereSetKind::kDilated;
     dilated.quality.surface_samples = 5000;
     ExpectPipelineEqualsStages(solid, dilated);
   }
@@ -161,8 +162,28 @@ TEST(GenerateSphereSet, BadParametersAreRefusedNamingTheField) {
       {[](SphereSetParameters& p) { p.medial.screen_samples = 5000; }, "screening samples"},
       {[](SphereSetParameters& p) { p.medial.pair_angle_margin = -0.1; }, "pair-angle margin"},
       {[](SphereSetParameters& p) { p.medial.max_voxels = 0; }, "voxel limit"},
-      {[](SphereSetParameters& p) { p.dilate = true, p.dilation.growth = 1.5; }, "growth"},
+      {[](SphereSetParameters& p) { p.kind = SphereSetKind::kDilated, p.dilation.growth = 1.5; },
+       "growth"},
       {[](SphereSetParameters& p) { p.quality.surface_samples = -2; }, "surface samples"},
+      {[](SphereSetParameters& p) { p.kind = SphereSetKind::kCover, p.voxel_size = 0.1; },
+       "not a voxel size"},
+      {[](SphereSetParameters& p) { p.max_protrusion = 0.1; }, "max_protrusion"},
+      {[](SphereSetParameters& p) { p.kind = SphereSetKind::kDilated, p.max_protrusion = 0.1; },
+       "dilated spheres"},
+      {[](SphereSetParameters& p) {
+         p.kind = SphereSetKind::kCover, p.max_spheres = 10, p.max_protrusion = 0.1;
+       },
+       "not both"},
+      {[](SphereSetParameters& p) { p.kind = SphereSetKind::kCover, p.max_protrusion = -1.0; },
+       "max_protrusion"},
+      {[](SphereSetParameters& p) {
+         p.kind = SphereSetKind::kCover, p.max_protrusion = std::nan("");
+       },
+       "max_protrusion"},
+      {[](SphereSetParameters& p) { p.kind = SphereSetKind::kCover, p.cover_resolution = 0.0; },
+       "resolution"},
+      {[](SphereSetParameters& p) { p.kind = SphereSetKind::kCover, p.cover_resolution = 2.0; },
+       "resolution"},
   };
   const Solid solid = MakeSolidOf(testing::UnitCube());
   for (const auto& c : cases) {
@@ -173,12 +194,49 @@ TEST(GenerateSphereSet, BadParametersAreRefusedNamingTheField) {
     EXPECT_THAT(checked.message(), HasSubstr(c.mentions));
     EXPECT_EQ(GenerateSphereSet(solid, p).status(), checked);
   }
-  // Growth is not checked without dilation, nor quality options without evaluation.
+  // Growth is not checked without dilation, the certificate's resolution without a cover,
+  // nor quality options without evaluation.
   SphereSetParameters unused;
   unused.dilation.growth = 7.0;
+  unused.cover_resolution = -1.0;
   unused.evaluate = false;
   unused.quality.surface_samples = -1;
   EXPECT_TRUE(CheckSphereSetParameters(unused).ok());
+}
+
+// A cover through the pipeline is GenerateCover's, certified, then evaluated like any set.
+TEST(GenerateSphereSet, ACoverIsCertifiedAndRecordsItsKind) {
+  const Solid solid = MakeSolidOf(testing::Box(Vector3::Zero(), Vector3(4, 2, 1)));
+  SphereSetParameters p;
+  p.kind = SphereSetKind::kCover;
+  p.max_spheres = 40;
+  p.cover_resolution = 1.0 / 256;
+  p.quality.surface_samples = 2000;
+  absl::StatusOr<GeneratedSphereSet> g = GenerateSphereSet(solid, p);
+  ASSERT_TRUE(g.ok()) << g.status();
+  EXPECT_EQ(g->kind, SphereSetKind::kCover);
+  EXPECT_STREQ(SphereSetKindName(g->kind), "cover");
+  ASSERT_TRUE(g->cover.has_value());
+  EXPECT_TRUE(g->cover->certificate.certified);
+  EXPECT_GE(g->cover->certificate.delta, 0.0);
+  // 1/256 of the largest side (4), rounded down to a power-of-two division of the cube.
+  EXPECT_LE(g->cover->certificate.resolution, 4.0 / 256);
+  EXPECT_GE(g->cover->certificate.resolution, 4.0 / 512);
+  EXPECT_TRUE(g->cover->set.spheres.empty());
+  EXPECT_FALSE(g->dilation.has_value());
+  EXPECT_FALSE(g->set.has_contacts());
+
+  absl::StatusOr<GeneratedCover> by_hand = GenerateCover(solid, CoverParametersOf(p));
+  ASSERT_TRUE(by_hand.ok()) << by_hand.status();
+  ExpectSameSet(g->set, by_hand->set);
+  EXPECT_EQ(g->cover->certificate.delta, by_hand->certificate.delta);
+  EXPECT_EQ(g->cover->certificate.cells, by_hand->certificate.cells);
+
+  // Evaluated like any set: every boundary sample lies in the certified union.
+  ASSERT_TRUE(g->quality.has_value());
+  EXPECT_EQ(g->quality->coverage, 1.0);
+  EXPECT_FALSE(g->quality->nerr_is_exact);  // the spheres protrude
+  EXPECT_GE(g->seconds, g->generation_seconds);
 }
 
 TEST(GenerateSphereSet, ReportsProgressAndStopsWhenCancelled) {

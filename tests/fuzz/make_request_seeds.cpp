@@ -83,6 +83,11 @@ int main(int argc, char** argv) {
   generate.mutable_parameters()->set_dilate(true);
   generate.mutable_parameters()->set_dilation_growth(0.5);
   Seed(dir, RequestKind::kGenerate, generate, "budget");
+  generate.mutable_parameters()->set_dilate(false);
+  generate.mutable_parameters()->clear_dilation_growth();
+  generate.mutable_parameters()->set_cover(true);
+  generate.mutable_parameters()->set_cover_resolution(1.0 / 64);
+  Seed(dir, RequestKind::kGenerate, generate, "cover");
 
   v1::PutSphereSetRequest put_set;
   for (double x : {0.5, 0.5, 0.5, 0.25, 0.25, 0.25}) put_set.mutable_spheres()->add_centers(x);
@@ -132,6 +137,24 @@ int main(int argc, char** argv) {
   distance.mutable_tolerance()->set_closer_than(0.5);
   Seed(dir, RequestKind::kDistance, distance, "closer");
 
+  v1::DistanceRequest certified = distance;
+  certified.set_cover_a(server.cover_set_key);
+  certified.set_cover_b(server.cover_set_key);
+  certified.set_sphere_set_b(server.sphere_set_key);
+  certified.set_volume(v1::SPHERE);
+  certified.mutable_tolerance()->set_rel_err(0.0);  // certified distances are exact
+  Seed(dir, RequestKind::kDistance, certified, "certified");
+
+  v1::PutSphereSetRequest put_cover;
+  put_cover.mutable_spheres()->add_centers(0.5);
+  put_cover.mutable_spheres()->add_centers(0.5);
+  put_cover.mutable_spheres()->add_centers(0.5);
+  put_cover.mutable_spheres()->add_radii(1.0);
+  put_cover.mutable_certificate()->set_certified(true);
+  put_cover.mutable_certificate()->set_delta(0.5);
+  put_cover.mutable_certificate()->set_resolution(1.0 / 512);
+  Seed(dir, RequestKind::kPutSphereSet, put_cover, "certificate");
+
   v1::DistanceFrame frame;
   frame.set_frame(7);
   for (const std::string& b : {server.plain_set_key, server.sphere_set_key}) {
@@ -143,6 +166,13 @@ int main(int argc, char** argv) {
     pair->mutable_pose_b()->set_tx(2.0);
   }
   Seed(dir, RequestKind::kDistanceStream, frame, "pairs");
+  for (v1::DistancePair& pair : *frame.mutable_pairs()) {
+    pair.set_sphere_set_b(server.sphere_set_key);
+    pair.set_cover_a(server.cover_set_key);
+    pair.set_cover_b(server.cover_set_key);
+  }
+  frame.mutable_tolerance()->set_closer_than(0.25);
+  Seed(dir, RequestKind::kDistanceStream, frame, "certified");
 
   v1::EvaluateRequest evaluate;
   evaluate.set_mesh_sha256(server.mesh_key);

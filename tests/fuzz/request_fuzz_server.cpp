@@ -139,6 +139,20 @@ FuzzServer* Start() {
   status = fuzz->stub->PutSphereSet(Context().get(), put_set, &set_reply);
   if (!status.ok()) Die("PutSphereSet: " + status.error_message());
   fuzz->plain_set_key = set_reply.sphere_set_key();
+
+  // The ball holds the cube (its corners are sqrt(3)/2 from the centre) and reaches 0.4 out.
+  v1::PutSphereSetRequest put_cover;
+  SphereSet ball;
+  ball.spheres = {Sphere{Vector3::Constant(0.5), 0.9}};
+  wire::SphereSetToProto(ball, put_cover.mutable_spheres());
+  CoverCertificate certificate;
+  certificate.certified = true;
+  certificate.delta = 0.4;
+  certificate.resolution = 1.0 / 512;
+  wire::CoverCertificateToProto(certificate, put_cover.mutable_certificate());
+  status = fuzz->stub->PutSphereSet(Context().get(), put_cover, &set_reply);
+  if (!status.ok()) Die("PutSphereSet of a cover: " + status.error_message());
+  fuzz->cover_set_key = set_reply.sphere_set_key();
   return fuzz.release();
 }
 

@@ -54,6 +54,9 @@ struct FuzzServer {
   std::string sphere_set_key;
   // Two spheres with no contacts and no mesh, stored with PutSphereSet.
   std::string plain_set_key;
+  // One ball around the cube, stored with PutSphereSet and its certificate: a cover for
+  // certified Distance and DistanceStream queries.
+  std::string cover_set_key;
 };
 
 // The process's server, started (and the entries above stored) on first use. Aborts with a

@@ -45,7 +45,7 @@ TEST(Client, GenerateSendsEverySettingAndConvertsTheResult) {
   settings.parameters.medial.epsilon = 1e-3;
   settings.parameters.medial.samples = 64;
   settings.parameters.medial.subdivide_boundary = true;
-  settings.parameters.dilate = true;
+  settings.parameters.kind = SphereSetKind::kDilated;
   settings.parameters.dilation.growth = 0.5;
   settings.fill_holes = true;
   settings.parameters.evaluate = false;

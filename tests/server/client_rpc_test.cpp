@@ -57,7 +57,7 @@ class ClientRpcTest : public ::testing::Test {
   GenerateResult Generated(const Mesh& mesh, double voxel_size, bool dilate = false) {
     GenerateSettings settings;
     settings.parameters.voxel_size = voxel_size;
-    settings.parameters.dilate = dilate;
+    if (dilate) settings.parameters.kind = SphereSetKind::kDilated;
     absl::StatusOr<GenerateResult> result = client_->Generate(mesh, settings);
     EXPECT_TRUE(result.ok()) << result.status();
     return result.ok() ? *std::move(result) : GenerateResult();

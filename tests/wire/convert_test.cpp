@@ -4,6 +4,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <functional>
+#include <string>
+#include <vector>
 
 #include "inscribe/mesh_validation.h"
 #include "support/synthetic_meshes.h"
@@ -160,9 +163,12 @@ bool SameParameters(const SphereSetParameters& a, const SphereSetParameters& b) 
          m.screen_samples == n.screen_samples && m.corner_screen == n.corner_screen &&
          m.pair_angle_margin == n.pair_angle_margin &&
          m.subdivide_boundary == n.subdivide_boundary && m.max_voxels == n.max_voxels &&
-         a.dilate == b.dilate && (!a.dilate || a.dilation.growth == b.dilation.growth) &&
+         a.kind == b.kind &&
+         (a.kind != SphereSetKind::kDilated || a.dilation.growth == b.dilation.growth) &&
          a.evaluate == b.evaluate &&
-         (!a.evaluate || a.quality.surface_samples == b.quality.surface_samples);
+         (!a.evaluate || a.quality.surface_samples == b.quality.surface_samples) &&
+         a.max_protrusion == b.max_protrusion &&
+         (a.kind != SphereSetKind::kCover || a.cover_resolution == b.cover_resolution);
 }
 
 TEST(GenerateParameters, EveryOptionSurvivesTheWire) {
@@ -177,14 +183,21 @@ TEST(GenerateParameters, EveryOptionSurvivesTheWire) {
   all.medial.pair_angle_margin = 0.1;
   all.medial.subdivide_boundary = true;
   all.medial.max_voxels = 12345;
-  all.dilate = true;
+  all.kind = SphereSetKind::kDilated;
   all.dilation.growth = 0.0;
   all.quality.surface_samples = 777;
   SphereSetParameters budget;
   budget.max_spheres = 42;
   budget.evaluate = false;
   SphereSetParameters defaults;  // the default budget goes as max_spheres
-  for (const SphereSetParameters& p : {all, budget, defaults}) {
+  SphereSetParameters cover;
+  cover.kind = SphereSetKind::kCover;
+  cover.max_protrusion = 0.02;
+  cover.cover_resolution = 1.0 / 128;
+  SphereSetParameters cover_budget;
+  cover_budget.kind = SphereSetKind::kCover;
+  cover_budget.max_spheres = 64;
+  for (const SphereSetParameters& p : {all, budget, defaults, cover, cover_budget}) {
     v1::GenerateRequest request;
     GenerateRequestToProto("sha256:x", p, true, &request);
     EXPECT_EQ(request.mesh_sha256(), "sha256:x");
@@ -202,7 +215,8 @@ TEST(GenerateParameters, EveryOptionSurvivesTheWire) {
   const v1::GenerateParameters& wire = plain.parameters();
   EXPECT_FALSE(wire.has_screen_samples() || wire.has_corner_screen() ||
                wire.has_pair_angle_margin() || wire.has_dilation_growth() ||
-               wire.has_quality_samples());
+               wire.has_quality_samples() || wire.has_max_protrusion() ||
+               wire.has_cover_resolution() || wire.cover());
   EXPECT_EQ(wire.object_angle(), 0.0);
   EXPECT_EQ(wire.samples(), 0);
   // The caller's grid limit always travels: a server with a larger --max-voxels must not
@@ -289,6 +303,36 @@ TEST(GenerateParameters, BadRequestsNameTheProblem) {
               HasSubstr("surface samples"));
 }
 
+TEST(GenerateParameters, BadCoverRequestsNameTheProblem) {
+  const auto refusal = [](const std::function<void(v1::GenerateParameters*)>& set) {
+    v1::GenerateRequest request;
+    set(request.mutable_parameters());
+    absl::StatusOr<SphereSetParameters> p = SphereSetParametersFromProto(request, 100);
+    EXPECT_EQ(p.status().code(), absl::StatusCode::kInvalidArgument);
+    return std::string(p.status().message());
+  };
+  EXPECT_THAT(refusal([](v1::GenerateParameters* p) {
+                p->set_max_spheres(10), p->set_dilate(true), p->set_cover(true);
+              }),
+              HasSubstr("dilate and cover"));
+  EXPECT_THAT(refusal([](v1::GenerateParameters* p) {
+                p->set_cover(true), p->set_max_spheres(10), p->set_max_protrusion(0.1);
+              }),
+              HasSubstr("exactly one of"));
+  EXPECT_THAT(
+      refusal([](v1::GenerateParameters* p) { p->set_cover(true), p->set_voxel_size(0.1); }),
+      HasSubstr("not a voxel size"));
+  EXPECT_THAT(refusal([](v1::GenerateParameters* p) { p->set_max_protrusion(0.1); }),
+              HasSubstr("max_protrusion"));
+  EXPECT_THAT(
+      refusal([](v1::GenerateParameters* p) { p->set_cover(true), p->set_max_protrusion(-1.0); }),
+      HasSubstr("max_protrusion"));
+  EXPECT_THAT(refusal([](v1::GenerateParameters* p) {
+                p->set_cover(true), p->set_max_spheres(10), p->set_cover_resolution(0.0);
+              }),
+              HasSubstr("resolution"));
+}
+
 TEST(GeneratedSphereSet, RoundTripsEveryFigure) {
   GeneratedSphereSet g;
   g.set.spheres = {Sphere{Vector3(1, 2, 3), 0.5}, Sphere{Vector3(-1, 0, 0.25), 0.125}};
@@ -338,6 +382,102 @@ TEST(GeneratedSphereSet, RoundTripsEveryFigure) {
   EXPECT_FALSE(back->dilation.has_value() || back->quality.has_value());
   wire.mutable_spheres()->set_radii(0, -1.0);
   EXPECT_EQ(GeneratedSphereSetFromProto(wire).status().code(), absl::StatusCode::kInvalidArgument);
+}
+
+TEST(GeneratedSphereSet, ACoverRoundTripsWithItsKindAndCertificate) {
+  GeneratedSphereSet g;
+  g.kind = SphereSetKind::kCover;
+  g.set.spheres = {Sphere{Vector3(1, 2, 3), 0.5}};
+  g.voxel_size = 0.25;
+  GeneratedCover cover;
+  cover.certificate.certified = true;
+  cover.certificate.delta = 0.0625;
+  cover.certificate.resolution = 1.0 / 2048;
+  cover.certificate.cells = 99;
+  cover.grown_spheres = 7;
+  cover.candidates = 4321;
+  cover.repair_rounds = 2;
+  cover.seconds = 0.75;
+  g.cover = cover;
+  v1::GenerateResult wire;
+  GeneratedSphereSetToProto(g, &wire);
+  EXPECT_EQ(wire.kind(), v1::SPHERE_SET_KIND_COVER);
+  absl::StatusOr<GeneratedSphereSet> back = GeneratedSphereSetFromProto(wire);
+  ASSERT_TRUE(back.ok()) << back.status();
+  EXPECT_EQ(back->kind, SphereSetKind::kCover);
+  ASSERT_TRUE(back->cover.has_value());
+  EXPECT_TRUE(back->cover->certificate.certified);
+  EXPECT_EQ(back->cover->certificate.delta, 0.0625);
+  EXPECT_EQ(back->cover->certificate.resolution, 1.0 / 2048);
+  EXPECT_EQ(back->cover->certificate.cells, 99);
+  EXPECT_EQ(back->cover->grown_spheres, 7);
+  EXPECT_EQ(back->cover->repair_rounds, 2);
+  EXPECT_EQ(back->cover->seconds, 0.75);
+  EXPECT_EQ(back->cover->candidates, 4321);
+  EXPECT_FALSE(back->dilation.has_value());
+
+  // A result cached before kinds were recorded: its dilation stats say it is dilated.
+  v1::GenerateResult old;
+  *old.mutable_spheres() = wire.spheres();
+  EXPECT_EQ(GeneratedSphereSetFromProto(old)->kind, SphereSetKind::kInternal);
+  old.mutable_dilation()->set_grown(1);
+  EXPECT_EQ(GeneratedSphereSetFromProto(old)->kind, SphereSetKind::kDilated);
+  wire.mutable_cover()->mutable_certificate()->add_uncovered_point(1.0);
+  EXPECT_EQ(GeneratedSphereSetFromProto(wire).status().code(), absl::StatusCode::kInvalidArgument);
+}
+
+TEST(CertifiedDistanceResults, RoundTripWithAndWithoutAnswers) {
+  std::vector<CertifiedDistanceResult> results(3);
+  const CloserAnswer answers[] = {CloserAnswer::kYes, CloserAnswer::kNo, CloserAnswer::kUndecided};
+  for (int i = 0; i < 3; ++i) {
+    CertifiedDistanceResult& r = results[static_cast<std::size_t>(i)];
+    r.lower = 0.25 * i;
+    r.upper = 0.25 * i + 0.125;
+    r.closer = answers[i];
+    r.internal.distance = 0.25 * i + 0.0625;
+    r.internal.sphere_a = i;
+    r.internal.sphere_b = 2 * i;
+    r.internal.point_a = Vector3(i, 1, 2);
+    r.internal.point_b = Vector3(3, i, 4);
+    r.cover.distance = -1.0;  // not sent
+  }
+  for (const bool with_answers : {true, false}) {
+    SCOPED_TRACE(with_answers);
+    v1::DistanceResults wire;
+    AppendCertifiedDistanceResults(results, with_answers, &wire);
+    EXPECT_EQ(wire.answers_size(), with_answers ? 3 : 0);
+    absl::StatusOr<std::vector<CertifiedDistanceResult>> back =
+        CertifiedDistanceResultsFromProto(wire);
+    ASSERT_TRUE(back.ok()) << back.status();
+    ASSERT_EQ(back->size(), 3u);
+    for (std::size_t i = 0; i < 3; ++i) {
+      EXPECT_EQ((*back)[i].lower, results[i].lower);
+      EXPECT_EQ((*back)[i].upper, results[i].upper);
+      EXPECT_EQ((*back)[i].closer, with_answers ? results[i].closer : CloserAnswer::kUndecided);
+      EXPECT_EQ((*back)[i].internal.distance, results[i].internal.distance);
+      EXPECT_EQ((*back)[i].internal.sphere_b, results[i].internal.sphere_b);
+      EXPECT_EQ((*back)[i].internal.point_a, results[i].internal.point_a);
+      EXPECT_EQ((*back)[i].cover.distance, DistanceResult().distance);
+    }
+    // The plain reading of the same answers: the internal sets'.
+    absl::StatusOr<std::vector<DistanceResult>> plain = DistanceResultsFromProto(wire);
+    ASSERT_TRUE(plain.ok());
+    EXPECT_EQ((*plain)[2].distance, results[2].internal.distance);
+  }
+  v1::DistanceResults wire;
+  AppendCertifiedDistanceResults(results, true, &wire);
+  v1::DistanceResults short_upper = wire;
+  short_upper.mutable_upper()->RemoveLast();
+  EXPECT_EQ(CertifiedDistanceResultsFromProto(short_upper).status().code(),
+            absl::StatusCode::kInvalidArgument);
+  v1::DistanceResults unknown = wire;
+  unknown.set_answers(1, v1::CLOSER_ANSWER_UNSPECIFIED);
+  EXPECT_EQ(CertifiedDistanceResultsFromProto(unknown).status().code(),
+            absl::StatusCode::kInvalidArgument);
+  v1::DistanceResults plain;
+  AppendDistanceResults({results[0].internal}, &plain);
+  EXPECT_EQ(CertifiedDistanceResultsFromProto(plain).status().code(),
+            absl::StatusCode::kInvalidArgument);
 }
 
 TEST(DeformedSpheres, RoundTripWithBounds) {

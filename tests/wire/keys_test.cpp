@@ -23,7 +23,7 @@ TEST(Keys, GeneratedKeysMatchVersionOneText) {
 
   SphereSetParameters dilated;  // neither given: core's default budget, 500
   dilated.max_spheres = 500;
-  dilated.dilate = true;
+  dilated.kind = SphereSetKind::kDilated;
   dilated.dilation.growth = 0.5;
   dilated.evaluate = false;
   EXPECT_EQ(GeneratedSphereSetKey(kMesh, dilated, true),
@@ -56,8 +56,8 @@ TEST(Keys, EveryParameterChangesTheKey) {
   p = base, p.medial.screen_samples = 0, add(p);
   p = base, p.medial.corner_screen = false, add(p);
   p = base, p.medial.pair_angle_margin = 0.1, add(p);
-  p = base, p.dilate = true, add(p);
-  p = base, p.dilate = true, p.dilation.growth = 0.0, add(p);
+  p = base, p.kind = SphereSetKind::kDilated, add(p);
+  p = base, p.kind = SphereSetKind::kDilated, p.dilation.growth = 0.0, add(p);
   p = base, p.evaluate = false, add(p);
   p = base, p.quality.surface_samples = 5000, add(p);
   EXPECT_EQ(keys.size(), 15u);
@@ -69,6 +69,38 @@ TEST(Keys, EveryParameterChangesTheKey) {
   p = unevaluated, p.quality.surface_samples = 7;
   EXPECT_EQ(GeneratedSphereSetKey(kMesh, p, false),
             GeneratedSphereSetKey(kMesh, unevaluated, false));
+}
+
+TEST(Keys, CoversHaveTheirOwnKeysAndLeaveOthersAlone) {
+  SphereSetParameters base;
+  base.max_spheres = 100;
+  // A cover's settings mean nothing for other kinds: their keys stay the version-1 ones.
+  SphereSetParameters unused = base;
+  unused.cover_resolution = 1.0 / 64;
+  EXPECT_EQ(GeneratedSphereSetKey(kMesh, unused, false), GeneratedSphereSetKey(kMesh, base, false));
+  SphereSetParameters by_size;
+  by_size.voxel_size = 0.1;
+  by_size.cover_resolution = 1.0 / 64;
+  EXPECT_EQ(GeneratedSphereSetKey(kMesh, by_size, false),
+            "spheres/v1/0123456789abcdeff9791a86a7a609b2b9c0cb9cf97e7688efd65e9bf382ee05");
+
+  std::set<std::string> keys = {GeneratedSphereSetKey(kMesh, base, false)};
+  SphereSetParameters cover = base;
+  cover.kind = SphereSetKind::kCover;
+  keys.insert(GeneratedSphereSetKey(kMesh, cover, false));
+  SphereSetParameters p = cover;
+  p.cover_resolution = 1.0 / 64;
+  keys.insert(GeneratedSphereSetKey(kMesh, p, false));
+  p = cover;
+  p.max_spheres.reset();
+  p.max_protrusion = 0.01;
+  keys.insert(GeneratedSphereSetKey(kMesh, p, false));
+  p.max_protrusion = 0.02;
+  keys.insert(GeneratedSphereSetKey(kMesh, p, false));
+  p = base, p.kind = SphereSetKind::kDilated;
+  keys.insert(GeneratedSphereSetKey(kMesh, p, false));
+  EXPECT_EQ(keys.size(), 6u);
+  for (const std::string& key : keys) EXPECT_EQ(RouteKey(key), RouteKey(kMesh));
 }
 
 TEST(Keys, RoutePrefixTakesLowercaseHexDigitsOfMeshAndSetKeys) {
@@ -101,6 +133,23 @@ TEST(Keys, UploadedAndDerivedKeys) {
   EXPECT_NE(DeformerKey(kMesh, with_mesh, options), deformer);
 
   EXPECT_EQ(HierarchyKey(with_mesh, HierarchyVolume::kRss), "hierarchy/v1/rss/" + with_mesh);
+
+  // A certificate uploaded with a set keys it apart; none keeps the key it had.
+  EXPECT_EQ(UploadedSphereSetKey(kMesh, "", "numbers", ""), with_mesh);
+  const std::string vouched = UploadedSphereSetKey(kMesh, "", "numbers", "certificate");
+  EXPECT_NE(vouched, with_mesh);
+  EXPECT_EQ(RouteKey(vouched), RouteKey(kMesh));
+  EXPECT_NE(UploadedSphereSetKey(kMesh, "", "numbers", "another certificate"), vouched);
+
+  CoverCertifyOptions certify;
+  const std::string certificate = CoverCertificateKey(with_mesh, kMesh, certify);
+  EXPECT_EQ(certificate.substr(0, 15), "certificate/v1/");
+  EXPECT_EQ(certificate.substr(15, 16), RouteKey(kMesh));
+  certify.max_failures_kept = 7;  // changes no verdict
+  EXPECT_EQ(CoverCertificateKey(with_mesh, kMesh, certify), certificate);
+  certify.resolution = 1.0 / 64;
+  EXPECT_NE(CoverCertificateKey(with_mesh, kMesh, certify), certificate);
+  EXPECT_NE(CoverCertificateKey(derived, kMesh, CoverCertifyOptions()), certificate);
   EXPECT_TRUE(IsMeshKey(kMesh));
   EXPECT_FALSE(IsMeshKey(with_mesh));
   EXPECT_TRUE(IsSphereSetKey(with_mesh));

@@ -1,6 +1,7 @@
 #include "inscribe/wire/convert.h"
 
 #include <cmath>
+#include <utility>
 
 #include "absl/strings/str_cat.h"
 
@@ -348,15 +349,21 @@ absl::StatusOr<std::vector<RigidPose>> PosesFromProto(const v1::PoseArray& poses
   return out;
 }
 
+namespace {
+
+void AppendDistanceResult(const DistanceResult& r, v1::DistanceResults* out) {
+  out->add_distances(r.distance);
+  out->add_spheres_a(r.sphere_a);
+  out->add_spheres_b(r.sphere_b);
+  for (int k = 0; k < kPerRow; ++k) out->add_points_a(r.point_a[k]);
+  for (int k = 0; k < kPerRow; ++k) out->add_points_b(r.point_b[k]);
+  out->add_closer(r.closer);
+}
+
+}  // namespace
+
 void AppendDistanceResults(const std::vector<DistanceResult>& results, v1::DistanceResults* out) {
-  for (const DistanceResult& r : results) {
-    out->add_distances(r.distance);
-    out->add_spheres_a(r.sphere_a);
-    out->add_spheres_b(r.sphere_b);
-    for (int k = 0; k < kPerRow; ++k) out->add_points_a(r.point_a[k]);
-    for (int k = 0; k < kPerRow; ++k) out->add_points_b(r.point_b[k]);
-    out->add_closer(r.closer);
-  }
+  for (const DistanceResult& r : results) AppendDistanceResult(r, out);
 }
 
 absl::StatusOr<std::vector<DistanceResult>> DistanceResultsFromProto(
@@ -378,6 +385,68 @@ absl::StatusOr<std::vector<DistanceResult>> DistanceResultsFromProto(
     r.point_a = Vector3(in.points_a(3 * i), in.points_a(3 * i + 1), in.points_a(3 * i + 2));
     r.point_b = Vector3(in.points_b(3 * i), in.points_b(3 * i + 1), in.points_b(3 * i + 2));
     r.closer = in.closer(i);
+  }
+  return out;
+}
+
+namespace {
+
+v1::CloserAnswer AnswerToProto(CloserAnswer answer) {
+  switch (answer) {
+    case CloserAnswer::kYes:
+      return v1::CLOSER_YES;
+    case CloserAnswer::kNo:
+      return v1::CLOSER_NO;
+    case CloserAnswer::kUndecided:
+      break;
+  }
+  return v1::CLOSER_UNDECIDED;
+}
+
+}  // namespace
+
+void AppendCertifiedDistanceResults(const std::vector<CertifiedDistanceResult>& results,
+                                    bool answers, v1::DistanceResults* out) {
+  for (const CertifiedDistanceResult& r : results) {
+    AppendDistanceResult(r.internal, out);
+    out->add_lower(r.lower);
+    out->add_upper(r.upper);
+    if (answers) out->add_answers(AnswerToProto(r.closer));
+  }
+}
+
+absl::StatusOr<std::vector<CertifiedDistanceResult>> CertifiedDistanceResultsFromProto(
+    const v1::DistanceResults& in) {
+  absl::StatusOr<std::vector<DistanceResult>> internal = DistanceResultsFromProto(in);
+  if (!internal.ok()) return internal.status();
+  const int n = in.distances_size();
+  if (in.lower_size() != n || in.upper_size() != n ||
+      (in.answers_size() != 0 && in.answers_size() != n)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("certified distance results: ", n, " distances but ", in.lower_size(),
+                     " lower, ", in.upper_size(), " upper and ", in.answers_size(), " answers"));
+  }
+  std::vector<CertifiedDistanceResult> out(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    CertifiedDistanceResult& r = out[static_cast<std::size_t>(i)];
+    r.lower = in.lower(i);
+    r.upper = in.upper(i);
+    r.internal = std::move((*internal)[static_cast<std::size_t>(i)]);
+    if (in.answers_size() == 0) continue;
+    switch (in.answers(i)) {
+      case v1::CLOSER_YES:
+        r.closer = CloserAnswer::kYes;
+        break;
+      case v1::CLOSER_NO:
+        r.closer = CloserAnswer::kNo;
+        break;
+      case v1::CLOSER_UNDECIDED:
+        r.closer = CloserAnswer::kUndecided;
+        break;
+      default:
+        return absl::InvalidArgumentError(
+            absl::StrCat("certified distance results: answer ", i, " is ", in.answers(i)));
+    }
   }
   return out;
 }

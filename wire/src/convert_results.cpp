@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
+#include <utility>
 
 #include "absl/strings/str_cat.h"
 #include "inscribe/wire/convert.h"
@@ -49,8 +51,8 @@ void GenerateRequestToProto(const std::string& mesh_sha256, const SphereSetParam
   // The wire has no "neither": core's default budget goes as a budget.
   if (p.voxel_size) {
     wire->set_voxel_size(*p.voxel_size);
-  } else {
-    wire->set_max_spheres(*EffectiveMaxSpheres(p));
+  } else if (const std::optional<std::int64_t> budget = EffectiveMaxSpheres(p)) {
+    wire->set_max_spheres(*budget);
   }
   const MedialSphereOptions& m = p.medial;
   const MedialSphereOptions& d = defaults.medial;
@@ -62,9 +64,14 @@ void GenerateRequestToProto(const std::string& mesh_sha256, const SphereSetParam
   if (m.corner_screen != d.corner_screen) wire->set_corner_screen(m.corner_screen);
   if (m.pair_angle_margin != d.pair_angle_margin) wire->set_pair_angle_margin(m.pair_angle_margin);
   wire->set_max_voxels(m.max_voxels);  // the caller's limit, which the server's caps
-  wire->set_dilate(p.dilate);
-  if (p.dilate && p.dilation.growth != defaults.dilation.growth) {
+  wire->set_dilate(p.kind == SphereSetKind::kDilated);
+  if (p.kind == SphereSetKind::kDilated && p.dilation.growth != defaults.dilation.growth) {
     wire->set_dilation_growth(p.dilation.growth);
+  }
+  wire->set_cover(p.kind == SphereSetKind::kCover);
+  if (p.max_protrusion) wire->set_max_protrusion(*p.max_protrusion);
+  if (p.kind == SphereSetKind::kCover && p.cover_resolution != defaults.cover_resolution) {
+    wire->set_cover_resolution(p.cover_resolution);
   }
   if (p.evaluate && p.quality.surface_samples != defaults.quality.surface_samples) {
     wire->set_quality_samples(p.quality.surface_samples);
@@ -77,13 +84,19 @@ absl::StatusOr<SphereSetParameters> SphereSetParametersFromProto(const v1::Gener
                                                                  std::int64_t max_voxels_limit) {
   const v1::GenerateParameters& wire = request.parameters();
   const bool by_size = wire.voxel_size() != 0.0, by_budget = wire.max_spheres() != 0;
-  if (by_size == by_budget) {
+  if (by_size + by_budget + wire.has_max_protrusion() != 1) {
     return absl::InvalidArgumentError(
-        "parameters: set exactly one of voxel_size (> 0) and max_spheres (> 0)");
+        "parameters: set exactly one of voxel_size (> 0), max_spheres (> 0) and, for a cover, "
+        "max_protrusion");
+  }
+  if (wire.dilate() && wire.cover()) {
+    return absl::InvalidArgumentError(
+        "parameters: dilate and cover exclude each other (a cover grows its own spheres)");
   }
   SphereSetParameters p;
   if (by_size) p.voxel_size = wire.voxel_size();
   if (by_budget) p.max_spheres = wire.max_spheres();
+  if (wire.has_max_protrusion()) p.max_protrusion = wire.max_protrusion();
   MedialSphereOptions& m = p.medial;
   // 0 means core's default for these three (proto3 scalars without presence).
   if (wire.object_angle() != 0.0) m.object_angle = wire.object_angle();
@@ -96,8 +109,11 @@ absl::StatusOr<SphereSetParameters> SphereSetParametersFromProto(const v1::Gener
   m.max_voxels =
       wire.max_voxels() > 0 ? std::min(wire.max_voxels(), max_voxels_limit) : max_voxels_limit;
   if (wire.max_voxels() < 0) m.max_voxels = wire.max_voxels();  // refused below
-  p.dilate = wire.dilate();
-  if (p.dilate && wire.has_dilation_growth()) p.dilation.growth = wire.dilation_growth();
+  p.kind = wire.cover()    ? SphereSetKind::kCover
+           : wire.dilate() ? SphereSetKind::kDilated
+                           : SphereSetKind::kInternal;
+  if (wire.dilate() && wire.has_dilation_growth()) p.dilation.growth = wire.dilation_growth();
+  if (wire.cover() && wire.has_cover_resolution()) p.cover_resolution = wire.cover_resolution();
   p.evaluate = !request.skip_quality();
   if (wire.has_quality_samples()) p.quality.surface_samples = wire.quality_samples();
   if (absl::Status s = CheckSphereSetParameters(p); !s.ok()) {
@@ -180,6 +196,30 @@ DilationResult DilationFromProto(const v1::DilationStats& d) {
   return out;
 }
 
+v1::SphereSetKind KindToProto(SphereSetKind kind) {
+  switch (kind) {
+    case SphereSetKind::kDilated:
+      return v1::SPHERE_SET_KIND_DILATED;
+    case SphereSetKind::kCover:
+      return v1::SPHERE_SET_KIND_COVER;
+    case SphereSetKind::kInternal:
+      break;
+  }
+  return v1::SPHERE_SET_KIND_INTERNAL;
+}
+
+// Results cached before kinds were recorded have none: a dilated one has its DilationStats.
+SphereSetKind KindFromProto(const v1::GenerateResult& result) {
+  switch (result.kind()) {
+    case v1::SPHERE_SET_KIND_COVER:
+      return SphereSetKind::kCover;
+    case v1::SPHERE_SET_KIND_DILATED:
+      return SphereSetKind::kDilated;
+    default:
+      return result.has_dilation() ? SphereSetKind::kDilated : SphereSetKind::kInternal;
+  }
+}
+
 }  // namespace
 
 void GeneratedSphereSetToProto(const GeneratedSphereSet& g, v1::GenerateResult* out) {
@@ -192,6 +232,15 @@ void GeneratedSphereSetToProto(const GeneratedSphereSet& g, v1::GenerateResult* 
   if (g.quality) QualityReportToProto(*g.quality, out->mutable_quality());
   out->set_generation_seconds(g.generation_seconds);
   out->set_seconds(g.seconds);
+  out->set_kind(KindToProto(g.kind));
+  if (g.cover) {
+    v1::CoverStats* cover = out->mutable_cover();
+    CoverCertificateToProto(g.cover->certificate, cover->mutable_certificate());
+    cover->set_grown_spheres(g.cover->grown_spheres);
+    cover->set_candidates(g.cover->candidates);
+    cover->set_repair_rounds(g.cover->repair_rounds);
+    cover->set_seconds(g.cover->seconds);
+  }
 }
 
 absl::StatusOr<GeneratedSphereSet> GeneratedSphereSetFromProto(const v1::GenerateResult& result) {
@@ -207,6 +256,19 @@ absl::StatusOr<GeneratedSphereSet> GeneratedSphereSetFromProto(const v1::Generat
   if (result.has_quality()) g.quality = QualityReportFromProto(result.quality());
   g.generation_seconds = result.generation_seconds();
   g.seconds = result.seconds();
+  g.kind = KindFromProto(result);
+  if (result.has_cover()) {
+    absl::StatusOr<CoverCertificate> certificate =
+        CoverCertificateFromProto(result.cover().certificate());
+    if (!certificate.ok()) return certificate.status();
+    GeneratedCover cover;
+    cover.certificate = *std::move(certificate);
+    cover.candidates = result.cover().candidates();
+    cover.grown_spheres = result.cover().grown_spheres();
+    cover.repair_rounds = result.cover().repair_rounds();
+    cover.seconds = result.cover().seconds();
+    g.cover = std::move(cover);
+  }
   return g;
 }
 

@@ -15,10 +15,15 @@ namespace {
 // Bumped whenever generation, dilation or quality would give different results for the same
 // input, so that old cache entries (memory, disk or Redis) are never served for new code.
 constexpr char kSphereAlgorithmVersion[] = "inscribe-spheres-1";
+// Written into the key of covers only, and bumped whenever GenerateCover would give another
+// cover for the same input (so that covers are recomputed without touching other sets' keys).
+constexpr char kCoverAlgorithmVersion[] = "inscribe-cover-2";
 constexpr char kHierarchyVersion[] = "v1";
 // Hashed with an uploaded set's numbers: uploaded keys never collide with generated ones.
 constexpr char kUploadedSetVersion[] = "inscribe-uploaded-spheres-1";
 constexpr char kDeformerVersion[] = "inscribe-deformer-1";
+// Bumped whenever CertifyCover would give another verdict or figures for the same input.
+constexpr char kCertificateVersion[] = "inscribe-certificate-1";
 
 // `prefix` (a RoutePrefix, or "") then the SHA-256 of `canonical`, 64 hex digits in all: the
 // prefix takes the place of the digest's last digits. The 192 bits left keep collisions out
@@ -60,12 +65,13 @@ std::string GeneratedSphereSetKey(const std::string& mesh_key, const SphereSetPa
   // defaults, so that the keys of sets made before they existed stay what they were.
   const MedialSphereOptions medial_defaults;
   const QualityOptions quality_defaults;
+  const bool dilated = p.kind == SphereSetKind::kDilated;
   std::string canonical = absl::StrFormat(
       "%s\n%s\nvoxel_size=%.17g\nmax_spheres=%d\nobject_angle=%.17g\nepsilon=%.17g\nsamples=%d\n"
       "subdivide_boundary=%d\ndilate=%d\ndilation_growth=%.17g\nfill_holes=%d\nquality=%d\n",
       kSphereAlgorithmVersion, mesh_key, p.voxel_size.value_or(0.0), p.max_spheres.value_or(0),
       p.medial.object_angle, p.medial.epsilon, p.medial.samples, p.medial.subdivide_boundary,
-      p.dilate, p.dilate ? p.dilation.growth : 0.0, fill_holes, p.evaluate);
+      dilated, dilated ? p.dilation.growth : 0.0, fill_holes, p.evaluate);
   if (p.medial.screen_samples != medial_defaults.screen_samples) {
     absl::StrAppendFormat(&canonical, "screen_samples=%d\n", p.medial.screen_samples);
   }
@@ -78,14 +84,28 @@ std::string GeneratedSphereSetKey(const std::string& mesh_key, const SphereSetPa
   if (p.evaluate && p.quality.surface_samples != quality_defaults.surface_samples) {
     absl::StrAppendFormat(&canonical, "quality_samples=%d\n", p.quality.surface_samples);
   }
+  if (p.kind == SphereSetKind::kCover) {
+    absl::StrAppendFormat(&canonical, "cover=%s\nmax_protrusion=%.17g\ncover_resolution=%.17g\n",
+                          kCoverAlgorithmVersion, p.max_protrusion.value_or(0.0),
+                          p.cover_resolution);
+  }
   return "spheres/v1/" + DerivedKeyHex(RoutePrefix(mesh_key), canonical);
 }
 
 std::string UploadedSphereSetKey(const std::string& mesh_key, const std::string& derived_from,
-                                 absl::string_view spheres_bytes) {
+                                 absl::string_view spheres_bytes,
+                                 absl::string_view certificate_bytes) {
   const std::string prefix = RoutePrefix(mesh_key.empty() ? derived_from : mesh_key);
-  return "spheres/v1/" + DerivedKeyHex(prefix, absl::StrCat(kUploadedSetVersion, "\n", mesh_key,
-                                                            "\n", spheres_bytes));
+  std::string canonical = absl::StrCat(kUploadedSetVersion, "\n", mesh_key, "\n", spheres_bytes);
+  if (!certificate_bytes.empty()) absl::StrAppend(&canonical, "\ncertificate\n", certificate_bytes);
+  return "spheres/v1/" + DerivedKeyHex(prefix, canonical);
+}
+
+std::string CoverCertificateKey(const std::string& set_key, const std::string& mesh_key,
+                                const CoverCertifyOptions& options) {
+  const std::string canonical = absl::StrFormat(
+      "%s\n%s\n%s\nresolution=%.17g\n", kCertificateVersion, set_key, mesh_key, options.resolution);
+  return "certificate/v1/" + DerivedKeyHex(RoutePrefix(set_key), canonical);
 }
 
 std::string DeformerKey(const std::string& mesh_key, const std::string& set_key,

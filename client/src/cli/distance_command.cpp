@@ -13,12 +13,15 @@
 
 #include "absl/strings/str_format.h"
 #include "command_outcome.h"
+#include "cover_file_fields.h"
+#include "inscribe/certified_distance.h"
 #include "inscribe/separation_distance.h"
 #include "inscribe/sphere_io.h"
 #include "nlohmann/json.hpp"
 #include "pose_file.h"
 #include "remote_options.h"
 #include "service_session.h"
+#include "solid_loading.h"
 
 namespace inscribe::cli {
 namespace {
@@ -26,23 +29,113 @@ namespace {
 struct DistanceCliOptions {
   std::string a_path, b_path, poses_path;
   SphereFileReadOptions a_read, b_read;  // .sph level, YAML link
+  // A certified query: covers of A's and B's solids, and the meshes that certify a cover whose
+  // file records no certificate.
+  std::string cover_paths[2], mesh_paths[2];
   std::string hierarchy = "sphere";
   std::string output_path;
   DistanceRequest request;
   bool json = false;
   RemoteOptions remote;
+
+  bool certified() const { return !cover_paths[0].empty(); }
 };
 
-std::string FormatCsv(const std::vector<DistanceResult>& results) {
+// One solid's cover as read: its spheres, and the certificate its file records, if any.
+struct CoverInput {
+  SphereFile file;
+  std::optional<CoverCertificate> certificate;
+};
+
+// CSV of the answers; a certified query adds lower,upper (and closer with --closer-than).
+std::string FormatCsv(const std::vector<DistanceResult>& results,
+                      const std::vector<CertifiedDistanceResult>& certified, bool answers) {
   std::ostringstream out;
-  out << "pose,distance,sphere_a,sphere_b,ax,ay,az,bx,by,bz\n";
+  out << "pose,distance,sphere_a,sphere_b,ax,ay,az,bx,by,bz";
+  if (!certified.empty()) out << (answers ? ",lower,upper,closer" : ",lower,upper");
+  out << "\n";
   for (std::size_t i = 0; i < results.size(); ++i) {
     const DistanceResult& r = results[i];
-    out << absl::StrFormat("%d,%.17g,%d,%d,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", i, r.distance,
+    out << absl::StrFormat("%d,%.17g,%d,%d,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g", i, r.distance,
                            r.sphere_a, r.sphere_b, r.point_a.x(), r.point_a.y(), r.point_a.z(),
                            r.point_b.x(), r.point_b.y(), r.point_b.z());
+    if (!certified.empty()) {
+      out << absl::StrFormat(",%.17g,%.17g", certified[i].lower, certified[i].upper);
+      if (answers) out << "," << CloserAnswerName(certified[i].closer);
+    }
+    out << "\n";
   }
   return out.str();
+}
+
+// The cover given for one solid (side 0: A, 1: B), read and checked against its internal set:
+// that set must not be recorded as dilated or a cover, the two must name the same mesh when
+// both name one, and the cover must record a certificate or come with the mesh to prove one.
+absl::StatusOr<CoverInput> ReadCover(const DistanceCliOptions& options, int side,
+                                     const SphereFile& internal) {
+  const char* names[2][3] = {{"A", "--cover-a", "--mesh-a"}, {"B", "--cover-b", "--mesh-b"}};
+  const auto [name, cover_flag, mesh_flag] = names[side];
+  const std::string& path = options.cover_paths[side];
+  const std::string kind = RecordedKind(internal);
+  if (!kind.empty() && kind != SphereSetKindName(SphereSetKind::kInternal)) {
+    return UsageError(absl::StrFormat(
+        "%s holds %s spheres; with %s, %s must be internal spheres (inside the solid: generate "
+        "them without --dilate or --cover)",
+        side == 0 ? options.a_path : options.b_path, kind, cover_flag, name));
+  }
+  CoverInput in;
+  absl::StatusOr<SphereFile> file = ReadSphereFile(path);
+  if (!file.ok()) return BadInputError(file.status().message());
+  if (file->set.spheres.empty()) return BadInputError(path + ": no spheres");
+  in.file = *std::move(file);
+  absl::StatusOr<std::optional<CoverCertificate>> recorded = RecordedCoverCertificate(in.file);
+  if (!recorded.ok()) return BadInputError(absl::StrCat(path, ": ", recorded.status().message()));
+  in.certificate = *std::move(recorded);
+  if (in.certificate && !in.certificate->certified) {
+    return BadInputError(path + " records a certificate that does not certify it");
+  }
+  if (!in.certificate && options.mesh_paths[side].empty()) {
+    return UsageError(absl::StrFormat(
+        "%s %s records no cover certificate (the files `inscribe generate --cover` writes do); "
+        "give %s MESH to certify it",
+        cover_flag, path, mesh_flag));
+  }
+  if (!internal.mesh_sha256.empty() && !in.file.mesh_sha256.empty() &&
+      internal.mesh_sha256 != in.file.mesh_sha256) {
+    return BadInputError(absl::StrFormat("%s was made for mesh %s, its cover %s for mesh %s",
+                                         side == 0 ? options.a_path : options.b_path,
+                                         internal.mesh_sha256, path, in.file.mesh_sha256));
+  }
+  return in;
+}
+
+// The cover stored in the service with its certificate: the one its file records (taken on
+// the file's word), else the service's proof against the mesh (CertifyCover by key, which the
+// service keeps for Distance). Not a cover: exit 1, with the point it misses.
+absl::StatusOr<std::string> StoreCover(const client::Client& client,
+                                       const DistanceCliOptions& options, int side,
+                                       const CoverInput& cover) {
+  if (cover.certificate) {
+    absl::StatusOr<client::PutSphereSetResult> stored =
+        client.PutCertifiedCover(cover.file.set, *cover.certificate);
+    if (!stored.ok()) return stored.status();
+    return stored->sphere_set_key;
+  }
+  absl::StatusOr<StoredSolid> solid = StoreSolid(client, options.mesh_paths[side]);
+  if (!solid.ok()) return solid.status();
+  absl::StatusOr<client::PutSphereSetResult> stored =
+      client.PutSphereSet(cover.file.set, solid->sha256);
+  if (!stored.ok()) return stored.status();
+  absl::StatusOr<CoverCertificate> certificate =
+      client.CertifyCover(solid->sha256, stored->sphere_set_key);
+  if (!certificate.ok()) return certificate.status();
+  if (!certificate->certified) {
+    return CommandError(absl::StatusCode::kFailedPrecondition,
+                        absl::StrCat(options.cover_paths[side], " is not a cover of ",
+                                     options.mesh_paths[side], ": ", CoverVerdict(*certificate)),
+                        kExitUnusableMesh);
+  }
+  return stored->sphere_set_key;
 }
 
 // Poses per Distance call: 100,000 poses are a 5.6 MB request and a 6.5 MB answer, far below
@@ -52,18 +145,20 @@ constexpr std::size_t kPosesPerCall = 100'000;
 
 // What distance reports: the service's answers and figures, summed over the calls.
 struct Distances {
-  std::vector<DistanceResult> results;  // entry i answers pose i
-  double seconds = 0.0;                 // the service's time on the queries
-  double build_seconds = 0.0;           // ... and on both hierarchies
+  std::vector<DistanceResult> results;             // entry i answers pose i
+  std::vector<CertifiedDistanceResult> certified;  // with covers: entry i's interval
+  double seconds = 0.0;                            // the service's time on the queries
+  double build_seconds = 0.0;                      // ... and on both hierarchies
   int threads = 0;
   std::int64_t volume_tests = 0, sphere_tests = 0;
 };
 
-// Both sets stored in the service (PutSphereSet), then the poses in calls of kPosesPerCall,
-// A at the origin.
+// Both sets (and covers) stored in the service (PutSphereSet), then the poses in calls of
+// kPosesPerCall, A at the origin.
 absl::StatusOr<Distances> ComputeDistances(const client::Client& client,
                                            const DistanceCliOptions& options, const SphereSet& a,
                                            const SphereSet& b,
+                                           const std::vector<CoverInput>& covers,
                                            const std::vector<RigidPose>& poses) {
   std::string keys[2];
   for (int k = 0; k < 2; ++k) {
@@ -75,6 +170,11 @@ absl::StatusOr<Distances> ComputeDistances(const client::Client& client,
   call.volume = options.hierarchy == "sphere" ? HierarchyVolume::kSphere : HierarchyVolume::kRss;
   call.brute_force = options.hierarchy == "none";
   call.tolerance = options.request;
+  for (std::size_t k = 0; k < covers.size(); ++k) {
+    absl::StatusOr<std::string> key = StoreCover(client, options, static_cast<int>(k), covers[k]);
+    if (!key.ok()) return key.status();
+    (k == 0 ? call.cover_a : call.cover_b) = *std::move(key);
+  }
   const std::vector<RigidPose> origin = {RigidPose()};
   Distances d;
   d.results.reserve(poses.size());
@@ -84,7 +184,12 @@ absl::StatusOr<Distances> ComputeDistances(const client::Client& client,
         poses.begin() + static_cast<std::ptrdiff_t>(std::min(poses.size(), first + kPosesPerCall)));
     absl::StatusOr<client::DistanceBatchResult> answer =
         client.Distance(keys[0], keys[1], origin, batch, call);
+    // Poses are checked here before sending: what the service refuses is the options.
+    if (answer.status().code() == absl::StatusCode::kInvalidArgument) {
+      return WithExitCode(answer.status(), kExitUsage);
+    }
     if (!answer.ok()) return answer.status();
+    for (CertifiedDistanceResult& r : answer->certified) d.certified.push_back(std::move(r));
     d.seconds += answer->server_seconds;
     d.build_seconds += answer->hierarchy_seconds;
     d.threads = std::max(d.threads, answer->threads);
@@ -118,9 +223,31 @@ void PrintSummary(const DistanceCliOptions& options, const SphereSet& a, const S
   j["build_seconds"] = d.build_seconds;
   j["min_distance"] = min_distance;
   j["touching"] = touching;
-  if (std::isfinite(options.request.closer_than)) {
-    j["closer_than"] = options.request.closer_than;
-    j["closer"] = closer;
+  const bool closer_than = std::isfinite(options.request.closer_than);
+  if (closer_than) j["closer_than"] = options.request.closer_than;
+  if (closer_than && !options.certified()) j["closer"] = closer;
+  if (options.certified()) {
+    // The intervals: their bounds' smallest values, widths, and the closer-than answers.
+    double min_lower = std::numeric_limits<double>::infinity(), min_upper = min_lower;
+    double width_sum = 0.0, max_width = 0.0;
+    std::int64_t answers[3] = {0, 0, 0};  // yes, no, undecided
+    for (const CertifiedDistanceResult& r : d.certified) {
+      min_lower = std::min(min_lower, r.lower);
+      min_upper = std::min(min_upper, r.upper);
+      width_sum += r.upper - r.lower;
+      max_width = std::max(max_width, r.upper - r.lower);
+      ++answers[static_cast<int>(r.closer)];
+    }
+    j["certified"] = true;
+    j["min_lower"] = min_lower;
+    j["min_upper"] = min_upper;
+    j["mean_width"] = width_sum / n;
+    j["max_width"] = max_width;
+    if (closer_than) {
+      j["closer_yes"] = answers[static_cast<int>(CloserAnswer::kYes)];
+      j["closer_no"] = answers[static_cast<int>(CloserAnswer::kNo)];
+      j["closer_undecided"] = answers[static_cast<int>(CloserAnswer::kUndecided)];
+    }
   }
   j["abs_err"] = options.request.abs_err;
   j["rel_err"] = options.request.rel_err;
@@ -141,21 +268,35 @@ absl::Status RunDistance(const DistanceCliOptions& options) {
       return BadInputError((file == &*a ? options.a_path : options.b_path) + ": no spheres");
     }
   }
+  std::vector<CoverInput> covers;
+  if (options.certified()) {
+    if (options.hierarchy == "none") {
+      return UsageError(
+          "--hierarchy none: a certified query (--cover-a, --cover-b) is exact already");
+    }
+    for (int side = 0; side < 2; ++side) {
+      absl::StatusOr<CoverInput> cover = ReadCover(options, side, side == 0 ? *a : *b);
+      if (!cover.ok()) return cover.status();
+      covers.push_back(*std::move(cover));
+    }
+  }
   absl::StatusOr<std::vector<RigidPose>> poses = ReadPoseFile(options.poses_path);
   if (!poses.ok()) return BadInputError(poses.status().message());
 
   absl::StatusOr<std::unique_ptr<ServiceSession>> session = ServiceSession::Open(options.remote);
   if (!session.ok()) return session.status();
   const absl::StatusOr<Distances> d =
-      ComputeDistances((*session)->client(), options, a->set, b->set, *poses);
+      ComputeDistances((*session)->client(), options, a->set, b->set, covers, *poses);
   if (!d.ok()) return d.status();
 
+  const std::string csv =
+      FormatCsv(d->results, d->certified, std::isfinite(options.request.closer_than));
   if (!options.output_path.empty()) {
     std::ofstream out(options.output_path, std::ios::binary | std::ios::trunc);
-    out << FormatCsv(d->results);
+    out << csv;
     if (!out.flush()) return BadInputError(options.output_path + ": cannot write");
   } else if (!options.json) {
-    std::cout << FormatCsv(d->results);
+    std::cout << csv;
   }
   if (options.json) PrintSummary(options, a->set, b->set, *d);
   return absl::OkStatus();
@@ -168,7 +309,8 @@ void AddDistanceCommand(CLI::App& app, CommandOutcome* outcome) {
   CLI::App* cmd = app.add_subcommand(
       "distance",
       "Separation distance between two sphere sets, B placed by each pose relative to A "
-      "(negative: the deepest overlap); CSV of one row per pose unless --json");
+      "(negative: the deepest overlap), or with covers an interval holding the exact distance "
+      "between the solids; CSV of one row per pose unless --json");
   cmd->add_option("A", options->a_path, "Sphere file (.json, .sph, .csv, .yml)")->required();
   cmd->add_option("B", options->b_path, "Sphere file (.json, .sph, .csv, .yml)")->required();
   cmd->add_option("--link-a", options->a_read.yaml_link,
@@ -195,9 +337,26 @@ void AddDistanceCommand(CLI::App& app, CommandOutcome* outcome) {
                   "... or by this fraction of the answer, whichever is larger")
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--closer-than", options->request.closer_than,
-                  "Only ask whether the sets are closer than D; stops at the first pair that is");
+                  "Only ask whether the sets are closer than D; stops at the first pair that is. "
+                  "With covers: yes, no or undecided per pose, never a wrong yes or no");
+  CLI::Option* cover_a = cmd->add_option(
+      "--cover-a", options->cover_paths[0],
+      "A certified query: a cover of A's solid (A then holds its internal spheres); each answer "
+      "gains an interval lower <= exact distance <= upper. The file must record its certificate "
+      "(as `generate --cover` writes it), or --mesh-a proves one");
+  CLI::Option* cover_b =
+      cmd->add_option("--cover-b", options->cover_paths[1], "A cover of B's solid (see --cover-a)");
+  cover_a->needs(cover_b);
+  cover_b->needs(cover_a);
+  cmd->add_option("--mesh-a", options->mesh_paths[0],
+                  "The mesh of A, to certify --cover-a when its file records no certificate")
+      ->needs(cover_a);
+  cmd->add_option("--mesh-b", options->mesh_paths[1],
+                  "The mesh of B, to certify --cover-b when its file records no certificate")
+      ->needs(cover_b);
   cmd->add_option("-o,--output", options->output_path,
-                  "Write the CSV here: pose,distance,sphere_a,sphere_b,ax,ay,az,bx,by,bz");
+                  "Write the CSV here: pose,distance,sphere_a,sphere_b,ax,ay,az,bx,by,bz (with "
+                  "covers also lower,upper, and closer with --closer-than)");
   cmd->add_flag("--json", options->json,
                 "Print one JSON summary (queries, seconds, us_per_query, ...) on stdout");
   AddRemoteOptions(cmd, &options->remote, 60.0);

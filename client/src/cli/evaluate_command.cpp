@@ -9,6 +9,7 @@
 
 #include "absl/strings/str_format.h"
 #include "command_outcome.h"
+#include "cover_file_fields.h"
 #include "inscribe/cover_certificate.h"
 #include "inscribe/sphere_io.h"
 #include "inscribe/sphere_quality.h"
@@ -115,19 +116,7 @@ void PrintCertificate(const EvaluateCliOptions& options, const SphereFile& file,
   };
   line("mesh", options.mesh_path);
   line("spheres", absl::StrFormat("%s (%d)", options.spheres_path, file.set.size()));
-  if (c.certified) {
-    line("cover", "certified: every point of the solid is in a sphere");
-  } else if (c.uncovered_point) {
-    const Vector3& p = *c.uncovered_point;
-    line("cover", absl::StrFormat("NOT certified: the point (%.10g %.10g %.10g), %.6g deep in the "
-                                  "solid, is %.6g from the nearest sphere",
-                                  p.x(), p.y(), p.z(), c.uncovered_depth, c.uncovered_gap));
-  } else {
-    line("cover", absl::StrFormat("NOT certified: %d cells of side %.6g near the boundary are "
-                                  "in no single sphere (no uncovered point found; a finer "
-                                  "--certify-resolution may settle them)",
-                                  c.failed_cells, c.resolution));
-  }
+  line("cover", CoverVerdict(c));
   line("delta (reach outside)", absl::StrFormat("%.6g", c.delta));
   line("proof",
        absl::StrFormat("%d cells: %d in one sphere, %d outside the solid, %d failed; "

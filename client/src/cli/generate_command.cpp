@@ -10,6 +10,7 @@
 
 #include "absl/strings/str_format.h"
 #include "command_outcome.h"
+#include "cover_file_fields.h"
 #include "inscribe/sphere_io.h"
 #include "inscribe/sphere_set_generation.h"
 #include "inscribe/view/report_json.h"
@@ -37,7 +38,7 @@ struct GenerateCliOptions {
 
 // What generate reports: the service's figures, in either mode.
 struct Generated {
-  GeneratedSphereSet result;  // S_D, or S_D+ with --dilate
+  GeneratedSphereSet result;  // S_D, S_D+ with --dilate, or a cover with --cover
   std::string mesh_sha256;
   std::int64_t triangles = 0;  // of the validated mesh
   double load_seconds = 0.0;   // reading, storing and validation
@@ -55,33 +56,52 @@ NamedValues DilationStats(const DilationResult& dilation) {
           {"dilation_seconds", dilation.seconds}};
 }
 
-// Params and stats of the sphere file (DESIGN.md section 3), in mesh units and radians.
+// What --cover adds to the file's stats and the JSON summary: the certificate's figures
+// (cover_file_fields.h) and the growth's.
+NamedValues CoverStats(const GeneratedCover& cover) {
+  NamedValues stats = CoverCertificateStats(cover.certificate);
+  stats.emplace_back("grown_spheres", cover.grown_spheres);
+  stats.emplace_back("cover_candidates", cover.candidates);
+  stats.emplace_back("repair_rounds", static_cast<std::int64_t>(cover.repair_rounds));
+  return stats;
+}
+
+// Params and stats of the sphere file (DESIGN.md section 3), in mesh units and radians. A
+// cover's internal set is the cover generator's own: no epsilon, runs or voxel counts.
 SphereFile MakeSphereFile(const GenerateCliOptions& options, const Generated& g) {
   const SphereSetParameters& p = options.parameters;
   const GeneratedSphereSet& r = g.result;
+  const bool medial_run = r.kind != SphereSetKind::kCover;
   SphereFile file;
   file.set = r.set;
   file.mesh_sha256 = g.mesh_sha256;
   file.params = {
+      {kKindParam, std::string(SphereSetKindName(r.kind))},
       {"voxel_size", r.voxel_size},
       {"object_angle", p.medial.object_angle},
-      {"epsilon", r.epsilon},
+  };
+  if (medial_run) file.params.emplace_back("epsilon", r.epsilon);
+  NamedValues medial = {
       {"samples", static_cast<std::int64_t>(p.medial.samples)},
       {"screen_samples", static_cast<std::int64_t>(p.medial.screen_samples)},
       {"pair_angle_margin", p.medial.pair_angle_margin},
       {"corner_screen", p.medial.corner_screen},
       {"subdivide_boundary", p.medial.subdivide_boundary},
   };
+  for (auto& param : medial) file.params.push_back(std::move(param));
   if (const std::optional<std::int64_t> budget = EffectiveMaxSpheres(p)) {
     file.params.emplace_back("max_spheres", *budget);
   }
-  if (p.dilate) {
-    file.params.emplace_back("dilated", true);
+  if (r.kind == SphereSetKind::kDilated) {
     file.params.emplace_back("dilation_growth", p.dilation.growth);
   }
+  if (r.kind == SphereSetKind::kCover) {
+    if (p.max_protrusion) file.params.emplace_back("max_protrusion", *p.max_protrusion);
+    file.params.emplace_back("cover_resolution", p.cover_resolution);
+  }
   const QualityReport& quality = *r.quality;
-  file.stats = {{"seconds", r.generation_seconds},
-                {"search_runs", static_cast<std::int64_t>(r.runs)}};
+  file.stats = {{"seconds", r.generation_seconds}};
+  if (medial_run) file.stats.emplace_back("search_runs", static_cast<std::int64_t>(r.runs));
   NamedValues figures = {
       {"volume_mesh", quality.volume_mesh},
       {"volume_union", quality.volume_union},
@@ -93,10 +113,15 @@ SphereFile MakeSphereFile(const GenerateCliOptions& options, const Generated& g)
       {"surface_samples", quality.surface_samples},
       {"fat", quality.fat},
   };
-  figures.emplace_back("visited_voxels", r.stats.visited_voxels);
-  figures.emplace_back("closest_point_queries", r.stats.closest_point_queries);
+  if (medial_run) {
+    figures.emplace_back("visited_voxels", r.stats.visited_voxels);
+    figures.emplace_back("closest_point_queries", r.stats.closest_point_queries);
+  }
   if (r.dilation) {
     for (auto& stat : DilationStats(*r.dilation)) figures.push_back(std::move(stat));
+  }
+  if (r.cover) {
+    for (auto& stat : CoverStats(*r.cover)) figures.push_back(std::move(stat));
   }
   for (auto& figure : figures) file.stats.push_back(std::move(figure));
   return file;
@@ -148,23 +173,26 @@ void PrintSummary(const GenerateCliOptions& options, const Generated& g) {
   summary["triangles"] = g.triangles;
   summary["voxel_size"] = r.voxel_size;
   summary["object_angle"] = p.medial.object_angle;
-  summary["epsilon"] = r.epsilon;
   summary["samples"] = p.medial.samples;
   summary["subdivide_boundary"] = p.medial.subdivide_boundary;
   if (const std::optional<std::int64_t> budget = EffectiveMaxSpheres(p)) {
     summary["max_spheres"] = *budget;
   }
-  summary["search_runs"] = r.runs;
+  if (p.max_protrusion) summary["max_protrusion"] = *p.max_protrusion;
   summary["seconds"] = r.generation_seconds;
   summary["load_seconds"] = g.load_seconds;
-  summary["visited_voxels"] = r.stats.visited_voxels;
-  summary["screened_voxels"] = r.stats.screened_voxels;
-  summary["closest_point_queries"] = r.stats.closest_point_queries;
-  summary["dilated"] = p.dilate;
-  if (r.dilation) {
-    for (const auto& [name, value] : DilationStats(*r.dilation)) {
-      std::visit([&summary, &name = name](const auto& v) { summary[name] = v; }, value);
-    }
+  if (r.kind != SphereSetKind::kCover) {  // figures of the medial run (see MakeSphereFile)
+    summary["epsilon"] = r.epsilon;
+    summary["search_runs"] = r.runs;
+    summary["visited_voxels"] = r.stats.visited_voxels;
+    summary["screened_voxels"] = r.stats.screened_voxels;
+    summary["closest_point_queries"] = r.stats.closest_point_queries;
+  }
+  summary[kKindParam] = SphereSetKindName(r.kind);
+  NamedValues figures = r.dilation ? DilationStats(*r.dilation) : NamedValues();
+  if (r.cover) figures = CoverStats(*r.cover);
+  for (const auto& [name, value] : figures) {
+    std::visit([&summary, &name = name](const auto& v) { summary[name] = v; }, value);
   }
   if (options.remote.enabled()) {
     summary["server"] = options.remote.server;
@@ -199,17 +227,36 @@ void AddGenerateCommand(CLI::App& app, CommandOutcome* outcome) {
   auto options = std::make_shared<GenerateCliOptions>();
   CLI::App* cmd = app.add_subcommand(
       "generate",
-      "Approximate a closed mesh by internal medial spheres (at most one per voxel); prints "
-      "the sphere-set JSON unless -o or --json says otherwise");
+      "Approximate a closed mesh by internal medial spheres (at most one per voxel), dilated "
+      "ones, or a certified cover; prints the sphere-set JSON unless -o or --json says "
+      "otherwise");
   cmd->add_option("MESH", options->mesh_path, "Mesh file (.off, .obj, .stl, .ply)")->required();
   CLI::Option* voxel = cmd->add_option("--voxel-size", options->parameters.voxel_size,
                                        "Voxel side sigma, mesh units");
   CLI::Option* budget = cmd->add_option(
       "--max-spheres", options->parameters.max_spheres,
       "Finest voxel grid giving at most N spheres (default mode, N = 500); the search's runs "
-      "count in the reported time");
+      "count in the reported time. With --cover: at most N spheres, the smallest delta reached");
   voxel->excludes(budget);
   budget->excludes(voxel);
+  CLI::Option* cover = cmd->add_flag_callback(
+      "--cover", [options] { options->parameters.kind = SphereSetKind::kCover; },
+      "Make a certified cover instead: spheres proven to hold the whole solid, with delta, a "
+      "sound bound on how far they reach outside it (written to the file's stats); no contacts");
+  CLI::Option* protrusion =
+      cmd->add_option("--max-protrusion", options->parameters.max_protrusion,
+                      "With --cover, instead of --max-spheres: delta at most D mesh units, with "
+                      "the fewest spheres");
+  protrusion->needs(cover)->excludes(budget)->excludes(voxel);
+  budget->excludes(protrusion);
+  voxel->excludes(protrusion);
+  cover->excludes(voxel);
+  voxel->excludes(cover);
+  cmd->add_option("--cover-resolution", options->parameters.cover_resolution,
+                  "With --cover: the certificate's finest cell side, as a fraction of the "
+                  "largest bounding-box side")
+      ->needs(cover)
+      ->capture_default_str();
   cmd->add_option("--object-angle", options->parameters.medial.object_angle,
                   "Drop medial points with a smaller object angle, radians in (0, pi)")
       ->capture_default_str();
@@ -243,9 +290,11 @@ void AddGenerateCommand(CLI::App& app, CommandOutcome* outcome) {
       ->check(CLI::IsMember({"json", "sph", "csv", "obj", "yaml", "yml"}, CLI::ignore_case));
   cmd->add_option("--link", options->link,
                   "cuRobo YAML output: the link name the spheres are listed under (default mesh)");
-  cmd->add_flag("--dilate", options->parameters.dilate,
-                "Grow the spheres to cover more of the boundary (conservative dilation, S_D+); "
-                "they then protrude, contacts are not written and nerr is a lower bound");
+  cmd->add_flag_callback(
+         "--dilate", [options] { options->parameters.kind = SphereSetKind::kDilated; },
+         "Grow the spheres to cover more of the boundary (conservative dilation, S_D+); they "
+         "then protrude, contacts are not written and nerr is a lower bound")
+      ->excludes(cover);
   cmd->add_option("--dilation-growth", options->parameters.dilation.growth,
                   "With --dilate: the fraction of the paper's growth each sphere makes (1 = "
                   "the paper's S_D+; 0.5 halved the distance error on 5 of 6 Table II models)")

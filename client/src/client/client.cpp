@@ -83,6 +83,17 @@ absl::StatusOr<PutMeshResult> PutMeshUntil(Connection& connection, const RetryPo
                        response->already_stored()};
 }
 
+absl::StatusOr<PutSphereSetResult> PutSphereSetUntil(Connection& connection,
+                                                     const RetryPolicy& retry,
+                                                     const v1::PutSphereSetRequest& request,
+                                                     Deadline deadline) {
+  absl::StatusOr<v1::PutSphereSetResponse> response =
+      Retried(retry, deadline, [&](Deadline d) { return connection.PutSphereSet(request, d); });
+  if (!response.ok()) return response.status();
+  return PutSphereSetResult{std::move(*response->mutable_sphere_set_key()),
+                            response->already_stored()};
+}
+
 v1::GenerateRequest GenerateRequestFor(const std::string& mesh_sha256,
                                        const GenerateSettings& settings,
                                        const GenerateOptions& options) {
@@ -207,12 +218,18 @@ absl::StatusOr<PutSphereSetResult> Client::PutSphereSet(const SphereSet& spheres
   v1::PutSphereSetRequest request;
   wire::SphereSetToProto(spheres, request.mutable_spheres());
   request.set_mesh_sha256(mesh_sha256);
-  absl::StatusOr<v1::PutSphereSetResponse> response =
-      Retried(options_.retry, DeadlineAfter(options.timeout, options_),
-              [&](Deadline d) { return connection_->PutSphereSet(request, d); });
-  if (!response.ok()) return response.status();
-  return PutSphereSetResult{std::move(*response->mutable_sphere_set_key()),
-                            response->already_stored()};
+  return PutSphereSetUntil(*connection_, options_.retry, request,
+                           DeadlineAfter(options.timeout, options_));
+}
+
+absl::StatusOr<PutSphereSetResult> Client::PutCertifiedCover(const SphereSet& spheres,
+                                                             const CoverCertificate& certificate,
+                                                             const CallOptions& options) const {
+  v1::PutSphereSetRequest request;
+  wire::SphereSetToProto(spheres, request.mutable_spheres());
+  wire::CoverCertificateToProto(certificate, request.mutable_certificate());
+  return PutSphereSetUntil(*connection_, options_.retry, request,
+                           DeadlineAfter(options.timeout, options_));
 }
 
 absl::StatusOr<StoredSphereSet> Client::GetSphereSet(const std::string& sphere_set_key,
@@ -297,6 +314,8 @@ absl::StatusOr<DistanceBatchResult> Client::Distance(const std::string& sphere_s
   wire::PosesToProto(poses_b, request.mutable_poses_b());
   wire::ToleranceToProto(options.tolerance, request.mutable_tolerance());
   request.set_brute_force(options.brute_force);
+  request.set_cover_a(options.cover_a);
+  request.set_cover_b(options.cover_b);
   absl::StatusOr<v1::DistanceResponse> response =
       Retried(options_.retry, DeadlineAfter(options.timeout, options_),
               [&](Deadline d) { return connection_->Distance(request, d); });
@@ -309,6 +328,12 @@ absl::StatusOr<DistanceBatchResult> Client::Distance(const std::string& sphere_s
                                               poses_b.size(), " pose pairs"));
   }
   DistanceBatchResult batch;
+  if (!options.cover_a.empty()) {
+    absl::StatusOr<std::vector<CertifiedDistanceResult>> certified =
+        wire::CertifiedDistanceResultsFromProto(response->results());
+    if (!certified.ok()) return Malformed("Distance", certified.status().message());
+    batch.certified = *std::move(certified);
+  }
   batch.results = *std::move(results);
   batch.server_seconds = response->seconds();
   batch.hierarchy_seconds = response->hierarchy_seconds();

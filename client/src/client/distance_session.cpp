@@ -3,10 +3,19 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/string_view.h"
 #include "inscribe/client/client.h"
 #include "inscribe/wire/convert.h"
 
 namespace inscribe::client {
+namespace {
+
+// A reply the server should never send: INTERNAL, with what is wrong with it.
+absl::Status Malformed(absl::string_view problem) {
+  return absl::InternalError(absl::StrCat("malformed DistanceStream response: ", problem));
+}
+
+}  // namespace
 
 DistanceSession::DistanceSession(std::unique_ptr<DistanceStreamConnection> stream,
                                  const DistanceSessionOptions& options)
@@ -17,7 +26,7 @@ DistanceSession& DistanceSession::operator=(DistanceSession&&) noexcept = defaul
 // Destroying the stream cancels the call if Close did not finish it.
 DistanceSession::~DistanceSession() = default;
 
-absl::StatusOr<std::vector<DistanceResult>> DistanceSession::Query(
+absl::StatusOr<v1::DistanceFrameResult> DistanceSession::RoundTrip(
     const std::vector<PosePair>& pairs) {
   if (!broken_.ok()) return broken_;
   if (stream_ == nullptr) return absl::FailedPreconditionError("distance session was moved from");
@@ -33,34 +42,50 @@ absl::StatusOr<std::vector<DistanceResult>> DistanceSession::Query(
     out->set_sphere_set_b(pair.sphere_set_b);
     wire::PoseToProto(pair.pose_a, out->mutable_pose_a());
     wire::PoseToProto(pair.pose_b, out->mutable_pose_b());
+    out->set_cover_a(pair.cover_a);
+    out->set_cover_b(pair.cover_b);
   }
-
   // Every failure below ends the session: the server's status, or a reply this frame cannot
   // be matched with (whose stream is then out of step for good).
-  absl::Status failure;
-  absl::StatusOr<std::vector<DistanceResult>> results;
   absl::StatusOr<v1::DistanceFrameResult> reply =
       stream_->RoundTrip(frame, std::chrono::system_clock::now() + options_.frame_timeout);
-  if (!reply.ok()) {
-    failure = reply.status();
-  } else if (reply->frame() != next_frame_) {
-    failure =
-        absl::InternalError(absl::StrCat("malformed DistanceStream response: frame ", next_frame_,
-                                         " was answered as frame ", reply->frame()));
-  } else if (results = wire::DistanceResultsFromProto(reply->results()); !results.ok()) {
-    failure = absl::InternalError(
-        absl::StrCat("malformed DistanceStream response: ", results.status().message()));
-  } else if (results->size() != pairs.size()) {
-    failure = absl::InternalError(absl::StrCat("malformed DistanceStream response: frame ",
-                                               next_frame_, " has ", results->size(),
-                                               " results for ", pairs.size(), " pairs"));
+  if (!reply.ok()) return Break(reply.status());
+  if (reply->frame() != next_frame_) {
+    return Break(
+        Malformed(absl::StrCat("frame ", next_frame_, " was answered as frame ", reply->frame())));
   }
-  if (!failure.ok()) {
-    broken_ = failure;
-    stream_.reset();  // cancels the call now rather than when the session goes away
-    return failure;
+  if (reply->results().distances_size() != static_cast<int>(pairs.size())) {
+    return Break(
+        Malformed(absl::StrCat("frame ", next_frame_, " has ", reply->results().distances_size(),
+                               " results for ", pairs.size(), " pairs")));
   }
   ++next_frame_;
+  return reply;
+}
+
+absl::Status DistanceSession::Break(absl::Status failure) {
+  broken_ = failure;
+  stream_.reset();  // cancels the call now rather than when the session goes away
+  return failure;
+}
+
+absl::StatusOr<std::vector<DistanceResult>> DistanceSession::Query(
+    const std::vector<PosePair>& pairs) {
+  absl::StatusOr<v1::DistanceFrameResult> reply = RoundTrip(pairs);
+  if (!reply.ok()) return reply.status();
+  absl::StatusOr<std::vector<DistanceResult>> results =
+      wire::DistanceResultsFromProto(reply->results());
+  if (!results.ok()) return Break(Malformed(results.status().message()));
+  return results;
+}
+
+absl::StatusOr<std::vector<CertifiedDistanceResult>> DistanceSession::QueryCertified(
+    const std::vector<PosePair>& pairs) {
+  absl::StatusOr<v1::DistanceFrameResult> reply = RoundTrip(pairs);
+  if (!reply.ok()) return reply.status();
+  absl::StatusOr<std::vector<CertifiedDistanceResult>> results =
+      wire::CertifiedDistanceResultsFromProto(reply->results());
+  if (!results.ok()) return Break(Malformed(results.status().message()));
   return results;
 }
 

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "inscribe/certified_distance.h"
 #include "inscribe/client/connection.h"
 #include "inscribe/cover_certificate.h"
 #include "inscribe/mesh.h"
@@ -133,13 +134,21 @@ struct DistanceOptions : CallOptions {
   DistanceRequest tolerance;  // abs_err, rel_err, closer_than
   // Every sphere pair instead of a hierarchy (BruteForceSeparationDistance on the server).
   bool brute_force = false;
+  // A certified query, both or neither: cached covers of the solids whose internal sets are
+  // the call's sets A and B (the server's certificate rule: service.proto, Distance). Its
+  // sphere distances are exact: abs_err and rel_err must be 0 and brute_force false.
+  std::string cover_a, cover_b;
 };
 
 struct DistanceBatchResult {
-  std::vector<DistanceResult> results;  // entry i answers pose pair i; witnesses in world frame
-  double server_seconds = 0.0;          // the server's time on the queries
-  double hierarchy_seconds = 0.0;       // ... and on getting both hierarchies (built or cached)
-  int threads = 0;                      // threads the queries ran on
+  // Entry i answers pose pair i; witnesses in world frame. With covers: the internal sets'.
+  std::vector<DistanceResult> results;
+  // With covers only: entry i's certified interval [lower, upper] and closer-than answer
+  // (kUndecided without closer_than). Its `internal` is results[i]; `cover` is not sent.
+  std::vector<CertifiedDistanceResult> certified;
+  double server_seconds = 0.0;     // the server's time on the queries
+  double hierarchy_seconds = 0.0;  // ... and on getting both hierarchies (built or cached)
+  int threads = 0;                 // threads the queries ran on
   // Bounding-volume and sphere-pair tests over all the queries.
   std::int64_t volume_tests = 0, sphere_tests = 0;
 };
@@ -182,6 +191,9 @@ struct PosePair {
   std::string sphere_set_b;
   RigidPose pose_a;
   RigidPose pose_b;
+  // For DistanceSession::QueryCertified: the covers of the two solids (DistanceOptions'
+  // cover_a and cover_b); empty for Query.
+  std::string cover_a, cover_b;
 };
 
 struct DistanceSessionOptions {
@@ -210,10 +222,21 @@ class DistanceSession {
   // frame). Frames are numbered 0, 1, ... and the reply's number is checked.
   absl::StatusOr<std::vector<DistanceResult>> Query(const std::vector<PosePair>& pairs);
 
+  // Certified intervals for every pair of one frame, each naming its covers (as
+  // Client::Distance with covers; `cover` of each result is not sent). The session's tolerance
+  // must then have abs_err and rel_err 0.
+  absl::StatusOr<std::vector<CertifiedDistanceResult>> QueryCertified(
+      const std::vector<PosePair>& pairs);
+
   // Ends the stream cleanly; the server's final status.
   absl::Status Close();
 
  private:
+  // Sends one frame of `pairs` and checks the reply's number; any failure ends the session.
+  absl::StatusOr<v1::DistanceFrameResult> RoundTrip(const std::vector<PosePair>& pairs);
+  // Ends the session with `failure` (its stream cancelled), which it then returns.
+  absl::Status Break(absl::Status failure);
+
   std::unique_ptr<DistanceStreamConnection> stream_;
   DistanceSessionOptions options_;
   std::int64_t next_frame_ = 0;
@@ -254,6 +277,12 @@ class Client {
   absl::StatusOr<PutSphereSetResult> PutSphereSet(const SphereSet& spheres,
                                                   const std::string& mesh_sha256 = "",
                                                   const CallOptions& options = {}) const;
+  // Uploads a cover with the certificate it was made with (e.g. read back from a file
+  // `inscribe generate --cover` wrote), which Distance then takes on the caller's word: the
+  // set is keyed with it. INVALID_ARGUMENT when it does not certify (certified false).
+  absl::StatusOr<PutSphereSetResult> PutCertifiedCover(const SphereSet& spheres,
+                                                       const CoverCertificate& certificate,
+                                                       const CallOptions& options = {}) const;
   absl::StatusOr<StoredSphereSet> GetSphereSet(const std::string& sphere_set_key,
                                                const CallOptions& options = {}) const;
   // The server's hierarchy, deserialised (SphereHierarchy::Deserialize checks it).
@@ -269,7 +298,8 @@ class Client {
                                                       const DeformationSettings& settings = {},
                                                       const CallOptions& options = {}) const;
 
-  // One batch: poses_a holds one pose (for all queries) or one per entry of poses_b.
+  // One batch: poses_a holds one pose (for all queries) or one per entry of poses_b. With
+  // options.cover_a and cover_b a certified query (DistanceBatchResult::certified).
   absl::StatusOr<DistanceBatchResult> Distance(const std::string& sphere_set_a,
                                                const std::string& sphere_set_b,
                                                const std::vector<RigidPose>& poses_a,

@@ -159,6 +159,13 @@ class InscribeService final : public v1::Inscribe::CallbackService {
                                    const DistanceRequest& tolerance,
                                    v1::DistanceResponse* response);
 
+  // Distance with covers: certified intervals (core's CertifiedDistances) from the objects
+  // ResultStore::GetCertifiedObject holds (the certificate rule).
+  absl::Status CertifiedDistances(const v1::DistanceRequest& request,
+                                  const std::vector<RigidPose>& poses_a,
+                                  const std::vector<RigidPose>& poses_b,
+                                  const DistanceRequest& tolerance, v1::DistanceResponse* response);
+
   // Remembers a stored mesh's size, for GenerateWorkBytes.
   void RecordMeshSize(const StoredMeshEntry& entry);
   // Estimated working memory of a Generate on `mesh_key` with `parameters`, from

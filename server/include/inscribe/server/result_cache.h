@@ -17,6 +17,7 @@
 
 namespace inscribe {
 class SphereHierarchy;
+struct CoverCertificate;
 }  // namespace inscribe
 
 namespace inscribe::server {
@@ -31,7 +32,7 @@ struct DeformerEntry;
 using CachedObject =
     std::variant<std::monostate, std::shared_ptr<const StoredMeshEntry>,
                  std::shared_ptr<const SphereSetEntry>, std::shared_ptr<const SphereHierarchy>,
-                 std::shared_ptr<const DeformerEntry>>;
+                 std::shared_ptr<const DeformerEntry>, std::shared_ptr<const CoverCertificate>>;
 
 // A change in the shared (Redis) tier's health, for the binary to log.
 struct SharedTierEvent {

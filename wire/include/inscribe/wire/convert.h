@@ -12,6 +12,7 @@
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
 #include "grpcpp/support/status.h"
+#include "inscribe/certified_distance.h"
 #include "inscribe/cover_certificate.h"
 #include "inscribe/mesh.h"
 #include "inscribe/mesh_validation.h"
@@ -92,6 +93,17 @@ void AppendDistanceResults(const std::vector<DistanceResult>& results, v1::Dista
 absl::StatusOr<std::vector<DistanceResult>> DistanceResultsFromProto(
     const v1::DistanceResults& results);
 
+// Appends certified answers: each result's internal-set answer as AppendDistanceResults does,
+// its lower and upper, and its closer answer when `answers` (closer_than was asked).
+void AppendCertifiedDistanceResults(const std::vector<CertifiedDistanceResult>& results,
+                                    bool answers, v1::DistanceResults* out);
+// The inverse, all queries of `results`: lower, upper, closer (kUndecided when no answers were
+// sent) and internal; the covers' answer is not sent (`cover` is left empty). INVALID_ARGUMENT
+// when the arrays' lengths disagree (no lower and upper: not a certified answer) or an answer
+// is unknown.
+absl::StatusOr<std::vector<CertifiedDistanceResult>> CertifiedDistanceResultsFromProto(
+    const v1::DistanceResults& results);
+
 // HIERARCHY_VOLUME_UNSPECIFIED and SPHERE are the sphere hierarchy.
 v1::HierarchyVolume VolumeToProto(HierarchyVolume volume);
 HierarchyVolume VolumeFromProto(v1::HierarchyVolume volume);
@@ -108,15 +120,18 @@ absl::StatusOr<DistanceRequest> ToleranceFromProto(const v1::DistanceTolerance& 
 void GenerateRequestToProto(const std::string& mesh_sha256, const SphereSetParameters& parameters,
                             bool fill_holes, v1::GenerateRequest* out);
 // The core parameters of a request, core's defaults where the wire leaves a field unset, then
-// CheckSphereSetParameters: INVALID_ARGUMENT "parameters: <why>". Exactly one of voxel_size
-// and max_spheres must be > 0 on the wire. `max_voxels_limit` (> 0) caps the voxel limit and
+// CheckSphereSetParameters: INVALID_ARGUMENT "parameters: <why>". Exactly one of voxel_size,
+// max_spheres (> 0) and max_protrusion must be set on the wire, and at most one of dilate and
+// cover. `max_voxels_limit` (> 0) caps the voxel limit and
 // stands in for an unset one.
 absl::StatusOr<SphereSetParameters> SphereSetParametersFromProto(const v1::GenerateRequest& request,
                                                                  std::int64_t max_voxels_limit);
 
-// Everything of a generated set but its key, mesh and cache source.
+// Everything of a generated set but its key, mesh and cache source (a cover's certificate
+// without its list of failed cells).
 void GeneratedSphereSetToProto(const GeneratedSphereSet& generated, v1::GenerateResult* out);
-// The inverse; INVALID_ARGUMENT as SphereSetFromProto for bad spheres.
+// The inverse; INVALID_ARGUMENT as SphereSetFromProto for bad spheres, as
+// CoverCertificateFromProto for a malformed certificate.
 absl::StatusOr<GeneratedSphereSet> GeneratedSphereSetFromProto(const v1::GenerateResult& result);
 
 // Evaluation options (Evaluate): the sample count, the voxel size and the coverage tolerance go

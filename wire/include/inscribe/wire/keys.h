@@ -7,6 +7,7 @@
 #include <string>
 
 #include "absl/strings/string_view.h"
+#include "inscribe/cover_certificate.h"
 #include "inscribe/sphere_deformation.h"
 #include "inscribe/sphere_hierarchy.h"
 #include "inscribe/sphere_set_generation.h"
@@ -36,9 +37,18 @@ std::string GeneratedSphereSetKey(const std::string& mesh_key,
 
 // "spheres/v1/<64 hex>" of an uploaded set: the route prefix of `mesh_key`, else of
 // `derived_from` (the key of the set it was computed from), else none (a full SHA-256), then
-// the SHA-256 of the mesh key and `spheres_bytes` (the set's serialised numbers).
+// the SHA-256 of the mesh key, `spheres_bytes` (the set's serialised numbers) and, when not
+// empty, `certificate_bytes` (the serialised certificate it was uploaded with; sets uploaded
+// without one keep the keys they had before certificates were uploaded).
 std::string UploadedSphereSetKey(const std::string& mesh_key, const std::string& derived_from,
-                                 absl::string_view spheres_bytes);
+                                 absl::string_view spheres_bytes,
+                                 absl::string_view certificate_bytes = "");
+
+// "certificate/v1/<64 hex>": the cover certificate of set `set_key` against mesh `mesh_key`
+// with `options` (its resolution; the failed cells kept change no verdict). Routes with the
+// set.
+std::string CoverCertificateKey(const std::string& set_key, const std::string& mesh_key,
+                                const CoverCertifyOptions& options);
 
 // "deformer/v1/<64 hex>": the deformer of (mesh, set, options).
 std::string DeformerKey(const std::string& mesh_key, const std::string& set_key,

@@ -1,0 +1,36 @@
+// A cover's certificate as the command line writes and reads it, in one place: the params and
+// stats of a sphere file (generate writes them, distance reads them back to use a file as a
+// cover) and the verdict's wording (evaluate --certify, distance).
+#pragma once
+
+#include <optional>
+#include <string>
+
+#include "absl/status/statusor.h"
+#include "inscribe/cover_certificate.h"
+#include "inscribe/sphere_io.h"
+#include "inscribe/sphere_set_generation.h"
+
+namespace inscribe::cli {
+
+// The param naming the set's kind: SphereSetKindName ("internal", "dilated", "cover").
+inline constexpr char kKindParam[] = "kind";
+
+// The certificate's figures as stats: delta and certificate_resolution (mesh units),
+// certified, certificate_cells, cells_in_sphere, cells_outside, failed_cells, certify_seconds.
+NamedValues CoverCertificateStats(const CoverCertificate& certificate);
+
+// The kind `file` records (its kKindParam), or "" when it records none (peer formats, files
+// written before kinds were recorded).
+std::string RecordedKind(const SphereFile& file);
+
+// The certificate a cover file records: kind "cover" and the stats CoverCertificateStats
+// writes. nullopt for a file of another kind or of none; INVALID_ARGUMENT naming the stat when
+// a cover file lacks one of them or gives it another type.
+absl::StatusOr<std::optional<CoverCertificate>> RecordedCoverCertificate(const SphereFile& file);
+
+// The verdict in words: "certified: ...", or "NOT certified: " and the point of the solid in no
+// sphere (its depth and gap), or the unsettled cells when no such point was found.
+std::string CoverVerdict(const CoverCertificate& certificate);
+
+}  // namespace inscribe::cli

@@ -1,0 +1,315 @@
+// Covers through the service: Generate with cover, certified Distance and DistanceStream, the
+// certificate rule, and the Client's typed view of them, against the real server in-process on
+// loopback (disk cache in a temporary directory).
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "inscribe/certified_distance.h"
+#include "inscribe/client/client.h"
+#include "inscribe/cover_certificate.h"
+#include "inscribe/separation_distance.h"
+#include "inscribe/solid.h"
+#include "spheres_rpc_fixture.h"
+#include "support/sphere_sets.h"
+#include "support/synthetic_meshes.h"
+
+namespace inscribe::server {
+namespace {
+
+using ::testing::HasSubstr;
+
+class CoverRpcTest : public SpheresRpcTest {
+ protected:
+  std::unique_ptr<client::Client> MakeClient() {
+    return std::make_unique<client::Client>(client::MakeGrpcConnection(server_->address()));
+  }
+
+  static v1::GenerateRequest CoverRequest(const std::string& mesh_key, std::int64_t max_spheres) {
+    v1::GenerateRequest request;
+    request.set_mesh_sha256(mesh_key);
+    request.mutable_parameters()->set_max_spheres(max_spheres);
+    request.mutable_parameters()->set_cover(true);
+    request.set_skip_quality(true);
+    return request;
+  }
+};
+
+const Mesh& Slab() {
+  static const Mesh slab = testing::Box(Vector3::Zero(), Vector3(2.0, 1.0, 0.5));
+  return slab;
+}
+
+// A generated cover carries its certificate through the cache (memory, then disk after a
+// restart), under a key of its own; the certificate is the one core proves for that set.
+TEST_F(CoverRpcTest, GenerateMakesACertifiedCoverAndCachesItsCertificate) {
+  const std::string mesh = PutMesh(Slab());
+  v1::GenerateResult cover, again, restarted, internal;
+  ASSERT_TRUE(Generate(CoverRequest(mesh, 30), &cover).ok());
+  EXPECT_EQ(cover.cache(), "computed");
+  EXPECT_EQ(cover.kind(), v1::SPHERE_SET_KIND_COVER);
+  ASSERT_TRUE(cover.has_cover());
+  const v1::CoverCertificate& certificate = cover.cover().certificate();
+  EXPECT_TRUE(certificate.certified());
+  EXPECT_GE(certificate.delta(), 0.0);
+  EXPECT_EQ(certificate.failed_cells(), 0);
+  EXPECT_EQ(cover.spheres().contact_triangles_size(), 0);
+  EXPECT_FALSE(cover.has_quality());
+
+  // Core agrees: the set is a cover with this delta.
+  absl::StatusOr<SphereSet> spheres = wire::SphereSetFromProto(cover.spheres());
+  ASSERT_TRUE(spheres.ok()) << spheres.status();
+  absl::StatusOr<Solid> solid = PrepareSolid(Slab());
+  ASSERT_TRUE(solid.ok()) << solid.status();
+  absl::StatusOr<CoverCertificate> core = CertifyCover(*solid, spheres->spheres);
+  ASSERT_TRUE(core.ok()) << core.status();
+  EXPECT_TRUE(core->certified);
+  EXPECT_EQ(core->delta, certificate.delta());
+
+  ASSERT_TRUE(Generate(CoverRequest(mesh, 30), &again).ok());
+  EXPECT_EQ(again.cache(), "memory");
+  EXPECT_EQ(again.cover().SerializeAsString(), cover.cover().SerializeAsString());
+  Restart();
+  ASSERT_TRUE(Generate(CoverRequest(mesh, 30), &restarted).ok());
+  EXPECT_EQ(restarted.cache(), "disk");
+  EXPECT_EQ(restarted.kind(), v1::SPHERE_SET_KIND_COVER);
+  EXPECT_EQ(restarted.cover().SerializeAsString(), cover.cover().SerializeAsString());
+
+  v1::GenerateRequest plain = CoverRequest(mesh, 30);
+  plain.mutable_parameters()->set_cover(false);
+  ASSERT_TRUE(Generate(plain, &internal).ok());
+  EXPECT_EQ(internal.kind(), v1::SPHERE_SET_KIND_INTERNAL);
+  EXPECT_FALSE(internal.has_cover());
+  EXPECT_NE(internal.sphere_set_key(), cover.sphere_set_key());
+}
+
+TEST_F(CoverRpcTest, ClientGeneratesACoverAndTheServerRefusesBadCombinations) {
+  const std::unique_ptr<client::Client> client = MakeClient();
+  client::GenerateSettings settings;
+  settings.parameters.kind = SphereSetKind::kCover;
+  settings.parameters.max_spheres = 30;
+  absl::StatusOr<client::GenerateResult> generated = client->Generate(Slab(), settings);
+  ASSERT_TRUE(generated.ok()) << generated.status();
+  EXPECT_EQ(generated->kind, SphereSetKind::kCover);
+  ASSERT_TRUE(generated->cover.has_value());
+  EXPECT_TRUE(generated->cover->certificate.certified);
+  EXPECT_LE(generated->set.size(), 30u);
+  ASSERT_TRUE(generated->quality.has_value());
+  EXPECT_EQ(generated->quality->coverage, 1.0);
+
+  // The raw request with the same settings names the same cached set.
+  v1::GenerateResult raw;
+  v1::GenerateRequest request = CoverRequest(generated->mesh_sha256, 30);
+  request.set_skip_quality(false);
+  ASSERT_TRUE(Generate(request, &raw).ok());
+  EXPECT_EQ(raw.sphere_set_key(), generated->sphere_set_key);
+  EXPECT_EQ(raw.cache(), "memory");
+
+  // The client refuses what core refuses, before sending.
+  settings.parameters.max_protrusion = 0.1;
+  absl::StatusOr<client::GenerateResult> both = client->Generate(Slab(), settings);
+  EXPECT_EQ(both.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(both.status().message(), HasSubstr("not both"));
+  // The server refuses what the wire can say but core cannot.
+  request.mutable_parameters()->set_dilate(true);
+  grpc::Status refused = Generate(request, &raw);
+  EXPECT_EQ(refused.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(refused.error_message(), HasSubstr("dilate and cover"));
+  request.mutable_parameters()->set_dilate(false);
+  request.mutable_parameters()->set_cover_resolution(2.0);
+  refused = Generate(request, &raw);
+  EXPECT_EQ(refused.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(refused.error_message(), HasSubstr("resolution"));
+}
+
+// Two solids, each with an internal set and a cover, generated through a Client.
+struct CertifiedSolids {
+  client::GenerateResult internal[2], cover[2];
+};
+
+CertifiedSolids GenerateSolids(const client::Client& client) {
+  const Mesh bar = testing::Box(Vector3::Zero(), Vector3(1.0, 0.4, 0.4));
+  CertifiedSolids out;
+  for (int k = 0; k < 2; ++k) {
+    client::GenerateSettings settings;
+    settings.parameters.max_spheres = 30;
+    settings.parameters.evaluate = false;
+    absl::StatusOr<client::GenerateResult> internal =
+        client.Generate(k == 0 ? Slab() : bar, settings);
+    EXPECT_TRUE(internal.ok()) << internal.status();
+    settings.parameters.kind = SphereSetKind::kCover;
+    absl::StatusOr<client::GenerateResult> cover = client.Generate(k == 0 ? Slab() : bar, settings);
+    EXPECT_TRUE(cover.ok()) << cover.status();
+    if (!internal.ok() || !cover.ok()) return out;
+    out.internal[k] = *std::move(internal);
+    out.cover[k] = *std::move(cover);
+  }
+  return out;
+}
+
+// Certified Distance and DistanceStream give, for every pose, exactly the interval the rule of
+// certified_distance.h makes of the brute-force sphere distances (covers: lower; internal
+// sets and deltas: upper) and the answer DecideCloser gives; the stream answers as the batch.
+TEST_F(CoverRpcTest, CertifiedIntervalsHoldTheBruteForceSphereDistances) {
+  const std::unique_ptr<client::Client> client = MakeClient();
+  const CertifiedSolids solids = GenerateSolids(*client);
+  ASSERT_FALSE(solids.cover[1].sphere_set_key.empty());
+  std::mt19937_64 rng(11);
+  std::vector<RigidPose> poses_b;
+  for (int i = 0; i < 200; ++i) poses_b.push_back(testing::RandomPose(rng, 2.5));
+  const std::vector<RigidPose> origin = {RigidPose()};
+  client::DistanceOptions options;
+  options.cover_a = solids.cover[0].sphere_set_key;
+  options.cover_b = solids.cover[1].sphere_set_key;
+  options.tolerance.closer_than = 0.3;
+  absl::StatusOr<client::DistanceBatchResult> batch =
+      client->Distance(solids.internal[0].sphere_set_key, solids.internal[1].sphere_set_key, origin,
+                       poses_b, options);
+  ASSERT_TRUE(batch.ok()) << batch.status();
+  ASSERT_EQ(batch->certified.size(), poses_b.size());
+  ASSERT_EQ(batch->results.size(), poses_b.size());
+  const double deltas =
+      solids.cover[0].cover->certificate.delta + solids.cover[1].cover->certificate.delta;
+  int decided = 0;
+  for (std::size_t i = 0; i < poses_b.size(); ++i) {
+    SCOPED_TRACE(i);
+    const CertifiedDistanceResult& r = batch->certified[i];
+    absl::StatusOr<DistanceResult> covers = BruteForceSeparationDistance(
+        solids.cover[0].set.spheres, origin[0], solids.cover[1].set.spheres, poses_b[i]);
+    absl::StatusOr<DistanceResult> internal = BruteForceSeparationDistance(
+        solids.internal[0].set.spheres, origin[0], solids.internal[1].set.spheres, poses_b[i]);
+    ASSERT_TRUE(covers.ok() && internal.ok());
+    const double lower = std::max(0.0, covers->distance);
+    const double upper = std::max(0.0, std::min(internal->distance, lower + deltas));
+    EXPECT_LE(r.lower, lower);
+    EXPECT_NEAR(r.lower, lower, 1e-9);
+    EXPECT_GE(r.upper, upper);
+    EXPECT_NEAR(r.upper, upper, 1e-9);
+    EXPECT_LE(r.lower, r.upper);
+    EXPECT_NEAR(batch->results[i].distance, internal->distance, 1e-9);
+    EXPECT_EQ(r.closer, DecideCloser(r.lower, r.upper, 0.3));
+    decided += r.closer != CloserAnswer::kUndecided;
+  }
+  EXPECT_GT(decided, 100);  // most poses are clearly apart or clearly close
+
+  client::DistanceSessionOptions session_options;
+  session_options.tolerance.closer_than = 0.3;
+  absl::StatusOr<client::DistanceSession> session = client->OpenDistanceSession(session_options);
+  ASSERT_TRUE(session.ok()) << session.status();
+  std::vector<client::PosePair> pairs;
+  for (std::size_t i = 0; i < 20; ++i) {
+    pairs.push_back(client::PosePair{solids.internal[0].sphere_set_key,
+                                     solids.internal[1].sphere_set_key, origin[0], poses_b[i],
+                                     options.cover_a, options.cover_b});
+  }
+  absl::StatusOr<std::vector<CertifiedDistanceResult>> frame = session->QueryCertified(pairs);
+  ASSERT_TRUE(frame.ok()) << frame.status();
+  ASSERT_EQ(frame->size(), pairs.size());
+  for (std::size_t i = 0; i < pairs.size(); ++i) {
+    EXPECT_EQ((*frame)[i].lower, batch->certified[i].lower) << i;
+    EXPECT_EQ((*frame)[i].upper, batch->certified[i].upper) << i;
+    EXPECT_EQ((*frame)[i].closer, batch->certified[i].closer) << i;
+  }
+  // A frame mixing certified and plain pairs ends the stream.
+  pairs.back().cover_a.clear();
+  pairs.back().cover_b.clear();
+  absl::StatusOr<std::vector<CertifiedDistanceResult>> mixed = session->QueryCertified(pairs);
+  EXPECT_EQ(mixed.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(mixed.status().message(), HasSubstr("all certified"));
+}
+
+// The certificate rule: a set serves as a cover only with a certificate the server holds.
+TEST_F(CoverRpcTest, ASetIsACoverOnlyWithACertificateTheServerHolds) {
+  const std::unique_ptr<client::Client> client = MakeClient();
+  const CertifiedSolids solids = GenerateSolids(*client);
+  ASSERT_FALSE(solids.cover[1].sphere_set_key.empty());
+  const std::string& a = solids.internal[0].sphere_set_key;
+  const std::string& b = solids.internal[1].sphere_set_key;
+  const std::vector<RigidPose> origin = {RigidPose()};
+  RigidPose apart;
+  apart.translation = Vector3(4, 0, 0);
+  const auto certified = [&](const std::string& internal_a, const std::string& cover_a,
+                             const std::string& cover_b) {
+    client::DistanceOptions options;
+    options.cover_a = cover_a;
+    options.cover_b = cover_b;
+    return client->Distance(internal_a, b, origin, {apart}, options);
+  };
+  ASSERT_TRUE(certified(a, solids.cover[0].sphere_set_key, solids.cover[1].sphere_set_key).ok());
+
+  // Generate's internal set names its mesh, so the server certifies it on first use: it is
+  // not a cover, and the refusal names its key and a point it misses.
+  absl::StatusOr<client::DistanceBatchResult> refused =
+      certified(a, a, solids.cover[1].sphere_set_key);
+  EXPECT_EQ(refused.status().code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_THAT(refused.status().message(), HasSubstr("sphere set " + a + " is not a cover"));
+  EXPECT_THAT(refused.status().message(), HasSubstr("the point ("));
+
+  // The cover's spheres uploaded without a mesh or a certificate: nothing to prove them by.
+  absl::StatusOr<client::PutSphereSetResult> loose = client->PutSphereSet(solids.cover[0].set);
+  ASSERT_TRUE(loose.ok()) << loose.status();
+  refused = certified(a, loose->sphere_set_key, solids.cover[1].sphere_set_key);
+  EXPECT_EQ(refused.status().code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_THAT(refused.status().message(),
+              HasSubstr("sphere set " + loose->sphere_set_key + " has no cover certificate"));
+
+  // With its mesh, the server proves it on first use and keeps the proof: CertifyCover by key
+  // afterwards computes nothing.
+  absl::StatusOr<client::PutSphereSetResult> with_mesh =
+      client->PutSphereSet(solids.cover[0].set, solids.cover[0].mesh_sha256);
+  ASSERT_TRUE(with_mesh.ok()) << with_mesh.status();
+  EXPECT_TRUE(certified(a, with_mesh->sphere_set_key, solids.cover[1].sphere_set_key).ok());
+  const std::int64_t computations = Stats().computations();
+  absl::StatusOr<CoverCertificate> proof =
+      client->CertifyCover(solids.cover[0].mesh_sha256, with_mesh->sphere_set_key);
+  ASSERT_TRUE(proof.ok()) << proof.status();
+  EXPECT_TRUE(proof->certified);
+  EXPECT_EQ(proof->delta, solids.cover[0].cover->certificate.delta);
+  EXPECT_EQ(Stats().computations(), computations);
+
+  // With a certificate: taken on the uploader's word, and keyed with it; one that does not
+  // certify is refused.
+  absl::StatusOr<client::PutSphereSetResult> vouched =
+      client->PutCertifiedCover(solids.cover[0].set, solids.cover[0].cover->certificate);
+  ASSERT_TRUE(vouched.ok()) << vouched.status();
+  EXPECT_NE(vouched->sphere_set_key, loose->sphere_set_key);
+  EXPECT_TRUE(certified(a, vouched->sphere_set_key, solids.cover[1].sphere_set_key).ok());
+  CoverCertificate failed = solids.cover[0].cover->certificate;
+  failed.certified = false;
+  absl::StatusOr<client::PutSphereSetResult> bad =
+      client->PutCertifiedCover(solids.cover[0].set, failed);
+  EXPECT_EQ(bad.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(bad.status().message(), HasSubstr("certificate"));
+
+  // A cover (or dilated set) as the internal set; covers of another mesh.
+  refused = certified(solids.cover[0].sphere_set_key, solids.cover[0].sphere_set_key,
+                      solids.cover[1].sphere_set_key);
+  EXPECT_EQ(refused.status().code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_THAT(refused.status().message(), HasSubstr("is a cover"));
+  refused = certified(a, solids.cover[1].sphere_set_key, solids.cover[1].sphere_set_key);
+  EXPECT_EQ(refused.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(refused.status().message(), HasSubstr("but its cover"));
+
+  // One cover without the other, tolerances, brute force.
+  EXPECT_EQ(certified(a, solids.cover[0].sphere_set_key, "").status().code(),
+            absl::StatusCode::kInvalidArgument);
+  client::DistanceOptions loose_tolerance;
+  loose_tolerance.cover_a = solids.cover[0].sphere_set_key;
+  loose_tolerance.cover_b = solids.cover[1].sphere_set_key;
+  loose_tolerance.tolerance.abs_err = 0.01;
+  refused = client->Distance(a, b, origin, {apart}, loose_tolerance);
+  EXPECT_EQ(refused.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(refused.status().message(), HasSubstr("abs_err"));
+  loose_tolerance.tolerance.abs_err = 0.0;
+  loose_tolerance.brute_force = true;
+  EXPECT_EQ(client->Distance(a, b, origin, {apart}, loose_tolerance).status().code(),
+            absl::StatusCode::kInvalidArgument);
+}
+
+}  // namespace
+}  // namespace inscribe::server

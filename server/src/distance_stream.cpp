@@ -202,7 +202,8 @@ class DistanceStreamReactor final
       absl::StatusOr<const SphereHierarchy*> b =
           Hierarchy(pair.sphere_set_b(), volume, "sphere_set_b");
       if (!b.ok()) return InPair(i, b.status());
-      pairs[i] = PosedPair{*a, *b};
+      pairs[i].a = *a;
+      pairs[i].b = *b;
       if (absl::Status s = ReadPoses(i, pair, &pairs[i].pose_a, &pairs[i].pose_b); !s.ok()) {
         return s;
       }
@@ -264,7 +265,8 @@ class DistanceStreamReactor final
       absl::StatusOr<const CertifiedObject*> b =
           Certified(pair.sphere_set_b(), pair.cover_b(), volume, "sphere_set_b");
       if (!b.ok()) return InPair(i, b.status());
-      pairs[i] = CertifiedPair{*a, *b};
+      pairs[i].a = *a;
+      pairs[i].b = *b;
       if (absl::Status s = ReadPoses(i, pair, &pairs[i].pose_a, &pairs[i].pose_b); !s.ok()) {
         return s;
       }

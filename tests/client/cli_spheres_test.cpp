@@ -200,6 +200,8 @@ TEST(CliGenerate, BadOptionsAreClearErrorsNotHangs) {
       {"--cover --max-spheres 10 --max-protrusion 0.1", 64, "excludes"},
       {"--cover --max-protrusion -1", 64, "max_protrusion must be a finite length > 0"},
       {"--cover --cover-resolution 0", 64, "resolution"},
+      {"--cover --object-angle 0.5", 64, "excludes"},
+      {"--cover --subdivide-boundary", 64, "excludes"},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.args);

@@ -30,7 +30,9 @@ DistanceSession SessionOver(std::unique_ptr<MockDistanceStream> stream,
 }
 
 PosePair Pair(const std::string& a, const std::string& b, double tx) {
-  PosePair pair{a, b, RigidPose(), RigidPose()};
+  PosePair pair;
+  pair.sphere_set_a = a;
+  pair.sphere_set_b = b;
   pair.pose_b.translation = Vector3(tx, 0, 0);
   return pair;
 }

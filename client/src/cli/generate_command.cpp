@@ -7,6 +7,7 @@
 #include <string>
 #include <utility>
 #include <variant>
+#include <vector>
 
 #include "absl/strings/str_format.h"
 #include "command_outcome.h"
@@ -257,30 +258,39 @@ void AddGenerateCommand(CLI::App& app, CommandOutcome* outcome) {
                   "largest bounding-box side")
       ->needs(cover)
       ->capture_default_str();
-  cmd->add_option("--object-angle", options->parameters.medial.object_angle,
-                  "Drop medial points with a smaller object angle, radians in (0, pi)")
-      ->capture_default_str();
-  cmd->add_option("--epsilon", options->parameters.medial.epsilon,
-                  "Centres within this of the medial surface, mesh units (default 1e-4 of the "
-                  "bounding-box diagonal)");
-  cmd->add_option("--samples", options->parameters.medial.samples,
-                  "Sample points per voxel on its circumscribed sphere")
-      ->capture_default_str();
-  cmd->add_option("--screen-samples", options->parameters.medial.screen_samples,
-                  "Samples tried first per voxel; 0 = every voxel gets the full set")
-      ->capture_default_str();
-  cmd->add_flag("!--no-corner-screen", options->parameters.medial.corner_screen,
-                "Sample every voxel, not only those whose corners' boundary directions differ "
-                "by about the object angle");
-  cmd->add_option("--pair-angle-margin", options->parameters.medial.pair_angle_margin,
-                  "Skip face-face sample pairs whose angle is below the object angle minus "
-                  "this, radians (default pi: search every crossing pair; 0.1 speeds up "
-                  "faceted tubes)");
-  cmd->add_flag("--subdivide-boundary", options->parameters.medial.subdivide_boundary,
-                "Split voxels the boundary may cross into 8 (up to 8 spheres there)");
-  cmd->add_option("--max-voxels", options->parameters.medial.max_voxels,
-                  "Refuse grids with more voxels than this")
-      ->capture_default_str();
+  // The medial-sphere options: covers choose from balls of their own.
+  std::vector<CLI::Option*> medial_options;
+  medial_options.push_back(
+      cmd->add_option("--object-angle", options->parameters.medial.object_angle,
+                      "Drop medial points with a smaller object angle, radians in (0, pi)")
+          ->capture_default_str());
+  medial_options.push_back(
+      cmd->add_option("--epsilon", options->parameters.medial.epsilon,
+                      "Centres within this of the medial surface, mesh units (default 1e-4 of the "
+                      "bounding-box diagonal)"));
+  medial_options.push_back(cmd->add_option("--samples", options->parameters.medial.samples,
+                                           "Sample points per voxel on its circumscribed sphere")
+                               ->capture_default_str());
+  medial_options.push_back(
+      cmd->add_option("--screen-samples", options->parameters.medial.screen_samples,
+                      "Samples tried first per voxel; 0 = every voxel gets the full set")
+          ->capture_default_str());
+  medial_options.push_back(
+      cmd->add_flag("!--no-corner-screen", options->parameters.medial.corner_screen,
+                    "Sample every voxel, not only those whose corners' boundary directions differ "
+                    "by about the object angle"));
+  medial_options.push_back(
+      cmd->add_option("--pair-angle-margin", options->parameters.medial.pair_angle_margin,
+                      "Skip face-face sample pairs whose angle is below the object angle minus "
+                      "this, radians (default pi: search every crossing pair; 0.1 speeds up "
+                      "faceted tubes)"));
+  medial_options.push_back(
+      cmd->add_flag("--subdivide-boundary", options->parameters.medial.subdivide_boundary,
+                    "Split voxels the boundary may cross into 8 (up to 8 spheres there)"));
+  medial_options.push_back(cmd->add_option("--max-voxels", options->parameters.medial.max_voxels,
+                                           "Refuse grids with more voxels than this")
+                               ->capture_default_str());
+  for (CLI::Option* medial : medial_options) medial->excludes(cover);
   cmd->add_option("--quality-samples", options->parameters.quality.surface_samples,
                   "Boundary samples for coverage and Hausdorff distance in the stats")
       ->capture_default_str();

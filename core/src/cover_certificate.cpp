@@ -22,6 +22,8 @@ namespace {
 
 // Levels below which children are visited in parallel (8^3 = 512 subtrees).
 constexpr int kParallelLevels = 3;
+// The resolution of the first pass that looks for a point of the solid in no sphere.
+constexpr double kWitnessPassResolution = 1.0 / 256;
 // Relative margins, far above the rounding of the few operations each test makes (a dozen
 // roundings of 2^-53 each), so that a settled cell is settled in exact arithmetic too.
 constexpr double kContainMargin = 1e-12;  // on squared distances
@@ -242,9 +244,25 @@ absl::StatusOr<CoverCertificate> CertifyCover(const Solid& solid,
   absl::StatusOr<double> delta = SphereProtrusionBound(solid, spheres);
   if (!delta.ok()) return delta.status();
 
-  Certifier certifier(solid, spheres, options, control);
+  // With stop_at_witness, a coarse pass first: a set that misses a point of the solid usually
+  // shows it there, without splitting the cells along its tangencies down to the finest.
+  CoverCertifyOptions coarse = options;
+  coarse.resolution = std::max(options.resolution, kWitnessPassResolution);
+  const bool two_passes = options.stop_at_witness && coarse.resolution > options.resolution;
+  GenerationControl quiet;
+  quiet.cancel = control.cancel;
+  Certifier first(solid, spheres, coarse, quiet);
   Counts counts;
-  if (absl::Status s = certifier.Run(&counts); !s.ok()) return s;
+  if (two_passes) {
+    if (absl::Status s = first.Run(&counts); !s.ok()) return s;
+  }
+  Certifier full(solid, spheres, options, control);
+  const bool disproved = two_passes && counts.deepest.has_value();
+  if (!disproved) {
+    counts = Counts{};
+    if (absl::Status s = full.Run(&counts); !s.ok()) return s;
+  }
+  const Certifier& certifier = disproved ? first : full;
 
   CoverCertificate out;
   out.certified = counts.failed == 0;

@@ -32,8 +32,11 @@ struct CoverCertifyOptions {
   std::int64_t max_failures_kept = 1 << 20;
   // A cell whose centre is inside the solid and in no sphere already disproves the cover: stop
   // there rather than split it down to the finest cells (a set that misses a large part of
-  // the solid is refused in milliseconds). Off for repairs, which grow a sphere around each
-  // failed cell and want them small.
+  // the solid is refused in milliseconds). Also: a first pass at 1/256 (when coarser than
+  // `resolution`) whose witness, if it finds one, is the answer (its counts and resolution are
+  // that pass's), so a set that is not a cover is not split to the finest cells along its
+  // tangencies. Off for repairs, which grow a sphere around each failed cell and want them
+  // small.
   bool stop_at_witness = true;
 };
 

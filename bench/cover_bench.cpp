@@ -7,15 +7,17 @@
 //    and its set put to CertifyCover; otherwise the figures quoted in issue 22 are printed,
 //    labelled so, and no verdict.
 // 2. The Table II protocol (bench/table2_poses.h: two copies of each model, 'near' and 'far'
-//    random pose pairs) with intervals: the internal set (500 spheres) and the 500-sphere cover
-//    give [lower, upper] per pose; mean and p95 width as % of the largest side, the share of
+//    random pose pairs) with intervals: the internal set (500 spheres) with the cover's cores
+//    (UpperBoundSpheres) and the cover (500 and 2,000 spheres, --interval-covers) give
+//    [lower, upper] per pose; mean and p95 width as % of the largest side, the mean distance
+//    from the exact distance down to lower and up to upper, the share of
 //    "closer than d" tests decided at d = 1% and 5% of it, and microseconds per interval query
 //    against FCL's exact mesh distance (fcl::distance, rel_err = abs_err = 0) on the same poses,
 //    each query timed alone on one thread. Every pose also checks that the exact distance
 //    between the solids (support/fcl_solid_distance.h) lies in its interval.
 //
 //   cover_bench [--models eight,cow,...] [--poses N] [--seed S] [--internal-spheres N]
-//               [--amaa DIR] [--data DIR] [--quick]
+//               [--interval-covers N,...] [--amaa DIR] [--data DIR] [--quick]
 //
 // Exit status: 0 every check passed (targets are reported, not enforced); 1 a check failed (a
 // cover not certified by CertifyCover, an exact distance outside its interval); 2 a model could
@@ -90,8 +92,9 @@ struct Options {
   int poses = 1000;
   std::uint64_t seed = 1;
   std::int64_t internal_spheres = kBudget;
-  std::int64_t budget = kBudget;  // --quick: a small one
-  bool amaa_counts = true;        // also at AMAA's sphere counts
+  std::int64_t budget = kBudget;                                 // --quick: a small one
+  std::vector<std::int64_t> interval_covers = {kBudget, 2'000};  // cover sizes of part 2
+  bool amaa_counts = true;                                       // also at AMAA's sphere counts
   std::string amaa_dir;
   std::string data_dir;
 };
@@ -117,6 +120,7 @@ struct IntervalRow {
   std::size_t internal = 0, cover = 0;
   double contact_percent = 0.0;              // poses where the solids touch (exact distance 0)
   double mean_width = 0.0, p95_width = 0.0;  // % of the largest side
+  double lower_gap = 0.0, upper_gap = 0.0;   // mean exact - lower, upper - exact, % of it
   double decided_1 = 0.0, decided_5 = 0.0;   // % of poses decided at d = 1%, 5% of it
   double rss_us = 0.0, sphere_us = 0.0, fcl_us = 0.0;  // medians of one query each
   int misses = 0;
@@ -158,18 +162,18 @@ void MeasureAmaa(const Solid& solid, const std::string& model, const Options& op
 
 struct MadeCover {
   std::vector<Sphere> spheres;
-  double delta = 0.0;  // the certificate's, mesh units
+  CoverCertificate certificate;
 };
 
-// Part 1 for one model; returns the cover at options.budget for part 2 (empty if it failed).
-MadeCover RunCovers(const Solid& solid, const std::string& model, const Options& options,
-                    Results& results) {
+// Part 1 for one model; returns the covers made, by budget, for part 2.
+std::map<std::int64_t, MadeCover> RunCovers(const Solid& solid, const std::string& model,
+                                            const Options& options, Results& results) {
   const double largest = ComputeBoundingBox(solid.mesh().vertices).extent().maxCoeff();
   std::vector<std::int64_t> budgets;
   const auto quote = AmaaQuotes().find(model);
   if (options.amaa_counts && quote != AmaaQuotes().end()) budgets.push_back(quote->second.spheres);
   budgets.push_back(options.budget);
-  MadeCover last;
+  std::map<std::int64_t, MadeCover> made;
   for (const std::int64_t budget : budgets) {
     CoverRow row;
     row.model = model;
@@ -205,25 +209,26 @@ MadeCover RunCovers(const Solid& solid, const std::string& model, const Options&
       MeasureAmaa(solid, model, options, largest, row);
     }
     results.covers.push_back(row);
-    last = MadeCover{std::move(cover->set.spheres), cover->certificate.delta};
+    made[budget] = MadeCover{std::move(cover->set.spheres), std::move(cover->certificate)};
   }
-  return last;
+  return made;
 }
 
-// Part 2 for one model: both pose sets.
-void RunIntervals(const Solid& solid, const std::string& model, const std::vector<Sphere>& cover,
-                  double delta, const Options& options, Results& results) {
-  SphereSetParameters parameters;
-  parameters.max_spheres = options.internal_spheres;
-  parameters.evaluate = false;
-  absl::StatusOr<GeneratedSphereSet> internal = GenerateSphereSet(solid, parameters);
-  if (!internal.ok()) {
-    results.errors.push_back(model + " internal set: " + internal.status().ToString());
+// Part 2 for one model and one cover: both pose sets.
+void RunIntervals(const Solid& solid, const std::string& model,
+                  const std::vector<Sphere>& internal_set, const MadeCover& made,
+                  const Options& options, Results& results) {
+  const std::vector<Sphere>& cover = made.spheres;
+  const double delta = made.certificate.delta;
+  absl::StatusOr<std::vector<Sphere>> upper_spheres =
+      UpperBoundSpheres(internal_set, cover, made.certificate.protrusions);
+  if (!upper_spheres.ok()) {
+    results.errors.push_back(model + " cores: " + upper_spheres.status().ToString());
     return;
   }
   // The same sets under both hierarchy kinds (RSS, spheres): both are timed and checked.
   std::vector<SphereHierarchy> hierarchies;
-  const std::vector<Sphere>* sets[] = {&internal->set.spheres, &cover};
+  const std::vector<Sphere>* sets[] = {&*upper_spheres, &cover};
   for (const HierarchyVolume volume : {HierarchyVolume::kRss, HierarchyVolume::kSphere}) {
     for (const std::vector<Sphere>* set : sets) {
       absl::StatusOr<SphereHierarchy> h = SphereHierarchy::Build(*set, volume);
@@ -255,9 +260,9 @@ void RunIntervals(const Solid& solid, const std::string& model, const std::vecto
     row.model = model;
     row.set = spec.name;
     row.poses = static_cast<int>(poses.size());
-    row.internal = internal->set.size();
+    row.internal = upper_spheres->size();
     row.cover = cover.size();
-    std::vector<double> widths, us[2], fcl_us;
+    std::vector<double> widths, lower_gaps, upper_gaps, us[2], fcl_us;
     int contacts = 0, decided_1 = 0, decided_5 = 0;
     for (std::size_t i = 0; i < poses.size(); ++i) {
       const bench::PosePair& p = poses[i];
@@ -282,6 +287,8 @@ void RunIntervals(const Solid& solid, const std::string& model, const std::vecto
       decided_5 += DecideCloser(lower, upper, d5) != CloserAnswer::kUndecided;
       const testing::ExactSolidDistance exact = testing::SolidDistance(fcl, p.a, fcl, p.b);
       contacts += exact.distance == 0.0;
+      lower_gaps.push_back(100.0 * (exact.distance - lower) / largest);
+      upper_gaps.push_back(100.0 * (upper - exact.distance) / largest);
       const double slack = kFclSlack * largest;
       for (int k = 0; k < 2; ++k) {
         if (!(interval[k].lower <= exact.distance + slack &&
@@ -298,6 +305,8 @@ void RunIntervals(const Solid& solid, const std::string& model, const std::vecto
     row.contact_percent = 100.0 * contacts / n;
     row.mean_width = Mean(widths);
     row.p95_width = Quantile(widths, 0.95);
+    row.lower_gap = Mean(lower_gaps);
+    row.upper_gap = Mean(upper_gaps);
     row.decided_1 = 100.0 * decided_1 / n;
     row.decided_5 = 100.0 * decided_5 / n;
     row.rss_us = Quantile(us[0], 0.5);
@@ -342,28 +351,32 @@ void PrintIntervals(const Options& options, const Results& results) {
   absl::PrintF(
       "\nCertified distance on the Table II protocol: two copies of each model, %d random pose "
       "pairs per set (seed %d; both copies rotated; box centres near: 0.4-0.9, far: 0.6-1.5 "
-      "diagonals apart). Internal set: GenerateSphereSet, <= %d spheres; cover: the %d-sphere "
-      "cover above. Widths (upper - lower) and d as %% of the largest side; contact = poses "
-      "where the solids touch (exact distance 0); decided = share of \"closer than d\" answered "
+      "diagonals apart). Internal spheres: GenerateSphereSet, <= %d spheres, with the cover's "
+      "cores (UpperBoundSpheres); covers: GenerateCover at the budgets shown. Widths (upper - "
+      "lower), the mean gaps exact - lower and upper - exact, and d as %% of the largest side; "
+      "contact = poses where the solids touch (exact distance 0); decided = share of \"closer than "
+      "d\" answered "
       "yes or no. Times: median microseconds of one query, each timed alone on one thread: "
       "CertifiedDistances for one pair over RSS hierarchies (RSSH) and over sphere hierarchies "
       "(SH), and fcl::distance (OBBRSS, exact); FCL / interval against the faster of the two. "
       "misses = intervals (either kind) that miss the exact distance (FCL).\n\n",
-      options.poses, options.seed, options.internal_spheres, options.budget);
+      options.poses, options.seed, options.internal_spheres);
   absl::PrintF(
       "| model | poses | internal / cover spheres | contact | mean width %% | p95 width %% | "
-      "decided d=1%% | decided d=5%% | RSSH us | SH us | FCL us | FCL / interval | misses | "
+      "exact - lower %% | upper - exact %% | decided d=1%% | decided d=5%% | RSSH us | SH us | FCL "
+      "us | FCL / interval | misses | "
       "mean width <= %.0f%% | >= %.0fx |\n",
       kTargetMeanWidthPercent, kTargetSpeedup);
-  absl::PrintF("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---|\n");
+  absl::PrintF(
+      "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---|\n");
   for (const IntervalRow& r : results.intervals) {
     absl::PrintF(
-        "| %s | %s | %d / %d | %.1f%% | %.3f | %.3f | %.1f%% | %.1f%% | %.1f | %.1f | %.1f | %.1f "
-        "| %d | "
-        "%s | %s |\n",
+        "| %s | %s | %d / %d | %.1f%% | %.3f | %.3f | %.3f | %.3f | %.1f%% | %.1f%% | %.1f | %.1f "
+        "| %.1f | %.1f | %d | %s | %s |\n",
         r.model, r.set, r.internal, r.cover, r.contact_percent, r.mean_width, r.p95_width,
-        r.decided_1, r.decided_5, r.rss_us, r.sphere_us, r.fcl_us, r.speedup(), r.misses,
-        Pass(r.mean_width <= kTargetMeanWidthPercent), Pass(r.speedup() >= kTargetSpeedup));
+        r.lower_gap, r.upper_gap, r.decided_1, r.decided_5, r.rss_us, r.sphere_us, r.fcl_us,
+        r.speedup(), r.misses, Pass(r.mean_width <= kTargetMeanWidthPercent),
+        Pass(r.speedup() >= kTargetSpeedup));
   }
 }
 
@@ -390,6 +403,11 @@ int main(int argc, char** argv) {
                  "Sphere budget of the internal sets behind the intervals")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  app.add_option("--interval-covers", options.interval_covers,
+                 "Cover sizes behind the intervals (those part 1 made are reused)")
+      ->delimiter(',')
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   app.add_option("--amaa", options.amaa_dir,
                  "Directory of AMAA's sphere files <model>.sph: measure their protrusion and "
                  "certify them (else issue 22's quoted figures are printed)");
@@ -405,6 +423,7 @@ int main(int argc, char** argv) {
     options.amaa_counts = false;
     options.internal_spheres = 100;
     options.poses = 20;
+    options.interval_covers = {100};
   }
 
   Results results;
@@ -419,9 +438,29 @@ int main(int argc, char** argv) {
       results.errors.push_back(model + ": " + solid.status().ToString());
       continue;
     }
-    const MadeCover cover = RunCovers(*solid, model, options, results);
-    if (cover.spheres.empty()) continue;
-    RunIntervals(*solid, model, cover.spheres, cover.delta, options, results);
+    std::map<std::int64_t, MadeCover> covers = RunCovers(*solid, model, options, results);
+    SphereSetParameters parameters;
+    parameters.max_spheres = options.internal_spheres;
+    parameters.evaluate = false;
+    absl::StatusOr<GeneratedSphereSet> internal = GenerateSphereSet(*solid, parameters);
+    if (!internal.ok()) {
+      results.errors.push_back(model + " internal set: " + internal.status().ToString());
+      continue;
+    }
+    for (const std::int64_t budget : options.interval_covers) {
+      if (covers.count(budget) == 0) {
+        CoverParameters cover_parameters;
+        cover_parameters.max_spheres = budget;
+        absl::StatusOr<GeneratedCover> cover = GenerateCover(*solid, cover_parameters);
+        if (!cover.ok()) {
+          results.errors.push_back(
+              absl::StrFormat("%s cover of %d: %s", model, budget, cover.status().ToString()));
+          continue;
+        }
+        covers[budget] = MadeCover{std::move(cover->set.spheres), std::move(cover->certificate)};
+      }
+      RunIntervals(*solid, model, internal->set.spheres, covers[budget], options, results);
+    }
   }
   PrintCovers(options, results);
   PrintIntervals(options, results);

@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "inscribe/cover_certificate.h"
 
 namespace inscribe {
 namespace {
@@ -26,6 +27,17 @@ absl::Status PairError(std::size_t index, const absl::Status& status) {
 }
 
 }  // namespace
+
+absl::StatusOr<std::vector<Sphere>> UpperBoundSpheres(const std::vector<Sphere>& internal,
+                                                      const std::vector<Sphere>& cover,
+                                                      const std::vector<double>& protrusions) {
+  std::vector<Sphere> out = internal;
+  if (protrusions.empty()) return out;
+  absl::StatusOr<std::vector<Sphere>> cores = CoverCores(cover, protrusions);
+  if (!cores.ok()) return cores.status();
+  out.insert(out.end(), cores->begin(), cores->end());
+  return out;
+}
 
 absl::Status CheckCertifiedObject(const CertifiedObject& object) {
   if (object.internal == nullptr) {

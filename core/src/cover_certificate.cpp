@@ -97,7 +97,7 @@ class Certifier {
   }
 
  private:
-  bool Cancelled() const { return control_.cancel != nullptr && control_.cancel->load(); }
+  bool Cancelled() const { return control_.cancelled(); }
 
   void Visit(int level, const Index& index, const std::vector<std::int32_t>& candidates,
              double distance_bound) {
@@ -203,25 +203,54 @@ class Certifier {
 
 }  // namespace
 
-absl::StatusOr<double> SphereProtrusionBound(const Solid& solid,
-                                             const std::vector<Sphere>& spheres) {
+absl::StatusOr<std::vector<double>> SphereProtrusions(const Solid& solid,
+                                                      const std::vector<Sphere>& spheres) {
   if (absl::Status s = CheckSpheres(spheres); !s.ok()) return s;
-  const double scale = ComputeBoundingBox(solid.mesh().vertices).extent().maxCoeff();
-  std::vector<double> reach(spheres.size());
+  // The oracle's distances err by a few ulps of the coordinates, not of the extent.
+  const BoundingBox box = ComputeBoundingBox(solid.mesh().vertices);
+  const double scale = std::max(
+      {box.extent().maxCoeff(), box.min.cwiseAbs().maxCoeff(), box.max.cwiseAbs().maxCoeff()});
+  std::vector<double> protrusions(spheres.size());
   tbb::parallel_for(std::size_t{0}, spheres.size(), [&](std::size_t i) {
     const Sphere& s = spheres[i];
     const BoundaryPoint closest = solid.oracle.ClosestPoint(s.center);
     // Depth of the centre: + inside, - outside. A centre too close to the boundary for its
-    // side to matter counts as outside (the larger reach).
+    // side to matter counts as outside (the larger protrusion).
     const bool inside = solid.oracle.Classify(s.center, closest) == Side::kInside &&
                         closest.distance > 1e-9 * scale;
     const double depth = inside ? closest.distance : -closest.distance;
     // Rounded up: the distance and the subtraction are each within a few ulps.
-    reach[i] = (s.radius - depth) * (1.0 + 1e-12) + 1e-12 * scale;
+    const double p = s.radius - depth;
+    protrusions[i] = p + 1e-12 * std::abs(p) + 1e-12 * scale;
   });
+  return protrusions;
+}
+
+absl::StatusOr<double> SphereProtrusionBound(const Solid& solid,
+                                             const std::vector<Sphere>& spheres) {
+  absl::StatusOr<std::vector<double>> protrusions = SphereProtrusions(solid, spheres);
+  if (!protrusions.ok()) return protrusions.status();
   double delta = 0.0;
-  for (const double r : reach) delta = std::max(delta, r);
+  for (const double p : *protrusions) delta = std::max(delta, p);
   return delta;
+}
+
+absl::StatusOr<std::vector<Sphere>> CoverCores(const std::vector<Sphere>& cover,
+                                               const std::vector<double>& protrusions) {
+  if (protrusions.size() != cover.size()) {
+    return absl::InvalidArgumentError(absl::StrCat("cover protrusions: ", protrusions.size(),
+                                                   " values for ", cover.size(), " spheres"));
+  }
+  std::vector<Sphere> cores;
+  for (std::size_t i = 0; i < cover.size(); ++i) {
+    if (!std::isfinite(protrusions[i])) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("cover protrusions: value ", i, " (", protrusions[i], ") is not finite"));
+    }
+    const double radius = cover[i].radius - protrusions[i];
+    if (radius > 0.0) cores.push_back(Sphere{cover[i].center, radius});
+  }
+  return cores;
 }
 
 absl::Status CheckCoverCertifyOptions(const CoverCertifyOptions& options) {
@@ -241,8 +270,8 @@ absl::StatusOr<CoverCertificate> CertifyCover(const Solid& solid,
                                               const GenerationControl& control) {
   const auto start = std::chrono::steady_clock::now();
   if (absl::Status s = CheckCoverCertifyOptions(options); !s.ok()) return s;
-  absl::StatusOr<double> delta = SphereProtrusionBound(solid, spheres);
-  if (!delta.ok()) return delta.status();
+  absl::StatusOr<std::vector<double>> protrusions = SphereProtrusions(solid, spheres);
+  if (!protrusions.ok()) return protrusions.status();
 
   // With stop_at_witness, a coarse pass first: a set that misses a point of the solid usually
   // shows it there, without splitting the cells along its tangencies down to the finest.
@@ -266,7 +295,8 @@ absl::StatusOr<CoverCertificate> CertifyCover(const Solid& solid,
 
   CoverCertificate out;
   out.certified = counts.failed == 0;
-  out.delta = *delta;
+  for (const double p : *protrusions) out.delta = std::max(out.delta, p);
+  out.protrusions = *std::move(protrusions);
   out.resolution = certifier.finest_side();
   out.cells = counts.cells;
   out.cells_in_sphere = counts.in_sphere;

@@ -43,10 +43,6 @@ double SecondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-bool Cancelled(const GenerationControl& control) {
-  return control.cancel != nullptr && control.cancel->load(std::memory_order_relaxed);
-}
-
 // K directions spread evenly over the unit sphere (Fibonacci lattice). The same set serves every
 // voxel, so a voxel's result depends only on its position.
 std::vector<Vector3> FibonacciDirections(int count) {
@@ -376,11 +372,11 @@ absl::StatusOr<MedialSphereResult> GenerateMedialSpheres(const BoundaryOracle& o
       ScreeningSubsetFirst(FibonacciDirections(options.samples), screen_count);
   const VoxelSearch search(oracle, directions, screen_count, params);
 
-  if (Cancelled(control)) return absl::CancelledError("medial-sphere generation cancelled");
+  if (control.cancelled()) return absl::CancelledError("medial-sphere generation cancelled");
   std::int64_t queries = 0;
   const std::vector<VisitedVoxel> voxels =
       internal::CullVoxels(oracle, *grid, queries, control.cancel);
-  if (Cancelled(control)) return absl::CancelledError("medial-sphere generation cancelled");
+  if (control.cancelled()) return absl::CancelledError("medial-sphere generation cancelled");
   result.stats.visited_voxels = static_cast<std::int64_t>(voxels.size());
   for (const VisitedVoxel& voxel : voxels) result.stats.boundary_voxels += voxel.boundary;
 
@@ -390,14 +386,14 @@ absl::StatusOr<MedialSphereResult> GenerateMedialSpheres(const BoundaryOracle& o
   if (options.corner_screen) {
     screened_in = internal::ScreenByCorners(
         oracle, *grid, voxels, options.object_angle - kCornerScreenMargin, queries, control.cancel);
-    if (Cancelled(control)) return absl::CancelledError("medial-sphere generation cancelled");
+    if (control.cancelled()) return absl::CancelledError("medial-sphere generation cancelled");
   }
   for (char pass : screened_in) result.stats.screened_voxels += pass == 0;
   const int slots = options.subdivide_boundary ? 8 : 1;
   const double size = grid->size;
   const std::size_t batch = 2048;
   for (std::size_t first = 0; first < voxels.size(); first += batch) {
-    if (Cancelled(control)) return absl::CancelledError("medial-sphere generation cancelled");
+    if (control.cancelled()) return absl::CancelledError("medial-sphere generation cancelled");
     const std::size_t last = std::min(voxels.size(), first + batch);
     std::vector<Candidate> found((last - first) * static_cast<std::size_t>(slots));
     std::vector<VoxelCounters> counters(last - first);
@@ -405,7 +401,7 @@ absl::StatusOr<MedialSphereResult> GenerateMedialSpheres(const BoundaryOracle& o
         tbb::blocked_range<std::size_t>(first, last, 8),
         [&](const tbb::blocked_range<std::size_t>& range) {
           for (std::size_t v = range.begin(); v != range.end(); ++v) {
-            if (Cancelled(control)) return;
+            if (control.cancelled()) return;
             if (!screened_in.empty() && !screened_in[v]) continue;
             const VisitedVoxel& voxel = voxels[v];
             const Vector3 corner = grid->corner(voxel.index[0], voxel.index[1], voxel.index[2]);
@@ -428,7 +424,7 @@ absl::StatusOr<MedialSphereResult> GenerateMedialSpheres(const BoundaryOracle& o
             }
           }
         });
-    if (Cancelled(control)) return absl::CancelledError("medial-sphere generation cancelled");
+    if (control.cancelled()) return absl::CancelledError("medial-sphere generation cancelled");
     for (const Candidate& candidate : found) {
       if (!candidate.valid) continue;
       result.set.spheres.push_back(candidate.sphere);

@@ -16,6 +16,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "cover_cells.h"
+#include "cover_choice.h"
 #include "inscribe/sphere_set_generation.h"
 #include "surface_sampling.h"
 
@@ -34,6 +35,8 @@ constexpr std::int64_t kDeltaModeBases = 4'000;
 // The first rung of the ladders and the sample grid's cell, as fractions of the bounding
 // box's largest side.
 constexpr double kFirstRung = 1.0 / 256;
+// Halvings of the first rung tried where it lies past the medial axis (a thin part).
+constexpr int kThinHalvings = 6;
 constexpr double kGridCell = 1.0 / 64;
 // Longest edge of the boundary's pieces each held whole by one sphere (a fraction of the
 // largest side): a piece costs at most this much more growth than its best point.
@@ -42,207 +45,6 @@ constexpr double kBoundaryEdge = 1.0 / 1024;
 constexpr int kGoldenSteps = 10;
 // Thresholds the delta mode tries.
 constexpr int kDeltaModeAttempts = 5;
-// Binary search steps on the threshold of the budget mode.
-constexpr int kThresholdSteps = 10;
-// The share of the farthest-first threshold the search tries first.
-constexpr double kFirstListPart = 0.65;
-
-// How much candidate i must grow to reach sample p: |p - c_i| - r_i.
-double Growth(const Sphere& s, const Vector3& p) { return (p - s.center).norm() - s.radius; }
-
-// The points a cover must reach: the mesh vertices, boundary samples, and the deepest
-// candidate centres (standing in for the interior).
-struct Samples {
-  std::vector<Vector3> points;
-};
-
-// Uniform grid over points, for the points within a distance of a centre.
-class PointGrid {
- public:
-  PointGrid(const std::vector<Vector3>& points, double cell) : points_(points), cell_(cell) {
-    lo_ = hi_ = points.empty() ? Vector3::Zero() : points[0];
-    for (const Vector3& p : points) {
-      lo_ = lo_.cwiseMin(p);
-      hi_ = hi_.cwiseMax(p);
-    }
-    for (int k = 0; k < 3; ++k) {
-      dims_[k] = std::max<std::int64_t>(1, static_cast<std::int64_t>((hi_[k] - lo_[k]) / cell) + 1);
-    }
-    std::vector<std::int64_t> key(points.size());
-    start_.assign(static_cast<std::size_t>(dims_[0] * dims_[1] * dims_[2]) + 1, 0);
-    for (std::size_t i = 0; i < points.size(); ++i) {
-      key[i] = Key(Cell(points[i]));
-      ++start_[static_cast<std::size_t>(key[i]) + 1];
-    }
-    for (std::size_t c = 1; c < start_.size(); ++c) start_[c] += start_[c - 1];
-    order_.resize(points.size());
-    std::vector<std::int64_t> fill(start_.begin(), start_.end() - 1);
-    for (std::size_t i = 0; i < points.size(); ++i) {
-      order_[static_cast<std::size_t>(fill[static_cast<std::size_t>(key[i])]++)] =
-          static_cast<std::int32_t>(i);
-    }
-  }
-
-  // Calls f(index) for every point within `radius` of `center` (and maybe a few more).
-  template <typename F>
-  void ForEachNear(const Vector3& center, double radius, F&& f) const {
-    const Eigen::Array3i a = Cell(center - Vector3::Constant(radius));
-    const Eigen::Array3i b = Cell(center + Vector3::Constant(radius));
-    for (int x = a[0]; x <= b[0]; ++x) {
-      for (int y = a[1]; y <= b[1]; ++y) {
-        for (int z = a[2]; z <= b[2]; ++z) {
-          const std::int64_t k = Key(Eigen::Array3i(x, y, z));
-          for (std::int64_t j = start_[static_cast<std::size_t>(k)];
-               j < start_[static_cast<std::size_t>(k) + 1]; ++j) {
-            f(static_cast<std::size_t>(order_[static_cast<std::size_t>(j)]));
-          }
-        }
-      }
-    }
-  }
-
- private:
-  Eigen::Array3i Cell(const Vector3& p) const {
-    Eigen::Array3i c;
-    for (int k = 0; k < 3; ++k) {
-      const double v = std::floor((p[k] - lo_[k]) / cell_);
-      c[k] = static_cast<int>(std::clamp(v, 0.0, static_cast<double>(dims_[k] - 1)));
-    }
-    return c;
-  }
-  std::int64_t Key(const Eigen::Array3i& c) const {
-    return (static_cast<std::int64_t>(c[0]) * dims_[1] + c[1]) * dims_[2] + c[2];
-  }
-
-  const std::vector<Vector3>& points_;
-  double cell_;
-  Vector3 lo_, hi_;
-  std::int64_t dims_[3] = {1, 1, 1};
-  std::vector<std::int64_t> start_;
-  std::vector<std::int32_t> order_;
-};
-
-// For each candidate, the samples it reaches by growing at most `limit`, sorted by growth:
-// the candidate's cover set at any threshold t <= limit is a prefix.
-struct ReachLists {
-  std::vector<std::size_t> begin;  // candidate i: entries [begin[i], begin[i + 1])
-  std::vector<float> growth;       // rounded; only orders and thresholds the choice
-  std::vector<std::int32_t> sample;
-
-  std::size_t Prefix(std::size_t i, double t) const {
-    const auto first = growth.begin() + static_cast<std::ptrdiff_t>(begin[i]);
-    const auto last = growth.begin() + static_cast<std::ptrdiff_t>(begin[i + 1]);
-    return static_cast<std::size_t>(std::upper_bound(first, last, static_cast<float>(t)) - first);
-  }
-};
-
-ReachLists MakeReachLists(const std::vector<Sphere>& candidates, const Samples& samples,
-                          const PointGrid& grid, double limit) {
-  std::vector<std::vector<std::pair<float, std::int32_t>>> lists(candidates.size());
-  tbb::parallel_for(std::size_t{0}, candidates.size(), [&](std::size_t i) {
-    std::vector<std::pair<float, std::int32_t>>& list = lists[i];
-    grid.ForEachNear(candidates[i].center, candidates[i].radius + limit, [&](std::size_t p) {
-      const double g = Growth(candidates[i], samples.points[p]);
-      if (g <= limit) list.emplace_back(static_cast<float>(g), static_cast<std::int32_t>(p));
-    });
-    std::sort(list.begin(), list.end());
-  });
-  ReachLists out;
-  out.begin.assign(candidates.size() + 1, 0);
-  for (std::size_t i = 0; i < candidates.size(); ++i) {
-    out.begin[i + 1] = out.begin[i] + lists[i].size();
-  }
-  out.growth.resize(out.begin.back());
-  out.sample.resize(out.begin.back());
-  tbb::parallel_for(std::size_t{0}, candidates.size(), [&](std::size_t i) {
-    for (std::size_t k = 0; k < lists[i].size(); ++k) {
-      out.growth[out.begin[i] + k] = lists[i][k].first;
-      out.sample[out.begin[i] + k] = lists[i][k].second;
-    }
-  });
-  return out;
-}
-
-// The farthest-first choice (Gonzalez): the deepest candidate, then repeatedly the candidate
-// that reaches the worst-served sample with the least growth. Returns the chosen candidates
-// and the growth that serves every sample (an upper bound for the threshold search).
-std::pair<std::vector<std::size_t>, double> FarthestFirst(const std::vector<Sphere>& candidates,
-                                                          const Samples& samples,
-                                                          std::size_t count) {
-  std::vector<double> served(samples.points.size(), std::numeric_limits<double>::infinity());
-  std::vector<char> taken(candidates.size(), 0);
-  std::vector<std::size_t> chosen;
-  std::size_t next = 0;
-  for (std::size_t i = 1; i < candidates.size(); ++i) {
-    if (candidates[i].radius > candidates[next].radius) next = i;
-  }
-  double worst = std::numeric_limits<double>::infinity();
-  while (true) {
-    chosen.push_back(next);
-    taken[next] = 1;
-    const Sphere& s = candidates[next];
-    tbb::parallel_for(std::size_t{0}, samples.points.size(), [&](std::size_t p) {
-      served[p] = std::min(served[p], Growth(s, samples.points[p]));
-    });
-    const auto at = std::max_element(served.begin(), served.end());
-    worst = *at;
-    if (chosen.size() == count || worst <= 0.0 || chosen.size() == candidates.size()) break;
-    const Vector3& p = samples.points[static_cast<std::size_t>(at - served.begin())];
-    double best = std::numeric_limits<double>::infinity();
-    for (std::size_t i = 0; i < candidates.size(); ++i) {
-      if (taken[i]) continue;
-      const double g = Growth(candidates[i], p);
-      if (g < best) {
-        best = g;
-        next = i;
-      }
-    }
-  }
-  return {std::move(chosen), std::max(worst, 0.0)};
-}
-
-// Greedy set cover at threshold t: repeatedly the candidate reaching the most samples not yet
-// reached (ties: the lower index), lazily re-counted. The chosen candidates, or nothing when
-// more than `limit` are needed or some sample is out of every candidate's reach.
-std::optional<std::vector<std::size_t>> GreedyCover(const ReachLists& lists,
-                                                    std::size_t num_samples, double t,
-                                                    std::size_t limit) {
-  const std::size_t n = lists.begin.size() - 1;
-  std::vector<std::size_t> prefix(n);
-  std::priority_queue<std::pair<std::size_t, std::int64_t>> queue;  // (gain, -index)
-  std::vector<char> reachable(num_samples, 0);
-  for (std::size_t i = 0; i < n; ++i) {
-    prefix[i] = lists.Prefix(i, t);
-    for (std::size_t k = 0; k < prefix[i]; ++k) reachable[lists.sample[lists.begin[i] + k]] = 1;
-    if (prefix[i] > 0) queue.emplace(prefix[i], -static_cast<std::int64_t>(i));
-  }
-  if (std::find(reachable.begin(), reachable.end(), 0) != reachable.end()) return std::nullopt;
-  std::vector<char> reached(num_samples, 0);
-  std::size_t left = num_samples;
-  std::vector<std::size_t> chosen;
-  while (left > 0) {
-    if (queue.empty()) return std::nullopt;
-    const auto [gain, negative] = queue.top();
-    queue.pop();
-    const auto i = static_cast<std::size_t>(-negative);
-    std::size_t fresh = 0;
-    for (std::size_t k = 0; k < prefix[i]; ++k) fresh += !reached[lists.sample[lists.begin[i] + k]];
-    if (fresh == 0) continue;
-    if (fresh < gain) {
-      queue.emplace(fresh, negative);
-      continue;
-    }
-    if (chosen.size() == limit) return std::nullopt;
-    chosen.push_back(i);
-    for (std::size_t k = 0; k < prefix[i]; ++k) {
-      char& r = reached[lists.sample[lists.begin[i] + k]];
-      left -= !r;
-      r = 1;
-    }
-  }
-  std::sort(chosen.begin(), chosen.end());
-  return chosen;
-}
 
 // The chosen spheres grown to hold the boundary exactly, with `margin` to spare: every mesh
 // triangle is cut into sub-triangles with edges of at most `edge`, and each goes whole to the
@@ -360,10 +162,6 @@ GenerationControl Stage(const GenerationControl& control, double from, double to
   return sub;
 }
 
-bool Cancelled(const GenerationControl& control) {
-  return control.cancel != nullptr && control.cancel->load();
-}
-
 // Inward normals of the base points: the face normal of the triangle a point lies on, the
 // vertex normal at a vertex.
 // The spheres a cover is chosen from. From each base point p of the boundary (the first
@@ -402,10 +200,23 @@ std::vector<Sphere> Candidates(const Solid& solid, const std::vector<LadderBase>
       const BoundaryPoint closest = oracle.ClosestPoint(c);
       return oracle.Classify(c, closest) == Side::kInside ? closest.distance : 0.0;
     };
+    // The solid may lie on the normal's other side (a triangle the mesh orients against its
+    // neighbours; a vertex where such triangles meet); a part thinner than 2 s0 has its
+    // medial axis before the first rung: start lower there.
+    if (!(normal.norm() > 0.0)) return;
+    normal.normalize();
+    double first = s0;
+    for (int halvings = 0; halvings <= kThinHalvings; ++halvings, first *= 0.5) {
+      if (depth(first) > 0.0) break;
+      if (depth(-first) > 0.0) {
+        normal = -normal;
+        break;
+      }
+    }
     double last = 0.0, last_s = 0.0, before_s = 0.0;
     int k = 0;
     for (; k < ladder; ++k) {
-      const double s = s0 * std::pow(factor, k);
+      const double s = first * std::pow(factor, k);
       const double d = depth(s);
       // Past the medial axis the centre nears another part of the boundary: stop.
       if (d <= last) break;
@@ -417,7 +228,7 @@ std::vector<Sphere> Candidates(const Solid& solid, const std::vector<LadderBase>
     if (k == 0) return;
     // The deepest centre lies between the rung before the last and the first that failed:
     // a golden-section search of the depth along the normal.
-    double lo = before_s, hi = k < ladder ? s0 * std::pow(factor, k) : last_s;
+    double lo = before_s, hi = k < ladder ? first * std::pow(factor, k) : last_s;
     const double phi = 0.5 * (std::sqrt(5.0) - 1.0);
     double m1 = hi - phi * (hi - lo), m2 = lo + phi * (hi - lo);
     double d1 = depth(m1), d2 = depth(m2);
@@ -452,38 +263,6 @@ std::vector<Sphere> Candidates(const Solid& solid, const std::vector<LadderBase>
     if (deepest != nullptr) interior->push_back(deepest->center);
   }
   return out;
-}
-
-// The budget mode's choice: at most `count` candidates reaching every sample with the least
-// growth threshold found (a binary search over greedy set covers, from the farthest-first
-// choice's threshold down).
-std::vector<std::size_t> ChooseForBudget(const std::vector<Sphere>& candidates,
-                                         const Samples& samples, const PointGrid& grid,
-                                         std::size_t count, const GenerationControl& control) {
-  auto [chosen, limit] = FarthestFirst(candidates, samples, count);
-  if (chosen.size() < count || limit <= 0.0) return chosen;
-  // The search usually ends near half the farthest-first threshold: lists up to a part of it
-  // first (they grow with the threshold), the whole when nothing fits below that part.
-  for (const double part : {kFirstListPart, 1.0}) {
-    const ReachLists lists = MakeReachLists(candidates, samples, grid, part * limit);
-    double lo = 0.0, hi = part * limit;
-    bool found = part == 1.0;
-    for (int step = 0; step < kThresholdSteps && !Cancelled(control); ++step) {
-      const double t = step == 0 && !found ? hi : 0.5 * (lo + hi);
-      if (std::optional<std::vector<std::size_t>> cover =
-              GreedyCover(lists, samples.points.size(), t, count)) {
-        chosen = *std::move(cover);
-        hi = t;
-        found = true;
-      } else if (!found) {
-        break;  // nothing fits within this part
-      } else {
-        lo = t;
-      }
-    }
-    if (found) break;
-  }
-  return chosen;
 }
 
 // Certifies `spheres`, growing spheres around the cells it could not settle until it passes.
@@ -555,7 +334,7 @@ absl::StatusOr<GeneratedCover> GenerateCover(const Solid& solid, const CoverPara
 
   // The boundary points a cover must reach, and the bases of the candidate ladders: every
   // vertex and the first area samples.
-  Samples samples;
+  internal::CoverSamples samples;
   const Vertices drawn =
       internal::SampleBoundaryByArea(mesh, parameters.growth_samples, kGrowthSeed);
   // Vertices (the corners of sharp features), as many as the area samples at most.
@@ -588,8 +367,8 @@ absl::StatusOr<GeneratedCover> GenerateCover(const Solid& solid, const CoverPara
     return absl::FailedPreconditionError("cover: the solid has no interior to cover");
   }
   samples.points.insert(samples.points.end(), interior.begin(), interior.end());
-  const PointGrid grid(samples.points, scale * kGridCell);
-  if (Cancelled(control)) return absl::CancelledError("cover generation cancelled");
+  const internal::PointGrid grid(samples.points, scale * kGridCell);
+  if (control.cancelled()) return absl::CancelledError("cover generation cancelled");
   if (control.on_progress) control.on_progress(0.2);
 
   // The chosen candidates, holding the boundary with margin, certified (repaired if need be).
@@ -615,9 +394,9 @@ absl::StatusOr<GeneratedCover> GenerateCover(const Solid& solid, const CoverPara
 
   absl::StatusOr<GeneratedCover> out;
   if (!parameters.max_protrusion) {
-    const std::vector<std::size_t> chosen =
-        ChooseForBudget(candidates, samples, grid, static_cast<std::size_t>(budget), control);
-    if (Cancelled(control)) return absl::CancelledError("cover generation cancelled");
+    const std::vector<std::size_t> chosen = internal::ChooseForBudget(
+        candidates, samples, grid, static_cast<std::size_t>(budget), control);
+    if (control.cancelled()) return absl::CancelledError("cover generation cancelled");
     if (control.on_progress) control.on_progress(0.5);
     out = finish(chosen, Stage(control, 0.5, 1.0));
   } else {
@@ -629,10 +408,10 @@ absl::StatusOr<GeneratedCover> GenerateCover(const Solid& solid, const CoverPara
     double unreachable = 0.0;  // a threshold at which some sample is out of every reach
     double least = std::numeric_limits<double>::infinity();  // certified delta, any attempt
     for (int attempt = 0; attempt < kDeltaModeAttempts; ++attempt) {
-      if (Cancelled(control)) return absl::CancelledError("cover generation cancelled");
-      const ReachLists lists = MakeReachLists(candidates, samples, grid, t);
+      if (control.cancelled()) return absl::CancelledError("cover generation cancelled");
+      const internal::ReachLists lists = internal::MakeReachLists(candidates, samples, grid, t);
       const std::optional<std::vector<std::size_t>> chosen =
-          GreedyCover(lists, samples.points.size(), t, candidates.size());
+          internal::GreedyCover(lists, samples.points.size(), t, candidates.size());
       if (!chosen) {
         unreachable = t;
         if (t >= bound - margin) break;

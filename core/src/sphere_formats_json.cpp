@@ -167,6 +167,31 @@ absl::Status ReadContacts(const Json& doc, SphereSet* set) {
   return absl::OkStatus();
 }
 
+absl::Status ReadProtrusions(const Json& doc, SphereFile* file) {
+  const auto it = doc.find("protrusions");
+  if (it == doc.end()) return absl::OkStatus();
+  if (!it->is_array()) {
+    return Invalid(absl::StrCat("\"protrusions\" is ", it->type_name(), ", expected an array"));
+  }
+  if (it->empty()) return absl::OkStatus();
+  if (it->size() != file->set.spheres.size()) {
+    return Invalid(absl::StrCat(it->size(), " protrusions for ", file->set.spheres.size(),
+                                " spheres (need one per sphere, or none)"));
+  }
+  for (std::size_t i = 0; i < it->size(); ++i) {
+    const Json& value = (*it)[i];
+    if (!value.is_number()) {
+      return Invalid(absl::StrCat("protrusion ", i, ": ", Shown(value), " is not a number"));
+    }
+    const double p = value.get<double>();
+    if (!std::isfinite(p)) {
+      return Invalid(absl::StrCat("protrusion ", i, ": ", Shown(value), " is not finite"));
+    }
+    file->protrusions.push_back(p);
+  }
+  return absl::OkStatus();
+}
+
 absl::StatusOr<Json> NamedValuesToJson(const NamedValues& values, const char* key) {
   Json object = Json::object();
   std::set<absl::string_view> seen;
@@ -233,6 +258,7 @@ absl::StatusOr<SphereFile> ParseJsonSphereFile(absl::string_view bytes) {
   }
   if (absl::Status status = ReadSpheres(doc, &file.set); !status.ok()) return status;
   if (absl::Status status = ReadContacts(doc, &file.set); !status.ok()) return status;
+  if (absl::Status status = ReadProtrusions(doc, &file); !status.ok()) return status;
   if (absl::Status status = ReadNamedValues(doc, "stats", &file.stats); !status.ok()) {
     return status;
   }
@@ -270,6 +296,9 @@ absl::StatusOr<std::string> FormatJsonSphereFile(const SphereFile& file) {
                                           c.barycentric.z()})));
       }
       absl::StrAppend(&out, "\n  ],\n");
+    }
+    if (!file.protrusions.empty()) {
+      absl::StrAppend(&out, "  \"protrusions\": ", dump(Json(file.protrusions)), ",\n");
     }
     absl::StrAppend(&out, "  \"stats\": ", dump(*stats), "\n}\n");
   } catch (const Json::exception& e) {

@@ -108,6 +108,17 @@ absl::Status CheckSphereSetForWrite(const SphereFile& file) {
           absl::StrCat("contact ", i, ": barycentric weights are not finite"));
     }
   }
+  if (!file.protrusions.empty() && file.protrusions.size() != set.spheres.size()) {
+    return absl::InvalidArgumentError(absl::StrCat(file.protrusions.size(), " protrusions for ",
+                                                   set.spheres.size(),
+                                                   " spheres (need one per sphere, or none)"));
+  }
+  for (std::size_t i = 0; i < file.protrusions.size(); ++i) {
+    if (!std::isfinite(file.protrusions[i])) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("protrusion ", i, ": ", file.protrusions[i], " is not finite"));
+    }
+  }
   return CheckMeshSha256(file.mesh_sha256);
 }
 

@@ -250,6 +250,12 @@ absl::StatusOr<std::shared_ptr<const SphereSetEntry>> ResultStore::PutSphereSet(
         "certificate: it does not certify the set (certified is false); send a certified one, "
         "or none and let CertifyCover prove it against the set's mesh");
   }
+  if (certificate && !certificate->protrusions.empty() &&
+      certificate->protrusions.size() != set.spheres.size()) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "certificate: ", certificate->protrusions.size(), " protrusions for ", set.spheres.size(),
+        " spheres; send one per sphere, in the set's order, or none"));
+  }
   if (!mesh_key.empty()) {
     absl::StatusOr<std::shared_ptr<const StoredMeshEntry>> mesh = GetMesh(mesh_key);
     if (!mesh.ok()) return mesh.status();
@@ -360,8 +366,30 @@ absl::StatusOr<std::shared_ptr<const CertifiedObjectEntry>> ResultStore::GetCert
   }
   absl::StatusOr<CoverCertificate> certificate = CoverCertificateOf(cover_key);
   if (!certificate.ok()) return certificate.status();
-  absl::StatusOr<std::shared_ptr<const SphereHierarchy>> internal_h =
-      GetHierarchy(internal_key, volume);
+  // The internal set with the cover's cores (UpperBoundSpheres), when the certificate gives
+  // them; else the internal set's own hierarchy.
+  absl::StatusOr<std::shared_ptr<const SphereHierarchy>> internal_h;
+  if (certificate->protrusions.empty()) {
+    internal_h = GetHierarchy(internal_key, volume);
+  } else {
+    const std::string upper_key = wire::UpperBoundHierarchyKey(internal_key, cover_key, volume);
+    absl::StatusOr<CacheLookup> found = cache_->GetOrCompute(
+        upper_key,
+        [&]() -> absl::StatusOr<CachedValue> {
+          absl::StatusOr<std::vector<Sphere>> spheres = UpperBoundSpheres(
+              (*internal)->set.spheres, (*cover)->set.spheres, certificate->protrusions);
+          if (!spheres.ok()) {
+            return absl::FailedPreconditionError(
+                absl::StrCat("cover ", cover_key, ": ", spheres.status().message()));
+          }
+          absl::StatusOr<SphereHierarchy> h = SphereHierarchy::Build(*spheres, volume);
+          if (!h.ok()) return h.status();
+          return DecodeHierarchy(h->Serialize());
+        },
+        DecodeHierarchy);
+    if (!found.ok()) return found.status();
+    internal_h = ObjectOf<SphereHierarchy>(*found, upper_key);
+  }
   if (!internal_h.ok()) return internal_h.status();
   absl::StatusOr<std::shared_ptr<const SphereHierarchy>> cover_h = GetHierarchy(cover_key, volume);
   if (!cover_h.ok()) return cover_h.status();

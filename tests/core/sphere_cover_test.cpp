@@ -17,6 +17,7 @@
 #include "inscribe/cover_certificate.h"
 #include "inscribe/solid.h"
 #include "inscribe/sphere_set_generation.h"
+#include "support/brute_force_closest_point.h"
 #include "support/synthetic_meshes.h"
 #include "support/test_meshes.h"
 #include "surface_sampling.h"
@@ -95,6 +96,24 @@ void ExpectSoundCover(const Solid& solid, const GeneratedCover& cover, const std
   }
   const double measured = MeasuredProtrusion(solid, cover.set.spheres, 200);
   EXPECT_GE(cover.certificate.delta, measured);
+  // The per-sphere protrusions: delta is the largest, and each sphere's core (radius less
+  // protrusion) is a ball inside the solid: its centre is inside, at least its radius from
+  // every triangle (brute force, not the oracle that made them).
+  ASSERT_EQ(cover.certificate.protrusions.size(), cover.set.size());
+  double largest_protrusion = 0.0;
+  for (const double p : cover.certificate.protrusions) {
+    largest_protrusion = std::max(largest_protrusion, p);
+  }
+  EXPECT_EQ(cover.certificate.delta, largest_protrusion);
+  absl::StatusOr<std::vector<Sphere>> cores =
+      CoverCores(cover.set.spheres, cover.certificate.protrusions);
+  ASSERT_TRUE(cores.ok()) << cores.status();
+  EXPECT_GT(cores->size(), cover.set.size() / 2);
+  for (std::size_t i = 0; i < cores->size(); i += std::max<std::size_t>(1, cores->size() / 100)) {
+    const Sphere& core = (*cores)[i];
+    EXPECT_EQ(solid.oracle.Classify(core.center), Side::kInside) << "core " << i;
+    EXPECT_LE(core.radius, testing::BruteForceDistance(solid.mesh(), core.center)) << "core " << i;
+  }
   const double largest = ComputeBoundingBox(solid.mesh().vertices).extent().maxCoeff();
   std::cout << name << ": " << cover.set.size() << " spheres, delta "
             << 100.0 * cover.certificate.delta / largest << "% of the largest side (measured "

@@ -85,6 +85,14 @@ TEST(SphereFileErrors, Json) {
   EXPECT_THAT(JsonError(Doc("[[0,NaN,0,1]]")), HasSubstr("not valid JSON"));
   EXPECT_THAT(JsonError(Doc("[[0,0,0,1],[0,0,0,1]]", R"(,"contacts":[[0,1,0,0]])")),
               HasSubstr("1 contacts for 2 spheres (need one per sphere, or none)"));
+  EXPECT_THAT(JsonError(Doc("[[0,0,0,1],[0,0,0,1]]", R"(,"protrusions":[0.5])")),
+              HasSubstr("1 protrusions for 2 spheres (need one per sphere, or none)"));
+  EXPECT_THAT(JsonError(Doc("[[0,0,0,1]]", R"(,"protrusions":["x"])")),
+              AllOf(HasSubstr("protrusion 0: "), HasSubstr(" is not a number")));
+  EXPECT_THAT(JsonError(Doc("[[0,0,0,1]]", R"(,"protrusions":[1e999])")),
+              HasSubstr("number overflow"));
+  EXPECT_THAT(JsonError(Doc("[[0,0,0,1]]", R"(,"protrusions":{})")),
+              HasSubstr("\"protrusions\" is object, expected an array"));
   EXPECT_THAT(JsonError(Doc("[[0,0,0,1]]", R"(,"contacts":[[-1,1,0,0]])")),
               HasSubstr("contact 0: triangle -1 is negative"));
   EXPECT_THAT(JsonError(Doc("[[0,0,0,1]]", R"(,"contacts":[[1.5,1,0,0]])")),

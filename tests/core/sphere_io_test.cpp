@@ -44,6 +44,7 @@ SphereFile Small() {
                  {"exact", true},
                  {"method", std::string("voxel")}};
   file.stats = {{"seconds", 0.42}, {"nerr", 0.031}};
+  file.protrusions = {0.5, -0.25};
   return file;
 }
 
@@ -80,6 +81,7 @@ SphereFile RandomBits(std::size_t n, std::uint32_t seed) {
     file.set.spheres.push_back(s);
     file.set.contacts.push_back(
         {static_cast<std::int32_t>(rng() % 2147483648u), Vector3(draw(), draw(), draw())});
+    file.protrusions.push_back(draw());
   }
   file.mesh_sha256 = kHash;
   file.params = {{"a", draw()}, {"b", static_cast<std::int64_t>(rng())}, {"c", false}};
@@ -119,6 +121,10 @@ void ExpectSameFileBitExact(const SphereFile& a, const SphereFile& b) {
     for (int k = 0; k < 3; ++k) {
       EXPECT_EQ(Bits(a.set.contacts[i].barycentric[k]), Bits(b.set.contacts[i].barycentric[k]));
     }
+  }
+  ASSERT_EQ(a.protrusions.size(), b.protrusions.size());
+  for (std::size_t i = 0; i < a.protrusions.size(); ++i) {
+    EXPECT_EQ(Bits(a.protrusions[i]), Bits(b.protrusions[i])) << i;
   }
   EXPECT_EQ(a.mesh_sha256, b.mesh_sha256);
   ExpectSameValuesBitExact(a.params, b.params);
@@ -209,6 +215,7 @@ TEST(SphereFileGolden, WritesJson) {
                 "    [3,0.25,0.25,0.5],\n"
                 "    [0,1.0,0.0,0.0]\n"
                 "  ],\n"
+                "  \"protrusions\": [0.5,-0.25],\n"
                 "  \"stats\": {\"seconds\":0.42,\"nerr\":0.031}\n"
                 "}\n");
 }

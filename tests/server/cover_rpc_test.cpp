@@ -154,7 +154,8 @@ CertifiedSolids GenerateSolids(const client::Client& client) {
 
 // Certified Distance and DistanceStream give, for every pose, exactly the interval the rule of
 // certified_distance.h makes of the brute-force sphere distances (covers: lower; internal
-// sets and deltas: upper) and the answer DecideCloser gives; the stream answers as the batch.
+// sets with the covers' cores, and deltas: upper) and the answer DecideCloser gives; the
+// stream answers as the batch.
 TEST_F(CoverRpcTest, CertifiedIntervalsHoldTheBruteForceSphereDistances) {
   const std::unique_ptr<client::Client> client = MakeClient();
   const CertifiedSolids solids = GenerateSolids(*client);
@@ -175,14 +176,24 @@ TEST_F(CoverRpcTest, CertifiedIntervalsHoldTheBruteForceSphereDistances) {
   ASSERT_EQ(batch->results.size(), poses_b.size());
   const double deltas =
       solids.cover[0].cover->certificate.delta + solids.cover[1].cover->certificate.delta;
+  std::vector<Sphere> upper_spheres[2];
+  for (int k = 0; k < 2; ++k) {
+    const CoverCertificate& certificate = solids.cover[k].cover->certificate;
+    ASSERT_EQ(certificate.protrusions.size(), solids.cover[k].set.size());
+    absl::StatusOr<std::vector<Sphere>> spheres = UpperBoundSpheres(
+        solids.internal[k].set.spheres, solids.cover[k].set.spheres, certificate.protrusions);
+    ASSERT_TRUE(spheres.ok()) << spheres.status();
+    ASSERT_GT(spheres->size(), solids.internal[k].set.size());
+    upper_spheres[k] = *std::move(spheres);
+  }
   int decided = 0;
   for (std::size_t i = 0; i < poses_b.size(); ++i) {
     SCOPED_TRACE(i);
     const CertifiedDistanceResult& r = batch->certified[i];
     absl::StatusOr<DistanceResult> covers = BruteForceSeparationDistance(
         solids.cover[0].set.spheres, origin[0], solids.cover[1].set.spheres, poses_b[i]);
-    absl::StatusOr<DistanceResult> internal = BruteForceSeparationDistance(
-        solids.internal[0].set.spheres, origin[0], solids.internal[1].set.spheres, poses_b[i]);
+    absl::StatusOr<DistanceResult> internal =
+        BruteForceSeparationDistance(upper_spheres[0], origin[0], upper_spheres[1], poses_b[i]);
     ASSERT_TRUE(covers.ok() && internal.ok());
     const double lower = std::max(0.0, covers->distance);
     const double upper = std::max(0.0, std::min(internal->distance, lower + deltas));
@@ -285,6 +296,12 @@ TEST_F(CoverRpcTest, ASetIsACoverOnlyWithACertificateTheServerHolds) {
       client->PutCertifiedCover(solids.cover[0].set, failed);
   EXPECT_EQ(bad.status().code(), absl::StatusCode::kInvalidArgument);
   EXPECT_THAT(bad.status().message(), HasSubstr("certificate"));
+  // Protrusions that are not one per sphere are refused (they would make wrong cores).
+  CoverCertificate short_protrusions = solids.cover[0].cover->certificate;
+  short_protrusions.protrusions.pop_back();
+  bad = client->PutCertifiedCover(solids.cover[0].set, short_protrusions);
+  EXPECT_EQ(bad.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(bad.status().message(), HasSubstr("protrusions for"));
 
   // A cover (or dilated set) as the internal set; covers of another mesh.
   refused = certified(solids.cover[0].sphere_set_key, solids.cover[0].sphere_set_key,

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -238,6 +239,7 @@ TEST(CoverCertificate, RoundTripsWithoutItsCellList) {
   c.uncovered_depth = 0.01;
   c.uncovered_gap = 0.002;
   c.seconds = 1.5;
+  c.protrusions = {0.125, -0.5, 1e-300};
   v1::CoverCertificate wire;
   CoverCertificateToProto(c, &wire);
   absl::StatusOr<CoverCertificate> back = CoverCertificateFromProto(wire);
@@ -254,6 +256,11 @@ TEST(CoverCertificate, RoundTripsWithoutItsCellList) {
   EXPECT_EQ(back->uncovered_depth, c.uncovered_depth);
   EXPECT_EQ(back->uncovered_gap, c.uncovered_gap);
   EXPECT_EQ(back->seconds, c.seconds);
+  EXPECT_EQ(back->protrusions, c.protrusions);
+  // A protrusion that is not finite is refused, naming it.
+  wire.set_protrusions(1, std::numeric_limits<double>::infinity());
+  EXPECT_THAT(std::string(CoverCertificateFromProto(wire).status().message()),
+              ::testing::HasSubstr("protrusions[1]"));
   // A certified set has no witness; a malformed one is refused.
   c.uncovered_point.reset();
   wire.Clear();

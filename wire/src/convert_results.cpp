@@ -347,6 +347,7 @@ void CoverCertificateToProto(const CoverCertificate& c, v1::CoverCertificate* ou
   out->set_uncovered_depth(c.uncovered_depth);
   out->set_uncovered_gap(c.uncovered_gap);
   out->set_seconds(c.seconds);
+  out->mutable_protrusions()->Assign(c.protrusions.begin(), c.protrusions.end());
 }
 
 absl::StatusOr<CoverCertificate> CoverCertificateFromProto(const v1::CoverCertificate& c) {
@@ -369,6 +370,13 @@ absl::StatusOr<CoverCertificate> CoverCertificateFromProto(const v1::CoverCertif
   out.uncovered_depth = c.uncovered_depth();
   out.uncovered_gap = c.uncovered_gap();
   out.seconds = c.seconds();
+  for (int i = 0; i < c.protrusions_size(); ++i) {
+    if (!std::isfinite(c.protrusions(i))) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("certificate: protrusions[", i, "] (", c.protrusions(i), ") is not finite"));
+    }
+  }
+  out.protrusions.assign(c.protrusions().begin(), c.protrusions().end());
   return out;
 }
 

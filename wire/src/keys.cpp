@@ -17,13 +17,13 @@ namespace {
 constexpr char kSphereAlgorithmVersion[] = "inscribe-spheres-1";
 // Written into the key of covers only, and bumped whenever GenerateCover would give another
 // cover for the same input (so that covers are recomputed without touching other sets' keys).
-constexpr char kCoverAlgorithmVersion[] = "inscribe-cover-2";
+constexpr char kCoverAlgorithmVersion[] = "inscribe-cover-3";
 constexpr char kHierarchyVersion[] = "v1";
 // Hashed with an uploaded set's numbers: uploaded keys never collide with generated ones.
 constexpr char kUploadedSetVersion[] = "inscribe-uploaded-spheres-1";
 constexpr char kDeformerVersion[] = "inscribe-deformer-1";
 // Bumped whenever CertifyCover would give another verdict or figures for the same input.
-constexpr char kCertificateVersion[] = "inscribe-certificate-1";
+constexpr char kCertificateVersion[] = "inscribe-certificate-2";
 
 // `prefix` (a RoutePrefix, or "") then the SHA-256 of `canonical`, 64 hex digits in all: the
 // prefix takes the place of the digest's last digits. The 192 bits left keep collisions out
@@ -120,6 +120,12 @@ std::string DeformerKey(const std::string& mesh_key, const std::string& set_key,
 std::string HierarchyKey(const std::string& set_key, HierarchyVolume volume) {
   return absl::StrCat("hierarchy/", kHierarchyVersion, "/", HierarchyVolumeName(volume), "/",
                       set_key);
+}
+
+std::string UpperBoundHierarchyKey(const std::string& internal_key, const std::string& cover_key,
+                                   HierarchyVolume volume) {
+  return absl::StrCat("hierarchy/", kHierarchyVersion, "/", HierarchyVolumeName(volume), "/upper/",
+                      Sha256Hex(absl::StrCat(internal_key, "\n", cover_key, "\n")));
 }
 
 bool IsMeshKey(absl::string_view key) { return absl::StartsWith(key, "sha256:"); }

@@ -69,6 +69,7 @@ absl::StatusOr<std::optional<CoverCertificate>> RecordedCoverCertificate(const S
   c.cells_in_sphere = *in_sphere;
   c.cells_outside = *outside;
   c.failed_cells = *failed;
+  c.protrusions = file.protrusions;
   return c;
 }
 

@@ -24,9 +24,9 @@ NamedValues CoverCertificateStats(const CoverCertificate& certificate);
 // written before kinds were recorded).
 std::string RecordedKind(const SphereFile& file);
 
-// The certificate a cover file records: kind "cover" and the stats CoverCertificateStats
-// writes. nullopt for a file of another kind or of none; INVALID_ARGUMENT naming the stat when
-// a cover file lacks one of them or gives it another type.
+// The certificate a cover file records: kind "cover", the stats CoverCertificateStats writes
+// and the file's protrusions (when it has them). nullopt for a file of another kind or of none;
+// INVALID_ARGUMENT naming the stat when a cover file lacks one of them or gives it another type.
 absl::StatusOr<std::optional<CoverCertificate>> RecordedCoverCertificate(const SphereFile& file);
 
 // The verdict in words: "certified: ...", or "NOT certified: " and the point of the solid in no

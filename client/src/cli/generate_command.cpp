@@ -122,6 +122,7 @@ SphereFile MakeSphereFile(const GenerateCliOptions& options, const Generated& g)
     for (auto& stat : DilationStats(*r.dilation)) figures.push_back(std::move(stat));
   }
   if (r.cover) {
+    file.protrusions = r.cover->certificate.protrusions;
     for (auto& stat : CoverStats(*r.cover)) figures.push_back(std::move(stat));
   }
   for (auto& figure : figures) file.stats.push_back(std::move(figure));

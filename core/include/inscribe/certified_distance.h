@@ -6,7 +6,9 @@
 //   lower = max(0, d(CA, CB))            the covers hold the solids, so these are no closer;
 //   upper = max(0, min(d(A, B), max(0, d(CA, CB)) + delta_A + delta_B))
 // where d is the sphere-union distance (negative when they overlap) and the exact distance is
-// the solids' separation (0 when they touch or overlap). The second term of upper: a point
+// the solids' separation (0 when they touch or overlap). A and B are best taken with the
+// covers' cores (UpperBoundSpheres): balls inside the solid right under the cover's spheres,
+// which bring upper within a few spheres' protrusions of lower. The second term of upper: a point
 // where the covers come closest (or overlap) is within delta_A of solid_A and delta_B of
 // solid_B. Every sphere distance is computed exactly over all sphere pairs (no tolerance), and
 // lower and upper are moved outward by a margin far above the rounding of the pose and of the
@@ -22,6 +24,7 @@
 #include "absl/status/statusor.h"
 #include "inscribe/rigid_pose.h"
 #include "inscribe/separation_distance.h"
+#include "inscribe/sphere.h"
 #include "inscribe/sphere_hierarchy.h"
 
 namespace inscribe {
@@ -39,9 +42,17 @@ inline constexpr double kCertifiedDistanceFloor = 1e-150;
 // apart. Such pairs are refused.
 inline constexpr double kCertifiedDistanceMaxScale = 1e100;
 
+// The spheres for CertifiedObject::internal: the solid's internal set and, when the cover's
+// certificate gives its per-sphere protrusions (CoverCertificate::protrusions; empty: none),
+// the cover's cores (CoverCores). INVALID_ARGUMENT for protrusions neither empty nor one
+// finite value per cover sphere. O(N).
+absl::StatusOr<std::vector<Sphere>> UpperBoundSpheres(const std::vector<Sphere>& internal,
+                                                      const std::vector<Sphere>& cover,
+                                                      const std::vector<double>& protrusions);
+
 // One solid of a certified query. The hierarchies are not owned and must outlive the call.
 struct CertifiedObject {
-  const SphereHierarchy* internal = nullptr;  // spheres inside the solid
+  const SphereHierarchy* internal = nullptr;  // spheres inside the solid (UpperBoundSpheres)
   const SphereHierarchy* cover = nullptr;     // spheres holding the whole solid (certified)
   double cover_delta = 0.0;                   // the cover's certified protrusion bound, >= 0
 };

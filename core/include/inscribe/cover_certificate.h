@@ -53,6 +53,10 @@ struct CoverCertificate {
   // of radius - depth(centre) (depth: distance to the boundary, negative outside), at least 0,
   // rounded up. Holds whether or not the set is certified. Mesh units.
   double delta = 0.0;
+  // Per sphere, in the set's order: radius - depth(centre) rounded up, a bound on how far
+  // that sphere reaches outside the solid (negative for a sphere deep inside); delta is the
+  // largest, or 0. Also what CoverCores takes. Mesh units.
+  std::vector<double> protrusions;
   // Finest cell side used, mesh units.
   double resolution = 0.0;
   // The octree: cells examined, settled inside one sphere, settled outside the solid, and the
@@ -84,9 +88,22 @@ absl::StatusOr<CoverCertificate> CertifyCover(const Solid& solid,
                                               const CoverCertifyOptions& options = {},
                                               const GenerationControl& control = {});
 
-// The protrusion bound of CoverCertificate::delta alone: max over spheres of radius -
-// depth(centre), at least 0, rounded up. Spheres must pass CheckSphere. O(N) oracle queries.
+// CoverCertificate::protrusions alone: per sphere, radius - depth(centre) rounded up by a
+// margin far above the rounding of the oracle's distance (relative to the mesh's largest
+// coordinate). A centre within that margin of the boundary counts as outside. Spheres must
+// pass CheckSphere. Parallel, O(N) oracle queries.
+absl::StatusOr<std::vector<double>> SphereProtrusions(const Solid& solid,
+                                                      const std::vector<Sphere>& spheres);
+
+// CoverCertificate::delta alone: the largest of SphereProtrusions, or 0.
 absl::StatusOr<double> SphereProtrusionBound(const Solid& solid,
                                              const std::vector<Sphere>& spheres);
+
+// The cover's cores: for each sphere i of `cover` with radius_i > protrusions[i], the ball at
+// its centre of radius radius_i - protrusions[i], at most the centre's depth, so inside the
+// solid (a ball around an inside point no larger than its depth). In the cover's order, the
+// others left out. INVALID_ARGUMENT unless there is one finite protrusion per sphere. O(N).
+absl::StatusOr<std::vector<Sphere>> CoverCores(const std::vector<Sphere>& cover,
+                                               const std::vector<double>& protrusions);
 
 }  // namespace inscribe

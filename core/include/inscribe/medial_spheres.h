@@ -59,6 +59,9 @@ struct MedialSphereOptions {
 struct GenerationControl {
   std::function<void(double fraction)> on_progress;
   const std::atomic<bool>* cancel = nullptr;
+
+  // Whether `cancel` is set.
+  bool cancelled() const { return cancel != nullptr && cancel->load(std::memory_order_relaxed); }
 };
 
 struct MedialSphereStats {

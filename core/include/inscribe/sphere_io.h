@@ -75,6 +75,9 @@ struct SphereFile {
   NamedValues params;
   // Figures about the run and the result (e.g. seconds, nerr).
   NamedValues stats;
+  // A cover's per-sphere protrusion bounds (CoverCertificate::protrusions), empty or one
+  // finite value per sphere. Only JSON holds them.
+  std::vector<double> protrusions;
 };
 
 struct SphereFileReadOptions {

@@ -57,6 +57,12 @@ std::string DeformerKey(const std::string& mesh_key, const std::string& set_key,
 // "hierarchy/v1/<volume>/<set key>".
 std::string HierarchyKey(const std::string& set_key, HierarchyVolume volume);
 
+// "hierarchy/v1/<volume>/upper/<64 hex>": the hierarchy over the spheres behind the upper bound
+// of a certified distance with internal set `internal_key` and cover `cover_key`
+// (UpperBoundSpheres). Routes with neither set (it is made where it is asked for).
+std::string UpperBoundHierarchyKey(const std::string& internal_key, const std::string& cover_key,
+                                   HierarchyVolume volume);
+
 // Whether `key` names a mesh ("sha256:"), or a sphere set ("spheres/"). O(1).
 bool IsMeshKey(absl::string_view key);
 bool IsSphereSetKey(absl::string_view key);

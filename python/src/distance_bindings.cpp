@@ -284,8 +284,18 @@ GIL; Ctrl-C cancels it. Witness points are in the world frame.)doc");
   py::class_<CertifiedBatch>(m, "CertifiedDistances",
                              "Intervals that provably hold the exact distance between two "
                              "solids, one per pose (mesh units).")
-      .def_readonly("lower", &CertifiedBatch::lower)
-      .def_readonly("upper", &CertifiedBatch::upper)
+      .def_property_readonly(
+          "lower",
+          [](const CertifiedBatch& b) {
+            return py::array_t<double>(static_cast<py::ssize_t>(b.lower.size()), b.lower.data());
+          },
+          "(N,) float64: no closer than this (mesh units)")
+      .def_property_readonly(
+          "upper",
+          [](const CertifiedBatch& b) {
+            return py::array_t<double>(static_cast<py::ssize_t>(b.upper.size()), b.upper.data());
+          },
+          "(N,) float64: no farther than this (mesh units)")
       .def_readonly("closer", &CertifiedBatch::closer,
                     "'yes', 'no' or 'undecided' per pose ('undecided' without closer_than)")
       .def("__len__", [](const CertifiedBatch& b) { return b.lower.size(); });

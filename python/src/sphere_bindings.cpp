@@ -139,12 +139,22 @@ void BindSpheres(py::module_& m) {
       .def_property_readonly(
           "centers",
           [](py::object self) {
-            return self.attr("spheres")[py::make_tuple(py::ellipsis(), py::slice(0, 3, 1))];
+            const SphereSet& set = self.cast<const PySphereSet&>().set;
+            const double* data = set.spheres.empty() ? nullptr : set.spheres.front().center.data();
+            return ReadOnlyView(data, static_cast<py::ssize_t>(set.size()), 3, sizeof(Sphere),
+                                self);
           },
           "(N, 3) float64 view of the centres")
       .def_property_readonly(
           "radii",
-          [](py::object self) { return self.attr("spheres")[py::make_tuple(py::ellipsis(), 3)]; },
+          [](py::object self) {
+            const SphereSet& set = self.cast<const PySphereSet&>().set;
+            const double* data = set.spheres.empty() ? nullptr : &set.spheres.front().radius;
+            py::array view(py::dtype::of<double>(), {static_cast<py::ssize_t>(set.size())},
+                           {static_cast<py::ssize_t>(sizeof(Sphere))}, data, self);
+            view.attr("flags").attr("writeable") = false;
+            return view;
+          },
           "(N,) float64 view of the radii")
       .def_property_readonly(
           "contact_triangles",

@@ -20,8 +20,13 @@ void BindRouting(py::module_& m) {
       },
       py::arg("spheres_bytes"),
       "What routes a set uploaded without a mesh: from its serialised SphereSet message.");
-  m.def("_rendezvous_order", &wire::RendezvousOrder, py::arg("route_key"), py::arg("names"),
-        "Replica indices for `route_key`, best first (wire::RendezvousOrder).");
+  m.def(
+      "_rendezvous_order",
+      [](const std::string& route_key, const std::vector<std::string>& names) {
+        return wire::RendezvousOrder(route_key, names);
+      },
+      py::arg("route_key"), py::arg("names"),
+      "Replica indices for `route_key`, best first (wire::RendezvousOrder).");
 }
 
 }  // namespace inscribe::python

@@ -90,6 +90,44 @@ std::shared_ptr<PySphereSet> Generate(
   return result;
 }
 
+// generate's docstring, with core's defaults.
+const std::string& GenerateDoc() {
+  static const std::string doc = [] {
+    const MedialSphereOptions medial;
+    return absl::StrCat(R"doc(Spheres for a closed mesh: the pipeline `inscribe generate` runs.
+
+mesh: an inscribe.Mesh (validated and prepared on each call) or an inscribe.Solid
+    (inscribe.prepare(mesh), reusable).
+max_spheres: at most N spheres: the finest voxel grid giving at most N (internal, dilated),
+    or the smallest protrusion reached with N (cover). voxel_size: sigma, the voxel side in
+    mesh units (internal, dilated only). At most one of the two; neither: a budget of )doc",
+                        kDefaultMaxSpheres, R"doc(.
+kind: 'internal' - medial spheres inside the solid, tangent to it, with contacts (for
+    Deformer); 'dilated' - grown to cover more of the boundary (they protrude);
+    'cover' - a certified cover holding the whole solid (.certificate.delta bounds how far
+    it reaches outside, mesh units).
+object_angle (radians, in (0, pi); default )doc",
+                        medial.object_angle, R"doc(), epsilon (mesh
+    units; default 1e-4 of the bounding-box diagonal), samples (per voxel; default )doc",
+                        medial.samples, R"doc(), subdivide_boundary, max_voxels:
+    medial-sphere settings (not for covers). dilation_growth in [0, 1] (dilated).
+    max_protrusion (mesh units, cover: the fewest spheres with delta at most this, instead of
+    a budget), cover_resolution (the certificate's finest cell, a fraction of the largest
+    bounding-box side). None means core's default for every one of them.
+evaluate: compute .quality (exact union volume, surface samples; quality_samples of them).
+progress: called on this thread with the fraction done in [0, 1]. Ctrl-C cancels the run
+    (KeyboardInterrupt) within about 50 ms of the core noticing.
+
+Returns a SphereSet: .spheres (N, 4) float64 [x, y, z, r] in the mesh's units and frame,
+.kind, .mesh_sha256 (the validated mesh's), .quality, .certificate (covers), .stats.
+The same mesh and settings give the same spheres bit for bit as `inscribe generate`.
+Raises ValueError for bad settings (the message names the field), inscribe.Error with code
+FAILED_PRECONDITION for a mesh that is not a usable solid, RESOURCE_EXHAUSTED when no grid
+fits the budget. The GIL is released while it runs.)doc");
+  }();
+  return doc;
+}
+
 }  // namespace
 
 void BindGeneration(py::module_& m) {
@@ -162,34 +200,7 @@ void BindGeneration(py::module_& m) {
         py::arg("max_voxels") = py::none(), py::arg("dilation_growth") = py::none(),
         py::arg("max_protrusion") = py::none(), py::arg("cover_resolution") = py::none(),
         py::arg("evaluate") = true, py::arg("quality_samples") = py::none(),
-        py::arg("progress") = py::none(),
-        R"doc(Spheres for a closed mesh: the pipeline `inscribe generate` runs.
-
-mesh: an inscribe.Mesh (validated and prepared on each call) or an inscribe.Solid
-    (inscribe.prepare(mesh), reusable).
-max_spheres: at most N spheres: the finest voxel grid giving at most N (internal, dilated),
-    or the smallest protrusion reached with N (cover). voxel_size: sigma, the voxel side in
-    mesh units (internal, dilated only). At most one of the two; neither: a budget of 500.
-kind: 'internal' - medial spheres inside the solid, tangent to it, with contacts (for
-    Deformer); 'dilated' - grown to cover more of the boundary (they protrude);
-    'cover' - a certified cover holding the whole solid (.certificate.delta bounds how far
-    it reaches outside, mesh units).
-object_angle (radians, in (0, pi); default 0.6), epsilon (mesh units; default 1e-4 of the
-    bounding-box diagonal), samples (per voxel; default 32), subdivide_boundary, max_voxels:
-    medial-sphere settings (not for covers). dilation_growth in [0, 1] (dilated).
-    max_protrusion (mesh units, cover: the fewest spheres with delta at most this, instead of
-    a budget), cover_resolution (the certificate's finest cell, a fraction of the largest
-    bounding-box side). None means core's default for every one of them.
-evaluate: compute .quality (exact union volume, surface samples; quality_samples of them).
-progress: called on this thread with the fraction done in [0, 1]. Ctrl-C cancels the run
-    (KeyboardInterrupt) within about 50 ms of the core noticing.
-
-Returns a SphereSet: .spheres (N, 4) float64 [x, y, z, r] in the mesh's units and frame,
-.kind, .mesh_sha256 (the validated mesh's), .quality, .certificate (covers), .stats.
-The same mesh and settings give the same spheres bit for bit as `inscribe generate`.
-Raises ValueError for bad settings (the message names the field), inscribe.Error with code
-FAILED_PRECONDITION for a mesh that is not a usable solid, RESOURCE_EXHAUSTED when no grid
-fits the budget. The GIL is released while it runs.)doc");
+        py::arg("progress") = py::none(), GenerateDoc().c_str());
 
   m.def(
       "evaluate",

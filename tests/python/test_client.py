@@ -92,7 +92,12 @@ def test_routing_picks_the_cpp_clients_replica_and_fails_over(tmp_path, eight):
         with inscribe.Client(endpoints) as client:
             result = client.generate(eight, max_spheres=40)
             assert result.cache == "memory"  # where the CLI's call computed it
-        owner = a if cli["server"] == a.address else b
+            assert result.sphere_set_key == cli["sphere_set_key"]
+        # The CLI's call computed the set on one replica only: the one Python routed to.
+        computed = {s.address: inscribe.Client(s.address).cache_stats()["computations"]
+                    for s in (a, b)}
+        owner = a if computed[a.address] > 0 else b
+        assert computed[owner.address] > 0 and computed[(b if owner is a else a).address] == 0
         # Failover: a dead replica that the mesh routes to first; the call moves on to the
         # live one at once (no backoff), as the C++ client's does.
         route = inscribe._inscribe._route_key(result.mesh_sha256)
@@ -114,16 +119,16 @@ def test_routing_picks_the_cpp_clients_replica_and_fails_over(tmp_path, eight):
 
 def test_bearer_tokens(tmp_path, eight):
     tokens = tmp_path / "tokens"
-    tokens.write_text("# test\ns3cret-token\n")
+    tokens.write_text("# test\n" + "s3cret-token-0123456789" + "\n")
     server = Server("--auth-tokens", str(tokens))
     try:
-        with inscribe.Client(server.address, token="s3cret-token") as client:
+        with inscribe.Client(server.address, token="s3cret-token-0123456789") as client:
             assert client.cache_stats()["entries"] >= 0
         with inscribe.Client(server.address) as client:
             with pytest.raises(inscribe.Error) as raised:
                 client.cache_stats()
             assert raised.value.code == "UNAUTHENTICATED"
-        with inscribe.Client(server.address, token="wrong") as client:
+        with inscribe.Client(server.address, token="wrong-token-0123456789") as client:
             with pytest.raises(inscribe.Error, match="invalid bearer token"):
                 client.cache_stats()
     finally:

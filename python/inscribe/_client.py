@@ -98,7 +98,19 @@ def _sphere_set_from_proto(message, kind: str = "", mesh_sha256: str = ""):
 
 
 def _fields(message) -> dict:
-    return {field.name: value for field, value in message.ListFields()}
+    """Every field of a response message by name, zeros included (proto3 leaves them out of
+    ListFields); unset sub-messages and optional scalars are left out, repeated ones listed."""
+    out = {}
+    for field in message.DESCRIPTOR.fields:
+        value = getattr(message, field.name)
+        if field.label == field.LABEL_REPEATED:
+            out[field.name] = [_fields(v) if field.message_type else v for v in value]
+        elif field.message_type is not None or field.has_presence:
+            if message.HasField(field.name):
+                out[field.name] = _fields(value) if field.message_type else value
+        else:
+            out[field.name] = value
+    return out
 
 
 @dataclasses.dataclass
@@ -397,6 +409,44 @@ class Client:
         figures.pop("spheres", None)
         return _sphere_set_from_proto(response.spheres, "internal"), figures
 
+    def inspect_mesh(self, mesh: _inscribe.Mesh, *, skip_self_intersections: bool = False,
+                     fill_holes: bool = False, timeout: Optional[float] = None) -> dict:
+        """The server's validation of `mesh` (nothing stored): {"mesh_sha256": ..., "report":
+        the MeshReport's fields as a dict, its "issues" a list of dicts}."""
+        request = service_pb2.InspectMeshRequest(
+            mesh=mesh_pb2.Mesh(vertices=mesh.vertices.ravel(), triangles=mesh.triangles.ravel()),
+            skip_self_intersections=skip_self_intersections, fill_holes=fill_holes)
+        response = self._unary(_inscribe._route_key(mesh.sha256), "InspectMesh", request, timeout)
+        return _fields(response)
+
+    def get_hierarchy(self, sphere_set_key: str, *, volume: str = "sphere",
+                      timeout: Optional[float] = None) -> _inscribe.Hierarchy:
+        """The server's hierarchy of a cached set, checked as it is read
+        (Hierarchy.deserialize): usable with inscribe.distance in-process."""
+        volumes = {"sphere": service_pb2.SPHERE, "rss": service_pb2.RSS}
+        if volume not in volumes:
+            raise ValueError(f"volume must be 'sphere' or 'rss', got {volume!r}")
+        request = service_pb2.GetHierarchyRequest(sphere_set_key=sphere_set_key,
+                                                  volume=volumes[volume])
+        response = self._unary(_inscribe._route_key(sphere_set_key), "GetHierarchy", request,
+                               timeout)
+        return _inscribe.Hierarchy.deserialize(response.hierarchy)
+
+    def certify_cover(self, mesh_sha256: str, spheres, *, resolution: Optional[float] = None,
+                      timeout: Optional[float] = None) -> dict:
+        """Whether a cached set (its key) or `spheres` (SphereSet or (N, 4) float64) provably
+        hold the whole solid of a stored mesh: the CoverCertificate's fields as a dict."""
+        request = service_pb2.CertifyCoverRequest(mesh_sha256=mesh_sha256)
+        if isinstance(spheres, str):
+            request.sphere_set_key = spheres
+        else:
+            request.sphere_set.CopyFrom(_sphere_set_to_proto(spheres))
+        if resolution is not None:
+            request.resolution = resolution
+        response = self._unary(_inscribe._route_key(mesh_sha256), "CertifyCover", request,
+                               timeout)
+        return _fields(response.certificate) if response.HasField("certificate") else {}
+
     def evaluate(self, mesh_sha256: str, sphere_set_key: str, *,
                  timeout: Optional[float] = None) -> dict:
         """The QualityReport of a cached set against a stored mesh, as a dict."""
@@ -408,8 +458,7 @@ class Client:
     def cache_stats(self, *, timeout: Optional[float] = None) -> dict:
         """The first listed replica's cache counters (the next when it is down), as a dict."""
         response = self._unary(None, "CacheStats", service_pb2.CacheStatsRequest(), timeout)
-        return {field.name: getattr(response, field.name)
-                for field in response.DESCRIPTOR.fields}
+        return _fields(response)
 
     def open_distance_session(self, *, volume: str = "sphere", abs_err: float = 0.0,
                               rel_err: float = 0.0, frame_timeout: float = 10.0,

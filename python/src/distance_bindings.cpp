@@ -117,11 +117,9 @@ std::vector<PosedPair> PairsOf(const SphereHierarchy& a, const SphereHierarchy& 
   return pairs;
 }
 
+// A (7,) pose rather than an (N, 7) batch; numpy arrays are looked at, not copied.
 bool IsOnePose(py::handle poses) {
-  return py::isinstance<py::array>(poses)
-             ? py::reinterpret_borrow<py::array>(poses).ndim() == 1
-             : py::len(poses) == 7 &&
-                   !py::isinstance<py::sequence>(py::reinterpret_borrow<py::sequence>(poses)[0]);
+  return py::module_::import("numpy").attr("ndim")(poses).cast<int>() == 1;
 }
 
 }  // namespace

@@ -59,6 +59,36 @@ def test_distance_batch_and_session_match_in_process(server, eight):
                 assert reply.distance[0] == ours.distance[frame]
 
 
+def test_every_other_call_agrees_with_in_process(server, eight):
+    with inscribe.Client(server.address) as client:
+        solid = inscribe.prepare(eight)
+        inspected = client.inspect_mesh(eight)
+        assert inspected["mesh_sha256"] == solid.sha256
+        assert inspected["report"]["volume"] == solid.report.volume
+        generated = client.generate(eight, max_spheres=60)
+        key, mesh_key = generated.sphere_set_key, generated.mesh_sha256
+        local = inscribe.generate(solid, max_spheres=60)
+        # Evaluation with the same settings as in-process.
+        assert client.evaluate(mesh_key, key)["nerr"] == local.quality.nerr
+        # The server's hierarchy answers as one built here.
+        pose = np.array([1.0, 0, 0, 0, 0.7, 0.1, 0])
+        remote_h = client.get_hierarchy(key)
+        assert inscribe.distance(remote_h, remote_h, pose).distance == \
+            inscribe.distance(local, local, pose).distance
+        # Deformation frames as inscribe.Deformer makes them.
+        vertices = np.ascontiguousarray(solid.mesh.vertices * np.array([1.03, 1.0, 0.98]))
+        moved, figures = client.update_deformation(key, vertices, bounds=True)
+        ours = inscribe.Deformer(solid, local).update(vertices)
+        assert np.array_equal(moved.spheres, ours.spheres)
+        assert figures["shrunk"] == ours.stats["shrunk"] and "nerr_upper" in figures
+        # Uploads and certificates.
+        uploaded = client.put_sphere_set(local, mesh_sha256=mesh_key)
+        assert np.array_equal(client.get_sphere_set(uploaded).spheres, local.spheres)
+        assert client.certify_cover(mesh_key, uploaded)["certified"] is False
+        cover = inscribe.generate(solid, max_spheres=80, kind="cover", evaluate=False)
+        assert client.certify_cover(mesh_key, cover)["certified"] is True
+
+
 def test_server_errors_map_to_python_exceptions(server, eight):
     with inscribe.Client(server.address) as client:
         with pytest.raises(inscribe.Error) as raised:

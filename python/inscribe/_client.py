@@ -508,16 +508,23 @@ class DistanceSession:
 
     def query(self, pairs: Sequence[tuple]) -> DistanceReply:
         """Distances of one frame: pairs of (set_key_a, set_key_b, pose_a, pose_b), poses
-        (7,) float64 [qw, qx, qy, qz, tx, ty, tz] in the world frame. Returns a DistanceReply
-        (entry i answers pairs[i])."""
+        (7,) float64 [qw, qx, qy, qz, tx, ty, tz] in the world frame; or, for certified
+        intervals, (set_key_a, set_key_b, pose_a, pose_b, cover_a, cover_b) with the covers'
+        keys (a frame's pairs are all certified or none). Returns a DistanceReply (entry i
+        answers pairs[i]; lower and upper filled when certified)."""
         if self._broken is not None:
             raise self._broken
         frame = service_pb2.DistanceFrame(frame=self._next_frame, volume=self._volume,
                                           tolerance=self._tolerance)
-        for i, (key_a, key_b, pose_a, pose_b) in enumerate(pairs):
+        for i, pair in enumerate(pairs):
+            if len(pair) not in (4, 6):
+                raise ValueError(f"pairs[{i}] must be (key_a, key_b, pose_a, pose_b[, cover_a, "
+                                 f"cover_b]), got {len(pair)} items")
+            key_a, key_b, pose_a, pose_b = pair[:4]
+            cover_a, cover_b = pair[4:] if len(pair) == 6 else ("", "")
             frame.pairs.append(service_pb2.DistancePair(
                 sphere_set_a=key_a, sphere_set_b=key_b, pose_a=_pose(pose_a, f"pairs[{i}] pose_a"),
-                pose_b=_pose(pose_b, f"pairs[{i}] pose_b")))
+                pose_b=_pose(pose_b, f"pairs[{i}] pose_b"), cover_a=cover_a, cover_b=cover_b))
         try:
             if self._stream is None:
                 self._open(_inscribe._route_key(frame.pairs[0].sphere_set_a if frame.pairs else ""))

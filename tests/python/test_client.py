@@ -89,6 +89,31 @@ def test_every_other_call_agrees_with_in_process(server, eight):
         assert client.certify_cover(mesh_key, cover)["certified"] is True
 
 
+def test_certified_intervals_over_the_service_are_the_in_process_ones(server, eight):
+    with inscribe.Client(server.address) as client:
+        internal = client.generate(eight, max_spheres=60, evaluate=False)
+        cover = client.generate(eight, max_spheres=80, kind="cover", evaluate=False)
+        assert cover.spheres.kind == "cover" and cover.certificate["certified"]
+        local = inscribe.CertifiedObject(internal.spheres, cover.spheres,
+                                         cover.certificate["delta"])
+        rng = np.random.default_rng(5)
+        q = rng.normal(size=(50, 4))
+        poses = np.hstack([q / np.linalg.norm(q, axis=1, keepdims=True),
+                           rng.uniform(-3, 3, size=(50, 3))])
+        remote = client.distance(internal.sphere_set_key, internal.sphere_set_key, poses,
+                                 cover_a=cover.sphere_set_key, cover_b=cover.sphere_set_key,
+                                 closer_than=0.2)
+        ours = inscribe.certified_distance(local, local, poses, closer_than=0.2)
+        assert np.array_equal(remote.lower, ours.lower)
+        assert np.array_equal(remote.upper, ours.upper)
+        assert remote.answers == ours.closer
+        identity = np.array([1.0, 0, 0, 0, 0, 0, 0])
+        with client.open_distance_session() as session:
+            reply = session.query([(internal.sphere_set_key, internal.sphere_set_key, identity,
+                                    poses[0], cover.sphere_set_key, cover.sphere_set_key)])
+            assert reply.lower[0] == ours.lower[0] and reply.upper[0] == ours.upper[0]
+
+
 def test_server_errors_map_to_python_exceptions(server, eight):
     with inscribe.Client(server.address) as client:
         with pytest.raises(inscribe.Error) as raised:

@@ -265,12 +265,17 @@ class Client:
                 return result
             except grpc.RpcError as error:
                 if error.code() != grpc.StatusCode.UNAVAILABLE:
+                    self._mark(replica, False)  # any answer proves the replica up
                     _raise_rpc_error(error)
+                # As the C++ routed connection: mark it down, name it, and with another replica
+                # to take the call, retry at once.
                 self._mark(replica, True)
-                elsewhere = len(order) > 1 and self._order(route_key)[0] != order[0]
-                wait = 0.0 if elsewhere else self._retry.backoff(n)
+                several = len(self._replicas) > 1
+                note = f" (replica {replica.name}, one of {len(self._replicas)})" if several else ""
+                wait = 0.0 if several else self._retry.backoff(n)
                 if n == attempts or time.monotonic() + wait >= deadline:
-                    _raise_rpc_error(error, "" if n == 1 else f" (gave up after {n} attempts)")
+                    _raise_rpc_error(error, note + ("" if n == 1 else
+                                                    f" (gave up after {n} attempts)"))
                 time.sleep(wait)
 
     def _unary(self, route_key, method: str, request, timeout):

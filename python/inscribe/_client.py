@@ -282,6 +282,18 @@ class Client:
         return self._call(route_key, lambda stub, left: getattr(stub, method)(
             request, timeout=left, metadata=self._metadata), timeout)
 
+    def _put(self, route_key: str, method: str, request, key_of: Callable, timeout):
+        """A put routed by `route_key`; when the key the server answers with routes to another
+        replica (a repaired mesh, a set without a mesh), put there too and return that answer,
+        as the C++ routed connection does."""
+        response = self._unary(route_key, method, request, timeout)
+        stored_route = _inscribe._route_key(key_of(response))
+        if stored_route == route_key or len(self._replicas) == 1:
+            return response
+        if self._order(stored_route)[0] == self._order(route_key)[0]:
+            return response
+        return self._unary(stored_route, method, request, timeout)
+
     # ---- calls ---------------------------------------------------------------------------
 
     def put_mesh(self, mesh: _inscribe.Mesh, *, fill_holes: bool = False,
@@ -291,7 +303,8 @@ class Client:
         request = service_pb2.PutMeshRequest(
             mesh=mesh_pb2.Mesh(vertices=mesh.vertices.ravel(), triangles=mesh.triangles.ravel()),
             fill_holes=fill_holes)
-        response = self._unary(_inscribe._route_key(mesh.sha256), "PutMesh", request, timeout)
+        response = self._put(_inscribe._route_key(mesh.sha256), "PutMesh", request,
+                             lambda r: r.mesh_sha256, timeout)
         return response.mesh_sha256
 
     def generate(self, mesh, *, max_spheres: Optional[int] = None,
@@ -369,7 +382,28 @@ class Client:
         route = (_inscribe._route_key(mesh_sha256) if mesh_sha256
                  else _inscribe._content_route_key(message.SerializeToString()))
         request = service_pb2.PutSphereSetRequest(spheres=message, mesh_sha256=mesh_sha256)
-        return self._unary(route, "PutSphereSet", request, timeout).sphere_set_key
+        return self._put(route, "PutSphereSet", request, lambda r: r.sphere_set_key,
+                         timeout).sphere_set_key
+
+    def put_certified_cover(self, spheres, certificate: _inscribe.CoverCertificate, *,
+                            timeout: Optional[float] = None) -> str:
+        """Uploads a cover with the certificate it was made with (inscribe.generate(...,
+        kind='cover').certificate, or inscribe.certify's), which Distance then takes on the
+        caller's word; returns its key. ValueError when the certificate does not certify."""
+        message = _sphere_set_to_proto(spheres)
+        proof = spheres_pb2.CoverCertificate(
+            certified=certificate.certified, delta=certificate.delta,
+            resolution=certificate.resolution, cells=certificate.cells,
+            cells_in_sphere=certificate.cells_in_sphere,
+            cells_outside=certificate.cells_outside, failed_cells=certificate.failed_cells,
+            uncovered_depth=certificate.uncovered_depth,
+            uncovered_gap=certificate.uncovered_gap, seconds=certificate.seconds)
+        if certificate.uncovered_point is not None:
+            proof.uncovered_point.extend(certificate.uncovered_point)
+        request = service_pb2.PutSphereSetRequest(spheres=message, certificate=proof)
+        route = _inscribe._content_route_key(message.SerializeToString())
+        return self._put(route, "PutSphereSet", request, lambda r: r.sphere_set_key,
+                         timeout).sphere_set_key
 
     def distance(self, sphere_set_a: str, sphere_set_b: str, poses_b, *, poses_a=None,
                  volume: str = "sphere", abs_err: float = 0.0, rel_err: float = 0.0,

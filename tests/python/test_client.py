@@ -107,6 +107,12 @@ def test_certified_intervals_over_the_service_are_the_in_process_ones(server, ei
         assert np.array_equal(remote.lower, ours.lower)
         assert np.array_equal(remote.upper, ours.upper)
         assert remote.answers == ours.closer
+        # A cover made in-process, uploaded with its certificate, gives the same intervals.
+        local_cover = inscribe.generate(eight, max_spheres=80, kind="cover", evaluate=False)
+        uploaded = client.put_certified_cover(local_cover, local_cover.certificate)
+        again = client.distance(internal.sphere_set_key, internal.sphere_set_key, poses,
+                                cover_a=uploaded, cover_b=uploaded, closer_than=0.2)
+        assert np.array_equal(again.lower, ours.lower)
         identity = np.array([1.0, 0, 0, 0, 0, 0, 0])
         with client.open_distance_session() as session:
             reply = session.query([(internal.sphere_set_key, internal.sphere_set_key, identity,
@@ -144,15 +150,22 @@ def test_routing_picks_the_cpp_clients_replica_and_fails_over(tmp_path, eight):
         endpoints = [a.address, b.address]
         cli = json.loads(run_cli("generate", mesh_path("eight.off"), "--max-spheres", "40",
                                  "--server", ",".join(endpoints), "--json").stdout)
-        with inscribe.Client(endpoints) as client:
-            result = client.generate(eight, max_spheres=40)
-            assert result.cache == "memory"  # where the CLI's call computed it
-            assert result.sphere_set_key == cli["sphere_set_key"]
-        # The CLI's call computed the set on one replica only: the one Python routed to.
+        # The CLI's call computed the set on one replica only: the one Python must route to.
         computed = {s.address: inscribe.Client(s.address).cache_stats()["computations"]
                     for s in (a, b)}
         owner = a if computed[a.address] > 0 else b
         assert computed[owner.address] > 0 and computed[(b if owner is a else a).address] == 0
+        with inscribe.Client(endpoints) as client:
+            result = client.generate(eight, max_spheres=40)
+            assert result.cache == "memory"  # where the CLI's call computed it
+            assert result.sphere_set_key == cli["sphere_set_key"]
+            # Sets without a mesh: put where their content routes and, when the key the server
+            # answers routes elsewhere, there too, so that they are found by key (8 sets: some
+            # move with probability 1 - 2^-8).
+            for i in range(8):
+                spheres = np.array([[float(i), 0.0, 0.0, 1.0]])
+                key = client.put_sphere_set(spheres)
+                assert np.array_equal(client.get_sphere_set(key).spheres, spheres)
         # Failover: a dead replica that the mesh routes to first; the call moves on to the
         # live one at once (no backoff), as the C++ client's does.
         route = inscribe._inscribe._route_key(result.mesh_sha256)

@@ -526,8 +526,10 @@ class DistanceSession:
         self._stream = None
         self._broken: Optional[BaseException] = None
 
-    def _open(self, route_key: str, skip: int = 0) -> None:
-        replica = self._client._replicas[self._client._order(route_key)[skip]]
+    def _open(self, route_key: str, tried: Sequence[_Replica] = ()) -> None:
+        """Opens the stream on the first replica of the key's order not tried yet."""
+        replica = next(r for r in (self._client._replicas[i]
+                                   for i in self._client._order(route_key)) if r not in tried)
         requests: queue.Queue = queue.Queue()
         call = replica.stub.DistanceStream(iter(requests.get, None),
                                            timeout=self._session_timeout,
@@ -576,8 +578,10 @@ class DistanceSession:
         return _distance_reply(reply.results)
 
     def _round_trip(self, frame):
-        for skip in range(len(self._client._replicas)):
+        tried = []
+        for _ in range(len(self._client._replicas)):
             replica, requests, call, replies = self._stream
+            tried.append(replica)
             requests.put(frame)
             try:
                 reply = replies.get(timeout=self._frame_timeout)
@@ -586,12 +590,13 @@ class DistanceSession:
                 raise Error(f"frame {frame.frame} took longer than {self._frame_timeout} s",
                             "DEADLINE_EXCEEDED") from None
             if isinstance(reply, grpc.RpcError):
-                if reply.code() != grpc.StatusCode.UNAVAILABLE or skip + 1 == len(self._client._replicas):
+                last = len(tried) == len(self._client._replicas)
+                if reply.code() != grpc.StatusCode.UNAVAILABLE or last:
                     _raise_rpc_error(reply)
                 # A broken routed stream is reopened on the next replica, the frame resent.
                 self._client._mark(replica, True)
                 requests.put(None)
-                self._open(_inscribe._route_key(frame.pairs[0].sphere_set_a), skip + 1)
+                self._open(_inscribe._route_key(frame.pairs[0].sphere_set_a), tried)
                 continue
             if reply is None:
                 raise Error("the server ended the stream", "INTERNAL")

@@ -180,6 +180,16 @@ def test_routing_picks_the_cpp_clients_replica_and_fails_over(tmp_path, eight):
             start = time.monotonic()
             assert client.generate(eight, max_spheres=40).cache == "memory"
             assert time.monotonic() - start < 10.0
+        # A distance stream routed to the dead replica is reopened on the next one, its frame
+        # resent (a fresh client: nothing is marked down yet).
+        with inscribe.Client([dead, owner.address]) as client:
+            identity = np.array([1.0, 0, 0, 0, 0, 0, 0])
+            shifted = np.array([1.0, 0, 0, 0, 3.0, 0, 0])
+            key = result.sphere_set_key
+            with client.open_distance_session() as session:
+                reply = session.query([(key, key, identity, shifted)])
+                local = inscribe.generate(eight, max_spheres=40, evaluate=False)
+                assert reply.distance[0] == inscribe.distance(local, local, shifted).distance
     finally:
         a.stop()
         b.stop()

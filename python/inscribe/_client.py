@@ -314,11 +314,13 @@ class Client:
                  max_protrusion: Optional[float] = None,
                  cover_resolution: Optional[float] = None, evaluate: bool = True,
                  fill_holes: bool = False, progress: Optional[Callable[[float], None]] = None,
+                 progress_interval: float = 0.0,
                  timeout: Optional[float] = None) -> GenerateResult:
         """Spheres for `mesh` (an inscribe.Mesh, uploaded first, or the key of a stored one),
         with the settings of inscribe.generate (None: the server's defaults, which are core's).
-        progress(fraction) is called on this thread as the server reports it. The result is
-        cached on the server by content."""
+        progress(fraction) is called on this thread as the server reports it, at most every
+        progress_interval seconds (0: the server's 0.5 s). The result is cached on the server
+        by content."""
         if kind not in ("internal", "dilated", "cover"):
             raise ValueError(f"kind must be 'internal', 'dilated' or 'cover', got {kind!r}")
         parameters = spheres_pb2.GenerateParameters(
@@ -333,7 +335,8 @@ class Client:
         uploaded = isinstance(mesh, _inscribe.Mesh)
         key = self.put_mesh(mesh, fill_holes=fill_holes, timeout=timeout) if uploaded else mesh
         request = service_pb2.GenerateRequest(mesh_sha256=key, parameters=parameters,
-                                              skip_quality=not evaluate)
+                                              skip_quality=not evaluate,
+                                              progress_interval=progress_interval)
 
         def attempt(stub, left):
             result = None

@@ -120,6 +120,17 @@ def test_certified_intervals_over_the_service_are_the_in_process_ones(server, ei
             assert reply.lower[0] == ours.lower[0] and reply.upper[0] == ours.upper[0]
 
 
+def test_progress_and_deadlines(server):
+    bunny = inscribe.load_mesh(mesh_path("bunny00.off"))
+    with inscribe.Client(server.address) as client:
+        with pytest.raises(inscribe.Error) as raised:
+            client.generate(bunny, max_spheres=450, timeout=0.3)
+        assert raised.value.code == "DEADLINE_EXCEEDED"
+        seen = []
+        client.generate(bunny, max_spheres=450, progress=seen.append, progress_interval=0.05)
+        assert seen and seen == sorted(seen) and 0.0 <= seen[0] and seen[-1] <= 1.0
+
+
 def test_server_errors_map_to_python_exceptions(server, eight):
     with inscribe.Client(server.address) as client:
         with pytest.raises(inscribe.Error) as raised:

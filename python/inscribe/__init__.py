@@ -1,7 +1,7 @@
 """inscribe: unions of spheres approximating closed triangle meshes.
 
 In-process (the C++ core, bound with pybind11): load_mesh, Mesh, prepare, generate, evaluate,
-certify, read_spheres, write_spheres, Hierarchy, distance, certified_distance, Deformer,
+certify, read_spheres, write_spheres, write_mesh, Hierarchy, distance, certified_distance, Deformer,
 spherize_urdf. Over the service (grpcio): Client, DistanceSession.
 
 Units and frames: every length is in the mesh's own units, every point in the mesh's own frame
@@ -40,6 +40,7 @@ from ._inscribe import (
     prepare,
     read_spheres,
     spherize_urdf,
+    write_mesh,
     write_spheres,
 )
 from ._client import Client, DistanceReply, DistanceSession, GenerateResult, RetryPolicy
@@ -52,5 +53,5 @@ __all__ = [
     "QualityReport", "RetryPolicy", "Severity", "Solid", "SphereSet", "SpherizedRobot",
     "certified_distance", "certify", "distance", "evaluate", "format_curobo_yaml", "generate",
     "load_mesh", "parse_curobo_yaml", "prepare", "read_spheres", "spherize_urdf",
-    "write_spheres",
+    "write_mesh", "write_spheres",
 ]

@@ -4,6 +4,7 @@
 
 #include <cstring>
 #include <memory>
+#include <mutex>
 #include <optional>
 
 #include "absl/strings/str_cat.h"
@@ -13,6 +14,17 @@
 #include "status_errors.h"
 
 namespace inscribe::python {
+namespace {
+
+// SphereDeformer is not thread-safe and its calls run without the GIL, so Python threads
+// sharing one Deformer take turns here.
+struct LockedDeformer {
+  explicit LockedDeformer(SphereDeformer d) : deformer(std::move(d)) {}
+  SphereDeformer deformer;
+  std::mutex mutex;
+};
+
+}  // namespace
 
 void BindDeformation(py::module_& m) {
   py::class_<DeformationErrorBounds>(m, "DeformationErrorBounds",
@@ -31,7 +43,7 @@ void BindDeformation(py::module_& m) {
                             ", nerr_upper=", b.nerr_upper, ")");
       });
 
-  py::class_<SphereDeformer, std::shared_ptr<SphereDeformer>>(
+  py::class_<LockedDeformer, std::shared_ptr<LockedDeformer>>(
       m, "Deformer",
       "Moves a reference set of internal spheres (with contacts) onto deformed vertex "
       "positions of the same mesh; every update starts from the reference. Not thread-safe.")
@@ -49,7 +61,7 @@ void BindDeformation(py::module_& m) {
                py::gil_scoped_release release;
                deformer = SphereDeformer::Create(solid->mesh(), spheres.set, options);
              }
-             return std::make_shared<SphereDeformer>(ValueOrRaise(std::move(deformer)));
+             return std::make_shared<LockedDeformer>(ValueOrRaise(std::move(deformer)));
            }),
            py::arg("reference"), py::arg("spheres"), py::kw_only(), py::arg("xi") = py::none(),
            py::arg("strict") = false, py::arg("interpolated_normal") = false,
@@ -58,18 +70,19 @@ void BindDeformation(py::module_& m) {
            "generate's do); spheres an internal SphereSet with contacts. xi: Algorithm 1's "
            "threshold in mesh units (None: 0.25% of the largest bounding-box extent).")
       .def_property_readonly(
-          "xi", [](const SphereDeformer& d) { return d.options().xi; },
+          "xi", [](const LockedDeformer& d) { return d.deformer.options().xi; },
           "the threshold in use, mesh units")
       .def(
           "update",
-          [](SphereDeformer& deformer, py::handle vertices) {
+          [](LockedDeformer& locked, py::handle vertices) {
             py::array_t<double> v = RequireMatrix<double>(vertices, 3, "vertices");
             Vertices deformed(v.shape(0), 3);
             if (v.size() > 0) std::memcpy(deformed.data(), v.data(), v.size() * sizeof(double));
             absl::StatusOr<DeformedSpheres> moved;
             {
               py::gil_scoped_release release;
-              moved = deformer.Update(deformed);
+              std::lock_guard<std::mutex> lock(locked.mutex);
+              moved = locked.deformer.Update(deformed);
             }
             DeformedSpheres result = ValueOrRaise(std::move(moved));
             auto set = std::make_shared<PySphereSet>();
@@ -92,12 +105,14 @@ void BindDeformation(py::module_& m) {
           "non-finite or inverted vertices (the deformer is then unchanged).")
       .def(
           "bounds",
-          [](const SphereDeformer& deformer, py::handle spheres) {
+          [](LockedDeformer& locked, py::handle spheres) {
             const std::vector<Sphere> balls = SpheresOf(spheres);
             absl::StatusOr<DeformationErrorBounds> bounds;
             {
               py::gil_scoped_release release;
-              bounds = BoundDeformationError(deformer.oracle(), balls, deformer.options().xi);
+              std::lock_guard<std::mutex> lock(locked.mutex);
+              bounds = BoundDeformationError(locked.deformer.oracle(), balls,
+                                             locked.deformer.options().xi);
             }
             return ValueOrRaise(std::move(bounds));
           },

@@ -173,6 +173,20 @@ void BindMesh(py::module_& m) {
       "Reads an OFF, OBJ, STL or PLY file (by extension) into a Mesh, polygons triangulated. "
       "FileNotFoundError for a missing file, ValueError for a malformed one. Not validated.");
 
+  m.def(
+      "write_mesh",
+      [](const Mesh& mesh, const std::string& path) {
+        absl::Status status;
+        {
+          py::gil_scoped_release release;
+          status = WriteMesh(path, mesh);
+        }
+        OkOrRaise(status);
+      },
+      py::arg("mesh"), py::arg("path"),
+      "Writes `mesh` as OFF, OBJ, PLY or STL (by extension) with 17 significant digits, so "
+      "load_mesh reads back the same doubles; atomically. ValueError for another extension.");
+
   py::class_<Solid, std::shared_ptr<Solid>>(
       m, "Solid",
       "A validated closed mesh with its boundary oracle, ready for generation, evaluation and "

@@ -9,13 +9,6 @@ import inscribe
 from conftest import mesh_path, run_cli
 
 
-def write_off(path, vertices, triangles):
-    lines = ["OFF", f"{len(vertices)} {len(triangles)} 0"]
-    lines += [" ".join(repr(float(c)) for c in v) for v in vertices]
-    lines += ["3 " + " ".join(str(int(i)) for i in t) for t in triangles]
-    path.write_text("\n".join(lines) + "\n")
-
-
 def bend(vertices, amount):
     out = vertices * np.array([1.0 + amount, 1.0, 1.0 - amount / 2])
     out[:, 1] += amount * np.sin(vertices[:, 0] * 3.0)
@@ -32,13 +25,13 @@ def test_update_is_the_cli_deform_bit_for_bit(tmp_path, reference):
     solid, spheres = reference
     mesh = solid.mesh
     reference_file, spheres_file = tmp_path / "ref.off", tmp_path / "s.json"
-    write_off(reference_file, mesh.vertices, mesh.triangles)
+    inscribe.write_mesh(mesh, str(reference_file))
     inscribe.write_spheres(spheres, str(spheres_file))
     deformer = inscribe.Deformer(solid, spheres)
     for frame, amount in enumerate([0.02, 0.05]):
         deformed = bend(mesh.vertices, amount)
         deformed_file, out = tmp_path / f"d{frame}.off", tmp_path / f"o{frame}.json"
-        write_off(deformed_file, deformed, mesh.triangles)
+        inscribe.write_mesh(inscribe.Mesh(deformed, mesh.triangles), str(deformed_file))
         run_cli("deform", reference_file, spheres_file, deformed_file, "-o", out)
         cli = inscribe.read_spheres(str(out))
         moved = deformer.update(deformed)
@@ -66,6 +59,18 @@ def test_bad_frames_are_refused_and_leave_the_deformer_usable(reference):
     with pytest.raises(ValueError):
         deformer.update(solid.mesh.vertices * np.array([1.0, 1.0, -1.0]))  # inside out
     assert len(deformer.update(np.array(solid.mesh.vertices))) == len(spheres)
+
+
+def test_threads_sharing_a_deformer_take_turns(reference):
+    import concurrent.futures
+
+    solid, spheres = reference
+    deformer = inscribe.Deformer(solid, spheres)
+    frames = [bend(solid.mesh.vertices, 0.01 * k) for k in range(8)]
+    alone = [deformer.update(f).spheres.copy() for f in frames]
+    with concurrent.futures.ThreadPoolExecutor(4) as pool:
+        together = list(pool.map(lambda f: deformer.update(f).spheres.copy(), frames))
+    assert all(np.array_equal(a, b) for a, b in zip(alone, together))
 
 
 def test_a_set_without_contacts_cannot_deform(reference):

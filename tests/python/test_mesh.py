@@ -81,3 +81,17 @@ def test_sha256_of_the_solid_is_the_cli_mesh_hash():
     info = json.loads(run_cli("info", mesh_path("eight.off"), "--json").stdout)
     assert solid.sha256 == info["mesh_sha256"]
     assert solid.report.usable and solid.report.volume > 0
+
+
+@pytest.mark.parametrize("extension", ["off", "obj", "ply", "stl"])
+def test_write_mesh_round_trips_the_doubles(tmp_path, extension):
+    mesh = inscribe.load_mesh(mesh_path("eight.off"))
+    path = str(tmp_path / f"eight.{extension}")
+    inscribe.write_mesh(mesh, path)
+    back = inscribe.load_mesh(path)
+    if extension != "stl":  # STL repeats vertices per triangle
+        assert np.array_equal(back.vertices, mesh.vertices)
+        assert np.array_equal(back.triangles, mesh.triangles)
+    assert back.num_triangles == mesh.num_triangles
+    with pytest.raises(ValueError):
+        inscribe.write_mesh(mesh, str(tmp_path / "eight.xyz"))

@@ -1,6 +1,6 @@
 """inscribe: unions of spheres approximating closed triangle meshes.
 
-In-process (the C++ core, bound with pybind11): load_mesh, Mesh, prepare, generate, evaluate,
+In-process (the C++ core, bound with pybind11): load_mesh, write_mesh, Mesh, prepare, generate, evaluate,
 certify, read_spheres, write_spheres, write_mesh, Hierarchy, distance, certified_distance, Deformer,
 spherize_urdf. Over the service (grpcio): Client, DistanceSession.
 

@@ -39,8 +39,8 @@ inline void OkOrRaise(const absl::Status& status) {
 template <typename T>
 py::array_t<T> RequireMatrix(py::handle value, py::ssize_t cols, const char* name);
 
-// A 1-D C-contiguous array of dtype T of length `length`, or (accept_matrix) a 2-D one with
-// `length` columns; same refusals as RequireMatrix. Returns it as 2-D (one row for 1-D).
+// A C-contiguous array of dtype T of shape (length,) or (N, length); same refusals as
+// RequireMatrix. Returns it as 2-D (one row for a 1-D array), without copying.
 template <typename T>
 py::array_t<T> RequireRowOrMatrix(py::handle value, py::ssize_t length, const char* name);
 

@@ -1,6 +1,7 @@
 #include "inscribe/wire/keys.h"
 
 #include <algorithm>
+#include <cstdint>
 
 #include "absl/strings/ascii.h"
 #include "absl/strings/match.h"
@@ -52,6 +53,25 @@ std::string RoutePrefix(absl::string_view key) {
 std::string RouteKey(absl::string_view key) {
   std::string prefix = RoutePrefix(key);
   return prefix.empty() ? std::string(key) : prefix;
+}
+
+std::vector<int> RendezvousOrder(absl::string_view route_key,
+                                 const std::vector<std::string>& names) {
+  // Score of each (key, name): the first 8 bytes of SHA-256(key NUL name), big-endian. The NUL
+  // keeps ("ab", "c") and ("a", "bc") apart.
+  std::vector<std::uint64_t> score(names.size());
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    const Sha256Digest digest =
+        Sha256(absl::StrCat(route_key, absl::string_view("\0", 1), names[i]));
+    for (int b = 0; b < 8; ++b) score[i] = (score[i] << 8) | digest[b];
+  }
+  std::vector<int> order(names.size());
+  for (std::size_t i = 0; i < names.size(); ++i) order[i] = static_cast<int>(i);
+  // Ties (2^-64 per pair) broken by name, so the order never depends on the vector's order.
+  std::sort(order.begin(), order.end(), [&](int a, int b) {
+    return score[a] != score[b] ? score[a] > score[b] : names[a] < names[b];
+  });
+  return order;
 }
 
 std::string ContentRouteKey(absl::string_view spheres_bytes) {

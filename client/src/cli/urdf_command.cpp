@@ -38,7 +38,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr std::int64_t kDefaultMaxSpheresPerLink = 32;
 // Larger files are refused before reading: real URDFs are kilobytes to a few megabytes.
 constexpr std::uintmax_t kMaxUrdfBytes = 256u << 20;
 
@@ -149,7 +148,7 @@ void PrintTable(const std::vector<LinkSpherizeResult>& results, const std::strin
 absl::Status RunUrdf(UrdfCliOptions options) {
   const auto start = std::chrono::steady_clock::now();
   if (!options.voxel_size && !options.max_spheres_per_link) {
-    options.max_spheres_per_link = kDefaultMaxSpheresPerLink;
+    options.max_spheres_per_link = robot::kDefaultMaxSpheresPerLink;
   }
   if (options.voxel_size && !(*options.voxel_size > 0.0 && std::isfinite(*options.voxel_size))) {
     return UsageError("--voxel-size must be a positive number of metres");

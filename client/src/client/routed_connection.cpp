@@ -375,21 +375,7 @@ class RoutedConnection final : public Connection {
 
 std::vector<int> RendezvousOrder(absl::string_view route_key,
                                  const std::vector<std::string>& names) {
-  // Score of each (key, name): the first 8 bytes of SHA-256(key NUL name), big-endian. The NUL
-  // keeps ("ab", "c") and ("a", "bc") apart.
-  std::vector<std::uint64_t> score(names.size());
-  for (std::size_t i = 0; i < names.size(); ++i) {
-    const Sha256Digest digest =
-        Sha256(absl::StrCat(route_key, absl::string_view("\0", 1), names[i]));
-    for (int b = 0; b < 8; ++b) score[i] = (score[i] << 8) | digest[b];
-  }
-  std::vector<int> order(names.size());
-  for (std::size_t i = 0; i < names.size(); ++i) order[i] = static_cast<int>(i);
-  // Ties (2^-64 per pair) broken by name, so the order never depends on the vector's order.
-  std::sort(order.begin(), order.end(), [&](int a, int b) {
-    return score[a] != score[b] ? score[a] > score[b] : names[a] < names[b];
-  });
-  return order;
+  return wire::RendezvousOrder(route_key, names);
 }
 
 absl::StatusOr<std::shared_ptr<Connection>> MakeRoutedConnection(std::vector<Endpoint> endpoints,

@@ -20,6 +20,10 @@
 
 namespace inscribe::robot {
 
+// The per-link sphere budget when neither a budget nor a voxel size is given (`inscribe urdf`
+// and the Python bindings).
+inline constexpr std::int64_t kDefaultMaxSpheresPerLink = 32;
+
 struct UrdfSpherizeOptions {
   // Exactly one of the two is > 0. max_spheres_per_link: at most this many spheres per link
   // (GenerateWithSphereBudget per element); voxel_size: sigma in metres for every element.

@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <string>
+#include <vector>
 
 #include "absl/strings/string_view.h"
 #include "inscribe/cover_certificate.h"
@@ -24,6 +25,13 @@ std::string RoutePrefix(absl::string_view key);
 // What routes `key` between replicas: RoutePrefix(key), or the whole key when that is "".
 // Equal for a mesh and everything computed from it.
 std::string RouteKey(absl::string_view key);
+
+// The replica order for `route_key` under rendezvous hashing: indices into `names` (the
+// replicas' names, e.g. "host:port"), best first. Every client (C++ or Python) given the same
+// names routes a key the same way; adding or removing a replica moves only the keys it owned.
+// One SHA-256 per name.
+std::vector<int> RendezvousOrder(absl::string_view route_key,
+                                 const std::vector<std::string>& names);
 
 // What routes a set uploaded without a mesh: the first kRouteDigits hex digits of the SHA-256
 // of its serialised numbers (the server's key for it is another hash). O(size).

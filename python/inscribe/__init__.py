@@ -1,0 +1,57 @@
+"""inscribe: unions of spheres approximating closed triangle meshes.
+
+In-process (the C++ core, bound with pybind11): load_mesh, write_mesh, Mesh, prepare, generate, evaluate,
+certify, read_spheres, write_spheres, write_mesh, Hierarchy, distance, certified_distance, Deformer,
+spherize_urdf. Over the service (grpcio): Client, DistanceSession.
+
+Units and frames: every length is in the mesh's own units, every point in the mesh's own frame
+unless a docstring says "world frame"; poses are rows [qw, qx, qy, qz, tx, ty, tz] (unit
+quaternion, then translation), mapping body coordinates to world ones.
+"""
+
+from ._errors import Error
+from ._inscribe import (
+    DEFAULT_MAX_SPHERES_PER_LINK,
+    CertifiedDistances,
+    CertifiedObject,
+    CoverCertificate,
+    DeformationErrorBounds,
+    Deformer,
+    DistanceBatch,
+    DistanceResult,
+    Hierarchy,
+    LinkSpheres,
+    Mesh,
+    MeshIssue,
+    MeshReport,
+    QualityReport,
+    Severity,
+    Solid,
+    SphereSet,
+    SpherizedRobot,
+    certified_distance,
+    certify,
+    distance,
+    evaluate,
+    format_curobo_yaml,
+    generate,
+    load_mesh,
+    parse_curobo_yaml,
+    prepare,
+    read_spheres,
+    spherize_urdf,
+    write_mesh,
+    write_spheres,
+)
+from ._client import Client, DistanceReply, DistanceSession, GenerateResult, RetryPolicy
+
+__all__ = [
+    "DEFAULT_MAX_SPHERES_PER_LINK", "CertifiedDistances", "CertifiedObject", "Client",
+    "DistanceReply", "GenerateResult",
+    "CoverCertificate", "DeformationErrorBounds", "Deformer", "DistanceBatch", "DistanceResult",
+    "DistanceSession", "Error", "Hierarchy", "LinkSpheres", "Mesh", "MeshIssue", "MeshReport",
+    "QualityReport", "RetryPolicy", "Severity", "Solid", "SphereSet", "SpherizedRobot",
+    "certified_distance", "certify", "distance", "evaluate", "format_curobo_yaml", "generate",
+    "load_mesh", "parse_curobo_yaml", "prepare", "read_spheres", "spherize_urdf",
+    "write_mesh", "write_spheres",
+]

@@ -1,0 +1,268 @@
+# Type stubs of the _inscribe extension (python/src/*.cpp), for editors and type checkers.
+# Shapes: (N, 4) float64 [x, y, z, r]; poses (7,) or (N, 7) float64 [qw, qx, qy, qz, tx, ty, tz].
+from typing import Callable, Optional, Sequence, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+Float64Array = npt.NDArray[np.float64]
+Int32Array = npt.NDArray[np.int32]
+Progress = Optional[Callable[[float], None]]
+Spheres = Union["SphereSet", Float64Array]
+
+DEFAULT_MAX_SPHERES_PER_LINK: int
+
+class Severity:
+    ERROR: Severity
+    WARNING: Severity
+    FIXED: Severity
+
+class MeshIssue:
+    severity: Severity
+    code: str
+    message: str
+    count: int
+
+class MeshReport:
+    vertices: int
+    triangles: int
+    non_finite_vertices: int
+    out_of_range_indices: int
+    degenerate_triangles: int
+    duplicate_triangles: int
+    unreferenced_vertices: int
+    border_edges: int
+    non_manifold_edges: int
+    non_manifold_vertices: int
+    inconsistent_edges: int
+    components: int
+    flipped_triangles: int
+    self_intersections_checked: bool
+    self_intersecting_pairs: int
+    holes_filled: int
+    hole_triangles_added: int
+    volume: float
+    bbox_min: Float64Array
+    bbox_max: Float64Array
+    issues: list[MeshIssue]
+    closed: bool
+    usable: bool
+    first_error: str
+
+class Mesh:
+    def __init__(self, vertices: Float64Array, triangles: Int32Array) -> None: ...
+    @property
+    def vertices(self) -> Float64Array: ...
+    @property
+    def triangles(self) -> Int32Array: ...
+    @property
+    def num_vertices(self) -> int: ...
+    @property
+    def num_triangles(self) -> int: ...
+    @property
+    def sha256(self) -> str: ...
+    def validate(self, *, check_self_intersections: bool = True,
+                 fill_holes: bool = False) -> MeshReport: ...
+
+class Solid:
+    @property
+    def report(self) -> MeshReport: ...
+    @property
+    def sha256(self) -> str: ...
+    @property
+    def mesh(self) -> Mesh: ...
+
+def load_mesh(path: str) -> Mesh: ...
+def write_mesh(mesh: Mesh, path: str) -> None: ...
+def prepare(mesh: Mesh, *, fill_holes: bool = False,
+            check_self_intersections: bool = True) -> Solid: ...
+
+class QualityReport:
+    spheres: int
+    volume_mesh: float
+    volume_union: float
+    nerr: float
+    nerr_is_exact: bool
+    protrusion_max: float
+    protrusion_mean: float
+    protrusion_p95: float
+    protruding_spheres: int
+    protrusion_tolerance: float
+    bbox_diagonal: float
+    surface_samples: int
+    coverage: float
+    coverage_tolerance: float
+    boundary_to_union_mean: float
+    boundary_to_union_hausdorff: float
+    radius_min: float
+    radius_max: float
+    fat_up_to_voxel_size: float
+    voxel_size: float
+    fat: bool
+    fraction_radius_over_sqrt3_sigma: float
+    seconds: float
+
+class CoverCertificate:
+    certified: bool
+    delta: float
+    resolution: float
+    cells: int
+    cells_in_sphere: int
+    cells_outside: int
+    failed_cells: int
+    uncovered_point: Optional[Float64Array]
+    uncovered_depth: float
+    uncovered_gap: float
+    seconds: float
+
+class SphereSet:
+    def __init__(self, spheres: Float64Array, contact_triangles: Optional[Int32Array] = None,
+                 contact_barycentrics: Optional[Float64Array] = None, *, kind: str = "",
+                 mesh_sha256: str = "") -> None: ...
+    @property
+    def spheres(self) -> Float64Array: ...
+    @property
+    def centers(self) -> Float64Array: ...
+    @property
+    def radii(self) -> Float64Array: ...
+    @property
+    def contact_triangles(self) -> Optional[Int32Array]: ...
+    @property
+    def contact_barycentrics(self) -> Optional[Float64Array]: ...
+    @property
+    def kind(self) -> str: ...
+    mesh_sha256: str
+    params: dict[str, Union[bool, int, float, str]]
+    stats: dict[str, Union[bool, int, float, str]]
+    @property
+    def quality(self) -> Optional[QualityReport]: ...
+    @property
+    def certificate(self) -> Optional[CoverCertificate]: ...
+    @property
+    def reference_index(self) -> Optional[Int32Array]: ...
+    def __len__(self) -> int: ...
+
+def generate(mesh: Union[Mesh, Solid], *, max_spheres: Optional[int] = None,
+             voxel_size: Optional[float] = None, kind: str = "internal",
+             object_angle: Optional[float] = None, epsilon: Optional[float] = None,
+             samples: Optional[int] = None, subdivide_boundary: Optional[bool] = None,
+             max_voxels: Optional[int] = None, dilation_growth: Optional[float] = None,
+             max_protrusion: Optional[float] = None, cover_resolution: Optional[float] = None,
+             evaluate: bool = True, quality_samples: Optional[int] = None,
+             progress: Progress = None) -> SphereSet: ...
+def evaluate(mesh: Union[Mesh, Solid], spheres: Spheres, *,
+             surface_samples: Optional[int] = None, voxel_size: Optional[float] = None,
+             coverage_tolerance: Optional[float] = None,
+             seed: Optional[int] = None) -> QualityReport: ...
+def certify(mesh: Union[Mesh, Solid], spheres: Spheres, *, resolution: Optional[float] = None,
+            stop_at_witness: Optional[bool] = None,
+            progress: Progress = None) -> CoverCertificate: ...
+def read_spheres(path: str, *, format: Optional[str] = None, sph_level: int = -1,
+                 yaml_link: str = "") -> SphereSet: ...
+def write_spheres(sphere_set: SphereSet, path: str, *, format: Optional[str] = None,
+                  csv_header: bool = True, obj_subdivision: int = 1,
+                  yaml_link_name: str = "mesh") -> None: ...
+def format_curobo_yaml(links: Sequence[Tuple[str, Spheres]],
+                       comment: str = "inscribe spheres") -> str: ...
+def parse_curobo_yaml(text: str) -> dict[str, SphereSet]: ...
+
+class Hierarchy:
+    def __init__(self, spheres: Spheres, volume: str = "sphere") -> None: ...
+    @property
+    def volume(self) -> str: ...
+    @property
+    def depth(self) -> int: ...
+    @property
+    def num_nodes(self) -> int: ...
+    def __len__(self) -> int: ...
+    def serialize(self) -> bytes: ...
+    @staticmethod
+    def deserialize(data: bytes) -> Hierarchy: ...
+
+class DistanceResult:
+    distance: float
+    sphere_a: int
+    sphere_b: int
+    point_a: Float64Array
+    point_b: Float64Array
+    closer: bool
+
+class DistanceBatch:
+    @property
+    def distance(self) -> Float64Array: ...
+    @property
+    def sphere_a(self) -> Int32Array: ...
+    @property
+    def sphere_b(self) -> Int32Array: ...
+    @property
+    def point_a(self) -> Float64Array: ...
+    @property
+    def point_b(self) -> Float64Array: ...
+    @property
+    def closer(self) -> npt.NDArray[np.bool_]: ...
+    def __len__(self) -> int: ...
+
+def distance(a: Union[Hierarchy, Spheres], b: Union[Hierarchy, Spheres], poses: Float64Array,
+             *, pose_a: Optional[Float64Array] = None, abs_err: Optional[float] = None,
+             rel_err: Optional[float] = None, closer_than: Optional[float] = None,
+             progress: Progress = None) -> Union[DistanceResult, DistanceBatch]: ...
+
+class CertifiedObject:
+    def __init__(self, internal: Union[Hierarchy, Spheres], cover: Union[Hierarchy, Spheres],
+                 delta: float) -> None: ...
+
+class CertifiedDistances:
+    @property
+    def lower(self) -> Float64Array: ...
+    @property
+    def upper(self) -> Float64Array: ...
+    closer: list[str]
+    def __len__(self) -> int: ...
+
+def certified_distance(a: CertifiedObject, b: CertifiedObject, poses: Float64Array, *,
+                       pose_a: Optional[Float64Array] = None,
+                       closer_than: Optional[float] = None) -> CertifiedDistances: ...
+
+class DeformationErrorBounds:
+    volume_mesh: float
+    volume_union: float
+    nerr_lower: float
+    nerr_upper: float
+    nerr_upper_uniform_xi: float
+    uniform_xi_holds: bool
+    exact: bool
+    seconds: float
+
+class Deformer:
+    def __init__(self, reference: Union[Mesh, Solid], spheres: SphereSet, *,
+                 xi: Optional[float] = None, strict: bool = False,
+                 interpolated_normal: bool = False) -> None: ...
+    @property
+    def xi(self) -> float: ...
+    def update(self, vertices: Float64Array) -> SphereSet: ...
+    def bounds(self, spheres: Spheres) -> DeformationErrorBounds: ...
+
+class LinkSpheres:
+    link: str
+    @property
+    def status(self) -> str: ...
+    from_visual: bool
+    elements: int
+    @property
+    def spheres(self) -> Float64Array: ...
+    error: str
+    seconds: float
+
+class SpherizedRobot:
+    name: str
+    links: list[LinkSpheres]
+    def urdf(self) -> str: ...
+    def curobo_yaml(self) -> str: ...
+
+def spherize_urdf(path: str, *, max_spheres_per_link: Optional[int] = None,
+                  voxel_size: Optional[float] = None,
+                  package_paths: Sequence[str] = ()) -> SpherizedRobot: ...
+
+def _route_key(key: str) -> str: ...
+def _content_route_key(spheres_bytes: bytes) -> str: ...
+def _rendezvous_order(route_key: str, names: Sequence[str]) -> list[int]: ...

@@ -1,0 +1,32 @@
+// The parts of the _inscribe extension module, one function per group of bindings, and what
+// they share.
+#pragma once
+
+#include <pybind11/pybind11.h>
+
+#include <memory>
+
+#include "inscribe/mesh.h"
+#include "inscribe/solid.h"
+
+namespace inscribe::python {
+
+namespace py = pybind11;
+
+void BindMesh(py::module_& m);
+void BindSpheres(py::module_& m);
+void BindGeneration(py::module_& m);
+void BindDistance(py::module_& m);
+void BindDeformation(py::module_& m);
+void BindRobot(py::module_& m);
+void BindRouting(py::module_& m);
+
+// PrepareSolid without the GIL; raises as RaiseStatus.
+std::shared_ptr<Solid> PrepareSolidReleasingGil(const Mesh& mesh, bool fill_holes,
+                                                bool check_self_intersections);
+
+// An inscribe.Solid as given, or one prepared from an inscribe.Mesh (default validation);
+// TypeError for anything else.
+std::shared_ptr<Solid> SolidOf(py::handle mesh_or_solid);
+
+}  // namespace inscribe::python

@@ -1,0 +1,257 @@
+// inscribe.generate, inscribe.evaluate, inscribe.certify and their reports.
+#include <pybind11/numpy.h>
+#include <pybind11/stl.h>
+
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "absl/strings/str_cat.h"
+#include "bindings.h"
+#include "inscribe/cover_certificate.h"
+#include "inscribe/sphere_quality.h"
+#include "inscribe/sphere_set_generation.h"
+#include "interruptible.h"
+#include "sphere_set.h"
+#include "status_errors.h"
+
+namespace inscribe::python {
+namespace {
+
+SphereSetKind KindOf(const std::string& name) {
+  for (SphereSetKind kind :
+       {SphereSetKind::kInternal, SphereSetKind::kDilated, SphereSetKind::kCover}) {
+    if (name == SphereSetKindName(kind)) return kind;
+  }
+  throw py::value_error("kind must be 'internal', 'dilated' or 'cover', got '" + name + "'");
+}
+
+// Only what the caller gave overrides core's defaults (SphereSetParameters and the option
+// structs it holds); CheckSphereSetParameters judges the result.
+template <typename T>
+void Override(T& field, const std::optional<T>& value) {
+  if (value) field = *value;
+}
+
+std::shared_ptr<PySphereSet> Generate(
+    py::handle mesh_or_solid, std::optional<std::int64_t> max_spheres,
+    std::optional<double> voxel_size, const std::string& kind, std::optional<double> object_angle,
+    std::optional<double> epsilon, std::optional<int> samples,
+    std::optional<bool> subdivide_boundary, std::optional<std::int64_t> max_voxels,
+    std::optional<double> dilation_growth, std::optional<double> max_protrusion,
+    std::optional<double> cover_resolution, bool evaluate,
+    std::optional<std::int64_t> quality_samples, const py::object& progress) {
+  SphereSetParameters parameters;
+  parameters.kind = KindOf(kind);
+  parameters.max_spheres = max_spheres;
+  parameters.voxel_size = voxel_size;
+  Override(parameters.medial.object_angle, object_angle);
+  Override(parameters.medial.epsilon, epsilon);
+  Override(parameters.medial.samples, samples);
+  Override(parameters.medial.subdivide_boundary, subdivide_boundary);
+  Override(parameters.medial.max_voxels, max_voxels);
+  Override(parameters.dilation.growth, dilation_growth);
+  parameters.max_protrusion = max_protrusion;
+  Override(parameters.cover_resolution, cover_resolution);
+  parameters.evaluate = evaluate;
+  Override(parameters.quality.surface_samples, quality_samples);
+  OkOrRaise(CheckSphereSetParameters(parameters));
+
+  const std::shared_ptr<Solid> solid = SolidOf(mesh_or_solid);
+  absl::StatusOr<GeneratedSphereSet> generated;
+  OkOrRaise(RunInterruptible(progress, [&](const GenerationControl& control) {
+    generated = GenerateSphereSet(*solid, parameters, control);
+    return generated.status();
+  }));
+
+  auto result = std::make_shared<PySphereSet>();
+  result->kind = SphereSetKindName(generated->kind);
+  result->mesh_sha256 = solid->sha256;
+  result->set = std::move(generated->set);
+  result->params = {{"kind", result->kind}};
+  if (const std::optional<std::int64_t> budget = EffectiveMaxSpheres(parameters)) {
+    result->params.emplace_back("max_spheres", *budget);
+  }
+  if (parameters.voxel_size) result->params.emplace_back("voxel_size", *parameters.voxel_size);
+  if (parameters.max_protrusion) {
+    result->params.emplace_back("max_protrusion", *parameters.max_protrusion);
+  }
+  result->stats = {{"voxel_size", generated->voxel_size},
+                   {"epsilon", generated->epsilon},
+                   {"runs", std::int64_t{generated->runs}},
+                   {"generation_seconds", generated->generation_seconds},
+                   {"seconds", generated->seconds}};
+  result->quality = generated->quality;
+  if (generated->quality) result->stats.emplace_back("nerr", generated->quality->nerr);
+  if (generated->cover) {
+    result->certificate = generated->cover->certificate;
+    result->stats.emplace_back("delta", generated->cover->certificate.delta);
+  }
+  return result;
+}
+
+// generate's docstring, with core's defaults.
+const std::string& GenerateDoc() {
+  static const std::string doc = [] {
+    const MedialSphereOptions medial;
+    return absl::StrCat(R"doc(Spheres for a closed mesh: the pipeline `inscribe generate` runs.
+
+mesh: an inscribe.Mesh (validated and prepared on each call) or an inscribe.Solid
+    (inscribe.prepare(mesh), reusable).
+max_spheres: at most N spheres: the finest voxel grid giving at most N (internal, dilated),
+    or the smallest protrusion reached with N (cover). voxel_size: sigma, the voxel side in
+    mesh units (internal, dilated only). At most one of the two; neither: a budget of )doc",
+                        kDefaultMaxSpheres, R"doc(.
+kind: 'internal' - medial spheres inside the solid, tangent to it, with contacts (for
+    Deformer); 'dilated' - grown to cover more of the boundary (they protrude);
+    'cover' - a certified cover holding the whole solid (.certificate.delta bounds how far
+    it reaches outside, mesh units).
+object_angle (radians, in (0, pi); default )doc",
+                        medial.object_angle, R"doc(), epsilon (mesh
+    units; default 1e-4 of the bounding-box diagonal), samples (per voxel; default )doc",
+                        medial.samples, R"doc(), subdivide_boundary, max_voxels:
+    medial-sphere settings (not for covers). dilation_growth in [0, 1] (dilated).
+    max_protrusion (mesh units, cover: the fewest spheres with delta at most this, instead of
+    a budget), cover_resolution (the certificate's finest cell, a fraction of the largest
+    bounding-box side). None means core's default for every one of them.
+evaluate: compute .quality (exact union volume, surface samples; quality_samples of them).
+progress: called on this thread with the fraction done in [0, 1]. Ctrl-C cancels the run
+    (KeyboardInterrupt) within about 50 ms of the core noticing.
+
+Returns a SphereSet: .spheres (N, 4) float64 [x, y, z, r] in the mesh's units and frame,
+.kind, .mesh_sha256 (the validated mesh's), .quality, .certificate (covers), .stats.
+The same mesh and settings give the same spheres bit for bit as `inscribe generate`.
+Raises ValueError for bad settings (the message names the field), inscribe.Error with code
+FAILED_PRECONDITION for a mesh that is not a usable solid, RESOURCE_EXHAUSTED when no grid
+fits the budget. The GIL is released while it runs.)doc");
+  }();
+  return doc;
+}
+
+}  // namespace
+
+void BindGeneration(py::module_& m) {
+  py::class_<QualityReport>(m, "QualityReport",
+                            "Quality of a sphere set against its solid (lengths in mesh units, "
+                            "volumes in mesh units cubed).")
+      .def_readonly("spheres", &QualityReport::spheres)
+      .def_readonly("volume_mesh", &QualityReport::volume_mesh)
+      .def_readonly("volume_union", &QualityReport::volume_union,
+                    "exact union-of-balls volume (not sampled)")
+      .def_readonly("nerr", &QualityReport::nerr,
+                    "Err / vol(mesh): exact when no sphere protrudes, else a lower bound")
+      .def_readonly("nerr_is_exact", &QualityReport::nerr_is_exact)
+      .def_readonly("protrusion_max", &QualityReport::protrusion_max)
+      .def_readonly("protrusion_mean", &QualityReport::protrusion_mean)
+      .def_readonly("protrusion_p95", &QualityReport::protrusion_p95)
+      .def_readonly("protruding_spheres", &QualityReport::protruding_spheres)
+      .def_readonly("protrusion_tolerance", &QualityReport::protrusion_tolerance)
+      .def_readonly("bbox_diagonal", &QualityReport::bbox_diagonal)
+      .def_readonly("surface_samples", &QualityReport::surface_samples)
+      .def_readonly("coverage", &QualityReport::coverage,
+                    "fraction of boundary samples within coverage_tolerance of the union")
+      .def_readonly("coverage_tolerance", &QualityReport::coverage_tolerance)
+      .def_readonly("boundary_to_union_mean", &QualityReport::boundary_to_union_mean)
+      .def_readonly("boundary_to_union_hausdorff", &QualityReport::boundary_to_union_hausdorff)
+      .def_readonly("radius_min", &QualityReport::radius_min)
+      .def_readonly("radius_max", &QualityReport::radius_max)
+      .def_readonly("fat_up_to_voxel_size", &QualityReport::fat_up_to_voxel_size)
+      .def_readonly("voxel_size", &QualityReport::voxel_size)
+      .def_readonly("fat", &QualityReport::fat)
+      .def_readonly("fraction_radius_over_sqrt3_sigma",
+                    &QualityReport::fraction_radius_over_sqrt3_sigma)
+      .def_readonly("seconds", &QualityReport::seconds)
+      .def("__repr__", [](const QualityReport& q) {
+        return absl::StrCat("QualityReport(spheres=", q.spheres, ", nerr=", q.nerr,
+                            ", protrusion_max=", q.protrusion_max, ", coverage=", q.coverage, ")");
+      });
+
+  py::class_<CoverCertificate>(m, "CoverCertificate",
+                               "Whether a sphere set provably holds the whole solid, and how far "
+                               "it reaches outside it (mesh units).")
+      .def_readonly("certified", &CoverCertificate::certified,
+                    "every point of the solid lies in some sphere (a proof)")
+      .def_readonly("delta", &CoverCertificate::delta,
+                    "no point of any sphere lies farther than this outside the solid")
+      .def_readonly("resolution", &CoverCertificate::resolution, "finest cell side, mesh units")
+      .def_readonly("cells", &CoverCertificate::cells)
+      .def_readonly("cells_in_sphere", &CoverCertificate::cells_in_sphere)
+      .def_readonly("cells_outside", &CoverCertificate::cells_outside)
+      .def_readonly("failed_cells", &CoverCertificate::failed_cells)
+      .def_property_readonly(
+          "uncovered_point",
+          [](const CoverCertificate& c) -> py::object {
+            if (!c.uncovered_point) return py::none();
+            return py::array_t<double>(3, c.uncovered_point->data());
+          },
+          "(3,) float64 point of the solid in no sphere (the disproof), or None")
+      .def_readonly("uncovered_depth", &CoverCertificate::uncovered_depth)
+      .def_readonly("uncovered_gap", &CoverCertificate::uncovered_gap)
+      .def_readonly("seconds", &CoverCertificate::seconds)
+      .def("__repr__", [](const CoverCertificate& c) {
+        return absl::StrCat("CoverCertificate(certified=", c.certified ? "True" : "False",
+                            ", delta=", c.delta, ")");
+      });
+
+  m.def("generate", &Generate, py::arg("mesh"), py::kw_only(), py::arg("max_spheres") = py::none(),
+        py::arg("voxel_size") = py::none(), py::arg("kind") = "internal",
+        py::arg("object_angle") = py::none(), py::arg("epsilon") = py::none(),
+        py::arg("samples") = py::none(), py::arg("subdivide_boundary") = py::none(),
+        py::arg("max_voxels") = py::none(), py::arg("dilation_growth") = py::none(),
+        py::arg("max_protrusion") = py::none(), py::arg("cover_resolution") = py::none(),
+        py::arg("evaluate") = true, py::arg("quality_samples") = py::none(),
+        py::arg("progress") = py::none(), GenerateDoc().c_str());
+
+  m.def(
+      "evaluate",
+      [](py::handle mesh_or_solid, py::handle spheres, std::optional<std::int64_t> surface_samples,
+         std::optional<double> voxel_size, std::optional<double> coverage_tolerance,
+         std::optional<std::uint64_t> seed) {
+        QualityOptions options;
+        Override(options.surface_samples, surface_samples);
+        Override(options.voxel_size, voxel_size);
+        Override(options.coverage_tolerance, coverage_tolerance);
+        Override(options.seed, seed);
+        OkOrRaise(CheckQualityOptions(options));
+        const std::shared_ptr<Solid> solid = SolidOf(mesh_or_solid);
+        const std::vector<Sphere> balls = SpheresOf(spheres);
+        absl::StatusOr<QualityReport> report;
+        {
+          py::gil_scoped_release release;
+          report = EvaluateSpheres(solid->oracle, balls, options);
+        }
+        return ValueOrRaise(std::move(report));
+      },
+      py::arg("mesh"), py::arg("spheres"), py::kw_only(), py::arg("surface_samples") = py::none(),
+      py::arg("voxel_size") = py::none(), py::arg("coverage_tolerance") = py::none(),
+      py::arg("seed") = py::none(),
+      "Quality of `spheres` (a SphereSet or an (N, 4) float64 array) against the solid of "
+      "`mesh` (Mesh or Solid): exact nerr, protrusion, coverage, Hausdorff distance, fatness "
+      "(QualityReport; mesh units). None: core's defaults (100,000 surface samples).");
+
+  m.def(
+      "certify",
+      [](py::handle mesh_or_solid, py::handle spheres, std::optional<double> resolution,
+         std::optional<bool> stop_at_witness, const py::object& progress) {
+        CoverCertifyOptions options;
+        Override(options.resolution, resolution);
+        Override(options.stop_at_witness, stop_at_witness);
+        OkOrRaise(CheckCoverCertifyOptions(options));
+        const std::shared_ptr<Solid> solid = SolidOf(mesh_or_solid);
+        const std::vector<Sphere> balls = SpheresOf(spheres);
+        absl::StatusOr<CoverCertificate> certificate;
+        OkOrRaise(RunInterruptible(progress, [&](const GenerationControl& control) {
+          certificate = CertifyCover(*solid, balls, options, control);
+          return certificate.status();
+        }));
+        return *std::move(certificate);
+      },
+      py::arg("mesh"), py::arg("spheres"), py::kw_only(), py::arg("resolution") = py::none(),
+      py::arg("stop_at_witness") = py::none(), py::arg("progress") = py::none(),
+      "Proves whether `spheres` (SphereSet or (N, 4) float64) contain the whole solid of "
+      "`mesh` (CoverCertificate: certified, delta in mesh units, or an uncovered point). "
+      "resolution: the finest cell side as a fraction of the largest bounding-box side "
+      "(default 1/2048). Ctrl-C cancels (KeyboardInterrupt).");
+}
+
+}  // namespace inscribe::python

@@ -1,0 +1,220 @@
+// inscribe.Mesh, inscribe.load_mesh, validation reports and inscribe.Solid.
+#include <pybind11/stl.h>
+
+#include <cstring>
+#include <memory>
+#include <string>
+
+#include "absl/strings/str_cat.h"
+#include "bindings.h"
+#include "inscribe/mesh.h"
+#include "inscribe/mesh_hash.h"
+#include "inscribe/mesh_io.h"
+#include "inscribe/mesh_validation.h"
+#include "inscribe/solid.h"
+#include "status_errors.h"
+
+namespace inscribe::python {
+namespace {
+
+Mesh MeshFromArrays(py::handle vertices, py::handle triangles) {
+  py::array_t<double> v = RequireMatrix<double>(vertices, 3, "vertices");
+  py::array_t<std::int32_t> t = RequireMatrix<std::int32_t>(triangles, 3, "triangles");
+  Mesh mesh;
+  mesh.vertices.resize(v.shape(0), 3);
+  mesh.triangles.resize(t.shape(0), 3);
+  // The one copy: Mesh owns Eigen storage with the same row-major layout.
+  if (v.size() > 0) std::memcpy(mesh.vertices.data(), v.data(), v.size() * sizeof(double));
+  if (t.size() > 0) std::memcpy(mesh.triangles.data(), t.data(), t.size() * sizeof(std::int32_t));
+  return mesh;
+}
+
+py::object VerticesView(const Mesh& mesh, py::handle owner) {
+  return ReadOnlyView(mesh.vertices.data(), mesh.num_vertices(), 3, 3 * sizeof(double), owner);
+}
+
+py::object TrianglesView(const Mesh& mesh, py::handle owner) {
+  return ReadOnlyView(mesh.triangles.data(), mesh.num_triangles(), 3, 3 * sizeof(std::int32_t),
+                      owner);
+}
+
+std::string ReportRepr(const MeshReport& report) {
+  return absl::StrCat("MeshReport(vertices=", report.vertices, ", triangles=", report.triangles,
+                      ", usable=", report.usable() ? "True" : "False", ", volume=", report.volume,
+                      ", issues=", report.issues.size(), ")");
+}
+
+}  // namespace
+
+std::shared_ptr<Solid> PrepareSolidReleasingGil(const Mesh& mesh, bool fill_holes,
+                                                bool check_self_intersections) {
+  SolidOptions options;
+  options.validate.fill_holes = fill_holes;
+  options.validate.check_self_intersections = check_self_intersections;
+  absl::StatusOr<Solid> solid;
+  {
+    py::gil_scoped_release release;
+    solid = PrepareSolid(mesh, options);
+  }
+  return std::make_shared<Solid>(ValueOrRaise(std::move(solid)));
+}
+
+std::shared_ptr<Solid> SolidOf(py::handle mesh_or_solid) {
+  if (py::isinstance<Solid>(mesh_or_solid)) return mesh_or_solid.cast<std::shared_ptr<Solid>>();
+  if (py::isinstance<Mesh>(mesh_or_solid)) {
+    return PrepareSolidReleasingGil(mesh_or_solid.cast<const Mesh&>(), false, true);
+  }
+  throw py::type_error(absl::StrCat("expected an inscribe.Mesh or inscribe.Solid, got ",
+                                    std::string(py::str(py::type::of(mesh_or_solid)))));
+}
+
+void BindMesh(py::module_& m) {
+  py::enum_<Severity>(m, "Severity", "How serious a MeshIssue is.")
+      .value("ERROR", Severity::kError, "the mesh cannot be used to generate spheres")
+      .value("WARNING", Severity::kWarning, "usable, but results may suffer")
+      .value("FIXED", Severity::kFixed, "was wrong and has been repaired in the returned mesh");
+
+  py::class_<MeshIssue>(m, "MeshIssue", "One finding of mesh validation.")
+      .def_readonly("severity", &MeshIssue::severity)
+      .def_readonly("code", &MeshIssue::code, "stable identifier, e.g. 'not_closed'")
+      .def_readonly("message", &MeshIssue::message, "one line a user can act on")
+      .def_readonly("count", &MeshIssue::count)
+      .def("__repr__", [](const MeshIssue& issue) {
+        return absl::StrCat("MeshIssue(", SeverityName(issue.severity), ", '", issue.code, "', '",
+                            issue.message, "')");
+      });
+
+  py::class_<MeshReport> report(m, "MeshReport",
+                                "What validation found; counts are about the mesh as given "
+                                "(before any fix) unless a field says otherwise.");
+  report.def_readonly("vertices", &MeshReport::vertices)
+      .def_readonly("triangles", &MeshReport::triangles)
+      .def_readonly("non_finite_vertices", &MeshReport::non_finite_vertices)
+      .def_readonly("out_of_range_indices", &MeshReport::out_of_range_indices)
+      .def_readonly("degenerate_triangles", &MeshReport::degenerate_triangles)
+      .def_readonly("duplicate_triangles", &MeshReport::duplicate_triangles)
+      .def_readonly("unreferenced_vertices", &MeshReport::unreferenced_vertices)
+      .def_readonly("border_edges", &MeshReport::border_edges)
+      .def_readonly("non_manifold_edges", &MeshReport::non_manifold_edges)
+      .def_readonly("non_manifold_vertices", &MeshReport::non_manifold_vertices)
+      .def_readonly("inconsistent_edges", &MeshReport::inconsistent_edges)
+      .def_readonly("components", &MeshReport::components)
+      .def_readonly("flipped_triangles", &MeshReport::flipped_triangles)
+      .def_readonly("self_intersections_checked", &MeshReport::self_intersections_checked)
+      .def_readonly("self_intersecting_pairs", &MeshReport::self_intersecting_pairs)
+      .def_readonly("holes_filled", &MeshReport::holes_filled)
+      .def_readonly("hole_triangles_added", &MeshReport::hole_triangles_added)
+      .def_readonly("volume", &MeshReport::volume,
+                    "enclosed volume of the validated mesh, mesh units cubed")
+      .def_property_readonly(
+          "bbox_min", [](const MeshReport& r) { return py::array_t<double>(3, r.bbox.min.data()); },
+          "(3,) float64: lower corner of the bounding box, mesh units")
+      .def_property_readonly(
+          "bbox_max", [](const MeshReport& r) { return py::array_t<double>(3, r.bbox.max.data()); },
+          "(3,) float64: upper corner of the bounding box, mesh units")
+      .def_readonly("issues", &MeshReport::issues)
+      .def_property_readonly("closed", &MeshReport::closed)
+      .def_property_readonly("usable", &MeshReport::usable,
+                             "True when no issue is an error: spheres can be generated")
+      .def_property_readonly("first_error", &MeshReport::first_error,
+                             "the first error as one line, or '' when usable")
+      .def("__repr__", &ReportRepr);
+
+  py::class_<Mesh, std::shared_ptr<Mesh>>(
+      m, "Mesh",
+      "A triangle mesh: vertices (V, 3) float64 in the mesh's own units and frame, triangles "
+      "(T, 3) int32, 0-based, counter-clockwise seen from outside.")
+      .def(py::init(&MeshFromArrays), py::arg("vertices"), py::arg("triangles"),
+           "Mesh(vertices, triangles): vertices a C-contiguous (V, 3) float64 array, triangles a "
+           "C-contiguous (T, 3) int32 array (copied once). Other dtypes raise TypeError, other "
+           "shapes or non-contiguous arrays ValueError. Nothing is validated here: see "
+           "validate() and prepare().")
+      .def_property_readonly(
+          "vertices", [](py::object self) { return VerticesView(self.cast<const Mesh&>(), self); },
+          "(V, 3) float64, read-only view (no copy), mesh units")
+      .def_property_readonly(
+          "triangles",
+          [](py::object self) { return TrianglesView(self.cast<const Mesh&>(), self); },
+          "(T, 3) int32, read-only view (no copy)")
+      .def_property_readonly("num_vertices", &Mesh::num_vertices)
+      .def_property_readonly("num_triangles", &Mesh::num_triangles)
+      .def_property_readonly(
+          "sha256", [](const Mesh& mesh) { return FormatSha256(MeshSha256(mesh)); },
+          "'sha256:<64 hex>' content hash of the mesh as it is (the service keys meshes by "
+          "the hash of the validated, re-oriented mesh: see Solid.sha256)")
+      .def(
+          "validate",
+          [](const Mesh& mesh, bool check_self_intersections, bool fill_holes) {
+            ValidateOptions options;
+            options.check_self_intersections = check_self_intersections;
+            options.fill_holes = fill_holes;
+            py::gil_scoped_release release;
+            return ValidateMesh(mesh, options).report;
+          },
+          py::kw_only(), py::arg("check_self_intersections") = true, py::arg("fill_holes") = false,
+          "The validation report (MeshReport) of this mesh; never raises for a bad mesh. "
+          "Cost O(T log T).")
+      .def("__repr__", [](const Mesh& mesh) {
+        return absl::StrCat("Mesh(vertices=", mesh.num_vertices(),
+                            ", triangles=", mesh.num_triangles(), ")");
+      });
+
+  m.def(
+      "load_mesh",
+      [](const std::string& path) {
+        absl::StatusOr<Mesh> mesh;
+        {
+          py::gil_scoped_release release;
+          mesh = ReadMesh(path);
+        }
+        return std::make_shared<Mesh>(ValueOrRaise(std::move(mesh)));
+      },
+      py::arg("path"),
+      "Reads an OFF, OBJ, STL or PLY file (by extension) into a Mesh, polygons triangulated. "
+      "FileNotFoundError for a missing file, ValueError for a malformed one. Not validated.");
+
+  m.def(
+      "write_mesh",
+      [](const Mesh& mesh, const std::string& path) {
+        absl::Status status;
+        {
+          py::gil_scoped_release release;
+          status = WriteMesh(path, mesh);
+        }
+        OkOrRaise(status);
+      },
+      py::arg("mesh"), py::arg("path"),
+      "Writes `mesh` as OFF, OBJ, PLY or STL (by extension) with 17 significant digits, so "
+      "load_mesh reads back the same doubles; atomically. ValueError for another extension.");
+
+  py::class_<Solid, std::shared_ptr<Solid>>(
+      m, "Solid",
+      "A validated closed mesh with its boundary oracle, ready for generation, evaluation and "
+      "certification. Make one with inscribe.prepare(mesh) and reuse it: generate(mesh) "
+      "prepares one on every call.")
+      .def_property_readonly("report", [](const Solid& s) { return s.report; })
+      .def_property_readonly(
+          "sha256", [](const Solid& s) { return s.sha256; },
+          "'sha256:<64 hex>' of the validated mesh: the service's mesh key")
+      .def_property_readonly(
+          "mesh", [](const Solid& s) { return std::make_shared<Mesh>(s.mesh()); },
+          "the validated mesh (orientation fixed), a copy")
+      .def("__repr__", [](const Solid& s) {
+        return absl::StrCat("Solid(", s.sha256.substr(0, 23),
+                            "..., triangles=", s.mesh().num_triangles(), ")");
+      });
+
+  m.def(
+      "prepare",
+      [](const Mesh& mesh, bool fill_holes, bool check_self_intersections) {
+        return PrepareSolidReleasingGil(mesh, fill_holes, check_self_intersections);
+      },
+      py::arg("mesh"), py::kw_only(), py::arg("fill_holes") = false,
+      py::arg("check_self_intersections") = true,
+      "Validates `mesh` (orientation fixed; holes closed when fill_holes) and builds its "
+      "boundary oracle. inscribe.Error with code FAILED_PRECONDITION naming the first problem "
+      "('mesh is not closed: 6 border edges') when it does not bound a usable solid. Cost "
+      "O(T log T).");
+}
+
+}  // namespace inscribe::python

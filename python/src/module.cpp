@@ -1,0 +1,16 @@
+// The _inscribe extension module: core and robot bound for Python. The package `inscribe`
+// (python/inscribe/__init__.py) re-exports it with the service client.
+#include <pybind11/pybind11.h>
+
+#include "bindings.h"
+
+PYBIND11_MODULE(_inscribe, m) {
+  m.doc() = "inscribe's core (meshes, sphere sets, distance, deformation) and robot functions";
+  inscribe::python::BindMesh(m);
+  inscribe::python::BindSpheres(m);
+  inscribe::python::BindGeneration(m);
+  inscribe::python::BindDistance(m);
+  inscribe::python::BindDeformation(m);
+  inscribe::python::BindRobot(m);
+  inscribe::python::BindRouting(m);
+}

@@ -400,7 +400,8 @@ class Client:
             cells_in_sphere=certificate.cells_in_sphere,
             cells_outside=certificate.cells_outside, failed_cells=certificate.failed_cells,
             uncovered_depth=certificate.uncovered_depth,
-            uncovered_gap=certificate.uncovered_gap, seconds=certificate.seconds)
+            uncovered_gap=certificate.uncovered_gap, seconds=certificate.seconds,
+            protrusions=list(certificate.protrusions))
         if certificate.uncovered_point is not None:
             proof.uncovered_point.extend(certificate.uncovered_point)
         request = service_pb2.PutSphereSetRequest(spheres=message, certificate=proof)

@@ -114,6 +114,8 @@ class CoverCertificate:
     uncovered_depth: float
     uncovered_gap: float
     seconds: float
+    @property
+    def protrusions(self) -> Float64Array: ...
 
 class SphereSet:
     def __init__(self, spheres: Float64Array, contact_triangles: Optional[Int32Array] = None,
@@ -209,7 +211,8 @@ def distance(a: Union[Hierarchy, Spheres], b: Union[Hierarchy, Spheres], poses: 
 
 class CertifiedObject:
     def __init__(self, internal: Union[Hierarchy, Spheres], cover: Union[Hierarchy, Spheres],
-                 delta: float) -> None: ...
+                 delta: Optional[float] = None,
+                 protrusions: Optional[Sequence[float]] = None) -> None: ...
 
 class CertifiedDistances:
     @property

@@ -266,18 +266,49 @@ GIL; Ctrl-C cancels it. Witness points are in the world frame.)doc");
   py::class_<CertifiedObjectHandle>(m, "CertifiedObject",
                                     "A solid for certified distance: its internal spheres and a "
                                     "certified cover with its delta (mesh units).")
-      .def(py::init([](py::handle internal, py::handle cover, double delta) {
+      .def(py::init([](py::handle internal, py::handle cover, std::optional<double> delta,
+                       std::optional<std::vector<double>> protrusions) {
+             // A cover SphereSet with its certificate gives delta and protrusions by default.
+             if (py::isinstance<PySphereSet>(cover)) {
+               const PySphereSet& set = cover.cast<const PySphereSet&>();
+               if (set.certificate) {
+                 if (!delta) delta = set.certificate->delta;
+                 if (!protrusions) protrusions = set.certificate->protrusions;
+               }
+             }
+             if (!delta) {
+               throw py::value_error(
+                   "delta: give the cover's certificate delta (or a cover SphereSet that "
+                   "carries its certificate)");
+             }
              CertifiedObjectHandle handle;
-             handle.internal = HierarchyOf(internal);
              handle.cover = HierarchyOf(cover);
-             handle.object = CertifiedObject{handle.internal.get(), handle.cover.get(), delta};
+             if (protrusions && !protrusions->empty() &&
+                 !py::isinstance<SphereHierarchy>(internal) &&
+                 !py::isinstance<SphereHierarchy>(cover)) {
+               const std::vector<Sphere> upper = ValueOrRaise(
+                   UpperBoundSpheres(SpheresOf(internal), SpheresOf(cover), *protrusions));
+               handle.internal = std::make_shared<const SphereHierarchy>(
+                   ValueOrRaise(SphereHierarchy::Build(upper, HierarchyVolume::kSphere)));
+             } else if (protrusions && !protrusions->empty()) {
+               throw py::value_error(
+                   "protrusions: the covers' cores need the internal and cover spheres (a "
+                   "SphereSet or an (N, 4) array), not built hierarchies");
+             } else {
+               handle.internal = HierarchyOf(internal);
+             }
+             handle.object = CertifiedObject{handle.internal.get(), handle.cover.get(), *delta};
              OkOrRaise(CheckCertifiedObject(handle.object));
              return handle;
            }),
-           py::arg("internal"), py::arg("cover"), py::arg("delta"),
+           py::arg("internal"), py::arg("cover"), py::arg("delta") = py::none(),
+           py::arg("protrusions") = py::none(),
            "internal: spheres inside the solid (Hierarchy, SphereSet or (N, 4) array); cover: a "
-           "certified cover of it; delta: the cover's certificate.delta. The caller vouches "
-           "for the certificate (see inscribe.certify).");
+           "certified cover of it; delta: the cover's certificate.delta; protrusions: its "
+           "certificate.protrusions, one per cover sphere (mesh units), whose cores (radius "
+           "less protrusion, inside the solid) join the internal spheres for a tighter upper "
+           "bound, as the service does. A cover SphereSet carrying its certificate gives both. "
+           "The caller vouches for the certificate (see inscribe.certify).");
 
   py::class_<CertifiedBatch>(m, "CertifiedDistances",
                              "Intervals that provably hold the exact distance between two "

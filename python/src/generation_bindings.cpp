@@ -188,6 +188,14 @@ void BindGeneration(py::module_& m) {
       .def_readonly("uncovered_depth", &CoverCertificate::uncovered_depth)
       .def_readonly("uncovered_gap", &CoverCertificate::uncovered_gap)
       .def_readonly("seconds", &CoverCertificate::seconds)
+      .def_property_readonly(
+          "protrusions",
+          [](const CoverCertificate& c) {
+            return py::array_t<double>(static_cast<py::ssize_t>(c.protrusions.size()),
+                                       c.protrusions.data());
+          },
+          "(N,) float64 per sphere: radius less the centre's depth, rounded up (delta is the "
+          "largest); the cores CertifiedObject adds to the internal spheres")
       .def("__repr__", [](const CoverCertificate& c) {
         return absl::StrCat("CoverCertificate(certified=", c.certified ? "True" : "False",
                             ", delta=", c.delta, ")");

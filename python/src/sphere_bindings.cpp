@@ -105,6 +105,7 @@ SphereFile FileOf(const PySphereSet& spheres) {
   file.mesh_sha256 = spheres.mesh_sha256;
   file.params = spheres.params;
   file.stats = spheres.stats;
+  if (spheres.certificate) file.protrusions = spheres.certificate->protrusions;
   return file;
 }
 

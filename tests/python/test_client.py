@@ -95,7 +95,8 @@ def test_certified_intervals_over_the_service_are_the_in_process_ones(server, ei
         cover = client.generate(eight, max_spheres=80, kind="cover", evaluate=False)
         assert cover.spheres.kind == "cover" and cover.certificate["certified"]
         local = inscribe.CertifiedObject(internal.spheres, cover.spheres,
-                                         cover.certificate["delta"])
+                                         cover.certificate["delta"],
+                                         protrusions=cover.certificate["protrusions"])
         rng = np.random.default_rng(5)
         q = rng.normal(size=(50, 4))
         poses = np.hstack([q / np.linalg.norm(q, axis=1, keepdims=True),

@@ -104,12 +104,22 @@ def test_certified_interval_holds_the_internal_distance():
     solid = inscribe.prepare(inscribe.load_mesh(mesh_path("eight.off")))
     internal = inscribe.generate(solid, max_spheres=60, evaluate=False)
     cover = inscribe.generate(solid, max_spheres=80, kind="cover", evaluate=False)
-    obj = inscribe.CertifiedObject(internal, cover, cover.certificate.delta)
+    obj = inscribe.CertifiedObject(internal, cover)  # delta and cores from its certificate
+    assert len(cover.certificate.protrusions) == len(cover)
+    assert cover.certificate.delta == max(0.0, cover.certificate.protrusions.max())
+    without_cores = inscribe.CertifiedObject(internal, cover, cover.certificate.delta,
+                                             protrusions=[])
     poses = random_poses(20, spread=4.0)
     result = inscribe.certified_distance(obj, obj, poses, closer_than=0.3)
+    plain = inscribe.certified_distance(without_cores, without_cores, poses)
     inner = inscribe.distance(internal, internal, poses).distance
     assert np.all(result.lower <= result.upper)
     assert np.all(result.upper <= np.maximum(inner, 0) + 1e-9)
+    assert np.all(result.upper <= plain.upper) and np.any(result.upper < plain.upper)
+    with pytest.raises(ValueError, match="protrusions"):
+        inscribe.CertifiedObject(internal, cover, protrusions=[0.1])
+    with pytest.raises(ValueError, match="delta"):
+        inscribe.CertifiedObject(internal, cover.spheres)
     assert set(result.closer) <= {"yes", "no", "undecided"}
     with pytest.raises(ValueError):
         inscribe.CertifiedObject(internal, cover, -1.0)

@@ -31,12 +31,11 @@ absl::Status PairError(std::size_t index, const absl::Status& status) {
 absl::StatusOr<std::vector<Sphere>> UpperBoundSpheres(const std::vector<Sphere>& internal,
                                                       const std::vector<Sphere>& cover,
                                                       const std::vector<double>& protrusions) {
-  std::vector<Sphere> out = internal;
-  if (protrusions.empty()) return out;
+  if (protrusions.empty()) return internal;
   absl::StatusOr<std::vector<Sphere>> cores = CoverCores(cover, protrusions);
   if (!cores.ok()) return cores.status();
-  out.insert(out.end(), cores->begin(), cores->end());
-  return out;
+  if (cores->empty()) return internal;
+  return cores;
 }
 
 absl::Status CheckCertifiedObject(const CertifiedObject& object) {

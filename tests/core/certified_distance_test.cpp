@@ -211,25 +211,28 @@ TEST(CertifiedDistances, UpperIsAtMostTheCoversDistancePlusTheDeltas) {
   EXPECT_NEAR((*r)[1].cover.distance, -0.5, 1e-9);
 }
 
-// The cores: a cover sphere of radius r whose protrusion bound is p adds the ball of radius
-// r - p at its centre (when positive); the internal set comes first; bad protrusions are refused.
-TEST(UpperBoundSpheres, AddsEachCoverSpheresCoreToTheInternalSet) {
+// The cores: a cover sphere of radius r whose protrusion bound is p gives the ball of radius
+// r - p at its centre (when positive), in place of the internal set; without protrusions, or
+// with no core left, the internal set; bad protrusions are refused.
+TEST(UpperBoundSpheres, AreTheCoverSpheresCoresElseTheInternalSet) {
   const std::vector<Sphere> internal = {Sphere{Vector3::Zero(), 0.1}};
   const std::vector<Sphere> cover = {Sphere{Vector3(1.0, 0.0, 0.0), 0.5},
                                      Sphere{Vector3(2.0, 0.0, 0.0), 0.5},
                                      Sphere{Vector3(3.0, 0.0, 0.0), 0.5}};
   absl::StatusOr<std::vector<Sphere>> upper = UpperBoundSpheres(internal, cover, {0.2, 0.5, -0.1});
   ASSERT_TRUE(upper.ok()) << upper.status();
-  ASSERT_EQ(upper->size(), 3u);
-  EXPECT_EQ((*upper)[0].radius, 0.1);
-  EXPECT_EQ((*upper)[1].center, cover[0].center);
-  EXPECT_DOUBLE_EQ((*upper)[1].radius, 0.3);
-  EXPECT_EQ((*upper)[2].center, cover[2].center);  // the second reaches its whole radius out
-  EXPECT_DOUBLE_EQ((*upper)[2].radius, 0.6);       // deep inside: a core beyond the sphere
-  // No protrusions: the internal set alone.
-  upper = UpperBoundSpheres(internal, cover, {});
-  ASSERT_TRUE(upper.ok());
-  EXPECT_EQ(upper->size(), 1u);
+  ASSERT_EQ(upper->size(), 2u);
+  EXPECT_EQ((*upper)[0].center, cover[0].center);
+  EXPECT_DOUBLE_EQ((*upper)[0].radius, 0.3);
+  EXPECT_EQ((*upper)[1].center, cover[2].center);  // the second reaches its whole radius out
+  EXPECT_DOUBLE_EQ((*upper)[1].radius, 0.6);       // deep inside: a core beyond the sphere
+  // No protrusions, or no core left: the internal set.
+  for (const std::vector<double>& none : {std::vector<double>{}, std::vector<double>{1, 1, 1}}) {
+    upper = UpperBoundSpheres(internal, cover, none);
+    ASSERT_TRUE(upper.ok());
+    ASSERT_EQ(upper->size(), 1u);
+    EXPECT_EQ((*upper)[0].radius, 0.1);
+  }
   upper = UpperBoundSpheres(internal, cover, {0.1, 0.1});
   EXPECT_EQ(upper.status().code(), absl::StatusCode::kInvalidArgument);
   EXPECT_THAT(std::string(upper.status().message()), ::testing::HasSubstr("2 values for 3"));

@@ -307,7 +307,8 @@ GIL; Ctrl-C cancels it. Witness points are in the world frame.)doc");
            "certified cover of it; delta: the cover's certificate.delta; protrusions: its "
            "certificate.protrusions, one per cover sphere (mesh units), whose cores (radius "
            "less protrusion, inside the solid) stand in for the internal spheres for a tighter "
-           "upper bound, as the service does. A cover SphereSet carrying its certificate gives both. "
+           "upper bound, as the service does. A cover SphereSet carrying its certificate gives "
+           "both. "
            "The caller vouches for the certificate (see inscribe.certify).");
 
   py::class_<CertifiedBatch>(m, "CertifiedDistances",

@@ -1,11 +1,12 @@
 // A URDF robot description as `inscribe urdf` needs it: each link's collision geometry (its
 // visual geometry when it has no <collision>), with origins and mesh scales, and where the
-// mesh files are (package://, file:// and relative paths). Parsed with tinyxml2. Joints,
-// materials and the rest are not represented: the writer (spherized_urdf.h) edits the
-// original document instead.
+// mesh files are (package://, file:// and relative paths), and its joints. Parsed with
+// tinyxml2. Materials, inertials and the rest are not represented: the writer
+// (spherized_urdf.h) edits the original document instead.
 #pragma once
 
 #include <Eigen/Core>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -67,9 +68,46 @@ struct UrdfLink {
   bool from_visual = false;
 };
 
+enum class UrdfJointType {
+  kFixed,
+  kRevolute,    // about `axis`, within [lower, upper] radians
+  kContinuous,  // about `axis`, unlimited
+  kPrismatic,   // along `axis`, within [lower, upper] metres
+  kFloating,    // 6 DOF; kinematics keeps it at its origin
+  kPlanar,      // 3 DOF in the plane normal to `axis`; kinematics keeps it at its origin
+};
+
+// "fixed", "revolute", "continuous", "prismatic", "floating", "planar": URDF's type names.
+const char* UrdfJointTypeName(UrdfJointType type);
+
+// <mimic joint="J" multiplier="m" offset="o">: this joint's value is m * value(J) + o.
+struct UrdfMimic {
+  std::string joint;
+  double multiplier = 1.0;
+  double offset = 0.0;
+};
+
+// One <joint>. The child link's frame is the parent link's frame moved by `origin` and then by
+// the joint's motion: a rotation by the joint value about `axis` (revolute, continuous) or a
+// translation by the value along `axis` (prismatic), `axis` given in the joint frame.
+struct UrdfJoint {
+  std::string name;
+  UrdfJointType type = UrdfJointType::kFixed;
+  std::string parent, child;  // link names
+  UrdfOrigin origin;
+  Vector3 axis = Vector3::UnitX();  // unit length (normalised when parsed); URDF's default
+  // <limit lower upper>: radians or metres; both 0 when absent (URDF's defaults). Not used for
+  // continuous joints. lower <= upper.
+  double lower = 0.0;
+  double upper = 0.0;
+  std::optional<UrdfMimic> mimic;
+  int line = 0;
+};
+
 struct UrdfRobot {
-  std::string name;             // <robot name>, may be empty
-  std::vector<UrdfLink> links;  // in file order
+  std::string name;               // <robot name>, may be empty
+  std::vector<UrdfLink> links;    // in file order
+  std::vector<UrdfJoint> joints;  // in file order
 };
 
 // Parses a URDF document. INVALID_ARGUMENT, naming the line and, where there is one, the link

@@ -17,9 +17,10 @@ constexpr double kFirstListPart = 0.65;
 // The farthest-first choice (Gonzalez): the deepest candidate, then repeatedly the candidate
 // that reaches the worst-served sample with the least growth. Returns the chosen candidates
 // and the growth that serves every sample (an upper bound for the threshold search).
-std::pair<std::vector<std::size_t>, double> FarthestFirst(const std::vector<Sphere>& candidates,
-                                                          const CoverSamples& samples,
-                                                          std::size_t count) {
+// `thresholds`, when given, gets the growth serving every sample after each pick.
+std::pair<std::vector<std::size_t>, double> FarthestFirst(
+    const std::vector<Sphere>& candidates, const CoverSamples& samples, std::size_t count,
+    std::vector<double>* thresholds = nullptr) {
   std::vector<double> served(samples.points.size(), std::numeric_limits<double>::infinity());
   std::vector<char> taken(candidates.size(), 0);
   std::vector<std::size_t> chosen;
@@ -37,6 +38,7 @@ std::pair<std::vector<std::size_t>, double> FarthestFirst(const std::vector<Sphe
     });
     const auto at = std::max_element(served.begin(), served.end());
     worst = *at;
+    if (thresholds != nullptr) thresholds->push_back(std::max(worst, 0.0));
     if (chosen.size() == count || worst <= 0.0 || chosen.size() == candidates.size()) break;
     const Vector3& p = samples.points[static_cast<std::size_t>(at - served.begin())];
     double best = std::numeric_limits<double>::infinity();
@@ -53,6 +55,15 @@ std::pair<std::vector<std::size_t>, double> FarthestFirst(const std::vector<Sphe
 }
 
 }  // namespace
+
+std::vector<double> FarthestFirstThresholds(const std::vector<Sphere>& candidates,
+                                            const CoverSamples& samples, std::size_t count) {
+  std::vector<double> thresholds;
+  FarthestFirst(candidates, samples, count, &thresholds);
+  // Fewer picks than asked: every sample was reached, or every candidate taken.
+  thresholds.resize(count, thresholds.empty() ? 0.0 : thresholds.back());
+  return thresholds;
+}
 
 ReachLists MakeReachLists(const std::vector<Sphere>& candidates, const CoverSamples& samples,
                           const PointGrid& grid, double limit) {

@@ -113,6 +113,13 @@ std::optional<std::vector<std::size_t>> GreedyCover(const ReachLists& lists,
                                                     std::size_t num_samples, double t,
                                                     std::size_t limit);
 
+// The farthest-first choice of `count` candidates (Gonzalez): the deepest, then repeatedly the
+// one reaching the worst-served sample with the least growth. Entry k-1: the growth that
+// serves every sample with the first k chosen (non-increasing; 0 once every sample is
+// reached). O(count * (#samples + #candidates)).
+std::vector<double> FarthestFirstThresholds(const std::vector<Sphere>& candidates,
+                                            const CoverSamples& samples, std::size_t count);
+
 // The budget mode's choice: at most `count` candidates reaching every sample with the least
 // growth threshold found (a binary search over greedy set covers, from the farthest-first
 // choice's threshold down).

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <queue>
 #include <utility>
 #include <vector>
@@ -29,28 +30,37 @@ constexpr double kReachMargin = 1e-9;
 // Fixed, so that covers are reproducible.
 constexpr std::uint64_t kGrowthSeed = 0x636f766572;  // "cover"
 constexpr int kMaxRounds = 8;
-// Ladder bases per sphere of the budget (besides the vertices); the delta mode's bases.
+// Ladder bases per sphere of the budget (besides the vertices).
 constexpr std::int64_t kBasesPerSphere = 8;
-constexpr std::int64_t kDeltaModeBases = 4'000;
 // The first rung of the ladders and the sample grid's cell, as fractions of the bounding
 // box's largest side.
 constexpr double kFirstRung = 1.0 / 256;
 // Halvings of the first rung tried where it lies past the medial axis (a thin part).
 constexpr int kThinHalvings = 6;
 constexpr double kGridCell = 1.0 / 64;
-// Longest edge of the boundary's pieces each held whole by one sphere (a fraction of the
-// largest side): a piece costs at most this much more growth than its best point.
+// Growth a boundary piece held whole may cost beyond its best point, and the longest edge a
+// piece is split to (both a fraction of the largest side).
 constexpr double kBoundaryEdge = 1.0 / 1024;
 // Steps of the search for the deepest centre on a normal (each shrinks the interval by 0.618).
 constexpr int kGoldenSteps = 10;
-// Thresholds the delta mode tries.
-constexpr int kDeltaModeAttempts = 5;
+// The delta mode's budgets: the first it makes candidates for and the most; the covers it
+// generates at most, and the share of the bound it aims at when predicting a budget.
+constexpr std::int64_t kDeltaModeFirstBudget = 32;
+constexpr std::int64_t kDeltaModeMaxBudget = 2'048;
+constexpr int kDeltaModeAttempts = 6;
+constexpr double kDeltaModeAim = 0.95;
+// Boundary samples a budget's choice reaches, per sphere of the budget, and at least (up to
+// CoverParameters::growth_samples): few spheres are large, and reach far between samples.
+constexpr std::int64_t kGrowthSamplesPerSphere = 40;
+constexpr std::int64_t kMinGrowthSamples = 2'000;
 
 // The chosen spheres grown to hold the boundary exactly, with `margin` to spare: every mesh
-// triangle is cut into sub-triangles with edges of at most `edge`, and each goes whole to the
-// sphere whose radius must grow least to hold its corners; a ball is convex, so it then holds
-// the sub-triangle and every point within `margin` of it. The `interior` points go to spheres
-// the same way. Radii only grow.
+// triangle goes whole to the sphere whose radius must grow least to hold its corners, or is
+// split in four until that costs at most `edge` more than the least growth any sphere needs at
+// its centroid (or its edges are at most `edge`); a ball is convex, so it then holds the piece
+// and every point within `margin` of it. Large flat triangles (boxes, CAD meshes) that lie
+// mostly inside one sphere are held without splitting them down. The `interior` points go to
+// spheres the same way. Radii only grow.
 std::vector<Sphere> HoldBoundary(const Mesh& mesh, const std::vector<Sphere>& chosen,
                                  const std::vector<Vector3>& interior, double edge, double margin) {
   const std::size_t n = chosen.size();
@@ -68,25 +78,29 @@ std::vector<Sphere> HoldBoundary(const Mesh& mesh, const std::vector<Sphere>& ch
       hold = [&](const Vector3& p, const Vector3& q, const Vector3& r,
                  const std::vector<std::size_t>& candidates, std::vector<double>& reach) {
         const double diameter = std::max({(q - p).norm(), (r - p).norm(), (r - q).norm()});
-        if (diameter <= edge) {
-          std::size_t pick = candidates.front();
-          double least = std::numeric_limits<double>::infinity();
-          for (const std::size_t i : candidates) {
-            const double g = std::max({growth(i, p), growth(i, q), growth(i, r)});
-            if (g < least) {
-              least = g;
-              pick = i;
-            }
+        // The sphere that holds the whole piece with the least growth (a ball holds a
+        // triangle when it holds its corners), and the least growth any sphere needs at the
+        // centroid, which no finer split can go below at that point.
+        std::size_t pick = candidates.front();
+        double least = std::numeric_limits<double>::infinity();
+        for (const std::size_t i : candidates) {
+          const double g = std::max({growth(i, p), growth(i, q), growth(i, r)});
+          if (g < least) {
+            least = g;
+            pick = i;
           }
-          const Vector3& o = chosen[pick].center;
-          reach[pick] = std::max({reach[pick], (p - o).norm(), (q - o).norm(), (r - o).norm()});
-          return;
         }
         const Vector3 centroid = (p + q + r) / 3.0;
         std::vector<double> at(candidates.size());
         double best = std::numeric_limits<double>::infinity();
         for (std::size_t k = 0; k < candidates.size(); ++k) {
           best = std::min(best, at[k] = growth(candidates[k], centroid));
+        }
+        // Whole, when splitting could save at most `edge` of growth (or the piece is small).
+        if (diameter <= edge || least <= std::max(best, 0.0) + edge) {
+          const Vector3& o = chosen[pick].center;
+          reach[pick] = std::max({reach[pick], (p - o).norm(), (q - o).norm(), (r - o).norm()});
+          return;
         }
         std::vector<std::size_t> near;
         for (std::size_t k = 0; k < candidates.size(); ++k) {
@@ -149,6 +163,10 @@ void GrowToContain(const std::vector<CoverCell>& cells, std::vector<Sphere>* sph
     Sphere& grown = (*spheres)[best];
     grown.radius = std::max(grown.radius, best_reach * (1.0 + kReachMargin));
   }
+}
+
+double SecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 GenerationControl Stage(const GenerationControl& control, double from, double to) {
@@ -312,31 +330,54 @@ absl::Status CheckCoverParameters(const CoverParameters& p) {
   return CheckCoverCertifyOptions(p.certify);
 }
 
-absl::StatusOr<GeneratedCover> GenerateCover(const Solid& solid, const CoverParameters& parameters,
-                                             const GenerationControl& control) {
+// What a cover is chosen from, made once for every budget asked of it.
+struct PreparedCover::State {
+  const Solid* solid = nullptr;
+  CoverParameters parameters;
+  double scale = 0.0;   // the bounding box's largest side
+  double margin = 0.0;  // one finest certificate cell's diagonal (and a little)
+  double edge = 0.0;    // the boundary pieces' longest edge (HoldBoundary)
+  internal::CoverSamples samples;
+  std::vector<Sphere> candidates;
+  std::vector<Vector3> interior;
+  std::unique_ptr<internal::PointGrid> grid;  // over samples.points
+  double prepare_seconds = 0.0;
+};
+
+namespace {
+
+// Boundary samples the choice reaches: fewer for small budgets (see kGrowthSamplesPerSphere).
+std::int64_t CoverGrowthSamples(const CoverParameters& parameters) {
+  const std::int64_t budget = parameters.max_spheres.value_or(kDefaultMaxSpheres);
+  const std::int64_t wanted = std::max(kMinGrowthSamples, kGrowthSamplesPerSphere * budget);
+  return std::min(parameters.growth_samples, wanted);
+}
+
+}  // namespace
+
+absl::StatusOr<PreparedCover> PreparedCover::Prepare(const Solid& solid,
+                                                     const CoverParameters& parameters,
+                                                     const GenerationControl& control) {
   const auto start = std::chrono::steady_clock::now();
   if (absl::Status s = CheckCoverParameters(parameters); !s.ok()) return s;
+  auto state = std::make_shared<State>();
+  state->solid = &solid;
+  state->parameters = parameters;
   const Mesh& mesh = solid.mesh();
   const BoundingBox box = ComputeBoundingBox(mesh.vertices);
-  const double scale = box.extent().maxCoeff();
+  state->scale = box.extent().maxCoeff();
   const internal::OctreeFrame frame = internal::MakeOctreeFrame(box, parameters.certify.resolution);
   // Every finest cell of the certificate that meets the boundary lies within its diagonal of
   // a boundary point, so inside one sphere when every boundary point has that much room in
   // one sphere: the cover passes at the first certificate.
-  const double margin = std::sqrt(3.0) * frame.finest_side() * (1.0 + 1e-6);
-  const double edge = kBoundaryEdge * scale;
-  if (parameters.max_protrusion && *parameters.max_protrusion <= margin) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("cover: max_protrusion ", *parameters.max_protrusion,
-                     " is within the certificate's finest cell diagonal ", margin,
-                     " (raise it, or refine the certificate's resolution)"));
-  }
+  state->margin = std::sqrt(3.0) * frame.finest_side() * (1.0 + 1e-6);
+  state->edge = kBoundaryEdge * state->scale;
 
   // The boundary points a cover must reach, and the bases of the candidate ladders: every
   // vertex and the first area samples.
-  internal::CoverSamples samples;
+  internal::CoverSamples& samples = state->samples;
   const Vertices drawn =
-      internal::SampleBoundaryByArea(mesh, parameters.growth_samples, kGrowthSeed);
+      internal::SampleBoundaryByArea(mesh, CoverGrowthSamples(parameters), kGrowthSeed);
   // Vertices (the corners of sharp features), as many as the area samples at most.
   const Eigen::Index vertex_stride = std::max<Eigen::Index>(
       1, (mesh.vertices.rows() + drawn.rows() - 1) / std::max<Eigen::Index>(1, drawn.rows()));
@@ -350,8 +391,7 @@ absl::StatusOr<GeneratedCover> GenerateCover(const Solid& solid, const CoverPara
   }
   const std::int64_t budget = parameters.max_spheres.value_or(kDefaultMaxSpheres);
   // As many vertices as area samples at most (evenly spread through the vertex list).
-  const std::int64_t per_kind =
-      parameters.max_protrusion ? kDeltaModeBases : kBasesPerSphere * budget;
+  const std::int64_t per_kind = kBasesPerSphere * budget;
   std::vector<LadderBase> bases;
   const std::size_t stride = (sampled_vertices.size() + per_kind - 1) / per_kind;
   for (std::size_t i = 0; i < sampled_vertices.size(); i += stride) {
@@ -360,90 +400,182 @@ absl::StatusOr<GeneratedCover> GenerateCover(const Solid& solid, const CoverPara
   for (Eigen::Index i = 0; i < std::min<Eigen::Index>(drawn.rows(), per_kind); ++i) {
     bases.push_back({drawn.row(i).transpose(), -1});
   }
-  std::vector<Vector3> interior;
-  const std::vector<Sphere> candidates =
-      Candidates(solid, bases, scale * kFirstRung, scale / 2, &interior);
-  if (candidates.empty()) {
+  state->candidates =
+      Candidates(solid, bases, state->scale * kFirstRung, state->scale / 2, &state->interior);
+  if (state->candidates.empty()) {
     return absl::FailedPreconditionError("cover: the solid has no interior to cover");
   }
-  samples.points.insert(samples.points.end(), interior.begin(), interior.end());
-  const internal::PointGrid grid(samples.points, scale * kGridCell);
+  samples.points.insert(samples.points.end(), state->interior.begin(), state->interior.end());
+  state->grid = std::make_unique<internal::PointGrid>(samples.points, state->scale * kGridCell);
   if (control.cancelled()) return absl::CancelledError("cover generation cancelled");
-  if (control.on_progress) control.on_progress(0.2);
+  state->prepare_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return PreparedCover(std::move(state));
+}
 
-  // The chosen candidates, holding the boundary with margin, certified (repaired if need be).
-  const auto finish = [&](const std::vector<std::size_t>& chosen,
-                          const GenerationControl& stage) -> absl::StatusOr<GeneratedCover> {
-    std::vector<Sphere> spheres;
-    spheres.reserve(chosen.size());
-    for (const std::size_t i : chosen) spheres.push_back(candidates[i]);
-    spheres = HoldBoundary(mesh, spheres, interior, edge, margin);
-    GeneratedCover out;
-    out.candidates = static_cast<std::int64_t>(candidates.size());
-    const std::vector<Sphere> held = spheres;
-    absl::StatusOr<CoverCertificate> certificate =
-        CertifyAndRepair(solid, parameters, &spheres, &out.repair_rounds, stage);
-    if (!certificate.ok()) return certificate.status();
-    out.certificate = *std::move(certificate);
-    for (std::size_t i = 0; i < spheres.size(); ++i) {
-      out.grown_spheres += spheres[i].radius > held[i].radius;
-    }
-    out.set.spheres = std::move(spheres);
-    return out;
-  };
+PreparedCover::PreparedCover(std::shared_ptr<const State> state) : state_(std::move(state)) {}
 
-  absl::StatusOr<GeneratedCover> out;
-  if (!parameters.max_protrusion) {
-    const std::vector<std::size_t> chosen = internal::ChooseForBudget(
-        candidates, samples, grid, static_cast<std::size_t>(budget), control);
-    if (control.cancelled()) return absl::CancelledError("cover generation cancelled");
-    if (control.on_progress) control.on_progress(0.5);
-    out = finish(chosen, Stage(control, 0.5, 1.0));
-  } else {
-    // The delta mode: the fewest candidates reaching every sample within a threshold t, with
-    // t moved until the certified delta is just within the bound (delta exceeds t by the
-    // margin and the boundary between samples).
-    const double bound = *parameters.max_protrusion;
-    double t = 0.5 * (bound - margin);
-    double unreachable = 0.0;  // a threshold at which some sample is out of every reach
-    double least = std::numeric_limits<double>::infinity();  // certified delta, any attempt
-    for (int attempt = 0; attempt < kDeltaModeAttempts; ++attempt) {
-      if (control.cancelled()) return absl::CancelledError("cover generation cancelled");
-      const internal::ReachLists lists = internal::MakeReachLists(candidates, samples, grid, t);
-      const std::optional<std::vector<std::size_t>> chosen =
-          internal::GreedyCover(lists, samples.points.size(), t, candidates.size());
-      if (!chosen) {
-        unreachable = t;
-        if (t >= bound - margin) break;
-        t = 0.5 * (t + bound - margin);
-        continue;
-      }
-      const double from = 0.2 + 0.8 * attempt / kDeltaModeAttempts;
-      absl::StatusOr<GeneratedCover> tried =
-          finish(*chosen, Stage(control, from, from + 0.8 / kDeltaModeAttempts));
-      if (!tried.ok()) return tried.status();
-      const double delta = tried->certificate.delta;
-      least = std::min(least, delta);
-      if (delta <= bound) {
-        if (!out.ok() || tried->set.size() < out->set.size()) out = *std::move(tried);
-        t += 0.5 * (bound - delta);  // room left: a larger threshold needs fewer spheres
-      } else {
-        t -= 1.2 * (delta - bound);  // over by this much: aim lower
-        if (t <= unreachable) break;
-      }
-    }
-    if (!out.ok()) {
-      return absl::FailedPreconditionError(absl::StrCat(
-          "cover: no certified cover within max_protrusion ", bound,
-          "; the least delta reached was ",
-          std::isfinite(least) ? absl::StrCat(least) : absl::StrCat("above ", unreachable + margin),
-          " (ask for a larger max_protrusion, or a sphere budget)"));
-    }
+const Solid& PreparedCover::solid() const { return *state_->solid; }
+
+double PreparedCover::margin() const { return state_->margin; }
+
+std::vector<double> PreparedCover::EstimatedDeltas(std::int64_t max_spheres) const {
+  std::vector<double> out = internal::FarthestFirstThresholds(
+      state_->candidates, state_->samples,
+      static_cast<std::size_t>(std::max<std::int64_t>(max_spheres, 1)));
+  for (double& t : out) t += state_->margin;
+  return out;
+}
+
+absl::StatusOr<GeneratedCover> PreparedCover::Finish(const std::vector<std::size_t>& chosen,
+                                                     const GenerationControl& stage) const {
+  const State& s = *state_;
+  std::vector<Sphere> spheres;
+  spheres.reserve(chosen.size());
+  for (const std::size_t i : chosen) spheres.push_back(s.candidates[i]);
+  spheres = HoldBoundary(s.solid->mesh(), spheres, s.interior, s.edge, s.margin);
+  GeneratedCover out;
+  out.candidates = static_cast<std::int64_t>(s.candidates.size());
+  const std::vector<Sphere> held = spheres;
+  absl::StatusOr<CoverCertificate> certificate =
+      CertifyAndRepair(*s.solid, s.parameters, &spheres, &out.repair_rounds, stage);
+  if (!certificate.ok()) return certificate.status();
+  out.certificate = *std::move(certificate);
+  for (std::size_t i = 0; i < spheres.size(); ++i) {
+    out.grown_spheres += spheres[i].radius > held[i].radius;
   }
+  out.set.spheres = std::move(spheres);
+  return out;
+}
+
+absl::StatusOr<GeneratedCover> PreparedCover::Generate(std::int64_t max_spheres,
+                                                       const GenerationControl& control) const {
+  const auto start = std::chrono::steady_clock::now();
+  if (max_spheres <= 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("cover: max_spheres must be positive, got ", max_spheres));
+  }
+  const State& s = *state_;
+  const std::vector<std::size_t> chosen = internal::ChooseForBudget(
+      s.candidates, s.samples, *s.grid, static_cast<std::size_t>(max_spheres), control);
+  if (control.cancelled()) return absl::CancelledError("cover generation cancelled");
+  if (control.on_progress) control.on_progress(0.5);
+  absl::StatusOr<GeneratedCover> out = Finish(chosen, Stage(control, 0.5, 1.0));
   if (!out.ok()) return out.status();
   if (control.on_progress) control.on_progress(1.0);
   out->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;
 }
+
+absl::StatusOr<GeneratedCover> GenerateCover(const Solid& solid, const CoverParameters& parameters,
+                                             const GenerationControl& control) {
+  const auto start = std::chrono::steady_clock::now();
+  if (absl::Status s = CheckCoverParameters(parameters); !s.ok()) return s;
+  if (!parameters.max_protrusion) {
+    absl::StatusOr<PreparedCover> prepared =
+        PreparedCover::Prepare(solid, parameters, Stage(control, 0.0, 0.2));
+    if (!prepared.ok()) return prepared.status();
+    if (control.on_progress) control.on_progress(0.2);
+    absl::StatusOr<GeneratedCover> out = prepared->Generate(
+        parameters.max_spheres.value_or(kDefaultMaxSpheres), Stage(control, 0.2, 1.0));
+    if (!out.ok()) return out.status();
+    out->seconds = SecondsSince(start);
+    return out;
+  }
+  // The delta mode: the fewest spheres whose certified delta is within the bound, searched over
+  // budgets. Candidates for a budget large enough that the farthest-first estimate reaches the
+  // bound (4x more at a time while it does not), then budgets from the first the estimate says
+  // is enough (the estimate is usually above what is certified), then fewer, predicted from
+  // the ratio of the certified delta to the estimate.
+  const double bound = *parameters.max_protrusion;
+  CoverParameters budgeted = parameters;
+  budgeted.max_protrusion.reset();
+  std::optional<PreparedCover> prepared;
+  std::vector<double> estimates;
+  for (std::int64_t most = kDeltaModeFirstBudget;; most *= 4) {
+    budgeted.max_spheres = std::min(most, kDeltaModeMaxBudget);
+    absl::StatusOr<PreparedCover> made = PreparedCover::Prepare(solid, budgeted, control);
+    if (!made.ok()) return made.status();
+    if (bound <= made->margin()) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "cover: max_protrusion ", bound, " is within the certificate's finest cell diagonal ",
+          made->margin(), " (raise it, or refine the certificate's resolution)"));
+    }
+    prepared.emplace(*std::move(made));
+    estimates = prepared->EstimatedDeltas(*budgeted.max_spheres);
+    if (estimates.back() <= bound || *budgeted.max_spheres == kDeltaModeMaxBudget) break;
+    if (control.cancelled()) return absl::CancelledError("cover generation cancelled");
+  }
+  if (control.on_progress) control.on_progress(0.2);
+  const std::int64_t most = *budgeted.max_spheres;
+  std::int64_t hi = most;
+  for (std::int64_t n = 1; n <= most; ++n) {
+    if (estimates[static_cast<std::size_t>(n - 1)] <= bound) {
+      hi = n;
+      break;
+    }
+  }
+  absl::StatusOr<GeneratedCover> out = absl::FailedPreconditionError("no attempt");
+  double least = std::numeric_limits<double>::infinity();  // certified delta, any attempt
+  // Tries a budget of n; true when its certified delta is within the bound.
+  const auto attempt = [&](std::int64_t n) -> absl::StatusOr<bool> {
+    absl::StatusOr<GeneratedCover> tried = prepared->Generate(n, control);
+    if (!tried.ok()) return tried.status();
+    least = std::min(least, tried->certificate.delta);
+    if (tried->certificate.delta > bound) return false;
+    if (!out.ok() || tried->set.size() < out->set.size()) out = *std::move(tried);
+    return true;
+  };
+  // The certified delta over the estimate at the last budget tried, which predicts the next.
+  double ratio = 1.0;
+  const auto tried_ratio = [&](std::int64_t n) {
+    const double estimate = estimates[static_cast<std::size_t>(n - 1)];
+    if (estimate > 0.0 && std::isfinite(least)) ratio = least / estimate;
+  };
+  absl::StatusOr<bool> fits = attempt(hi);
+  if (!fits.ok()) return fits.status();
+  tried_ratio(hi);
+  // Over the bound at the estimate: larger budgets, doubling, up to the candidates' budget.
+  int attempts = 1;
+  std::int64_t lo = 0;  // the largest budget known not to fit (0: none)
+  while (!*fits && hi < most && attempts < kDeltaModeAttempts) {
+    lo = hi;
+    hi = std::min(most, 2 * hi);
+    fits = attempt(hi);
+    if (!fits.ok()) return fits.status();
+    ++attempts;
+  }
+  if (!out.ok()) {
+    return absl::FailedPreconditionError(
+        absl::StrCat("cover: no certified cover within max_protrusion ", bound, " with up to ", hi,
+                     " spheres; the least delta reached was ", least,
+                     " (ask for a larger max_protrusion, or a sphere budget)"));
+  }
+  // Fewer: the budget whose estimate, scaled by the last certified ratio, just meets the bound
+  // (a little below it), kept strictly between the budgets known not to fit and to fit.
+  for (; attempts < kDeltaModeAttempts && hi - lo > 1; ++attempts) {
+    if (control.cancelled()) return absl::CancelledError("cover generation cancelled");
+    std::int64_t next = hi - 1;
+    for (std::int64_t n = lo + 1; n < hi; ++n) {
+      if (estimates[static_cast<std::size_t>(n - 1)] * ratio <= kDeltaModeAim * bound) {
+        next = n;
+        break;
+      }
+    }
+    const double before = least;
+    least = std::numeric_limits<double>::infinity();
+    absl::StatusOr<bool> next_fits = attempt(next);
+    if (!next_fits.ok()) return next_fits.status();
+    tried_ratio(next);
+    least = std::min(least, before);
+    (*next_fits ? hi : lo) = next;
+    if (control.on_progress) control.on_progress(0.2 + 0.8 * (attempts + 1) / kDeltaModeAttempts);
+  }
+  if (control.on_progress) control.on_progress(1.0);
+  out->seconds = SecondsSince(start);
+  return out;
+}
+
+double PreparedCover::prepare_seconds() const { return state_->prepare_seconds; }
 
 }  // namespace inscribe

@@ -47,6 +47,15 @@ const char* SphereSetKindName(SphereSetKind kind) {
   return "internal";
 }
 
+absl::StatusOr<SphereSetKind> ParseSphereSetKind(absl::string_view name) {
+  for (const SphereSetKind kind :
+       {SphereSetKind::kInternal, SphereSetKind::kDilated, SphereSetKind::kCover}) {
+    if (name == SphereSetKindName(kind)) return kind;
+  }
+  return absl::InvalidArgumentError(
+      absl::StrCat("kind must be 'internal', 'dilated' or 'cover', got '", name, "'"));
+}
+
 CoverParameters CoverParametersOf(const SphereSetParameters& parameters) {
   CoverParameters cover;
   cover.max_spheres = parameters.max_spheres;

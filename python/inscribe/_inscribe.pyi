@@ -1,6 +1,6 @@
 # Type stubs of the _inscribe extension (python/src/*.cpp), for editors and type checkers.
 # Shapes: (N, 4) float64 [x, y, z, r]; poses (7,) or (N, 7) float64 [qw, qx, qy, qz, tx, ty, tz].
-from typing import Callable, Optional, Sequence, Tuple, Union
+from typing import Callable, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -253,6 +253,14 @@ class LinkSpheres:
     elements: int
     @property
     def spheres(self) -> Float64Array: ...
+    @property
+    def kind(self) -> str: ...
+    delta: Optional[float]
+    @property
+    def certified(self) -> bool: ...
+    @property
+    def cores(self) -> Float64Array: ...
+    budget: int
     error: str
     seconds: float
 
@@ -262,9 +270,15 @@ class SpherizedRobot:
     def urdf(self) -> str: ...
     def curobo_yaml(self) -> str: ...
 
-def spherize_urdf(path: str, *, max_spheres_per_link: Optional[int] = None,
+def spherize_urdf(path: str, *, kind: str = "cover", max_spheres: Optional[int] = None,
+                  max_spheres_per_link: Optional[int] = None,
+                  max_protrusion: Optional[float] = None,
                   voxel_size: Optional[float] = None,
-                  package_paths: Sequence[str] = ()) -> SpherizedRobot: ...
+                  link_max_spheres: Mapping[str, int] = ...,
+                  padding: float = 0.0,
+                  clip_planes: Sequence[tuple[str, tuple[float, float, float], float]] = (),
+                  package_paths: Sequence[str] = (),
+                  progress: Optional[Callable[[float], object]] = None) -> SpherizedRobot: ...
 
 def _route_key(key: str) -> str: ...
 def _content_route_key(spheres_bytes: bytes) -> str: ...

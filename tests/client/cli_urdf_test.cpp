@@ -19,9 +19,11 @@
 #include "absl/strings/str_format.h"
 #include "client/cli_run.h"
 #include "inscribe/boundary_oracle.h"
+#include "inscribe/cover_certificate.h"
 #include "inscribe/medial_spheres.h"
 #include "inscribe/mesh_io.h"
 #include "inscribe/mesh_validation.h"
+#include "inscribe/solid.h"
 #include "inscribe/sphere_io.h"
 #include "support/synthetic_meshes.h"
 #include "support/test_meshes.h"
@@ -183,7 +185,8 @@ const tinyxml2::XMLElement* FindLink(const tinyxml2::XMLDocument& document,
 
 TEST_F(CliUrdf, SpheresMatchARecomputationInEachLinksOwnFrame) {
   REQUIRE_MESHES();
-  const CliRun run = RunCli(Args() + " -o " + Quote(Out("robot_spheres.urdf")) + " --json");
+  const CliRun run =
+      RunCli(Args() + " --kind internal -o " + Quote(Out("robot_spheres.urdf")) + " --json");
   ASSERT_EQ(run.exit_code, 1) << run.err;  // two links skipped
   EXPECT_THAT(run.err, HasSubstr("link 'gripper' skipped"));
   EXPECT_THAT(run.err, HasSubstr("gripper.stl"));
@@ -269,6 +272,91 @@ TEST_F(CliUrdf, SpheresMatchARecomputationInEachLinksOwnFrame) {
   RecordProperty("figures", figures);
 }
 
+// The default: certified covers. Each link's written spheres are certified again here against
+// the link's mesh placed by the test itself, and hold it within the delta the CLI reported.
+void ExpectCertifiedCovers(const nlohmann::json& report, const std::string& urdf_path,
+                           double padding) {
+  tinyxml2::XMLDocument document;
+  ASSERT_EQ(document.LoadFile(urdf_path.c_str()), tinyxml2::XML_SUCCESS);
+  std::map<std::string, nlohmann::json> by_link;
+  for (const nlohmann::json& link : report.at("links")) by_link[link.at("link")] = link;
+  for (const LinkSpec& spec : SpherizedLinks()) {
+    SCOPED_TRACE(spec.name);
+    const nlohmann::json& link = by_link[spec.name];
+    ASSERT_EQ(link.at("status"), "spherized") << link.dump();
+    ASSERT_TRUE(link.at("certified").get<bool>());
+    const double delta = link.at("delta").get<double>();
+    EXPECT_GE(delta, padding);
+    std::vector<Sphere> written = UrdfSpheres(*FindLink(document, spec.name));
+    ASSERT_FALSE(written.empty());
+    absl::StatusOr<Solid> solid = PrepareSolid(LinkMesh(spec));
+    ASSERT_TRUE(solid.ok()) << solid.status();
+    const absl::StatusOr<CoverCertificate> certificate = CertifyCover(*solid, written);
+    ASSERT_TRUE(certificate.ok()) << certificate.status();
+    EXPECT_TRUE(certificate->certified);
+    EXPECT_LE(certificate->delta, delta * (1 + 1e-9) + 1e-12);
+    // Without the padding the spheres still hold the link: padding only adds.
+    for (Sphere& s : written) s.radius -= padding;
+    const absl::StatusOr<CoverCertificate> bare = CertifyCover(*solid, written);
+    ASSERT_TRUE(bare.ok());
+    EXPECT_TRUE(bare->certified);
+  }
+}
+
+TEST_F(CliUrdf, CoversByDefaultAreCertifiedInEachLinksFrame) {
+  REQUIRE_MESHES();
+  const CliRun run = RunCli(Args() + " -o " + Quote(Out("covers.urdf")) + " --json");
+  ASSERT_EQ(run.exit_code, 1) << run.err;  // the two broken links
+  const nlohmann::json report = nlohmann::json::parse(run.out);
+  EXPECT_EQ(report.at("kind"), "cover");
+  EXPECT_EQ(report.at("max_spheres_per_link"), 32);
+  ExpectCertifiedCovers(report, Out("covers.urdf"), 0.0);
+  std::cout << "covers, 32 per link: " << report.at("spheres") << " spheres, largest delta "
+            << report.at("delta") << " m, " << report.at("spherize_seconds") << " s\n";
+}
+
+TEST_F(CliUrdf, ARobotBudgetIsSharedAndPaddingAndProtrusionBoundsHold) {
+  REQUIRE_MESHES();
+  const CliRun shared = RunCli(Args() + " --max-spheres 24 --padding 0.005 -o " +
+                               Quote(Out("shared.urdf")) + " --json");
+  ASSERT_EQ(shared.exit_code, 1) << shared.err;
+  const nlohmann::json report = nlohmann::json::parse(shared.out);
+  EXPECT_EQ(report.at("max_spheres"), 24);
+  EXPECT_LE(report.at("spheres").get<int>(), 24);
+  std::int64_t budgets = 0;
+  for (const nlohmann::json& link : report.at("links")) {
+    if (link.at("status") == "spherized") {
+      EXPECT_GE(link.at("budget").get<int>(), 1);
+      EXPECT_LE(link.at("spheres").get<int>(), link.at("budget").get<int>());
+      budgets += link.at("budget").get<int>();
+    }
+  }
+  EXPECT_EQ(budgets, 24);
+  ExpectCertifiedCovers(report, Out("shared.urdf"), 0.005);
+
+  // An override takes its link out of the shared budget.
+  const CliRun pinned = RunCli(Args() + " --max-spheres 24 --link-max-spheres plate=3 -o " +
+                               Quote(Out("pinned.urdf")) + " --json");
+  ASSERT_EQ(pinned.exit_code, 1) << pinned.err;
+  for (const nlohmann::json& link : nlohmann::json::parse(pinned.out).at("links")) {
+    if (link.at("link") == "plate") EXPECT_EQ(link.at("budget"), 3);
+  }
+
+  const CliRun within =
+      RunCli(Args() + " --max-protrusion 0.02 -o " + Quote(Out("within.urdf")) + " --json");
+  ASSERT_EQ(within.exit_code, 1) << within.err;
+  const nlohmann::json bounded = nlohmann::json::parse(within.out);
+  for (const nlohmann::json& link : bounded.at("links")) {
+    if (link.at("status") == "spherized") EXPECT_LE(link.at("delta").get<double>(), 0.02);
+  }
+  ExpectCertifiedCovers(bounded, Out("within.urdf"), 0.0);
+
+  // Too small a robot budget for its elements is a usage error.
+  const CliRun tiny = RunCli(Args() + " --max-spheres 2 -o " + Quote(Out("tiny.urdf")));
+  EXPECT_EQ(tiny.exit_code, 64);
+  EXPECT_THAT(tiny.err, HasSubstr("fewer than"));
+}
+
 TEST_F(CliUrdf, EverythingButSphereCollisionsIsKeptAndSkippedLinksSayWhy) {
   REQUIRE_MESHES();
   const CliRun run = RunCli(Args() + " -o " + Quote(Out("kept.urdf")) + " --yaml " +
@@ -320,8 +408,8 @@ TEST_F(CliUrdf, EverythingButSphereCollisionsIsKeptAndSkippedLinksSayWhy) {
 
 TEST_F(CliUrdf, VoxelSizeModeAndOptionErrors) {
   REQUIRE_MESHES();
-  const CliRun voxel =
-      RunCli(Args() + " --voxel-size 0.02 -o " + Quote(Out("voxel.urdf")) + " --json");
+  const CliRun voxel = RunCli(Args() + " --kind internal --voxel-size 0.02 -o " +
+                              Quote(Out("voxel.urdf")) + " --json");
   ASSERT_EQ(voxel.exit_code, 1) << voxel.err;
   const nlohmann::json report = nlohmann::json::parse(voxel.out);
   EXPECT_EQ(report.at("voxel_size"), 0.02);
@@ -334,7 +422,19 @@ TEST_F(CliUrdf, VoxelSizeModeAndOptionErrors) {
   EXPECT_EQ(RunCli(Args()).exit_code, 64);  // -o is required
   const CliRun zero = RunCli(Args() + " --max-spheres-per-link 0 -o " + Quote(Out("x.urdf")));
   EXPECT_EQ(zero.exit_code, 64);
-  EXPECT_THAT(zero.err, HasSubstr("at least 1"));
+  EXPECT_THAT(zero.err, HasSubstr("max_spheres_per_link must lie in 1.."));
+  const CliRun cover_voxel = RunCli(Args() + " --voxel-size 0.02 -o " + Quote(Out("x.urdf")));
+  EXPECT_EQ(cover_voxel.exit_code, 64);
+  EXPECT_THAT(cover_voxel.err, HasSubstr("covers take no voxel_size"));
+  const CliRun negative = RunCli(Args() + " --padding -0.01 -o " + Quote(Out("x.urdf")));
+  EXPECT_EQ(negative.exit_code, 64);
+  EXPECT_THAT(negative.err, HasSubstr("padding"));
+  const CliRun unknown = RunCli(Args() + " --link-max-spheres nolink=4 -o " + Quote(Out("x.urdf")));
+  EXPECT_EQ(unknown.exit_code, 64);
+  EXPECT_THAT(unknown.err, HasSubstr("'nolink'"));
+  const CliRun clip = RunCli(Args() + " --clip base=0,0,1 -o " + Quote(Out("x.urdf")));
+  EXPECT_EQ(clip.exit_code, 64);
+  EXPECT_THAT(clip.err, HasSubstr("LINK=NX,NY,NZ,OFFSET"));
   const CliRun same = RunCli(Args() + " -o " + Quote(Out("x.yml")));
   EXPECT_EQ(same.exit_code, 64);
   EXPECT_THAT(same.err, HasSubstr("--yaml"));

@@ -61,5 +61,35 @@ def test_bad_urdf_and_missing_file(tmp_path):
     bad.write_text("<robot><link></robot>")
     with pytest.raises(ValueError, match="bad.urdf"):
         inscribe.spherize_urdf(str(bad))
-    with pytest.raises(ValueError, match="not both"):
-        inscribe.spherize_urdf(str(bad), max_spheres_per_link=3, voxel_size=0.1)
+    good = tmp_path / "robot.urdf"
+    good.write_text(ROBOT.format(mesh=mesh_path("eight.off")))
+    with pytest.raises(ValueError, match="at most one of"):
+        inscribe.spherize_urdf(str(good), max_spheres_per_link=3, max_spheres=10)
+    with pytest.raises(ValueError, match="covers take no voxel_size"):
+        inscribe.spherize_urdf(str(good), voxel_size=0.1)
+    with pytest.raises(ValueError, match="kind must be"):
+        inscribe.spherize_urdf(str(good), kind="outer")
+    with pytest.raises(ValueError, match="'nolink'"):
+        inscribe.spherize_urdf(str(good), clip_planes=[("nolink", (0, 0, 1), 0.0)])
+
+
+def test_covers_budget_padding_and_clip_planes_are_the_clis(tmp_path):
+    urdf = tmp_path / "robot.urdf"
+    urdf.write_text(ROBOT.format(mesh=mesh_path("eight.off")))
+    out = tmp_path / "shared.urdf"
+    run_cli("urdf", urdf, "-o", out, "--max-spheres", "20", "--padding", "0.002",
+            "--clip", "base=0,0,-1,-0.02", "--link-max-spheres", "arm=12")
+    robot = inscribe.spherize_urdf(str(urdf), max_spheres=20, padding=0.002,
+                                   clip_planes=[("base", (0, 0, -1), -0.02)],
+                                   link_max_spheres={"arm": 12})
+    base, arm = robot.links[0], robot.links[1]
+    assert base.kind == "cover" and base.certified and arm.certified
+    assert arm.budget == 12 and base.budget == 20
+    assert base.delta >= 0.002 and arm.delta >= 0.002
+    # The base's box starts at z = 0; the part below z = 0.02 is cut off.
+    assert np.all(base.spheres[:, 2] - base.spheres[:, 3] >= 0.02 - base.delta - 1e-12)
+    assert base.cores.shape[1] == 4 and len(base.cores) > 0
+    cli_yaml = inscribe.parse_curobo_yaml((tmp_path / "shared.yml").read_text())
+    for link in (base, arm):
+        assert np.array_equal(link.spheres, cli_yaml[link.link].spheres)
+    assert robot.urdf() == out.read_text()

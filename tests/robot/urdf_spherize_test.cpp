@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <tinyxml2.h>
 
+#include <cmath>
 #include <numeric>
 #include <string>
 
@@ -61,25 +62,56 @@ UrdfElement Element(UrdfShape shape) {
   return element;
 }
 
-TEST(UrdfSpherizeLink, SpheresStayAsTheyAreAndBoxesGetInternalSpheresInTheLinkFrame) {
+// A robot of the given links and no joints.
+UrdfRobot RobotOf(std::vector<UrdfLink> links) {
+  UrdfRobot robot;
+  robot.name = "r";
+  robot.links = std::move(links);
+  return robot;
+}
+
+UrdfLink LinkOf(const char* name, std::vector<UrdfElement> elements) {
   UrdfLink link;
-  link.name = "hand";
+  link.name = name;
+  link.elements = std::move(elements);
+  return link;
+}
+
+LinkSpherizeResult SpherizeOne(const UrdfLink& link, const UrdfSpherizeOptions& options) {
+  absl::StatusOr<RobotSpherizeResult> result = SpherizeRobot(RobotOf({link}), options);
+  EXPECT_TRUE(result.ok()) << result.status();
+  return result.ok() ? result->links.at(0) : LinkSpherizeResult{};
+}
+
+UrdfElement Ball(const Vector3& centre, double radius) {
   UrdfElement ball = Element(UrdfShape::kSphere);
-  ball.geometry.radius = 0.05;
-  ball.origin.xyz = Vector3(0, 0, 0.3);
+  ball.geometry.radius = radius;
+  ball.origin.xyz = centre;
   ball.origin.rpy = Vector3(1, 2, 3);  // irrelevant for a sphere
+  return ball;
+}
+
+UrdfElement BoxAt(const Vector3& size, const Vector3& centre) {
   UrdfElement box = Element(UrdfShape::kBox);
-  box.geometry.size = Vector3(0.1, 0.2, 0.4);
-  box.origin.xyz = Vector3(1, 0, 0);
-  link.elements = {ball, box};
+  box.geometry.size = size;
+  box.origin.xyz = centre;
+  return box;
+}
+
+TEST(UrdfSpherizeRobot, SpheresStayAsTheyAreAndBoxesGetInternalSpheresInTheLinkFrame) {
+  const UrdfLink link = LinkOf(
+      "hand", {Ball(Vector3(0, 0, 0.3), 0.05), BoxAt(Vector3(0.1, 0.2, 0.4), Vector3(1, 0, 0))});
   UrdfSpherizeOptions options;
+  options.kind = SphereSetKind::kInternal;
   options.max_spheres_per_link = 12;
-  const LinkSpherizeResult result = SpherizeLink(link, options);
+  const LinkSpherizeResult result = SpherizeOne(link, options);
   ASSERT_EQ(result.status, LinkStatus::kSpherized) << result.error;
   ASSERT_GE(result.spheres.size(), 2u);
   EXPECT_LE(result.spheres.size(), 12u);
   EXPECT_EQ(result.spheres[0].center, Vector3(0, 0, 0.3));
   EXPECT_EQ(result.spheres[0].radius, 0.05);
+  EXPECT_FALSE(result.delta.has_value());
+  EXPECT_EQ(result.cores.size(), result.spheres.size());  // internal: the spheres themselves
   for (std::size_t i = 1; i < result.spheres.size(); ++i) {
     const Sphere& s = result.spheres[i];
     const Vector3 lo = s.center - Vector3::Constant(s.radius),
@@ -89,38 +121,216 @@ TEST(UrdfSpherizeLink, SpheresStayAsTheyAreAndBoxesGetInternalSpheresInTheLinkFr
   }
 }
 
-TEST(UrdfSpherizeLink, ProblemsSkipTheWholeLinkNamingTheElement) {
-  UrdfLink link;
-  link.name = "odd";
-  UrdfElement box = Element(UrdfShape::kBox);
-  box.geometry.size = Vector3::Ones();
+void ExpectSameSpheres(const std::vector<Sphere>& a, const std::vector<Sphere>& b) {
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].center, b[i].center) << i;
+    EXPECT_EQ(a[i].radius, b[i].radius) << i;
+  }
+}
+
+// Whether `spheres` hold every point of the box [lo, hi] (checked on a fine grid of it, faces
+// included) and stay within `delta` of it.
+void ExpectBoxCovered(const std::vector<Sphere>& spheres, const Vector3& lo, const Vector3& hi,
+                      double delta) {
+  const int n = 12;
+  for (int i = 0; i <= n; ++i) {
+    for (int j = 0; j <= n; ++j) {
+      for (int k = 0; k <= n; ++k) {
+        const Vector3 p = lo + (hi - lo).cwiseProduct(Vector3(i, j, k) / n);
+        bool held = false;
+        for (const Sphere& s : spheres) held = held || (p - s.center).norm() <= s.radius;
+        EXPECT_TRUE(held) << p.transpose();
+      }
+    }
+  }
+  // Points of each sphere's surface in 26 directions are within delta of the box.
+  for (const Sphere& s : spheres) {
+    for (int x = -1; x <= 1; ++x) {
+      for (int y = -1; y <= 1; ++y) {
+        for (int z = -1; z <= 1; ++z) {
+          if (x == 0 && y == 0 && z == 0) continue;
+          const Vector3 p = s.center + s.radius * Vector3(x, y, z).normalized();
+          EXPECT_LE((p - p.cwiseMax(lo).cwiseMin(hi)).norm(), delta * (1 + 1e-9) + 1e-12);
+        }
+      }
+    }
+  }
+}
+
+TEST(UrdfSpherizeRobot, CoversByDefaultHoldTheLinkAndPaddingGrowsThemAndTheirDelta) {
+  const Vector3 size(0.2, 0.1, 0.3), centre(0.5, -0.2, 0.1);
+  const UrdfLink link = LinkOf("arm", {BoxAt(size, centre), Ball(Vector3(0, 0, 1), 0.05)});
+  UrdfSpherizeOptions options;
+  options.max_spheres_per_link = 10;
+  const LinkSpherizeResult bare = SpherizeOne(link, options);
+  ASSERT_EQ(bare.status, LinkStatus::kSpherized) << bare.error;
+  EXPECT_EQ(bare.kind, SphereSetKind::kCover);
+  ASSERT_TRUE(bare.delta.has_value());
+  EXPECT_GT(*bare.delta, 0.0);
+  EXPECT_LE(bare.spheres.size(), 10u);
+  EXPECT_EQ(bare.spheres.back().center, Vector3(0, 0, 1));  // the <sphere>, as it is
+  EXPECT_EQ(bare.spheres.back().radius, 0.05);
+  ExpectBoxCovered({bare.spheres.begin(), bare.spheres.end() - 1}, centre - size / 2,
+                   centre + size / 2, *bare.delta);
+  EXPECT_FALSE(bare.cores.empty());
+  for (const Sphere& core : bare.cores) {  // inside the box or the ball element
+    const bool in_ball = (core.center - Vector3(0, 0, 1)).norm() + core.radius <= 0.05 + 1e-12;
+    const bool in_box =
+        ((core.center - centre).cwiseAbs().array() + core.radius <= (size / 2).array() + 1e-12)
+            .all();
+    EXPECT_TRUE(in_ball || in_box) << core.center.transpose() << " r " << core.radius;
+  }
+
+  options.padding = 0.01;
+  const LinkSpherizeResult padded = SpherizeOne(link, options);
+  ASSERT_EQ(padded.spheres.size(), bare.spheres.size());
+  for (std::size_t i = 0; i < bare.spheres.size(); ++i) {
+    EXPECT_EQ(padded.spheres[i].center, bare.spheres[i].center);
+    EXPECT_EQ(padded.spheres[i].radius, bare.spheres[i].radius + 0.01);
+  }
+  EXPECT_DOUBLE_EQ(*padded.delta, *bare.delta + 0.01);
+  ExpectSameSpheres(padded.cores, bare.cores);  // still inside: padding does not touch them
+}
+
+TEST(UrdfSpherizeRobot, ClipPlanesCutTheMeshBeforeItIsSpherized) {
+  // A 0.4 m cube on a table at z = 0 in its link frame, half of it below.
+  const UrdfLink link = LinkOf(
+      "base", {BoxAt(Vector3(0.4, 0.4, 0.4), Vector3::Zero()), Ball(Vector3(0, 0, -1), 0.1)});
+  UrdfSpherizeOptions options;
+  options.max_spheres_per_link = 16;
+  options.clip_planes = {ClipPlane{"base", Vector3(0, 0, -2), 0.0}};  // keeps z >= 0
+  const LinkSpherizeResult clipped = SpherizeOne(link, options);
+  ASSERT_EQ(clipped.status, LinkStatus::kSpherized) << clipped.error;
+  ASSERT_TRUE(clipped.delta.has_value());
+  // The ball below the table is gone; the spheres reach below z = 0 by at most delta.
+  for (const Sphere& s : clipped.spheres) {
+    EXPECT_GE(s.center.z() - s.radius, -*clipped.delta - 1e-12) << s.center.transpose();
+  }
+  ExpectBoxCovered(clipped.spheres, Vector3(-0.2, -0.2, 0), Vector3(0.2, 0.2, 0.2), *clipped.delta);
+
+  options.kind = SphereSetKind::kInternal;
+  const LinkSpherizeResult inside = SpherizeOne(link, options);
+  ASSERT_EQ(inside.status, LinkStatus::kSpherized) << inside.error;
+  for (const Sphere& s : inside.spheres) EXPECT_GE(s.center.z() - s.radius, -1e-9);
+
+  // Everything beyond the plane: nothing left to spherize, said so.
+  options.clip_planes = {ClipPlane{"base", Vector3(0, 0, 1), -5.0}};
+  const LinkSpherizeResult gone = SpherizeOne(link, options);
+  EXPECT_EQ(gone.status, LinkStatus::kNoGeometry);
+  EXPECT_THAT(gone.error, HasSubstr("clip planes"));
+}
+
+TEST(UrdfSpherizeRobot, ARobotBudgetGoesWhereTheEstimatedDeltaIsLargest) {
+  // Curves made up: element 0 gains little per sphere, element 1 a lot at first.
+  EXPECT_THAT(RobotSphereBudgets(2, {{1.0, 0.9}, {2.0, 0.5}}), ElementsAre(1, 1));
+  EXPECT_THAT(RobotSphereBudgets(3, {{1.0, 0.9, 0.8}, {2.0, 0.5, 0.4}}), ElementsAre(1, 2));
+  EXPECT_THAT(RobotSphereBudgets(4, {{1.0, 0.9, 0.8}, {2.0, 0.5, 0.4}}), ElementsAre(2, 2));
+  EXPECT_THAT(RobotSphereBudgets(5, {{1.0, 0.9, 0.8}, {2.0, 0.5, 0.4}}), ElementsAre(3, 2));
+  // Ties go to the lower index; a curve's end stops its element.
+  EXPECT_THAT(RobotSphereBudgets(3, {{1.0, 0.5}, {1.0, 0.5}}), ElementsAre(2, 1));
+  EXPECT_THAT(RobotSphereBudgets(10, {{1.0}, {1.0, 0.5}}), ElementsAre(1, 2));
+  EXPECT_TRUE(RobotSphereBudgets(1, {{1.0}, {1.0}}).empty());
+
+  // On a robot: two boxes, one 8x the other's volume, share 12 spheres.
+  const UrdfRobot robot =
+      RobotOf({LinkOf("big", {BoxAt(Vector3(0.4, 0.4, 0.4), Vector3::Zero())}),
+               LinkOf("small", {BoxAt(Vector3(0.2, 0.2, 0.2), Vector3::Zero())})});
+  UrdfSpherizeOptions options;
+  options.max_spheres = 12;
+  absl::StatusOr<RobotSpherizeResult> result = SpherizeRobot(robot, options);
+  ASSERT_TRUE(result.ok()) << result.status();
+  EXPECT_EQ(result->links[0].budget + result->links[1].budget, 12);
+  EXPECT_GT(result->links[0].budget, result->links[1].budget);
+  for (const LinkSpherizeResult& link : result->links) {
+    EXPECT_LE(static_cast<std::int64_t>(link.spheres.size()), link.budget);
+    ASSERT_TRUE(link.delta.has_value());
+  }
+  // Deterministic, bit for bit.
+  absl::StatusOr<RobotSpherizeResult> again = SpherizeRobot(robot, options);
+  ASSERT_TRUE(again.ok());
+  for (std::size_t l = 0; l < 2; ++l) {
+    ExpectSameSpheres(again->links[l].spheres, result->links[l].spheres);
+    EXPECT_EQ(again->links[l].delta, result->links[l].delta);
+  }
+
+  options.link_max_spheres = {{"small", 2}};
+  result = SpherizeRobot(robot, options);
+  ASSERT_TRUE(result.ok()) << result.status();
+  EXPECT_EQ(result->links[0].budget, 12);
+  EXPECT_EQ(result->links[1].budget, 2);
+
+  options.max_spheres.reset();
+  options.link_max_spheres.clear();
+  options.max_protrusion = 0.03;
+  result = SpherizeRobot(robot, options);
+  ASSERT_TRUE(result.ok()) << result.status();
+  for (const LinkSpherizeResult& link : result->links) EXPECT_LE(*link.delta, 0.03);
+}
+
+TEST(UrdfSpherizeRobot, BadOptionsAreRefusedNamingTheProblem) {
+  const UrdfRobot robot = RobotOf({LinkOf("a", {BoxAt(Vector3::Ones(), Vector3::Zero())})});
+  const auto refused = [&](const UrdfSpherizeOptions& options, const char* what) {
+    const absl::StatusOr<RobotSpherizeResult> result = SpherizeRobot(robot, options);
+    ASSERT_FALSE(result.ok()) << what;
+    EXPECT_EQ(result.status().code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_THAT(result.status().message(), HasSubstr(what));
+  };
+  UrdfSpherizeOptions options;
+  options.max_spheres = 4;
+  options.max_spheres_per_link = 4;
+  refused(options, "at most one of");
+  options = {};
+  options.voxel_size = 0.01;
+  refused(options, "covers take no voxel_size");
+  options = {};
+  options.kind = SphereSetKind::kInternal;
+  options.max_protrusion = 0.01;
+  refused(options, "max_protrusion is for covers");
+  options = {};
+  options.padding = -0.01;
+  refused(options, "padding");
+  options = {};
+  options.padding = std::nan("");
+  refused(options, "padding");
+  options = {};
+  options.max_spheres = 0;
+  refused(options, "max_spheres must lie in 1..");
+  options = {};
+  options.link_max_spheres = {{"b", 3}};
+  refused(options, "'b'");
+  options = {};
+  options.clip_planes = {ClipPlane{"a", Vector3::Zero(), 0.0}};
+  refused(options, "non-zero finite normal");
+  options = {};
+  options.clip_planes = {ClipPlane{"c", Vector3::UnitZ(), 0.0}};
+  refused(options, "'c'");
+  options = {};
+  options.max_protrusion = 0.01;
+  options.padding = 0.02;
+  refused(options, "beyond the padding");
+
+  // Links that cannot be done are skipped with the reason; the rest go on.
+  UrdfLink odd = LinkOf("odd", {BoxAt(Vector3::Ones(), Vector3::Zero())});
   UrdfElement capsule = Element(UrdfShape::kUnsupported);
   capsule.geometry.unsupported = "capsule";
   capsule.name = "cap";
-  link.elements = {box, capsule};
-  UrdfSpherizeOptions options;
-  options.max_spheres_per_link = 8;
-  LinkSpherizeResult result = SpherizeLink(link, options);
-  EXPECT_EQ(result.status, LinkStatus::kSkipped);
-  EXPECT_TRUE(result.spheres.empty());
-  EXPECT_THAT(result.error, HasSubstr("line 7 (<collision> 'cap'): <capsule> is not"));
+  odd.elements.push_back(capsule);
+  absl::StatusOr<RobotSpherizeResult> result =
+      SpherizeRobot(RobotOf({odd, LinkOf("empty", {})}), UrdfSpherizeOptions{});
+  ASSERT_TRUE(result.ok()) << result.status();
+  EXPECT_EQ(result->links[0].status, LinkStatus::kSkipped);
+  EXPECT_TRUE(result->links[0].spheres.empty());
+  EXPECT_THAT(result->links[0].error, HasSubstr("line 7 (<collision> 'cap'): <capsule> is not"));
+  EXPECT_EQ(result->links[1].status, LinkStatus::kNoGeometry);
 
-  UrdfElement collada = Element(UrdfShape::kMesh);
-  collada.geometry.filename = "package://arm/meshes/Link.DAE";
-  link.elements = {collada};
-  result = SpherizeLink(link, options);
-  EXPECT_EQ(result.status, LinkStatus::kSkipped);
-  EXPECT_THAT(result.error, HasSubstr("Collada (.dae)"));
-
-  link.elements = {box};
-  options.max_spheres_per_link = 0;
-  options.voxel_size = 1e-5;  // 1e15 voxels
-  result = SpherizeLink(link, options);
-  EXPECT_EQ(result.status, LinkStatus::kSkipped);
-  EXPECT_THAT(result.error, HasSubstr("voxels"));
-
-  link.elements.clear();
-  EXPECT_EQ(SpherizeLink(link, options).status, LinkStatus::kNoGeometry);
+  UrdfSpherizeOptions voxels;
+  voxels.kind = SphereSetKind::kInternal;
+  voxels.voxel_size = 1e-5;  // 1e15 voxels
+  result = SpherizeRobot(robot, voxels);
+  ASSERT_TRUE(result.ok());
+  EXPECT_EQ(result->links[0].status, LinkStatus::kSkipped);
+  EXPECT_THAT(result->links[0].error, HasSubstr("voxels"));
 }
 
 TEST(SpherizedUrdf, ReplacesCollisionsOfSpherizedLinksAndAnnotatesSkippedOnes) {

@@ -18,7 +18,7 @@ namespace {
 constexpr char kSphereAlgorithmVersion[] = "inscribe-spheres-1";
 // Written into the key of covers only, and bumped whenever GenerateCover would give another
 // cover for the same input (so that covers are recomputed without touching other sets' keys).
-constexpr char kCoverAlgorithmVersion[] = "inscribe-cover-3";
+constexpr char kCoverAlgorithmVersion[] = "inscribe-cover-4";
 constexpr char kHierarchyVersion[] = "v1";
 // Hashed with an uploaded set's numbers: uploaded keys never collide with generated ones.
 constexpr char kUploadedSetVersion[] = "inscribe-uploaded-spheres-1";

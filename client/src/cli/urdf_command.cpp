@@ -13,25 +13,29 @@
 #include <system_error>
 #include <vector>
 
+#include "absl/strings/numbers.h"
 #include "absl/strings/str_format.h"
+#include "absl/strings/str_split.h"
 #include "command_outcome.h"
 #include "inscribe/atomic_file.h"
 #include "inscribe/robot/spherized_urdf.h"
 #include "inscribe/robot/urdf_robot.h"
 #include "inscribe/robot/urdf_spherize.h"
+#include "inscribe/sphere_set_generation.h"
 #include "nlohmann/json.hpp"
 
 namespace inscribe::cli {
 
+using robot::ClipPlane;
 using robot::LinkSpherizeResult;
 using robot::LinkStatus;
 using robot::LinkStatusName;
 using robot::PackageSearchFromEnvironment;
 using robot::ParseUrdf;
+using robot::RobotSpherizeResult;
 using robot::SpherizedCuroboYaml;
 using robot::SpherizedUrdf;
-using robot::SpherizeLink;
-using robot::UrdfLink;
+using robot::SpherizeRobot;
 using robot::UrdfRobot;
 using robot::UrdfSpherizeOptions;
 namespace {
@@ -44,8 +48,14 @@ constexpr std::uintmax_t kMaxUrdfBytes = 256u << 20;
 struct UrdfCliOptions {
   std::string urdf_path;
   std::vector<std::string> package_paths;
+  std::string kind = "cover";
+  std::optional<std::int64_t> max_spheres;
   std::optional<std::int64_t> max_spheres_per_link;
+  std::optional<double> max_protrusion;
   std::optional<double> voxel_size;
+  std::vector<std::string> link_budgets;  // LINK=N
+  std::vector<std::string> clips;         // LINK=NX,NY,NZ,OFFSET
+  double padding = 0.0;
   std::string output_path;
   std::string yaml_path;
   bool json = false;
@@ -69,6 +79,55 @@ absl::StatusOr<std::string> ReadWholeFile(const std::string& path) {
   return contents.str();
 }
 
+// "LINK=VALUE" split at the last '=' (link names may hold '=').
+absl::StatusOr<std::pair<std::string, std::string>> SplitLinkValue(const std::string& text,
+                                                                   const char* flag) {
+  const std::size_t at = text.rfind('=');
+  if (at == std::string::npos || at == 0 || at + 1 == text.size()) {
+    return absl::InvalidArgumentError(absl::StrFormat("%s '%s' is not LINK=VALUE", flag, text));
+  }
+  return std::pair{text.substr(0, at), text.substr(at + 1)};
+}
+
+// The spherizer's options from the flags; the spherizer checks them (CheckUrdfSpherizeOptions).
+absl::StatusOr<UrdfSpherizeOptions> SpherizeOptionsOf(const UrdfCliOptions& options) {
+  UrdfSpherizeOptions spherize;
+  absl::StatusOr<SphereSetKind> kind = ParseSphereSetKind(options.kind);
+  if (!kind.ok()) return kind.status();
+  spherize.kind = *kind;
+  spherize.max_spheres = options.max_spheres;
+  spherize.max_spheres_per_link = options.max_spheres_per_link;
+  spherize.max_protrusion = options.max_protrusion;
+  spherize.voxel_size = options.voxel_size;
+  spherize.padding = options.padding;
+  for (const std::string& text : options.link_budgets) {
+    absl::StatusOr<std::pair<std::string, std::string>> parts =
+        SplitLinkValue(text, "--link-max-spheres");
+    if (!parts.ok()) return parts.status();
+    std::int64_t n = 0;
+    if (!absl::SimpleAtoi(parts->second, &n)) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "--link-max-spheres '%s': '%s' is not a whole number", text, parts->second));
+    }
+    spherize.link_max_spheres[parts->first] = n;
+  }
+  for (const std::string& text : options.clips) {
+    absl::StatusOr<std::pair<std::string, std::string>> parts = SplitLinkValue(text, "--clip");
+    if (!parts.ok()) return parts.status();
+    const std::vector<std::string> numbers = absl::StrSplit(parts->second, ',');
+    double values[4];
+    bool ok = numbers.size() == 4;
+    for (std::size_t k = 0; ok && k < 4; ++k) ok = absl::SimpleAtod(numbers[k], &values[k]);
+    if (!ok) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "--clip '%s': expected LINK=NX,NY,NZ,OFFSET (4 numbers after '=')", text));
+    }
+    spherize.clip_planes.push_back(
+        ClipPlane{parts->first, Vector3(values[0], values[1], values[2]), values[3]});
+  }
+  return spherize;
+}
+
 // --yaml, or OUT with its extension replaced by .yml.
 std::string YamlPath(const UrdfCliOptions& options) {
   if (!options.yaml_path.empty()) return options.yaml_path;
@@ -79,65 +138,88 @@ bool SameFile(const std::string& a, const std::string& b) {
   return fs::absolute(a).lexically_normal() == fs::absolute(b).lexically_normal();
 }
 
-void PrintJson(const UrdfCliOptions& options, const UrdfRobot& robot,
-               const std::vector<LinkSpherizeResult>& results, const std::string& yaml_path,
-               const std::vector<std::string>& left_out, double seconds) {
+// The mode the run used, as the flags name it.
+void AddMode(const UrdfSpherizeOptions& options, nlohmann::json* report) {
+  if (options.max_spheres) (*report)["max_spheres"] = *options.max_spheres;
+  if (options.max_spheres_per_link) {
+    (*report)["max_spheres_per_link"] = *options.max_spheres_per_link;
+  }
+  if (options.max_protrusion) (*report)["max_protrusion"] = *options.max_protrusion;
+  if (options.voxel_size) (*report)["voxel_size"] = *options.voxel_size;
+}
+
+void PrintJson(const UrdfCliOptions& options, const UrdfSpherizeOptions& spherize,
+               const UrdfRobot& robot, const RobotSpherizeResult& result,
+               const std::string& yaml_path, const std::vector<std::string>& left_out,
+               double seconds) {
   nlohmann::json report;
   report["urdf"] = options.urdf_path;
   report["robot"] = robot.name;
   report["output"] = options.output_path;
   report["yaml"] = yaml_path;
-  if (options.voxel_size) {
-    report["voxel_size"] = *options.voxel_size;
-  } else {
-    report["max_spheres_per_link"] = *options.max_spheres_per_link;
-  }
+  report["kind"] = SphereSetKindName(spherize.kind);
+  report["padding"] = spherize.padding;
+  AddMode(robot::WithDefaultMode(spherize), &report);
   int spherized = 0, skipped = 0;
   std::int64_t spheres = 0;
+  std::optional<double> delta;
   nlohmann::json links = nlohmann::json::array();
-  for (const LinkSpherizeResult& result : results) {
+  for (const LinkSpherizeResult& link_result : result.links) {
     nlohmann::json link;
-    link["link"] = result.link;
-    link["status"] = LinkStatusName(result.status);
-    link["elements"] = result.elements;
-    link["from_visual"] = result.from_visual;
-    link["spheres"] = result.spheres.size();
-    link["generation_runs"] = result.generation_runs;
-    link["seconds"] = result.seconds;
-    if (result.status == LinkStatus::kSkipped) link["error"] = result.error;
+    link["link"] = link_result.link;
+    link["status"] = LinkStatusName(link_result.status);
+    link["elements"] = link_result.elements;
+    link["from_visual"] = link_result.from_visual;
+    link["spheres"] = link_result.spheres.size();
+    if (link_result.budget > 0) link["budget"] = link_result.budget;
+    link["certified"] = link_result.delta.has_value();
+    if (link_result.delta) {
+      link["delta"] = *link_result.delta;
+      delta = std::max(delta.value_or(0.0), *link_result.delta);
+    }
+    link["generation_runs"] = link_result.generation_runs;
+    link["seconds"] = link_result.seconds;
+    if (!link_result.error.empty()) link["error"] = link_result.error;
     links.push_back(std::move(link));
-    spherized += result.status == LinkStatus::kSpherized;
-    skipped += result.status == LinkStatus::kSkipped;
-    spheres += static_cast<std::int64_t>(result.spheres.size());
+    spherized += link_result.status == LinkStatus::kSpherized;
+    skipped += link_result.status == LinkStatus::kSkipped;
+    spheres += static_cast<std::int64_t>(link_result.spheres.size());
   }
   report["links"] = std::move(links);
   report["spherized"] = spherized;
   report["skipped"] = skipped;
   report["spheres"] = spheres;
+  if (delta) report["delta"] = *delta;
   report["left_out_of_yaml"] = left_out;
+  report["spherize_seconds"] = result.seconds;
   report["seconds"] = seconds;
   // Names and messages come from the URDF, whose bytes tinyxml2 does not check as UTF-8.
   std::cout << report.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
 }
 
-void PrintTable(const std::vector<LinkSpherizeResult>& results, const std::string& output_path,
+void PrintTable(const RobotSpherizeResult& result, const std::string& output_path,
                 const std::string& yaml_path, const std::vector<std::string>& left_out,
                 double seconds) {
   std::size_t width = 4;
-  for (const LinkSpherizeResult& result : results) width = std::max(width, result.link.size());
+  for (const LinkSpherizeResult& link : result.links) width = std::max(width, link.link.size());
   const int w = static_cast<int>(width);
-  std::cout << absl::StrFormat("%-*s  %-11s  %7s  %8s  %s\n", w, "link", "status", "spheres",
-                               "seconds", "note");
+  std::cout << absl::StrFormat("%-*s  %-11s  %7s  %11s  %8s  %s\n", w, "link", "status", "spheres",
+                               "delta (mm)", "seconds", "note");
   int skipped = 0;
-  for (const LinkSpherizeResult& result : results) {
-    std::string note = result.status == LinkStatus::kSkipped ? result.error : "";
-    if (result.status == LinkStatus::kSpherized && result.from_visual) note = "visual geometry";
-    std::cout << absl::StrFormat("%-*s  %-11s  %7d  %8.3f  %s\n", w, result.link,
-                                 LinkStatusName(result.status), result.spheres.size(),
-                                 result.seconds, note);
-    skipped += result.status == LinkStatus::kSkipped;
+  std::int64_t spheres = 0;
+  for (const LinkSpherizeResult& link : result.links) {
+    std::string note = link.error;
+    if (link.status == LinkStatus::kSpherized && link.from_visual) note = "visual geometry";
+    const std::string delta =
+        link.delta ? absl::StrFormat("%.3f", *link.delta * 1000.0) : std::string("-");
+    std::cout << absl::StrFormat("%-*s  %-11s  %7d  %11s  %8.3f  %s\n", w, link.link,
+                                 LinkStatusName(link.status), link.spheres.size(), delta,
+                                 link.seconds, note);
+    skipped += link.status == LinkStatus::kSkipped;
+    spheres += static_cast<std::int64_t>(link.spheres.size());
   }
-  std::cout << absl::StrFormat("wrote %s and %s in %.3f s", output_path, yaml_path, seconds);
+  std::cout << absl::StrFormat("wrote %s and %s (%d spheres) in %.3f s", output_path, yaml_path,
+                               spheres, seconds);
   if (skipped > 0) std::cout << absl::StrFormat("; %d link(s) skipped, kept as they were", skipped);
   if (!left_out.empty()) {
     std::cout << absl::StrFormat("; %d link(s) left out of the YAML (names)", left_out.size());
@@ -145,16 +227,12 @@ void PrintTable(const std::vector<LinkSpherizeResult>& results, const std::strin
   std::cout << "\n";
 }
 
-absl::Status RunUrdf(UrdfCliOptions options) {
+absl::Status RunUrdf(const UrdfCliOptions& options) {
   const auto start = std::chrono::steady_clock::now();
-  if (!options.voxel_size && !options.max_spheres_per_link) {
-    options.max_spheres_per_link = robot::kDefaultMaxSpheresPerLink;
-  }
-  if (options.voxel_size && !(*options.voxel_size > 0.0 && std::isfinite(*options.voxel_size))) {
-    return UsageError("--voxel-size must be a positive number of metres");
-  }
-  if (options.max_spheres_per_link && *options.max_spheres_per_link <= 0) {
-    return UsageError("--max-spheres-per-link must be at least 1");
+  absl::StatusOr<UrdfSpherizeOptions> spherize = SpherizeOptionsOf(options);
+  if (!spherize.ok()) return UsageError(spherize.status().message());
+  if (absl::Status checked = robot::CheckUrdfSpherizeOptions(*spherize); !checked.ok()) {
+    return UsageError(checked.message());
   }
   const std::string yaml_path = YamlPath(options);
   if (SameFile(yaml_path, options.output_path)) {
@@ -178,18 +256,14 @@ absl::Status RunUrdf(UrdfCliOptions options) {
     return BadInputError(options.urdf_path + ": " + std::string(robot.status().message()));
   }
 
-  UrdfSpherizeOptions spherize;
-  spherize.max_spheres_per_link = options.max_spheres_per_link.value_or(0);
-  spherize.voxel_size = options.voxel_size.value_or(0.0);
-  spherize.packages = PackageSearchFromEnvironment(options.package_paths);
-  spherize.urdf_dir = fs::absolute(options.urdf_path).parent_path().string();
-  // Links one after another: the generation inside each is already parallel over voxels, and
-  // per-link times then mean what they say.
-  std::vector<LinkSpherizeResult> results;
-  for (const UrdfLink& link : robot->links) {
-    results.push_back(SpherizeLink(link, spherize));
-    if (results.back().status == LinkStatus::kSkipped) {
-      std::cerr << "inscribe: link '" << link.name << "' skipped: " << results.back().error << "\n";
+  spherize->packages = PackageSearchFromEnvironment(options.package_paths);
+  spherize->urdf_dir = fs::absolute(options.urdf_path).parent_path().string();
+  absl::StatusOr<RobotSpherizeResult> spherized = SpherizeRobot(*robot, *spherize);
+  if (!spherized.ok()) return UsageError(spherized.status().message());
+  const std::vector<LinkSpherizeResult>& results = spherized->links;
+  for (const LinkSpherizeResult& link : results) {
+    if (link.status == LinkStatus::kSkipped) {
+      std::cerr << "inscribe: link '" << link.link << "' skipped: " << link.error << "\n";
     }
   }
 
@@ -212,9 +286,9 @@ absl::Status RunUrdf(UrdfCliOptions options) {
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (options.json) {
-    PrintJson(options, *robot, results, yaml_path, left_out, seconds);
+    PrintJson(options, *spherize, *robot, *spherized, yaml_path, left_out, seconds);
   } else {
-    PrintTable(results, options.output_path, yaml_path, left_out, seconds);
+    PrintTable(*spherized, options.output_path, yaml_path, left_out, seconds);
   }
   const auto skipped = std::count_if(results.begin(), results.end(), [](const auto& result) {
     return result.status == LinkStatus::kSkipped;
@@ -237,26 +311,55 @@ void AddUrdfCommand(CLI::App& app, CommandOutcome* outcome) {
   CLI::App* cmd = app.add_subcommand(
       "urdf",
       "Spherize a robot: every link's collision meshes (visual when it has none; box, "
-      "cylinder and sphere too) become internal spheres in the link's frame; writes the URDF "
-      "with sphere collisions and cuRobo's collision_spheres YAML. Links that cannot be done "
-      "are named, kept as they were, and make the exit status 1");
-  cmd->add_option("ROBOT", options->urdf_path, "URDF file (xacro must be expanded first)")
+      "cylinder and sphere too) become spheres in the link's frame, certified covers by "
+      "default; writes the URDF with sphere collisions and cuRobo's collision_spheres YAML. "
+      "Links that cannot be done are named, kept as they were, and make the exit status 1");
+  cmd->add_option("ROBOT", options->urdf_path,
+                  "URDF file (expand xacro first: xacro robot.urdf.xacro > robot.urdf)")
       ->required();
   cmd->add_option("--package-path", options->package_paths,
                   "Directory holding ROS packages (or a package itself) for package:// URIs; "
                   "repeatable, searched before ROS_PACKAGE_PATH and AMENT_PREFIX_PATH");
+  cmd->add_option("--kind", options->kind,
+                  "cover: spheres proven to hold each link, with a certified delta; internal: "
+                  "medial spheres inside it; dilated: grown medial spheres")
+      ->check(CLI::IsMember({"cover", "internal", "dilated"}))
+      ->capture_default_str();
+  CLI::Option* robot_budget = cmd->add_option(
+      "--max-spheres", options->max_spheres,
+      "At most N spheres for the whole robot, shared among links: covers by greedy marginal "
+      "gain on their estimated delta, other kinds by volume");
   CLI::Option* budget = cmd->add_option(
       "--max-spheres-per-link", options->max_spheres_per_link,
-      "At most N spheres per link, shared among its elements by volume (default mode, N = 32)");
+      "At most N spheres per link, shared among its elements by volume (the default, N = 32)");
+  CLI::Option* protrusion = cmd->add_option(
+      "--max-protrusion", options->max_protrusion,
+      "Covers: every link's certified delta at most D metres (padding included), with the "
+      "fewest spheres");
   CLI::Option* voxel = cmd->add_option("--voxel-size", options->voxel_size,
-                                       "Voxel side sigma for every element, metres");
-  voxel->excludes(budget);
-  budget->excludes(voxel);
+                                       "Internal and dilated sets: voxel side sigma for every "
+                                       "element, metres");
+  for (CLI::Option* a : {robot_budget, budget, protrusion, voxel}) {
+    for (CLI::Option* b : {robot_budget, budget, protrusion, voxel}) {
+      if (a != b) a->excludes(b);
+    }
+  }
+  cmd->add_option("--link-max-spheres", options->link_budgets,
+                  "LINK=N: that link gets N spheres of its own, outside the shared budget; "
+                  "repeatable");
+  cmd->add_option("--padding", options->padding,
+                  "Metres added to every radius, as a planner's collision buffer (covers: >= 0, "
+                  "and their delta grows by it)");
+  cmd->add_option("--clip", options->clips,
+                  "LINK=NX,NY,NZ,OFFSET: cut off what lies beyond the plane NX x + NY y + NZ z "
+                  "= OFFSET in the link's frame (the side the normal points to) before "
+                  "spherizing, e.g. a table under the base; repeatable");
   cmd->add_option("-o,--output", options->output_path, "The spherized URDF to write")->required();
   cmd->add_option("--yaml", options->yaml_path,
                   "cuRobo collision_spheres YAML to write (default: -o with extension .yml)");
   cmd->add_flag("--json", options->json,
-                "Print one JSON report on stdout: per link status, spheres, seconds, error");
+                "Print one JSON report on stdout: per link status, spheres, budget, delta, "
+                "certified, seconds, error");
   cmd->callback([options, outcome] { outcome->status = RunUrdf(*options); });
 }
 

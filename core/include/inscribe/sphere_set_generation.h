@@ -37,6 +37,8 @@ enum class SphereSetKind {
 
 // "internal", "dilated", "cover": the name sphere files and the CLI use.
 const char* SphereSetKindName(SphereSetKind kind);
+// The kind SphereSetKindName names; INVALID_ARGUMENT listing the three names otherwise.
+absl::StatusOr<SphereSetKind> ParseSphereSetKind(absl::string_view name);
 
 struct SphereSetParameters {
   SphereSetKind kind = SphereSetKind::kInternal;

@@ -128,11 +128,11 @@ TEST(RobotViewLink, ProtrusionIsExactOnABoxAndABall) {
   // A box [0.2, 0.6] x [-0.1, 0.1] x [-0.1, 0.1] and a ball of radius 0.2 at the origin.
   link.elements = {BoxElement({0.4, 0.2, 0.2}, {0.4, 0, 0}), BallElement(0.2, Vector3::Zero())};
   const std::vector<Sphere> spheres = {
-      {{0.4, 0.0, 0.0}, 0.05},    // inside the box
-      {{0.55, 0.0, 0.0}, 0.1},    // 0.05 past the box's x = 0.6 face
-      {{0.0, 0.15, 0.0}, 0.1},    // 0.05 past the ball
-      {{0.15, 0.0, 0.0}, 0.04},   // inside the ball, 0.09 past the box: 0
-      {{0.0, 0.0, 0.5}, 0.1},     // outside both: the least of the two
+      {{0.4, 0.0, 0.0}, 0.05},   // inside the box
+      {{0.55, 0.0, 0.0}, 0.1},   // 0.05 past the box's x = 0.6 face
+      {{0.0, 0.15, 0.0}, 0.1},   // 0.05 past the ball
+      {{0.15, 0.0, 0.0}, 0.04},  // inside the ball, 0.09 past the box: 0
+      {{0.0, 0.0, 0.5}, 0.1},    // outside both: the least of the two
   };
   const RobotViewLink view = MakeRobotViewLink(link, spheres, {});
   EXPECT_TRUE(view.problems.empty());
@@ -151,7 +151,8 @@ TEST(RobotViewLink, ProtrusionIsExactOnABoxAndABall) {
 }
 
 TEST(RobotViewLink, UnreadableGeometryIsNamedAndProtrusionUnknown) {
-  const fs::path dir = fs::temp_directory_path() / ("robot_view_test_" + std::to_string(::getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("robot_view_test_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   robot::UrdfSpherizeOptions options;
   options.urdf_dir = dir.string();
@@ -213,7 +214,7 @@ robot::UrdfRobot ChainRobot() {
   };
   joint("ja", robot::UrdfJointType::kRevolute, "base", "a");
   joint("jb", robot::UrdfJointType::kPrismatic, "a", "b");
-  robot.joints.back().lower = 0.5;  // home is then clamped to 0.5
+  robot.joints.back().lower = 0.5;  // home is then the middle, 1.25
   joint("jc", robot::UrdfJointType::kRevolute, "a", "c");
   robot.joints.back().mimic = robot::UrdfMimic{"ja", 2.0, 0.5};
   joint("jd", robot::UrdfJointType::kContinuous, "c", "d");
@@ -229,7 +230,7 @@ TEST(RobotViewData, JointsCarryTheirVariableAndComposedMimics) {
   ASSERT_EQ(data.at("variables").size(), 2u);
   EXPECT_EQ(data.at("variables")[0].at("joint"), "ja");
   EXPECT_EQ(data.at("variables")[0].at("value"), 0.0);
-  EXPECT_EQ(data.at("variables")[1].at("value"), 0.5);
+  EXPECT_EQ(data.at("variables")[1].at("value"), 1.25);
   const nlohmann::json& joints = data.at("joints");
   ASSERT_EQ(joints.size(), 4u);
   EXPECT_EQ(joints[0].at("variable"), 0);

@@ -127,12 +127,14 @@ nlohmann::json KinematicsJson(const robot::UrdfRobot& robot, const robot::Kinema
                       {"mimic", joint.mimic ? nlohmann::json(joint.mimic->joint) : nullptr}});
   }
   nlohmann::json variables = nlohmann::json::array();
-  for (const robot::JointVariable& v : kinematics.variables()) {
+  const std::vector<double> home = robot::DefaultConfiguration(kinematics);
+  for (std::size_t i = 0; i < kinematics.variables().size(); ++i) {
+    const robot::JointVariable& v = kinematics.variables()[i];
     variables.push_back({{"joint", v.joint},
                          {"type", robot::UrdfJointTypeName(v.type)},
                          {"lower", v.lower},
                          {"upper", v.upper},
-                         {"value", std::clamp(0.0, v.lower, std::max(v.lower, v.upper))}});
+                         {"value", home[i]}});
   }
   return {{"links", std::move(links)},
           {"order", std::move(order)},

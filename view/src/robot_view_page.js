@@ -129,6 +129,9 @@
     if (x === 0) return '0';
     return String(Number(x.toPrecision(digits)));
   }
+  function plural(n, word) {
+    return n + ' ' + word + (n === 1 ? '' : 's');
+  }
   function element(tag, attributes = {}, text) {
     const e = document.createElement(tag);
     for (const [key, value] of Object.entries(attributes)) e.setAttribute(key, value);
@@ -244,10 +247,10 @@
     const problems = data.geometry.reduce((n, g) => n + g.problems.length, 0);
     const rows = [
       ['robot', (data.robot.name || '(unnamed)') + ' (' + data.robot.file + '): ' +
-        data.robot.links + ' links, ' + data.robot.joints + ' joints, ' +
-        data.variables.length + ' variables'],
+        plural(data.robot.links, 'link') + ', ' + plural(data.robot.joints, 'joint') + ', ' +
+        plural(data.variables.length, 'variable')],
       ['spheres', s.count + ' (' + s.file + ', ' + s.format + ')'],
-      ['protrusion', s.protruding + ' spheres reach outside their link; max ' +
+      ['protrusion', plural(s.protruding, 'sphere') + ' reaching outside its link; max ' +
         num(s.protrusion_max) + ' m', 'per sphere: max(0, r + signed distance of the centre ' +
         'to its link\'s geometry), metres'],
       ['problems', problems === 0 ? 'none' : problems + ' (see the links)'],
@@ -345,7 +348,7 @@
       swatch.style.background = cssColor(linkColor(l));
       let worst = 0;
       if (g.protrusion !== null) for (const p of g.protrusion) worst = Math.max(worst, p);
-      const facts = (g.spheres.length / 4) + ' spheres' +
+      const facts = plural(g.spheres.length / 4, 'sphere') +
           (g.spheres.length === 0 ? '' : g.protrusion === null ? ', protrusion unknown'
                                                                 : ', max protrusion ' + num(worst, 3));
       label.append(box, swatch, element('span', {class: 'name'}, link.name),

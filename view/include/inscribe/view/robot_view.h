@@ -33,8 +33,8 @@ struct RobotViewOptions {
 //   joints: [{name, type (URDF's name), xyz, rpy, axis, variable, multiplier, offset}] in
 //     UrdfRobot::joints order; a joint's value is multiplier * q[variable] + offset (variable
 //     -1: no motion; an active joint: itself, 1, 0; a mimic: its chain of leaders composed),
-//   variables: [{joint, type, lower, upper, value}] in Kinematics::variables order; value is 0
-//     clamped into [lower, upper], the pose the page opens in.
+//   variables: [{joint, type, lower, upper, value}] in Kinematics::variables order; value is
+//     DefaultConfiguration's (MoveIt's default state), the pose the page opens in.
 // Numbers as given (no rounding): the page's poses must equal Kinematics::LinkPoses.
 nlohmann::json KinematicsJson(const robot::UrdfRobot& robot, const robot::Kinematics& kinematics);
 

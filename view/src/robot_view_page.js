@@ -334,6 +334,28 @@
     colorLabel.append(colorSelect);
     controls.append(meshLabel, spheresLabel, colorLabel);
     panel.appendChild(controls);
+    const legend = element('div', {class: 'note legend-text'});
+    panel.appendChild(legend);
+    function drawLegend() {
+      legend.replaceChildren();
+      if (options.color !== 'error') {
+        legend.textContent = 'each link\'s colour is the swatch beside its name';
+        return;
+      }
+      const swatch = (rgb, text) => {
+        const s = element('span', {class: 'swatch'});
+        s.style.background = cssColor(rgb);
+        legend.append(s, ' ' + text + '  ');
+      };
+      swatch(NOT_PROTRUDING, 'inside');
+      if (data.spheres.protruding > 0) {
+        swatch(PROTRUDING[0], '> 0');
+        swatch(PROTRUDING[2], num(data.spheres.protrusion_max, 3) + ' m');
+      } else {
+        legend.append('(none reaches outside)  ');
+      }
+      swatch(UNKNOWN, 'unknown');
+    }
 
     // Links: a checkbox each, their spheres and problems.
     panel.appendChild(element('h2', {}, 'links'));
@@ -458,6 +480,7 @@
         if (object.spheres) object.spheres.visible = options.spheres;
         paintLink(data, l, object, options.color);
       });
+      drawLegend();
     }
 
     meshBox.addEventListener('change', () => {

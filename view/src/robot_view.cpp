@@ -218,8 +218,6 @@ absl::StatusOr<std::string> MakeRobotViewPageFromFiles(const std::string& urdf_p
   if (!urdf_bytes.ok()) return urdf_bytes.status();
   absl::StatusOr<robot::UrdfRobot> robot = robot::ParseUrdf(*urdf_bytes);
   if (!robot.ok()) return Prefixed(urdf_path, robot.status());
-  absl::StatusOr<robot::Kinematics> kinematics = robot::Kinematics::Create(*robot);
-  if (!kinematics.ok()) return Prefixed(urdf_path, kinematics.status());
   absl::StatusOr<std::string> sphere_bytes = ReadWholeFile(spheres_path);
   if (!sphere_bytes.ok()) return sphere_bytes.status();
   absl::StatusOr<RobotSpheres> spheres = ParseRobotSpheres(*sphere_bytes, spheres_path);
@@ -230,7 +228,12 @@ absl::StatusOr<std::string> MakeRobotViewPageFromFiles(const std::string& urdf_p
   if (options.urdf_dir.empty()) {
     options.urdf_dir = std::filesystem::absolute(urdf_path).parent_path().string();
   }
-  return MakeRobotViewPage(*robot, *spheres, options);
+  // The spheres passed their check: what MakeRobotViewPage refuses now is the robot's tree.
+  absl::StatusOr<std::string> page = MakeRobotViewPage(*robot, *spheres, options);
+  if (page.status().code() == absl::StatusCode::kInvalidArgument) {
+    return Prefixed(urdf_path, page.status());
+  }
+  return page;
 }
 
 }  // namespace inscribe::view

@@ -30,9 +30,9 @@ absl::Status ErrorAt(int line, absl::string_view what) {
   return absl::InvalidArgumentError(absl::StrCat("URDF line ", line, ": ", what));
 }
 
-// " in link 'NAME'" or "" before the link's name is known.
-std::string InLink(const std::string& link) {
-  return link.empty() ? "" : absl::StrCat(" (link '", link, "')");
+// " (OWNER)" for an owner such as "link 'base'" or "joint 'elbow'"; "" when it is not known.
+std::string InOwner(const std::string& owner) {
+  return owner.empty() ? "" : absl::StrCat(" (", owner, ")");
 }
 
 // `count` whitespace-separated finite numbers from attribute `name` of `element`; `fallback`
@@ -45,12 +45,12 @@ absl::StatusOr<std::vector<double>> ParseNumbers(const XMLElement& element, cons
   if (attribute == nullptr) {
     if (!required) return fallback;
     return ErrorAt(element.GetLineNum(), absl::StrCat("<", element.Name(), "> has no ", name,
-                                                      " attribute", InLink(link)));
+                                                      " attribute", InOwner(link)));
   }
   const std::string text = attribute->Value();
   const auto malformed = [&](absl::string_view why) {
     return ErrorAt(attribute->GetLineNum(), absl::StrCat("<", element.Name(), " ", name, "=\"",
-                                                         text, "\">: ", why, InLink(link)));
+                                                         text, "\">: ", why, InOwner(link)));
   };
   if (absl::StrContains(text, "${") || absl::StrContains(text, "$(")) {
     return malformed("unexpanded xacro expression; run xacro first");
@@ -89,7 +89,7 @@ absl::StatusOr<double> ParsePositive(const XMLElement& element, const char* name
   if ((*values)[0] <= 0.0) {
     return ErrorAt(element.GetLineNum(),
                    absl::StrCat("<", element.Name(), "> ", name, " ", (*values)[0],
-                                " is not positive", InLink(link)));
+                                " is not positive", InOwner(link)));
   }
   return (*values)[0];
 }
@@ -117,14 +117,14 @@ absl::StatusOr<UrdfGeometry> ParseGeometry(const XMLElement& element, const std:
     const char* filename = shape->Attribute("filename");
     if (filename == nullptr || filename[0] == '\0') {
       return ErrorAt(shape->GetLineNum(),
-                     absl::StrCat("<mesh> has no filename attribute", InLink(link)));
+                     absl::StrCat("<mesh> has no filename attribute", InOwner(link)));
     }
     absl::StatusOr<Vector3> scale = ParseVector(*shape, "scale", false, Vector3::Ones(), link);
     if (!scale.ok()) return scale.status();
     if ((scale->array() == 0.0).any()) {
       return ErrorAt(
           shape->GetLineNum(),
-          absl::StrCat("<mesh scale> has a zero component: the mesh would be flat", InLink(link)));
+          absl::StrCat("<mesh scale> has a zero component: the mesh would be flat", InOwner(link)));
     }
     geometry.shape = UrdfShape::kMesh;
     geometry.filename = filename;
@@ -134,7 +134,7 @@ absl::StatusOr<UrdfGeometry> ParseGeometry(const XMLElement& element, const std:
     if (!size.ok()) return size.status();
     if (!(size->array() > 0.0).all()) {
       return ErrorAt(shape->GetLineNum(),
-                     absl::StrCat("<box size> must be 3 positive numbers", InLink(link)));
+                     absl::StrCat("<box size> must be 3 positive numbers", InOwner(link)));
     }
     geometry.shape = UrdfShape::kBox;
     geometry.size = *size;
@@ -170,6 +170,125 @@ absl::StatusOr<UrdfElement> ParseElement(const XMLElement& element, const std::s
   return parsed;
 }
 
+std::string InJoint(const std::string& joint) {
+  return InOwner(absl::StrCat("joint '", joint, "'"));
+}
+
+// One number from attribute `name`, `fallback` when it is absent.
+absl::StatusOr<double> ParseNumber(const XMLElement& element, const char* name, double fallback,
+                                   const std::string& where) {
+  absl::StatusOr<std::vector<double>> values =
+      ParseNumbers(element, name, 1, false, {fallback}, where);
+  if (!values.ok()) return values.status();
+  return (*values)[0];
+}
+
+std::optional<UrdfJointType> JointTypeFromName(absl::string_view name) {
+  for (UrdfJointType type :
+       {UrdfJointType::kFixed, UrdfJointType::kRevolute, UrdfJointType::kContinuous,
+        UrdfJointType::kPrismatic, UrdfJointType::kFloating, UrdfJointType::kPlanar}) {
+    if (name == UrdfJointTypeName(type)) return type;
+  }
+  return std::nullopt;
+}
+
+// The link attribute of <parent> or <child> (`kind`) of joint `element`.
+absl::StatusOr<std::string> JointLink(const XMLElement& element, const char* kind,
+                                      const std::string& joint) {
+  const XMLElement* node = element.FirstChildElement(kind);
+  if (node == nullptr) {
+    return ErrorAt(element.GetLineNum(),
+                   absl::StrCat("<joint> has no <", kind, "> element", InJoint(joint)));
+  }
+  const char* link = node->Attribute("link");
+  if (link == nullptr || link[0] == '\0') {
+    return ErrorAt(node->GetLineNum(),
+                   absl::StrCat("<", kind, "> has no link attribute", InJoint(joint)));
+  }
+  return std::string(link);
+}
+
+absl::StatusOr<UrdfJoint> ParseJoint(const XMLElement& element) {
+  UrdfJoint joint;
+  joint.line = element.GetLineNum();
+  const char* name = element.Attribute("name");
+  if (name == nullptr || name[0] == '\0') {
+    return ErrorAt(joint.line, "<joint> has no name attribute");
+  }
+  joint.name = name;
+  const std::string in_joint = absl::StrCat("joint '", joint.name, "'");
+  const char* type = element.Attribute("type");
+  if (type == nullptr) {
+    return ErrorAt(joint.line, absl::StrCat("<joint> has no type attribute", InJoint(joint.name)));
+  }
+  const std::optional<UrdfJointType> parsed_type = JointTypeFromName(type);
+  if (!parsed_type) {
+    return ErrorAt(joint.line,
+                   absl::StrCat("<joint type=\"", type,
+                                "\"> is not a URDF joint type (fixed, revolute, continuous, "
+                                "prismatic, floating, planar)",
+                                InJoint(joint.name)));
+  }
+  joint.type = *parsed_type;
+  absl::StatusOr<std::string> parent = JointLink(element, "parent", joint.name);
+  if (!parent.ok()) return parent.status();
+  absl::StatusOr<std::string> child = JointLink(element, "child", joint.name);
+  if (!child.ok()) return child.status();
+  joint.parent = *std::move(parent);
+  joint.child = *std::move(child);
+  absl::StatusOr<UrdfOrigin> origin = ParseOrigin(element, in_joint);
+  if (!origin.ok()) return origin.status();
+  joint.origin = *origin;
+
+  const bool has_axis =
+      joint.type != UrdfJointType::kFixed && joint.type != UrdfJointType::kFloating;
+  if (const XMLElement* axis = element.FirstChildElement("axis"); axis != nullptr && has_axis) {
+    absl::StatusOr<Vector3> xyz = ParseVector(*axis, "xyz", false, Vector3::UnitX(), in_joint);
+    if (!xyz.ok()) return xyz.status();
+    const double norm = xyz->norm();
+    if (!(norm > 0.0) || !std::isfinite(norm)) {
+      return ErrorAt(axis->GetLineNum(),
+                     absl::StrCat("<axis xyz> of a ", type, " joint is zero (or overflows)",
+                                  InJoint(joint.name)));
+    }
+    joint.axis = *xyz / norm;
+  }
+
+  const bool limited =
+      joint.type == UrdfJointType::kRevolute || joint.type == UrdfJointType::kPrismatic;
+  if (const XMLElement* limit = element.FirstChildElement("limit"); limit != nullptr) {
+    absl::StatusOr<double> lower = ParseNumber(*limit, "lower", 0.0, in_joint);
+    if (!lower.ok()) return lower.status();
+    absl::StatusOr<double> upper = ParseNumber(*limit, "upper", 0.0, in_joint);
+    if (!upper.ok()) return upper.status();
+    if (limited && *lower > *upper) {
+      return ErrorAt(limit->GetLineNum(),
+                     absl::StrCat("<limit lower=\"", *lower, "\" upper=\"", *upper,
+                                  "\">: lower > upper", InJoint(joint.name)));
+    }
+    joint.lower = *lower;
+    joint.upper = *upper;
+  }
+
+  if (const XMLElement* mimic = element.FirstChildElement("mimic"); mimic != nullptr) {
+    const char* of = mimic->Attribute("joint");
+    if (of == nullptr || of[0] == '\0') {
+      return ErrorAt(mimic->GetLineNum(),
+                     absl::StrCat("<mimic> has no joint attribute", InJoint(joint.name)));
+    }
+    UrdfMimic parsed;
+    parsed.joint = of;
+    absl::StatusOr<double> multiplier = ParseNumber(*mimic, "multiplier", 1.0, in_joint);
+    if (!multiplier.ok()) return multiplier.status();
+    absl::StatusOr<double> offset = ParseNumber(*mimic, "offset", 0.0, in_joint);
+    if (!offset.ok()) return offset.status();
+    parsed.multiplier = *multiplier;
+    parsed.offset = *offset;
+    joint.mimic = std::move(parsed);
+  }
+  return joint;
+}
+
 // The first element, in document order, whose name is in the xacro namespace.
 const XMLElement* FindXacro(const XMLElement& element) {
   if (absl::StartsWith(element.Name(), "xacro:")) return &element;
@@ -191,7 +310,8 @@ absl::StatusOr<UrdfLink> ParseLink(const XMLElement& element) {
   for (const char* kind : {"collision", "visual"}) {
     for (const XMLElement* child = element.FirstChildElement(kind); child != nullptr;
          child = child->NextSiblingElement(kind)) {
-      absl::StatusOr<UrdfElement> parsed = ParseElement(*child, link.name);
+      absl::StatusOr<UrdfElement> parsed =
+          ParseElement(*child, absl::StrCat("link '", link.name, "'"));
       if (!parsed.ok()) return parsed.status();
       link.elements.push_back(*std::move(parsed));
     }
@@ -347,6 +467,24 @@ absl::StatusOr<std::string> ResolvePackageUri(absl::string_view rest, const std:
 
 }  // namespace
 
+const char* UrdfJointTypeName(UrdfJointType type) {
+  switch (type) {
+    case UrdfJointType::kFixed:
+      return "fixed";
+    case UrdfJointType::kRevolute:
+      return "revolute";
+    case UrdfJointType::kContinuous:
+      return "continuous";
+    case UrdfJointType::kPrismatic:
+      return "prismatic";
+    case UrdfJointType::kFloating:
+      return "floating";
+    case UrdfJointType::kPlanar:
+      return "planar";
+  }
+  return "unknown";
+}
+
 Eigen::Matrix3d RotationFromRpy(const Vector3& rpy) {
   return (Eigen::AngleAxisd(rpy.z(), Vector3::UnitZ()) *
           Eigen::AngleAxisd(rpy.y(), Vector3::UnitY()) *
@@ -388,6 +526,12 @@ absl::StatusOr<UrdfRobot> ParseUrdf(absl::string_view bytes) {
       return ErrorAt(link->line, absl::StrCat("link name '", link->name, "' is used twice"));
     }
     robot.links.push_back(*std::move(link));
+  }
+  for (const XMLElement* element = root->FirstChildElement("joint"); element != nullptr;
+       element = element->NextSiblingElement("joint")) {
+    absl::StatusOr<UrdfJoint> joint = ParseJoint(*element);
+    if (!joint.ok()) return joint.status();
+    robot.joints.push_back(*std::move(joint));
   }
   return robot;
 }

@@ -1,7 +1,10 @@
 // libFuzzer target: the URDF side of `inscribe urdf`. The bytes go through ParseUrdf; a refused
 // document must say why. An accepted one must keep urdf_robot.h's promises (named, unique
 // links; finite origins; positive sizes and radii; non-zero scales; a filename for every mesh)
-// and survive the writers: every link is given a made-up result (spherized with a few extreme
+// and its joints' (named, with parent and child; finite origins and limits, lower <= upper
+// where used; unit axes; mimics naming a joint), Kinematics::Create must refuse it with a
+// message or give finite rotations at sampled configurations, and the document must survive
+// the writers: every link is given a made-up result (spherized with a few extreme
 // but valid spheres, skipped with a reason full of XML-hostile text, or left alone, by the
 // link's position), SpherizedUrdf must accept the document, and ParseUrdf must read its output
 // back with the same links in the same order: a spherized link's elements are exactly its
@@ -20,6 +23,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/string_view.h"
+#include "inscribe/robot/kinematics.h"
 #include "inscribe/robot/spherized_urdf.h"
 #include "inscribe/robot/urdf_robot.h"
 #include "inscribe/sphere_io.h"
@@ -28,10 +32,13 @@ namespace {
 
 using inscribe::Sphere;
 using inscribe::Vector3;
+using inscribe::robot::Kinematics;
 using inscribe::robot::LinkSpherizeResult;
 using inscribe::robot::LinkStatus;
 using inscribe::robot::UrdfElement;
 using inscribe::robot::UrdfGeometry;
+using inscribe::robot::UrdfJoint;
+using inscribe::robot::UrdfJointType;
 using inscribe::robot::UrdfLink;
 using inscribe::robot::UrdfRobot;
 using inscribe::robot::UrdfShape;
@@ -73,6 +80,52 @@ void CheckPromises(const UrdfRobot& robot) {
           break;
         case UrdfShape::kUnsupported:
           break;
+      }
+    }
+  }
+  for (const UrdfJoint& joint : robot.joints) {
+    if (joint.name.empty() || joint.parent.empty() || joint.child.empty()) {
+      Fail("a parsed joint has no name, parent or child");
+    }
+    if (!joint.origin.xyz.allFinite() || !joint.origin.rpy.allFinite()) {
+      Fail("a parsed joint origin is not finite: " + joint.name);
+    }
+    if (!joint.axis.allFinite() || std::abs(joint.axis.norm() - 1.0) > 1e-12) {
+      Fail("a parsed joint axis is not a unit vector: " + joint.name);
+    }
+    const bool limited =
+        joint.type == UrdfJointType::kRevolute || joint.type == UrdfJointType::kPrismatic;
+    if (!std::isfinite(joint.lower) || !std::isfinite(joint.upper) ||
+        (limited && joint.lower > joint.upper)) {
+      Fail("parsed joint limits are not finite and ordered: " + joint.name);
+    }
+    if (joint.mimic && (joint.mimic->joint.empty() || !std::isfinite(joint.mimic->multiplier) ||
+                        !std::isfinite(joint.mimic->offset))) {
+      Fail("a parsed mimic has no joint or a non-finite number: " + joint.name);
+    }
+  }
+}
+
+// Kinematics::Create on any parsed robot: an error with a message, or a tree whose poses at a
+// few sampled configurations are finite rigid motions.
+void CheckKinematics(const UrdfRobot& robot) {
+  absl::StatusOr<Kinematics> kinematics = Kinematics::Create(robot);
+  if (!kinematics.ok()) {
+    if (kinematics.status().message().empty()) Fail("a refused tree has an empty error message");
+    return;
+  }
+  if (kinematics->links() != static_cast<int>(robot.links.size())) {
+    Fail("the kinematic tree has another link count");
+  }
+  for (const std::vector<double>& q : inscribe::robot::SampleConfigurations(*kinematics, 3, 1)) {
+    absl::StatusOr<std::vector<Eigen::Isometry3d>> poses = kinematics->LinkPoses(q);
+    if (!poses.ok()) Fail("LinkPoses refuses a sampled configuration");
+    for (const Eigen::Isometry3d& pose : *poses) {
+      // Huge but finite origins may overflow to inf under composition; NaN from inf - inf is
+      // possible then too, so only the rotation part is checked.
+      if (!pose.linear().allFinite() || !(pose.linear().transpose() * pose.linear())
+                                             .isApprox(Eigen::Matrix3d::Identity(), 1e-6)) {
+        Fail("a link pose's rotation is not a rotation");
       }
     }
   }
@@ -156,6 +209,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     return 0;
   }
   CheckPromises(*robot);
+  CheckKinematics(*robot);
 
   // Link i: spherized when i % 3 == 0, skipped when i % 3 == 1, left alone otherwise. The
   // reason text carries what comments and attributes must not break on.

@@ -185,6 +185,120 @@ TEST(UrdfParse, ErrorsNameTheLineTheLinkAndTheProblem) {
               HasSubstr("not"));
 }
 
+constexpr char kJoints[] = R"(<robot name="arm">
+  <link name="base"/><link name="a"/><link name="b"/><link name="c"/><link name="d"/>
+  <link name="e"/><link name="f"/>
+  <joint name="shoulder" type="revolute">
+    <parent link="base"/><child link="a"/>
+    <origin xyz="0 0 0.1" rpy="0 0.5 0"/>
+    <axis xyz="0 0 2"/>
+    <limit lower="-1.5" upper="2" effort="10" velocity="1"/>
+    <dynamics damping="0.1"/><safety_controller k_velocity="1"/>
+  </joint>
+  <joint name="slide" type="prismatic"><parent link="a"/><child link="b"/>
+    <axis xyz="3 4 0"/><limit lower="0" upper="0.2"/></joint>
+  <joint name="wrist" type="continuous"><parent link="b"/><child link="c"/>
+    <axis xyz="0 1 0"/><limit effort="1" velocity="1"/></joint>
+  <joint name="finger" type="revolute"><parent link="c"/><child link="d"/>
+    <mimic joint="shoulder" multiplier="-2" offset="0.25"/></joint>
+  <joint name="finger2" type="revolute"><parent link="c"/><child link="e"/>
+    <mimic joint="finger"/></joint>
+  <joint name="tool" type="fixed"><parent link="c"/><child link="f"/><axis xyz="0 0 0"/></joint>
+</robot>
+)";
+
+TEST(UrdfParse, ReadsJointsTypesLinksOriginsAxesLimitsAndMimics) {
+  const absl::StatusOr<UrdfRobot> robot = ParseUrdf(kJoints);
+  ASSERT_TRUE(robot.ok()) << robot.status();
+  ASSERT_EQ(robot->joints.size(), 6u);
+  const UrdfJoint& shoulder = robot->joints[0];
+  EXPECT_EQ(shoulder.name, "shoulder");
+  EXPECT_EQ(shoulder.type, UrdfJointType::kRevolute);
+  EXPECT_EQ(shoulder.parent, "base");
+  EXPECT_EQ(shoulder.child, "a");
+  EXPECT_EQ(shoulder.origin.xyz, Vector3(0, 0, 0.1));
+  EXPECT_EQ(shoulder.origin.rpy, Vector3(0, 0.5, 0));
+  EXPECT_EQ(shoulder.axis, Vector3(0, 0, 1));  // normalised
+  EXPECT_EQ(shoulder.lower, -1.5);
+  EXPECT_EQ(shoulder.upper, 2.0);
+  EXPECT_FALSE(shoulder.mimic.has_value());
+  EXPECT_EQ(shoulder.line, 4);
+  const UrdfJoint& slide = robot->joints[1];
+  EXPECT_EQ(slide.type, UrdfJointType::kPrismatic);
+  EXPECT_TRUE(slide.axis.isApprox(Vector3(0.6, 0.8, 0), 1e-15));
+  EXPECT_EQ(slide.upper, 0.2);
+  EXPECT_EQ(robot->joints[2].type, UrdfJointType::kContinuous);
+  EXPECT_EQ(robot->joints[2].lower, 0.0);  // <limit> without lower/upper: URDF's zeros
+  // A revolute joint without <limit> is accepted (urdfdom refuses it) and stays at 0.
+  const UrdfJoint& finger = robot->joints[3];
+  EXPECT_EQ(finger.axis, Vector3::UnitX());  // URDF's default
+  EXPECT_EQ(finger.lower, 0.0);
+  EXPECT_EQ(finger.upper, 0.0);
+  ASSERT_TRUE(finger.mimic.has_value());
+  EXPECT_EQ(finger.mimic->joint, "shoulder");
+  EXPECT_EQ(finger.mimic->multiplier, -2.0);
+  EXPECT_EQ(finger.mimic->offset, 0.25);
+  ASSERT_TRUE(robot->joints[4].mimic.has_value());
+  EXPECT_EQ(robot->joints[4].mimic->multiplier, 1.0);
+  EXPECT_EQ(robot->joints[4].mimic->offset, 0.0);
+  // A fixed joint's axis is not read, a zero one included.
+  EXPECT_EQ(robot->joints[5].type, UrdfJointType::kFixed);
+  EXPECT_EQ(robot->joints[5].axis, Vector3::UnitX());
+  for (UrdfJointType type :
+       {UrdfJointType::kFixed, UrdfJointType::kRevolute, UrdfJointType::kContinuous,
+        UrdfJointType::kPrismatic, UrdfJointType::kFloating, UrdfJointType::kPlanar}) {
+    const std::string doc =
+        std::string("<robot><link name=\"a\"/><link name=\"b\"/><joint name=\"j\" type=\"") +
+        UrdfJointTypeName(type) + "\"><parent link=\"a\"/><child link=\"b\"/></joint></robot>";
+    const absl::StatusOr<UrdfRobot> one = ParseUrdf(doc);
+    ASSERT_TRUE(one.ok()) << one.status();
+    EXPECT_EQ(one->joints.at(0).type, type);
+  }
+}
+
+std::string OneJoint(const std::string& attributes, const std::string& body) {
+  return "<robot name=\"r\">\n<link name=\"a\"/><link name=\"b\"/>\n<joint " + attributes + ">\n" +
+         body + "\n</joint>\n</robot>\n";
+}
+
+TEST(UrdfParse, JointErrorsNameTheLineTheJointAndTheProblem) {
+  const std::string links = "<parent link=\"a\"/><child link=\"b\"/>";
+  EXPECT_THAT(ParseError(OneJoint("type=\"fixed\"", links)),
+              HasSubstr("line 3: <joint> has no name attribute"));
+  EXPECT_THAT(ParseError(OneJoint("name=\"j\"", links)),
+              HasSubstr("line 3: <joint> has no type attribute (joint 'j')"));
+  EXPECT_THAT(ParseError(OneJoint("name=\"j\" type=\"ball\"", links)),
+              HasSubstr("line 3: <joint type=\"ball\"> is not a URDF joint type"));
+  EXPECT_THAT(ParseError(OneJoint("name=\"j\" type=\"fixed\"", "<child link=\"b\"/>")),
+              HasSubstr("line 3: <joint> has no <parent> element (joint 'j')"));
+  EXPECT_THAT(ParseError(OneJoint("name=\"j\" type=\"fixed\"", "<parent link=\"a\"/>\n<child/>")),
+              HasSubstr("line 5: <child> has no link attribute (joint 'j')"));
+  EXPECT_THAT(ParseError(OneJoint("name=\"j\" type=\"fixed\"", links + "<origin xyz=\"1 2\"/>")),
+              HasSubstr("line 4: <origin xyz=\"1 2\">: expected 3 numbers, found 2 (joint 'j')"));
+  for (const char* type : {"revolute", "continuous", "prismatic", "planar"}) {
+    EXPECT_THAT(ParseError(OneJoint(std::string("name=\"j\" type=\"") + type + "\"",
+                                    links + "\n<axis xyz=\"0 0 0\"/>")),
+                HasSubstr("line 5: <axis xyz> of a " + std::string(type) + " joint is zero"));
+  }
+  EXPECT_THAT(ParseError(OneJoint("name=\"j\" type=\"revolute\"", links + "<axis xyz=\"1 x 0\"/>")),
+              HasSubstr("'x' is not a number (joint 'j')"));
+  EXPECT_THAT(ParseError(OneJoint("name=\"j\" type=\"prismatic\"",
+                                  links + "\n<limit lower=\"1\" upper=\"0.5\"/>")),
+              HasSubstr("line 5: <limit lower=\"1\" upper=\"0.5\">: lower > upper (joint 'j')"));
+  EXPECT_THAT(ParseError(OneJoint("name=\"j\" type=\"revolute\"",
+                                  links + "<limit lower=\"inf\" upper=\"1\"/>")),
+              HasSubstr("'inf' is not finite"));
+  EXPECT_THAT(ParseError(OneJoint("name=\"j\" type=\"revolute\"", links + "\n<mimic/>")),
+              HasSubstr("line 5: <mimic> has no joint attribute (joint 'j')"));
+  EXPECT_THAT(ParseError(OneJoint("name=\"j\" type=\"revolute\"",
+                                  links + "<mimic joint=\"k\" multiplier=\"two\"/>")),
+              HasSubstr("'two' is not a number"));
+  // Continuous joints do not use their limits: lower > upper there is no error.
+  EXPECT_TRUE(ParseUrdf(OneJoint("name=\"j\" type=\"continuous\"",
+                                 links + "<limit lower=\"1\" upper=\"0\"/>"))
+                  .ok());
+}
+
 class UrdfResolve : public ::testing::Test {
  protected:
   void SetUp() override {

@@ -12,6 +12,8 @@ extern const unsigned char kThreeLicense[];
 extern const std::size_t kThreeLicenseSize;
 extern const unsigned char kViewPageJs[];
 extern const std::size_t kViewPageJsSize;
+extern const unsigned char kRobotViewPageJs[];
+extern const std::size_t kRobotViewPageJsSize;
 extern const unsigned char kViewPageCss[];
 extern const std::size_t kViewPageCssSize;
 }  // namespace inscribe::view::embedded
@@ -33,6 +35,9 @@ absl::string_view ThreeJsLicense() {
   return View(embedded::kThreeLicense, embedded::kThreeLicenseSize);
 }
 absl::string_view ViewPageJs() { return View(embedded::kViewPageJs, embedded::kViewPageJsSize); }
+absl::string_view RobotViewPageJs() {
+  return View(embedded::kRobotViewPageJs, embedded::kRobotViewPageJsSize);
+}
 absl::string_view ViewPageCss() { return View(embedded::kViewPageCss, embedded::kViewPageCssSize); }
 
 }  // namespace inscribe::view

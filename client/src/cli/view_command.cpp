@@ -15,11 +15,14 @@
 #include <variant>
 #include <vector>
 
+#include "absl/strings/ascii.h"
 #include "absl/strings/str_format.h"
 #include "command_outcome.h"
 #include "inscribe/atomic_file.h"
+#include "inscribe/robot/urdf_robot.h"
 #include "inscribe/sphere_io.h"
 #include "inscribe/sphere_quality.h"
+#include "inscribe/view/robot_view.h"
 #include "inscribe/view/view_report.h"
 #include "solid_loading.h"
 
@@ -40,7 +43,15 @@ struct ViewCliOptions {
   std::uint64_t seed = 1;
   bool fill_holes = false;
   std::string title;
+  std::vector<std::string> package_paths;  // robots: where package:// URIs are looked for
+  // Options given that only the mesh form reads, by name, to refuse them for a robot.
+  std::vector<std::string> mesh_only_given;
 };
+
+// The first argument names a robot (`inscribe view ROBOT.urdf SPHERES`), not a mesh.
+bool IsRobot(const std::string& path) {
+  return absl::AsciiStrToLower(fs::path(path).extension().string()) == ".urdf";
+}
 
 double SecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -71,16 +82,9 @@ std::string OutputPathProblem(const std::string& path) {
   return "";
 }
 
-absl::Status RunView(const ViewCliOptions& options) {
-  const auto start = std::chrono::steady_clock::now();
-  SphereFileReadOptions read;
-  if (!options.format.empty()) read.format = *ParseSphereFileFormat(options.format);
-  read.sph_level = options.sph_level;
-  read.yaml_link = options.link;
-  absl::StatusOr<SphereFile> file = ReadSphereFile(options.spheres_path, read);
-  if (!file.ok()) return BadInputError(file.status().message());
-  const std::vector<Sphere>& spheres = file->set.spheres;
-  if (spheres.empty()) return BadInputError(options.spheres_path + ": no spheres to show");
+// The page's path (-o, or SPHERES with .html), checked before any work: it must not be the
+// sphere file, and its directory must be writable.
+absl::StatusOr<std::string> PagePath(const ViewCliOptions& options) {
   const std::string output =
       !options.output_path.empty()
           ? options.output_path
@@ -95,6 +99,58 @@ absl::Status RunView(const ViewCliOptions& options) {
   if (const std::string problem = OutputPathProblem(output); !problem.empty()) {
     return BadInputError("cannot write the page to " + output + ": " + problem);
   }
+  return output;
+}
+
+// `inscribe view ROBOT.urdf SPHERES`: the robot page (view/robot_view.h).
+absl::Status RunRobotView(const ViewCliOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  if (!options.mesh_only_given.empty()) {
+    return UsageError(options.mesh_only_given.front() +
+                      " applies to a mesh, not to a robot (ROBOT.urdf)");
+  }
+  absl::StatusOr<std::string> output = PagePath(options);
+  if (!output.ok()) return output.status();
+  view::RobotViewOptions robot;
+  robot.robot_name = fs::path(options.mesh_path).filename().string();
+  robot.spheres_name = fs::path(options.spheres_path).filename().string();
+  robot.title =
+      !options.title.empty() ? options.title : robot.robot_name + " \u00b7 " + robot.spheres_name;
+  robot.packages = robot::PackageSearchFromEnvironment(options.package_paths);
+  const absl::StatusOr<std::string> page =
+      view::MakeRobotViewPageFromFiles(options.mesh_path, options.spheres_path, robot);
+  if (!page.ok()) {
+    const absl::StatusCode code = page.status().code();
+    const bool bad_input =
+        code == absl::StatusCode::kInvalidArgument || code == absl::StatusCode::kNotFound;
+    return bad_input ? BadInputError(page.status().message()) : BugError(page.status().message());
+  }
+  if (absl::Status written = WriteFileAtomically(*output, *page); !written.ok()) {
+    return BadInputError(written.message());
+  }
+  std::cout << *output << "\n";
+  std::cerr << absl::StrFormat("inscribe: %.0f KB page, %.2f s\n", page->size() / 1024.0,
+                               SecondsSince(start));
+  return absl::OkStatus();
+}
+
+absl::Status RunView(const ViewCliOptions& options) {
+  if (IsRobot(options.mesh_path)) return RunRobotView(options);
+  if (!options.package_paths.empty()) {
+    return UsageError("--package-path applies to a robot (ROBOT.urdf), not to a mesh");
+  }
+  const auto start = std::chrono::steady_clock::now();
+  SphereFileReadOptions read;
+  if (!options.format.empty()) read.format = *ParseSphereFileFormat(options.format);
+  read.sph_level = options.sph_level;
+  read.yaml_link = options.link;
+  absl::StatusOr<SphereFile> file = ReadSphereFile(options.spheres_path, read);
+  if (!file.ok()) return BadInputError(file.status().message());
+  const std::vector<Sphere>& spheres = file->set.spheres;
+  if (spheres.empty()) return BadInputError(options.spheres_path + ": no spheres to show");
+  absl::StatusOr<std::string> page_path = PagePath(options);
+  if (!page_path.ok()) return page_path.status();
+  const std::string& output = *page_path;
 
   absl::StatusOr<LoadedSolid> solid = LoadSolid(options.mesh_path, {options.fill_holes});
   if (!solid.ok()) return solid.status();
@@ -140,10 +196,14 @@ void AddViewCommand(CLI::App& app, CommandOutcome* outcome) {
       "view",
       "One self-contained HTML page (three.js embedded, no network needed) showing the mesh "
       "and the spheres in 3D with the quality report and histograms of signed distances "
-      "between the boundary and the spheres' envelope (the paper's Fig. 7)");
-  cmd->add_option("MESH", options->mesh_path, "Mesh file (.off, .obj, .stl, .ply)")->required();
+      "between the boundary and the spheres' envelope (the paper's Fig. 7); or, for "
+      "ROBOT.urdf, the whole robot posed by sliders per joint with every link's spheres");
+  cmd->add_option("MESH", options->mesh_path,
+                  "Mesh file (.off, .obj, .stl, .ply), or a robot (.urdf)")
+      ->required();
   cmd->add_option("SPHERES", options->spheres_path,
-                  "Sphere file (.json, .sph, .csv, cuRobo .yml/.yaml)")
+                  "Sphere file (.json, .sph, .csv, cuRobo .yml/.yaml); for a robot, what "
+                  "`inscribe urdf` wrote: the spherized URDF or the cuRobo YAML")
       ->required();
   cmd->add_option("-o,--output", options->output_path,
                   "HTML file to write (default: SPHERES with the extension .html)");
@@ -163,7 +223,17 @@ void AddViewCommand(CLI::App& app, CommandOutcome* outcome) {
                 "Close the mesh's holes first (see inscribe info --fill-holes)");
   cmd->add_option("--title", options->title,
                   "Heading of the page (default: the mesh and sphere file names)");
-  cmd->callback([options, outcome] { outcome->status = RunView(*options); });
+  cmd->add_option("--package-path", options->package_paths,
+                  "Robots: a directory where package://NAME/... meshes are looked for (NAME "
+                  "under it, or it itself when named NAME); before ROS_PACKAGE_PATH and "
+                  "AMENT_PREFIX_PATH. Repeatable");
+  cmd->callback([cmd, options, outcome] {
+    for (const char* name :
+         {"--format", "--link", "--sph-level", "--samples", "--seed", "--fill-holes"}) {
+      if (cmd->get_option(name)->count() > 0) options->mesh_only_given.push_back(name);
+    }
+    outcome->status = RunView(*options);
+  });
 }
 
 }  // namespace inscribe::cli

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <initializer_list>
 #include <limits>
 #include <utility>
 
@@ -19,13 +20,15 @@ namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
-// Spheres as columns (x, y, z, r): in the link frame when prepared, in the world per sample.
-using SphereColumns = Eigen::Matrix<double, 4, Eigen::Dynamic>;
+// Spheres one per row, x, y, z, r as contiguous columns (vectorised arithmetic): in the link
+// frame when prepared, in the world per sample.
+using SphereColumns = Eigen::Array<double, Eigen::Dynamic, 4>;
 
 SphereColumns Columns(const std::vector<Sphere>& spheres) {
-  SphereColumns columns(4, static_cast<Eigen::Index>(spheres.size()));
+  SphereColumns columns(static_cast<Eigen::Index>(spheres.size()), 4);
   for (std::size_t i = 0; i < spheres.size(); ++i) {
-    columns.col(static_cast<Eigen::Index>(i)) << spheres[i].center, spheres[i].radius;
+    columns.row(static_cast<Eigen::Index>(i)) << spheres[i].center.x(), spheres[i].center.y(),
+        spheres[i].center.z(), spheres[i].radius;
   }
   return columns;
 }
@@ -35,6 +38,10 @@ struct PreparedLink {
   SphereColumns spheres, inner;  // inner: the spheres themselves when not certified
   double delta = 0.0;
   double reach = 0.0;  // largest |centre| + radius, link frame
+  // Balls holding every sphere of `spheres` and of `inner` (centre of their centres' box),
+  // link frame.
+  Vector3 bound_centre = Vector3::Zero(), inner_bound_centre = Vector3::Zero();
+  double bound_radius = 0.0, inner_bound_radius = 0.0;
 };
 
 struct Prepared {
@@ -42,6 +49,23 @@ struct Prepared {
   std::vector<std::pair<int, int>> pairs;  // indices into `links`, ascending
   bool certified = true;
 };
+
+// A ball holding every sphere (none: radius 0), centred on the box of their centres.
+void BoundingBall(const SphereColumns& spheres, Vector3* centre, double* radius) {
+  *centre = Vector3::Zero();
+  *radius = 0.0;
+  if (spheres.rows() == 0) return;
+  *centre = 0.5 * (spheres.leftCols<3>().colwise().minCoeff() +
+                   spheres.leftCols<3>().colwise().maxCoeff())
+                      .transpose()
+                      .matrix();
+  for (Eigen::Index i = 0; i < spheres.rows(); ++i) {
+    const Vector3 c(spheres(i, 0), spheres(i, 1), spheres(i, 2));
+    *radius = std::max(*radius, (c - *centre).norm() + spheres(i, 3));
+  }
+  // Rounding of the norms: the ball must hold every sphere, so grow it a little.
+  *radius *= 1.0 + 1e-12;
+}
 
 Prepared Prepare(const std::vector<LinkCollisionGeometry>& geometry) {
   Prepared prepared;
@@ -57,10 +81,13 @@ Prepared Prepare(const std::vector<LinkCollisionGeometry>& geometry) {
     // Certified without inner spheres: no inner bound (an empty set is infinitely far).
     p.inner = certified ? Columns(g.inner) : p.spheres;
     for (const SphereColumns* set : {&p.spheres, &p.inner}) {
-      for (Eigen::Index i = 0; i < set->cols(); ++i) {
-        p.reach = std::max(p.reach, set->col(i).head<3>().norm() + set->col(i)(3));
+      for (Eigen::Index i = 0; i < set->rows(); ++i) {
+        const Vector3 c((*set)(i, 0), (*set)(i, 1), (*set)(i, 2));
+        p.reach = std::max(p.reach, c.norm() + (*set)(i, 3));
       }
     }
+    BoundingBall(p.spheres, &p.bound_centre, &p.bound_radius);
+    BoundingBall(p.inner, &p.inner_bound_centre, &p.inner_bound_radius);
     prepared.links.push_back(std::move(p));
   }
   for (int a = 0; a < static_cast<int>(prepared.links.size()); ++a) {
@@ -71,62 +98,141 @@ Prepared Prepare(const std::vector<LinkCollisionGeometry>& geometry) {
   return prepared;
 }
 
-// Signed distance between two posed sphere unions: exact over all pairs (+inf when one is
-// empty).
-double UnionDistance(const SphereColumns& a, const SphereColumns& b) {
+using WorldSpheres = SphereColumns;
+
+// Signed distance between two posed sphere unions, min over sphere pairs of
+// |c_a - c_b| - r_a - r_b (+inf when one is empty), exact where it matters: the result is the
+// exact minimum when that is below `cutoff`, and otherwise some value >= cutoff (never below the
+// exact minimum). Once a pair at most `collide_at` apart is found, the cutoff drops to
+// `cutoff_once_colliding`. `a_ball` (centre, radius) holds every sphere of `a`: a sphere of b
+// whose distance to it exceeds min(best, cutoff) by more than `slack` (far above the rounding
+// of the test) is skipped; the others are measured against all of a at once. With infinite
+// cutoffs the result is the exact minimum.
+double UnionDistance(const WorldSpheres& a, const Eigen::Vector4d& a_ball, const WorldSpheres& b,
+                     double slack, double cutoff = kInfinity, double collide_at = -kInfinity,
+                     double cutoff_once_colliding = kInfinity) {
   double best = kInfinity;
-  for (Eigen::Index j = 0; j < b.cols(); ++j) {
-    const double bx = b(0, j), by = b(1, j), bz = b(2, j), br = b(3, j);
-    for (Eigen::Index i = 0; i < a.cols(); ++i) {
-      const double dx = a(0, i) - bx, dy = a(1, i) - by, dz = a(2, i) - bz;
-      best = std::min(best, std::sqrt(dx * dx + dy * dy + dz * dz) - a(3, i) - br);
+  if (a.rows() == 0) return best;
+  for (Eigen::Index j = 0; j < b.rows(); ++j) {
+    const double bx = b(j, 0), by = b(j, 1), bz = b(j, 2), br = b(j, 3);
+    const double reach = std::min(best, cutoff) + a_ball(3) + br + slack;
+    if (!(reach > 0.0)) continue;  // |d| >= 0 >= reach
+    const double ex = a_ball(0) - bx, ey = a_ball(1) - by, ez = a_ball(2) - bz;
+    if (ex * ex + ey * ey + ez * ez >= reach * reach) continue;
+    const double row =
+        (((a.col(0) - bx).square() + (a.col(1) - by).square() + (a.col(2) - bz).square()).sqrt() -
+         a.col(3))
+            .minCoeff() -
+        br;
+    if (row < best) {
+      best = row;
+      if (best <= collide_at) cutoff = std::min(cutoff, cutoff_once_colliding);
     }
   }
   return best;
 }
 
-void Transform(const Eigen::Isometry3d& pose, const SphereColumns& local, SphereColumns* world) {
-  world->resize(4, local.cols());
-  world->topRows<3>().noalias() = pose.linear() * local.topRows<3>();
-  world->topRows<3>().colwise() += pose.translation();
-  world->row(3) = local.row(3);
+// Column by column (no general matrix product: these are a few dozen spheres).
+void Transform(const Eigen::Isometry3d& pose, const SphereColumns& local, WorldSpheres* world) {
+  world->resize(local.rows(), 4);
+  const Eigen::Matrix3d& r = pose.linear();
+  const Vector3& t = pose.translation();
+  for (int axis = 0; axis < 3; ++axis) {
+    world->col(axis) =
+        r(axis, 0) * local.col(0) + r(axis, 1) * local.col(1) + r(axis, 2) * local.col(2) + t(axis);
+  }
+  world->col(3) = local.col(3);
 }
 
 // Per thread: poses and posed spheres.
 struct Workspace {
   std::vector<Eigen::Isometry3d> poses;
-  std::vector<SphereColumns> spheres, inner;
+  std::vector<WorldSpheres> spheres, inner;
+  std::vector<Eigen::Vector4d> ball, inner_ball;  // world centre and radius
   std::vector<double> scale;
+  std::vector<char> inner_posed;  // inner[i] holds this sample's inner spheres
 };
 
-// Every pair's interval at q, handed to visit(pair index, interval). Fails only for q.
+// The smallest values a pair has shown so far (on one thread): a sample that cannot go below
+// them, and does not collide, changes nothing.
+struct PairMinima {
+  double lower = kInfinity, upper = kInfinity, sphere_distance = kInfinity;
+};
+
+// Every pair's interval at q, handed to visit(pair index, interval). With `minima` (one per
+// pair), work that cannot change the pair's statistics is skipped: a pair whose bounding balls
+// are apart by more than its margin and its minima is not visited, and when neither lower nor
+// the margin is below minima.upper the inner spheres are not measured (upper is then +inf).
+// The statistics come out exactly as without `minima`. Fails only for q.
 template <typename Visit>
 absl::Status VisitIntervals(const Kinematics& kinematics, const Prepared& prepared,
-                            absl::Span<const double> q, Workspace* work, Visit&& visit) {
+                            absl::Span<const double> q, Workspace* work,
+                            const std::vector<PairMinima>* minima, Visit&& visit) {
   if (absl::Status status = kinematics.LinkPoses(q, &work->poses); !status.ok()) return status;
   const std::size_t n = prepared.links.size();
   work->spheres.resize(n);
   work->inner.resize(n);
+  work->ball.resize(n);
+  work->inner_ball.resize(n);
   work->scale.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     const PreparedLink& link = prepared.links[i];
     const Eigen::Isometry3d& pose = work->poses[link.link];
     Transform(pose, link.spheres, &work->spheres[i]);
-    Transform(pose, link.inner, &work->inner[i]);
+    work->ball[i] << pose * link.bound_centre, link.bound_radius;
+    work->inner_ball[i] << pose * link.inner_bound_centre, link.inner_bound_radius;
     work->scale[i] = pose.translation().norm() + link.reach;
   }
+  work->inner_posed.assign(n, 0);
   for (std::size_t k = 0; k < prepared.pairs.size(); ++k) {
     const auto [a, b] = prepared.pairs[k];
+    const PreparedLink& la = prepared.links[a];
+    const PreparedLink& lb = prepared.links[b];
     const double margin = kCertifiedDistanceMargin * std::max(work->scale[a], work->scale[b]) +
                           kCertifiedDistanceFloor;
+    if (minima != nullptr) {
+      // A lower bound on the spheres' distance (margin covers its rounding).
+      const double apart = (work->ball[a].head<3>() - work->ball[b].head<3>()).norm() -
+                           la.bound_radius - lb.bound_radius - margin;
+      const PairMinima& m = (*minima)[k];
+      if (apart > margin && apart > m.lower && apart > m.upper && apart > m.sphere_distance) {
+        continue;
+      }
+    }
     LinkPairInterval interval;
-    interval.link_a = prepared.links[a].link;
-    interval.link_b = prepared.links[b].link;
-    interval.sphere_distance = UnionDistance(work->spheres[a], work->spheres[b]);
+    interval.link_a = la.link;
+    interval.link_b = lb.link;
+    if (minima == nullptr) {
+      interval.sphere_distance =
+          UnionDistance(work->spheres[a], work->ball[a], work->spheres[b], margin);
+    } else {
+      // Exact only where the statistics can change: below every minimum (lower and upper
+      // moved by the margin) and 2 margins (colliding); once colliding, below the smallest
+      // sphere distance seen. Beyond that, lower, upper and the distance cannot go below the
+      // minima and the sample is not colliding (see PairMinima).
+      const PairMinima& m = (*minima)[k];
+      const double cutoff =
+          std::max({m.sphere_distance, m.lower + margin, m.upper + margin, 2.0 * margin});
+      interval.sphere_distance = UnionDistance(work->spheres[a], work->ball[a], work->spheres[b],
+                                               margin, cutoff, margin, m.sphere_distance);
+    }
     interval.lower = std::max(0.0, interval.sphere_distance - margin);
-    const double inner = UnionDistance(work->inner[a], work->inner[b]);
-    const double through_covers =
-        std::max(0.0, interval.sphere_distance) + prepared.links[a].delta + prepared.links[b].delta;
+    // upper >= max(lower, margin): no use measuring when that is not below the minimum.
+    if (minima != nullptr && std::max(interval.lower, margin) >= (*minima)[k].upper) {
+      interval.upper = kInfinity;
+      visit(k, interval);
+      continue;
+    }
+    for (const int i : {a, b}) {
+      if (!work->inner_posed[i]) {
+        Transform(work->poses[prepared.links[i].link], prepared.links[i].inner, &work->inner[i]);
+        work->inner_posed[i] = 1;
+      }
+    }
+    // With minima, exact below minima.upper: above it, upper cannot lower the minimum.
+    const double inner = UnionDistance(work->inner[a], work->inner_ball[a], work->inner[b], margin,
+                                       minima == nullptr ? kInfinity : (*minima)[k].upper);
+    const double through_covers = std::max(0.0, interval.sphere_distance) + la.delta + lb.delta;
     interval.upper =
         std::max(interval.lower, std::max(0.0, std::min(inner, through_covers)) + margin);
     visit(k, interval);
@@ -170,26 +276,32 @@ std::vector<std::vector<bool>> AdjacentLinks(const Kinematics& kinematics,
   return adjacent;
 }
 
+// Per pair: colliding samples and minima, over the samples one thread saw (or all).
 struct PairStatistics {
-  std::int64_t colliding = 0;
-  double min_lower = kInfinity, min_upper = kInfinity, min_sphere_distance = kInfinity;
+  std::vector<std::int64_t> colliding;
+  std::vector<PairMinima> minima;
 
-  void Add(const LinkPairInterval& interval) {
-    colliding += interval.colliding() ? 1 : 0;
-    min_lower = std::min(min_lower, interval.lower);
-    min_upper = std::min(min_upper, interval.upper);
-    min_sphere_distance = std::min(min_sphere_distance, interval.sphere_distance);
+  explicit PairStatistics(std::size_t pairs) : colliding(pairs, 0), minima(pairs) {}
+  void Add(std::size_t k, const LinkPairInterval& interval) {
+    colliding[k] += interval.colliding() ? 1 : 0;
+    Lower(k, PairMinima{interval.lower, interval.upper, interval.sphere_distance});
+  }
+  void Lower(std::size_t k, const PairMinima& other) {
+    PairMinima& m = minima[k];
+    m.lower = std::min(m.lower, other.lower);
+    m.upper = std::min(m.upper, other.upper);
+    m.sphere_distance = std::min(m.sphere_distance, other.sphere_distance);
   }
   void Merge(const PairStatistics& other) {
-    colliding += other.colliding;
-    min_lower = std::min(min_lower, other.min_lower);
-    min_upper = std::min(min_upper, other.min_upper);
-    min_sphere_distance = std::min(min_sphere_distance, other.min_sphere_distance);
+    for (std::size_t k = 0; k < colliding.size(); ++k) {
+      colliding[k] += other.colliding[k];
+      Lower(k, other.minima[k]);
+    }
   }
 };
 
 // Samples are drawn on the calling thread in blocks of this many, then checked in parallel.
-constexpr std::int64_t kBlock = 2048;
+constexpr std::int64_t kBlock = 16384;
 
 }  // namespace
 
@@ -245,7 +357,7 @@ absl::StatusOr<std::vector<LinkPairInterval>> LinkPairIntervals(
   std::vector<LinkPairInterval> intervals(prepared.pairs.size());
   Workspace work;
   if (absl::Status status = VisitIntervals(
-          kinematics, prepared, q, &work,
+          kinematics, prepared, q, &work, nullptr,
           [&](std::size_t k, const LinkPairInterval& interval) { intervals[k] = interval; });
       !status.ok()) {
     return status;
@@ -276,7 +388,7 @@ absl::StatusOr<SelfCollisionMatrix> ComputeSelfCollisionMatrix(
     Workspace work;
     const std::vector<double> q = DefaultConfiguration(kinematics);
     if (absl::Status status = VisitIntervals(
-            kinematics, prepared, q, &work,
+            kinematics, prepared, q, &work, nullptr,
             [&](std::size_t k, const LinkPairInterval& i) { at_default[k] = i.colliding(); });
         !status.ok()) {
       return status;
@@ -285,13 +397,11 @@ absl::StatusOr<SelfCollisionMatrix> ComputeSelfCollisionMatrix(
 
   struct Local {
     Workspace work;
-    std::vector<PairStatistics> statistics;
+    PairStatistics statistics;
     absl::Status status;
   };
   tbb::enumerable_thread_specific<Local> locals([&] {
-    Local local;
-    local.statistics.resize(pair_count);
-    return local;
+    return Local{Workspace{}, PairStatistics(pair_count), absl::OkStatus()};
   });
   ConfigurationSampler sampler(kinematics, options.seed);
   const std::size_t variables = kinematics.variables().size();
@@ -312,8 +422,9 @@ absl::StatusOr<SelfCollisionMatrix> ComputeSelfCollisionMatrix(
                           const absl::Status status = VisitIntervals(
                               kinematics, prepared,
                               absl::MakeConstSpan(block.data() + s * variables, variables),
-                              &local.work, [&](std::size_t k, const LinkPairInterval& interval) {
-                                local.statistics[k].Add(interval);
+                              &local.work, &local.statistics.minima,
+                              [&](std::size_t k, const LinkPairInterval& interval) {
+                                local.statistics.Add(k, interval);
                               });
                           if (!status.ok() && local.status.ok()) local.status = status;
                         }
@@ -323,11 +434,11 @@ absl::StatusOr<SelfCollisionMatrix> ComputeSelfCollisionMatrix(
                                   static_cast<double>(options.samples));
     }
   }
-  std::vector<PairStatistics> statistics(pair_count);
+  PairStatistics statistics(pair_count);
   for (const Local& local : locals) {
     // Sampled values are finite, so only an overflowing mimic can fail here.
     if (!local.status.ok()) return local.status;
-    for (std::size_t k = 0; k < pair_count; ++k) statistics[k].Merge(local.statistics[k]);
+    statistics.Merge(local.statistics);
   }
 
   const std::vector<std::vector<bool>> adjacent = AdjacentLinks(kinematics, links);
@@ -344,12 +455,12 @@ absl::StatusOr<SelfCollisionMatrix> ComputeSelfCollisionMatrix(
     pair.link_a = prepared.links[prepared.pairs[k].first].link;
     pair.link_b = prepared.links[prepared.pairs[k].second].link;
     pair.colliding_at_default = at_default[k];
-    pair.colliding_samples = statistics[k].colliding;
+    pair.colliding_samples = statistics.colliding[k];
     pair.colliding_fraction =
         static_cast<double>(pair.colliding_samples) / static_cast<double>(options.samples);
-    pair.min_lower = statistics[k].min_lower;
-    pair.min_upper = statistics[k].min_upper;
-    pair.min_sphere_distance = statistics[k].min_sphere_distance;
+    pair.min_lower = statistics.minima[k].lower;
+    pair.min_upper = statistics.minima[k].upper;
+    pair.min_sphere_distance = statistics.minima[k].sphere_distance;
     if (adjacent[pair.link_a][pair.link_b]) {
       pair.type = CollisionPairClass::kAdjacent;
     } else if (pair.colliding_at_default) {

@@ -169,7 +169,7 @@ TEST_F(SelfCollisionMesh, MatrixEqualsABruteForceOverEverySpherePair) {
 
   struct Brute {
     std::int64_t colliding = 0;
-    double min_lower = INFINITY, min_upper = INFINITY;
+    double min_lower = INFINITY, min_upper = INFINITY, min_sphere_distance = INFINITY;
     bool at_default = false;
   };
   std::map<std::pair<int, int>, Brute> brute;
@@ -186,6 +186,8 @@ TEST_F(SelfCollisionMesh, MatrixEqualsABruteForceOverEverySpherePair) {
         r.colliding += lower > 0.0 ? 0 : 1;
         r.min_lower = std::min(r.min_lower, lower);
         r.min_upper = std::min(r.min_upper, upper);
+        r.min_sphere_distance = std::min(r.min_sphere_distance,
+                                         AllPairs(g[a].spheres, poses[a], g[b].spheres, poses[b]));
       }
     }
   };
@@ -202,6 +204,7 @@ TEST_F(SelfCollisionMesh, MatrixEqualsABruteForceOverEverySpherePair) {
     EXPECT_EQ(pair.colliding_at_default, r.at_default) << name;
     EXPECT_NEAR(pair.min_lower, r.min_lower, 1e-12) << name;
     EXPECT_NEAR(pair.min_upper, r.min_upper, 1e-12) << name;
+    EXPECT_NEAR(pair.min_sphere_distance, r.min_sphere_distance, 1e-12) << name;
     // Adjacent by hand: parent and child (link6 hangs from link4, beside link5).
     const bool adjacent = pair.link_b == pair.link_a + 1 && pair.link_b != 6;
     CollisionPairClass expected = CollisionPairClass::kSometimes;

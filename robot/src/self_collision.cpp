@@ -119,11 +119,11 @@ double UnionDistance(const WorldSpheres& a, const Eigen::Vector4d& a_ball, const
     if (!(reach > 0.0)) continue;  // |d| >= 0 >= reach
     const double ex = a_ball(0) - bx, ey = a_ball(1) - by, ez = a_ball(2) - bz;
     if (ex * ex + ey * ey + ez * ez >= reach * reach) continue;
-    const double row =
-        (((a.col(0) - bx).square() + (a.col(1) - by).square() + (a.col(2) - bz).square()).sqrt() -
-         a.col(3))
-            .minCoeff() -
-        br;
+    const auto d2 = (a.col(0) - bx).square() + (a.col(1) - by).square() + (a.col(2) - bz).square();
+    // Square roots only for rows with a sphere that can beat min(best, cutoff) + slack.
+    const double beat = std::min(best, cutoff) + br + slack;
+    if (!(d2 < (a.col(3) + beat).max(0.0).square()).any()) continue;
+    const double row = (d2.sqrt() - a.col(3)).minCoeff() - br;
     if (row < best) {
       best = row;
       if (best <= collide_at) cutoff = std::min(cutoff, cutoff_once_colliding);

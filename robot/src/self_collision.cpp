@@ -47,6 +47,7 @@ struct PreparedLink {
 struct Prepared {
   std::vector<PreparedLink> links;         // the links with spheres, by link index
   std::vector<std::pair<int, int>> pairs;  // indices into `links`, ascending
+  std::vector<char> measured;              // per pair: 0 to leave it out of every sample
   bool certified = true;
 };
 
@@ -93,6 +94,7 @@ Prepared Prepare(const std::vector<LinkCollisionGeometry>& geometry) {
   for (int a = 0; a < static_cast<int>(prepared.links.size()); ++a) {
     for (int b = a + 1; b < static_cast<int>(prepared.links.size()); ++b) {
       prepared.pairs.emplace_back(a, b);
+      prepared.measured.push_back(1);
     }
   }
   return prepared;
@@ -185,6 +187,7 @@ absl::Status VisitIntervals(const Kinematics& kinematics, const Prepared& prepar
   }
   work->inner_posed.assign(n, 0);
   for (std::size_t k = 0; k < prepared.pairs.size(); ++k) {
+    if (!prepared.measured[k]) continue;
     const auto [a, b] = prepared.pairs[k];
     const PreparedLink& la = prepared.links[a];
     const PreparedLink& lb = prepared.links[b];
@@ -380,8 +383,14 @@ absl::StatusOr<SelfCollisionMatrix> ComputeSelfCollisionMatrix(
     return absl::InvalidArgumentError(
         absl::StrCat("always_fraction ", options.always_fraction, " is outside (0, 1]"));
   }
-  const Prepared prepared = Prepare(links);
+  const std::vector<std::vector<bool>> adjacent = AdjacentLinks(kinematics, links);
+  Prepared prepared = Prepare(links);
   const std::size_t pair_count = prepared.pairs.size();
+  for (std::size_t k = 0; k < pair_count; ++k) {
+    const int a = prepared.links[prepared.pairs[k].first].link;
+    const int b = prepared.links[prepared.pairs[k].second].link;
+    if (adjacent[a][b] && !options.sample_adjacent) prepared.measured[k] = 0;
+  }
 
   std::vector<bool> at_default(pair_count, false);
   {
@@ -441,7 +450,6 @@ absl::StatusOr<SelfCollisionMatrix> ComputeSelfCollisionMatrix(
     statistics.Merge(local.statistics);
   }
 
-  const std::vector<std::vector<bool>> adjacent = AdjacentLinks(kinematics, links);
   SelfCollisionMatrix matrix;
   for (int link = 0; link < kinematics.links(); ++link) {
     matrix.links.push_back(kinematics.link_name(link));
@@ -461,6 +469,11 @@ absl::StatusOr<SelfCollisionMatrix> ComputeSelfCollisionMatrix(
     pair.min_lower = statistics.minima[k].lower;
     pair.min_upper = statistics.minima[k].upper;
     pair.min_sphere_distance = statistics.minima[k].sphere_distance;
+    if (!prepared.measured[k]) {
+      pair.sampled = false;
+      pair.min_lower = pair.min_upper = pair.min_sphere_distance =
+          std::numeric_limits<double>::quiet_NaN();
+    }
     if (adjacent[pair.link_a][pair.link_b]) {
       pair.type = CollisionPairClass::kAdjacent;
     } else if (pair.colliding_at_default) {

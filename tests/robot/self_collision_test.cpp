@@ -172,6 +172,35 @@ TEST(SelfCollisionMatrix, IsTheSameForASeedAndChangesWithIt) {
   EXPECT_NE(tq_a.colliding_samples, tq_c.colliding_samples);
 }
 
+TEST(SelfCollisionMatrix, AdjacentPairsLeftOutKeepEveryClassAndOtherStatistic) {
+  const Spheres r = SphereRobot();
+  const Kinematics kinematics = Create(r.robot);
+  SelfCollisionOptions options;
+  options.samples = 3000;
+  const auto all = ComputeSelfCollisionMatrix(kinematics, r.geometry, options);
+  options.sample_adjacent = false;
+  const auto some = ComputeSelfCollisionMatrix(kinematics, r.geometry, options);
+  ASSERT_TRUE(all.ok() && some.ok());
+  ASSERT_EQ(all->pairs.size(), some->pairs.size());
+  for (std::size_t i = 0; i < all->pairs.size(); ++i) {
+    const LinkPairCollision& a = all->pairs[i];
+    const LinkPairCollision& b = some->pairs[i];
+    EXPECT_EQ(a.type, b.type);
+    EXPECT_TRUE(a.sampled);
+    if (a.type == CollisionPairClass::kAdjacent) {
+      EXPECT_FALSE(b.sampled);
+      EXPECT_EQ(b.colliding_samples, 0);
+      EXPECT_TRUE(std::isnan(b.min_lower) && std::isnan(b.min_upper));
+      continue;
+    }
+    EXPECT_TRUE(b.sampled);
+    EXPECT_EQ(a.colliding_samples, b.colliding_samples);
+    EXPECT_EQ(a.min_lower, b.min_lower);
+    EXPECT_EQ(a.min_upper, b.min_upper);
+    EXPECT_EQ(a.min_sphere_distance, b.min_sphere_distance);
+  }
+}
+
 TEST(SelfCollisionMatrix, RefusesBadInputAndStopsWhenCancelled) {
   const Spheres r = SphereRobot();
   const Kinematics kinematics = Create(r.robot);

@@ -66,6 +66,10 @@ struct SelfCollisionOptions {
   // A pair colliding in at least this fraction of the samples is "Always" (MoveIt's
   // min_collision_fraction, 0.95). In (0, 1].
   double always_fraction = 0.95;
+  // Whether adjacent pairs are checked at the samples too. Their class does not depend on it
+  // (MoveIt never checks them); false skips their work (often the most: they touch at every
+  // sample), and leaves their statistics empty (LinkPairCollision::sampled).
+  bool sample_adjacent = true;
   // Cancellation (CANCELLED) and progress in [0, 1], both on the calling thread between
   // blocks of samples.
   GenerationControl control;
@@ -82,6 +86,9 @@ struct LinkPairInterval {
 struct LinkPairCollision {
   int link_a = -1, link_b = -1;  // link_a < link_b
   CollisionPairClass type = CollisionPairClass::kSometimes;
+  // False for adjacent pairs left out (SelfCollisionOptions::sample_adjacent): colliding
+  // counts 0, minima NaN.
+  bool sampled = true;
   bool colliding_at_default = false;
   std::int64_t colliding_samples = 0;
   double colliding_fraction = 0.0;  // colliding_samples / samples
@@ -114,10 +121,13 @@ absl::StatusOr<std::vector<LinkPairInterval>> LinkPairIntervals(
     absl::Span<const double> q);
 
 // The matrix over options.samples configurations (see above). Deterministic for a seed
-// whatever the thread count (TBB; the per-pair statistics are counts and minima). Errors:
+// whatever the thread count (TBB; the per-pair statistics are counts and minima, and work that
+// cannot change them is skipped: pairs whose bounding balls are farther apart than anything
+// they have shown, sphere rows that cannot beat the pair's minima). Errors:
 // CheckLinkCollisionGeometry's; INVALID_ARGUMENT for samples outside
-// 1..kMaxSelfCollisionSamples or always_fraction outside (0, 1]; CANCELLED. Cost
-// O(samples * (#links + sum over pairs of |S_a| |S_b| + |I_a| |I_b|)).
+// 1..kMaxSelfCollisionSamples or always_fraction outside (0, 1]; CANCELLED. Cost at most
+// O(samples * (#links + sum over pairs of |S_a| |S_b| + |I_a| |I_b|)), far less for pairs that
+// stay apart.
 absl::StatusOr<SelfCollisionMatrix> ComputeSelfCollisionMatrix(
     const Kinematics& kinematics, const std::vector<LinkCollisionGeometry>& links,
     const SelfCollisionOptions& options = {});

@@ -4,10 +4,14 @@
 
 #include <cassert>
 #include <charconv>
+#include <cmath>
 #include <map>
+#include <set>
+#include <utility>
 
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_join.h"
 #include "absl/strings/str_replace.h"
 #include "inscribe/sphere_io.h"
 
@@ -130,6 +134,61 @@ std::string SpherizedCuroboYaml(const std::vector<LinkSpherizeResult>& links,
   // Only a bad name or a bad sphere is refused, and neither is left.
   assert(yaml.ok());
   return *std::move(yaml);
+}
+
+absl::StatusOr<std::string> SpherizedCuroboYaml(const std::vector<LinkSpherizeResult>& links,
+                                                const std::string& robot_name,
+                                                const SelfCollisionMatrix& matrix,
+                                                const std::map<std::string, double>& buffers,
+                                                std::vector<std::string>* left_out) {
+  for (const auto& [link, buffer] : buffers) {
+    if (!std::isfinite(buffer)) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("self_collision_buffer of link '", link, "' is not finite"));
+    }
+  }
+  const std::size_t left_before = left_out->size();
+  std::string yaml = SpherizedCuroboYaml(links, robot_name, left_out);
+  const std::set<std::string> left(left_out->begin() + static_cast<std::ptrdiff_t>(left_before),
+                                   left_out->end());
+  std::vector<std::string> written;
+  for (const LinkSpherizeResult& result : links) {
+    if (result.status == LinkStatus::kSpherized && left.count(result.link) == 0) {
+      written.push_back(result.link);
+    }
+  }
+  std::set<std::pair<std::string, std::string>> disabled;
+  for (const LinkPairCollision& pair : matrix.pairs) {
+    if (!CollisionDisabled(pair.type)) continue;
+    disabled.emplace(matrix.links[pair.link_a], matrix.links[pair.link_b]);
+    disabled.emplace(matrix.links[pair.link_b], matrix.links[pair.link_a]);
+  }
+  // Names are quoted as FormatCuroboYaml quotes them (plain keys such as `null` or `1` would
+  // be read as other types); they hold only letters, digits and _ - . /.
+  std::string ignore;
+  for (std::size_t i = 0; i < written.size(); ++i) {
+    std::vector<std::string> ignored;
+    for (std::size_t j = i + 1; j < written.size(); ++j) {
+      if (disabled.count({written[i], written[j]}) != 0) {
+        ignored.push_back(absl::StrCat("\"", written[j], "\""));
+      }
+    }
+    if (ignored.empty()) continue;
+    absl::StrAppend(&ignore, "  \"", written[i], "\": [", absl::StrJoin(ignored, ", "), "]\n");
+  }
+  absl::StrAppend(&yaml, "self_collision_ignore:", ignore.empty() ? " {}\n" : "\n", ignore);
+  absl::StrAppend(&yaml, "self_collision_buffer:", written.empty() ? " {}\n" : "\n");
+  for (const std::string& link : written) {
+    const auto found = buffers.find(link);
+    // A YAML 1.1 float for PyYAML (cuRobo's loader): a '.' in the mantissa.
+    std::string value = ShortestDecimal(found == buffers.end() ? 0.0 : found->second);
+    if (value.find_first_of(".") == std::string::npos) {
+      const std::size_t e = value.find_first_of("eE");
+      value.insert(e == std::string::npos ? value.size() : e, ".0");
+    }
+    absl::StrAppend(&yaml, "  \"", link, "\": ", value, "\n");
+  }
+  return yaml;
 }
 
 }  // namespace inscribe::robot

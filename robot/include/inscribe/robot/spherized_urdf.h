@@ -2,11 +2,13 @@
 // cuRobo's collision_spheres YAML.
 #pragma once
 
+#include <map>
 #include <string>
 #include <vector>
 
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
+#include "inscribe/robot/self_collision.h"
 #include "inscribe/robot/urdf_spherize.h"
 
 namespace inscribe::robot {
@@ -29,6 +31,21 @@ absl::StatusOr<std::string> SpherizedUrdf(absl::string_view urdf_bytes,
 // digits and _ - . /): their names are appended to *left_out. Cost O(#spheres).
 std::string SpherizedCuroboYaml(const std::vector<LinkSpherizeResult>& links,
                                 const std::string& robot_name, std::vector<std::string>* left_out);
+
+// SpherizedCuroboYaml followed by cuRobo's self-collision settings for the links it wrote
+// (robot_cfg.kinematics keys, as in cuRobo's robot configurations):
+//   self_collision_ignore: per link, the links whose pair with it `matrix` disables (every
+//     class but Sometimes), each pair once, under the link that comes first in `links`; links
+//     with nothing to ignore are left out ({} when none is left). cuRobo skips a pair listed
+//     in either direction.
+//   self_collision_buffer: every written link's value in `buffers` (metres, 0 when absent),
+//     which cuRobo adds to that link's sphere radii in self-collision checks only.
+// Pairs are matched by link name. INVALID_ARGUMENT for a buffer that is not finite.
+absl::StatusOr<std::string> SpherizedCuroboYaml(const std::vector<LinkSpherizeResult>& links,
+                                                const std::string& robot_name,
+                                                const SelfCollisionMatrix& matrix,
+                                                const std::map<std::string, double>& buffers,
+                                                std::vector<std::string>* left_out);
 
 // The shortest decimal that std::from_chars reads back as exactly `value` (finite).
 std::string ShortestDecimal(double value);

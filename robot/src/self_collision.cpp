@@ -324,6 +324,21 @@ const char* CollisionPairClassName(CollisionPairClass type) {
   return "Sometimes";
 }
 
+std::vector<LinkCollisionGeometry> LinkCollisionGeometries(
+    const std::vector<LinkSpherizeResult>& links) {
+  std::vector<LinkCollisionGeometry> out(links.size());
+  for (std::size_t l = 0; l < links.size(); ++l) {
+    const LinkSpherizeResult& link = links[l];
+    if (link.status != LinkStatus::kSpherized) continue;
+    out[l].spheres = link.spheres;
+    if (link.delta) {
+      out[l].certified_delta = link.delta;
+      out[l].inner = link.cores;
+    }
+  }
+  return out;
+}
+
 absl::Status CheckLinkCollisionGeometry(const Kinematics& kinematics,
                                         const std::vector<LinkCollisionGeometry>& links) {
   if (static_cast<int>(links.size()) != kinematics.links()) {

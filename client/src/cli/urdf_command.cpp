@@ -18,6 +18,9 @@
 #include "absl/strings/str_split.h"
 #include "command_outcome.h"
 #include "inscribe/atomic_file.h"
+#include "inscribe/robot/kinematics.h"
+#include "inscribe/robot/self_collision.h"
+#include "inscribe/robot/self_collision_srdf.h"
 #include "inscribe/robot/spherized_urdf.h"
 #include "inscribe/robot/urdf_robot.h"
 #include "inscribe/robot/urdf_spherize.h"
@@ -58,6 +61,9 @@ struct UrdfCliOptions {
   double padding = 0.0;
   std::string output_path;
   std::string yaml_path;
+  std::string srdf_path;
+  std::int64_t samples = robot::SelfCollisionOptions{}.samples;
+  std::uint64_t seed = robot::SelfCollisionOptions{}.seed;
   bool json = false;
 };
 
@@ -148,8 +154,55 @@ void AddMode(const UrdfSpherizeOptions& options, nlohmann::json* report) {
   if (options.voxel_size) (*report)["voxel_size"] = *options.voxel_size;
 }
 
+nlohmann::json MatrixJson(const robot::SelfCollisionMatrix& matrix, const std::string& srdf) {
+  nlohmann::json out;
+  out["samples"] = matrix.samples;
+  out["seed"] = matrix.seed;
+  out["always_fraction"] = matrix.always_fraction;
+  out["certified"] = matrix.certified;
+  out["seconds"] = matrix.seconds;
+  if (!srdf.empty()) out["srdf"] = srdf;
+  nlohmann::json pairs = nlohmann::json::array();
+  std::int64_t disabled = 0;
+  for (const robot::LinkPairCollision& pair : matrix.pairs) {
+    nlohmann::json entry;
+    entry["link1"] = matrix.links[static_cast<std::size_t>(pair.link_a)];
+    entry["link2"] = matrix.links[static_cast<std::size_t>(pair.link_b)];
+    entry["class"] = robot::CollisionPairClassName(pair.type);
+    entry["disabled"] = robot::CollisionDisabled(pair.type);
+    entry["colliding_at_default"] = pair.colliding_at_default;
+    if (pair.sampled) {
+      entry["colliding_fraction"] = pair.colliding_fraction;
+      entry["min_lower"] = pair.min_lower;
+      entry["min_upper"] = pair.min_upper;
+    }
+    disabled += robot::CollisionDisabled(pair.type);
+    pairs.push_back(std::move(entry));
+  }
+  out["pairs"] = std::move(pairs);
+  out["disabled"] = disabled;
+  return out;
+}
+
+// "21 link pairs from 10000 samples (certified): 6 Adjacent, 2 Never, ... disabled; 13 enabled"
+std::string MatrixSummary(const robot::SelfCollisionMatrix& matrix) {
+  std::map<std::string, int> counts;
+  for (const robot::LinkPairCollision& pair : matrix.pairs) {
+    ++counts[robot::CollisionPairClassName(pair.type)];
+  }
+  std::string text = absl::StrFormat("self-collision: %d link pairs from %d samples%s in %.3f s:",
+                                     matrix.pairs.size(), matrix.samples,
+                                     matrix.certified ? " (certified bounds)" : "",
+                                     matrix.seconds);
+  for (const char* name : {"Adjacent", "Default", "Always", "Never", "Sometimes"}) {
+    absl::StrAppendFormat(&text, " %d %s", counts[name], name);
+  }
+  return text;
+}
+
 void PrintJson(const UrdfCliOptions& options, const UrdfSpherizeOptions& spherize,
                const UrdfRobot& robot, const RobotSpherizeResult& result,
+               const std::optional<robot::SelfCollisionMatrix>& matrix,
                const std::string& yaml_path, const std::vector<std::string>& left_out,
                double seconds) {
   nlohmann::json report;
@@ -191,14 +244,17 @@ void PrintJson(const UrdfCliOptions& options, const UrdfSpherizeOptions& spheriz
   report["spheres"] = spheres;
   if (delta) report["delta"] = *delta;
   report["left_out_of_yaml"] = left_out;
+  if (matrix) report["self_collision"] = MatrixJson(*matrix, options.srdf_path);
   report["spherize_seconds"] = result.seconds;
   report["seconds"] = seconds;
   // Names and messages come from the URDF, whose bytes tinyxml2 does not check as UTF-8.
   std::cout << report.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
 }
 
-void PrintTable(const RobotSpherizeResult& result, const std::string& output_path,
-                const std::string& yaml_path, const std::vector<std::string>& left_out,
+void PrintTable(const RobotSpherizeResult& result,
+                const std::optional<robot::SelfCollisionMatrix>& matrix,
+                const std::string& output_path, const std::string& yaml_path,
+                const std::string& srdf_path, const std::vector<std::string>& left_out,
                 double seconds) {
   std::size_t width = 4;
   for (const LinkSpherizeResult& link : result.links) width = std::max(width, link.link.size());
@@ -218,8 +274,9 @@ void PrintTable(const RobotSpherizeResult& result, const std::string& output_pat
     skipped += link.status == LinkStatus::kSkipped;
     spheres += static_cast<std::int64_t>(link.spheres.size());
   }
-  std::cout << absl::StrFormat("wrote %s and %s (%d spheres) in %.3f s", output_path, yaml_path,
-                               spheres, seconds);
+  if (matrix) std::cout << MatrixSummary(*matrix) << "\n";
+  std::cout << absl::StrFormat("wrote %s, %s%s (%d spheres) in %.3f s", output_path, yaml_path,
+                               srdf_path.empty() ? "" : " and " + srdf_path, spheres, seconds);
   if (skipped > 0) std::cout << absl::StrFormat("; %d link(s) skipped, kept as they were", skipped);
   if (!left_out.empty()) {
     std::cout << absl::StrFormat("; %d link(s) left out of the YAML (names)", left_out.size());
@@ -240,8 +297,18 @@ absl::Status RunUrdf(const UrdfCliOptions& options) {
                       "; give --yaml PATH or an -o ending in .urdf");
   }
 
+  if (!options.srdf_path.empty() &&
+      (SameFile(options.srdf_path, options.output_path) || SameFile(options.srdf_path, yaml_path))) {
+    return UsageError("--srdf " + options.srdf_path + " would overwrite another output");
+  }
+  if (options.samples < 1 || options.samples > robot::kMaxSelfCollisionSamples) {
+    return UsageError(absl::StrFormat("--samples must lie in 1..%d, got %d",
+                                      robot::kMaxSelfCollisionSamples, options.samples));
+  }
+
   // Before any work: a missing output directory would otherwise only show at the end.
-  for (const std::string& path : {options.output_path, yaml_path}) {
+  for (const std::string& path : {options.output_path, yaml_path, options.srdf_path}) {
+    if (path.empty()) continue;
     const fs::path directory = fs::absolute(path).parent_path();
     std::error_code error;
     if (!fs::is_directory(directory, error)) {
@@ -267,17 +334,50 @@ absl::Status RunUrdf(const UrdfCliOptions& options) {
     }
   }
 
+  // The self-collision matrix, for the SRDF and the YAML's self_collision_ignore. A joint tree
+  // the kinematics refuses only matters when an SRDF was asked for.
+  std::optional<robot::SelfCollisionMatrix> matrix;
+  absl::StatusOr<robot::Kinematics> kinematics = robot::Kinematics::Create(*robot);
+  if (kinematics.ok()) {
+    robot::SelfCollisionOptions collision;
+    collision.samples = options.samples;
+    collision.seed = options.seed;
+    absl::StatusOr<robot::SelfCollisionMatrix> made = robot::ComputeSelfCollisionMatrix(
+        *kinematics, robot::LinkCollisionGeometries(results), collision);
+    if (!made.ok()) return BugError(made.status().message());  // the spherizer's own spheres
+    matrix = *std::move(made);
+  } else if (!options.srdf_path.empty()) {
+    return BadInputError(options.urdf_path + ": no self-collision matrix: " +
+                         std::string(kinematics.status().message()));
+  } else {
+    std::cerr << "inscribe: no self-collision matrix (the YAML has no self_collision_ignore): "
+              << kinematics.status().message() << "\n";
+  }
+
   absl::StatusOr<std::string> urdf = SpherizedUrdf(*bytes, results);
   if (!urdf.ok()) return BugError(urdf.status().message());  // ParseUrdf accepted them
   std::vector<std::string> left_out;
-  const std::string yaml = SpherizedCuroboYaml(results, robot->name, &left_out);
+  std::string yaml;
+  if (matrix) {
+    // The padding is in the radii already: no extra self-collision buffer.
+    absl::StatusOr<std::string> with_matrix =
+        SpherizedCuroboYaml(results, robot->name, *matrix, {}, &left_out);
+    if (!with_matrix.ok()) return BugError(with_matrix.status().message());
+    yaml = *std::move(with_matrix);
+  } else {
+    yaml = SpherizedCuroboYaml(results, robot->name, &left_out);
+  }
   for (const std::string& link : left_out) {
     std::cerr << "inscribe: link '" << link << "' is spherized in " << options.output_path
               << " but left out of " << yaml_path
               << ": cuRobo YAML link names are letters, digits and _ - . /\n";
   }
-  for (const auto& [path, contents] :
-       {std::pair{options.output_path, *urdf}, std::pair{yaml_path, yaml}}) {
+  std::vector<std::pair<std::string, std::string>> outputs = {{options.output_path, *urdf},
+                                                               {yaml_path, yaml}};
+  if (!options.srdf_path.empty()) {
+    outputs.emplace_back(options.srdf_path, robot::SelfCollisionSrdf(*matrix, robot->name));
+  }
+  for (const auto& [path, contents] : outputs) {
     if (absl::Status written = WriteFileAtomically(path, contents); !written.ok()) {
       return BadInputError(written.message());
     }
@@ -286,9 +386,10 @@ absl::Status RunUrdf(const UrdfCliOptions& options) {
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (options.json) {
-    PrintJson(options, *spherize, *robot, *spherized, yaml_path, left_out, seconds);
+    PrintJson(options, *spherize, *robot, *spherized, matrix, yaml_path, left_out, seconds);
   } else {
-    PrintTable(*spherized, options.output_path, yaml_path, left_out, seconds);
+    PrintTable(*spherized, matrix, options.output_path, yaml_path, options.srdf_path, left_out,
+               seconds);
   }
   const auto skipped = std::count_if(results.begin(), results.end(), [](const auto& result) {
     return result.status == LinkStatus::kSkipped;
@@ -357,6 +458,16 @@ void AddUrdfCommand(CLI::App& app, CommandOutcome* outcome) {
   cmd->add_option("-o,--output", options->output_path, "The spherized URDF to write")->required();
   cmd->add_option("--yaml", options->yaml_path,
                   "cuRobo collision_spheres YAML to write (default: -o with extension .yml)");
+  cmd->add_option("--srdf", options->srdf_path,
+                  "Write MoveIt's SRDF with the self-collision matrix's disabled pairs "
+                  "(disable_collisions, reason Adjacent, Default, Always or Never)");
+  cmd->add_option("--samples", options->samples,
+                  "Random joint configurations the self-collision matrix is sampled at (MoveIt's "
+                  "default density)")
+      ->capture_default_str();
+  cmd->add_option("--seed", options->seed, "Seed of the configurations: the same seed, the same "
+                                           "matrix on every machine")
+      ->capture_default_str();
   cmd->add_flag("--json", options->json,
                 "Print one JSON report on stdout: per link status, spheres, budget, delta, "
                 "certified, seconds, error");

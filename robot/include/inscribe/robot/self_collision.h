@@ -33,6 +33,7 @@
 #include "absl/types/span.h"
 #include "inscribe/medial_spheres.h"
 #include "inscribe/robot/kinematics.h"
+#include "inscribe/robot/urdf_spherize.h"
 #include "inscribe/sphere.h"
 
 namespace inscribe::robot {
@@ -52,6 +53,12 @@ struct LinkCollisionGeometry {
   // cover): tighter upper bounds. Used only with certified_delta.
   std::vector<Sphere> inner;
 };
+
+// What SpherizeRobot made for each link, as the matrix takes it: the written spheres; for a
+// certified cover its delta (padding included) and its cores as `inner`. One entry per link,
+// in the robot's order; skipped links and links without geometry get no spheres. O(#spheres).
+std::vector<LinkCollisionGeometry> LinkCollisionGeometries(
+    const std::vector<LinkSpherizeResult>& links);
 
 enum class CollisionPairClass { kAdjacent, kDefault, kAlways, kNever, kSometimes };
 

@@ -4,13 +4,11 @@
 #include <chrono>
 #include <cmath>
 #include <exception>
-#include <filesystem>
 #include <numeric>
 #include <optional>
 #include <utility>
 
 #include "absl/status/status.h"
-#include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
 #include "inscribe/mesh_io.h"
 #include "inscribe/robot/primitive_meshes.h"
@@ -140,14 +138,6 @@ absl::StatusOr<Mesh> ElementMeshInLinkFrame(const UrdfElement& element,
   Vector3 scale = Vector3::Ones();
   switch (geometry.shape) {
     case UrdfShape::kMesh: {
-      const std::string extension =
-          absl::AsciiStrToLower(std::filesystem::path(geometry.filename).extension().string());
-      if (extension == ".dae") {
-        return absl::InvalidArgumentError(absl::StrCat(
-            "mesh '", geometry.filename,
-            "' is Collada (.dae), which inscribe cannot read; convert it to .stl, .obj, .ply "
-            "or .off and point the URDF at that"));
-      }
       absl::StatusOr<std::string> path =
           ResolveMeshFilename(geometry.filename, options.urdf_dir, options.packages);
       if (!path.ok()) return path.status();

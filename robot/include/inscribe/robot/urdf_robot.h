@@ -75,10 +75,11 @@ struct UrdfRobot {
 // Parses a URDF document. INVALID_ARGUMENT, naming the line and, where there is one, the link
 // and the attribute, for: bytes that are not XML (text or a second element beside the root
 // included, which tinyxml2 alone accepts), a root that is not <robot>, unexpanded xacro
-// (xacro: elements), a link without a name or with a name used before, a missing or malformed
-// number (xyz, rpy, scale: 3 finite numbers; size: 3 positive; radius, length: one positive),
-// a zero scale component, a <mesh> without filename. Geometry URDF does not define is not an
-// error here (kUnsupported). Cost O(size of the document).
+// (elements in the xacro namespace, ${...} or $(...) values: the message says to run
+// `xacro robot.urdf.xacro > robot.urdf`), a link without a name or with a name used before, a
+// missing or malformed number (xyz, rpy, scale: 3 finite numbers; size: 3 positive; radius, length:
+// one positive), a zero scale component, a <mesh> without filename. Geometry URDF does not define
+// is not an error here (kUnsupported). Cost O(size of the document).
 absl::StatusOr<UrdfRobot> ParseUrdf(absl::string_view bytes);
 
 // Where package://PKG/... URIs are looked for, in this order: for each directory D of

@@ -39,6 +39,7 @@ struct ViewCliOptions {
   std::int64_t samples = 100'000;
   std::uint64_t seed = 1;
   bool fill_holes = false;
+  double weld_tolerance = 0.0;
   std::string title;
 };
 
@@ -96,7 +97,8 @@ absl::Status RunView(const ViewCliOptions& options) {
     return BadInputError("cannot write the page to " + output + ": " + problem);
   }
 
-  absl::StatusOr<LoadedSolid> solid = LoadSolid(options.mesh_path, {options.fill_holes});
+  absl::StatusOr<LoadedSolid> solid =
+      LoadSolid(options.mesh_path, {options.fill_holes, options.weld_tolerance});
   if (!solid.ok()) return solid.status();
   if (!file->mesh_sha256.empty() && file->mesh_sha256 != solid->solid.sha256) {
     std::cerr << "inscribe: warning: " << options.spheres_path << " was made for mesh "
@@ -161,6 +163,7 @@ void AddViewCommand(CLI::App& app, CommandOutcome* outcome) {
   cmd->add_option("--seed", options->seed, "Seed of the samples")->capture_default_str();
   cmd->add_flag("--fill-holes", options->fill_holes,
                 "Close the mesh's holes first (see inscribe info --fill-holes)");
+  AddWeldToleranceOption(cmd, &options->weld_tolerance);
   cmd->add_option("--title", options->title,
                   "Heading of the page (default: the mesh and sphere file names)");
   cmd->callback([options, outcome] { outcome->status = RunView(*options); });

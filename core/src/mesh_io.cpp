@@ -25,6 +25,7 @@
 #include "inscribe/atomic_file.h"
 #include "inscribe/mesh_validation.h"
 #include "mesh_file_diagnosis.h"
+#include "scene_import.h"
 
 namespace inscribe {
 namespace {
@@ -167,9 +168,13 @@ absl::StatusOr<Mesh> SoupToMesh(const std::vector<Point>& points,
 
 absl::StatusOr<Mesh> ParseNamed(const std::string& bytes, const std::string& format,
                                 const std::string& what, ReadMeshInfo* info) {
+  if (internal::IsSceneFormat(format)) {
+    return internal::ImportSceneBytes(bytes, format, what, info);
+  }
   if (format != "off" && format != "obj" && format != "stl" && format != "ply") {
     return absl::InvalidArgumentError(absl::StrCat(what, ": unsupported mesh format '", format,
-                                                   "' (expected off, obj, stl or ply)"));
+                                                   "' (expected off, obj, stl, ply, dae, gltf or "
+                                                   "glb)"));
   }
   if (bytes.find_first_not_of(" \t\r\n") == std::string::npos) {
     return absl::InvalidArgumentError(absl::StrCat(what, ": file is empty"));
@@ -232,10 +237,18 @@ absl::StatusOr<Mesh> ReadMesh(const std::string& path, ReadMeshInfo* info) {
   }
   std::string ext = Lowercase(fs::path(path).extension().string());
   if (!ext.empty()) ext.erase(0, 1);
-  if (ext != "off" && ext != "obj" && ext != "stl" && ext != "ply") {
+  if (ext != "off" && ext != "obj" && ext != "stl" && ext != "ply" &&
+      !internal::IsSceneFormat(ext)) {
     return absl::InvalidArgumentError(absl::StrCat(
         path, ": unsupported mesh format '", ext.empty() ? std::string("(no extension)") : ext,
-        "' (expected .off, .obj, .stl or .ply)"));
+        "' (expected .off, .obj, .stl, .ply, .dae, .gltf or .glb)"));
+  }
+  if (internal::IsSceneFormat(ext)) {
+    // assimp reads the file itself: a .gltf may name its buffers as sibling files.
+    if (fs::file_size(path, ec) == 0 && !ec) {
+      return absl::InvalidArgumentError(absl::StrCat(path, ": file is empty"));
+    }
+    return internal::ImportSceneFile(path, info);
   }
   std::ifstream file(path, std::ios::in | std::ios::binary);
   if (!file) {

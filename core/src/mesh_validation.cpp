@@ -11,6 +11,7 @@
 #include "hole_filling.h"
 #include "mesh_topology.h"
 #include "self_intersections.h"
+#include "vertex_welding.h"
 
 namespace inscribe {
 namespace {
@@ -211,7 +212,14 @@ void CheckEdges(const Mesh& mesh, const std::vector<EdgeUse>& uses, const EdgeGr
              absl::StrCat(
                  "mesh is not closed: ", Plural(report.border_edges, "border edge", "border edges"),
                  " (edges in only one triangle; first: vertices ", first_border->lo, "-",
-                 first_border->hi, " in triangle ", first_border->triangle, ")"),
+                 first_border->hi, " in triangle ", first_border->triangle, ")",
+                 // Every edge a border: no two triangles share a vertex, as when an exporter
+                 // repeats each vertex per face at positions that differ in the last digits.
+                 report.border_edges == static_cast<std::int64_t>(groups.ranges.size()) &&
+                         mesh.num_triangles() > 1
+                     ? "; no two triangles share an edge: if the file repeats each vertex per "
+                       "face at slightly different positions, weld them with a weld tolerance"
+                     : ""),
              report.border_edges);
   }
   if (report.non_manifold_edges > 0) {
@@ -225,7 +233,6 @@ void CheckEdges(const Mesh& mesh, const std::vector<EdgeUse>& uses, const EdgeGr
   }
   // Inconsistent orientation is reported by the orientation step, which knows if it is fixed.
   (void)first_inconsistent;
-  (void)mesh;
 }
 
 void CheckVertexManifold(const Mesh& mesh, const std::vector<EdgeUse>& uses,
@@ -550,6 +557,41 @@ void FillHolesAndOrient(Mesh& mesh, const std::vector<EdgeUse>& uses, const Edge
   mesh = std::move(closed);
 }
 
+// options.weld_vertices: merges coincident vertices (internal::WeldVertices) and reports it.
+// Returns false, with the error "invalid_weld_tolerance", for a tolerance that is negative or
+// not finite; the mesh is then not examined further.
+bool WeldCoincidentVertices(Mesh& mesh, double tolerance, MeshReport& report) {
+  if (!(tolerance >= 0.0) || !std::isfinite(tolerance)) {
+    AddIssue(report, Severity::kError, "invalid_weld_tolerance",
+             absl::StrFormat("weld tolerance %g is not a finite distance >= 0", tolerance), 0);
+    return false;
+  }
+  const internal::Weld weld = internal::WeldVertices(mesh, tolerance);
+  report.welded_vertices = weld.merged_vertices;
+  report.weld_collapsed_triangles = weld.collapsed_triangles;
+  if (weld.merged_vertices > 0 || weld.collapsed_triangles > 0) {
+    AddIssue(report, Severity::kFixed, "welded_vertices",
+             absl::StrCat("welded ", Plural(weld.merged_vertices, "vertex", "vertices"),
+                          tolerance > 0.0 ? absl::StrFormat(" within %g", tolerance)
+                                          : std::string(" at identical positions"),
+                          " into the ", Plural(mesh.num_vertices(), "vertex", "vertices"), " kept",
+                          weld.collapsed_triangles > 0
+                              ? absl::StrCat("; removed ",
+                                             Plural(weld.collapsed_triangles, "triangle that",
+                                                    "triangles that"),
+                                             " welding left with a repeated corner")
+                              : std::string()),
+             weld.merged_vertices);
+    report.bbox = ComputeBoundingBox(mesh.vertices);
+  }
+  if (mesh.num_triangles() == 0) {
+    AddIssue(report, Severity::kError, "no_triangles",
+             "mesh has no triangles left once its coincident vertices were welded", 0);
+    return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 const char* SeverityName(Severity severity) {
@@ -599,6 +641,10 @@ ValidatedMesh ValidateMesh(Mesh mesh, const ValidateOptions& options) {
              huge);
     return ValidatedMesh{std::move(mesh), std::move(report)};
   }
+  if (options.weld_vertices && !WeldCoincidentVertices(mesh, options.weld_tolerance, report)) {
+    return ValidatedMesh{std::move(mesh), std::move(report)};
+  }
+  const std::int64_t welded_triangles = mesh.num_triangles();
   CheckDegenerateAndDuplicate(mesh, report);
   const std::vector<EdgeUse> uses = internal::SortedEdgeUses(mesh);
   const EdgeGroups groups = GroupEdges(uses);
@@ -626,8 +672,8 @@ ValidatedMesh ValidateMesh(Mesh mesh, const ValidateOptions& options) {
             report.hole_triangles_added == 0
                 ? 0
                 : std::count_if(pairs->begin(), pairs->end(),
-                                [&report](const std::pair<std::int32_t, std::int32_t>& p) {
-                                  return p.second >= report.triangles;
+                                [welded_triangles](const std::pair<std::int32_t, std::int32_t>& p) {
+                                  return p.second >= welded_triangles;
                                 });
         AddIssue(
             report, Severity::kWarning, "self_intersections",

@@ -297,12 +297,13 @@ class Client:
     # ---- calls ---------------------------------------------------------------------------
 
     def put_mesh(self, mesh: _inscribe.Mesh, *, fill_holes: bool = False,
-                 timeout: Optional[float] = None) -> str:
+                 weld_tolerance: float = 0.0, timeout: Optional[float] = None) -> str:
         """Validates and stores `mesh` on its replica; returns its key "sha256:<hex>" (of the
-        mesh as the server fixed it). inscribe.Error FAILED_PRECONDITION for an unusable mesh."""
+        mesh as the server fixed it: coincident vertices welded, also those within
+        weld_tolerance). inscribe.Error FAILED_PRECONDITION for an unusable mesh."""
         request = service_pb2.PutMeshRequest(
             mesh=mesh_pb2.Mesh(vertices=mesh.vertices.ravel(), triangles=mesh.triangles.ravel()),
-            fill_holes=fill_holes)
+            fill_holes=fill_holes, weld_tolerance=weld_tolerance)
         response = self._put(_inscribe._route_key(mesh.sha256), "PutMesh", request,
                              lambda r: r.mesh_sha256, timeout)
         return response.mesh_sha256
@@ -453,12 +454,14 @@ class Client:
         return _sphere_set_from_proto(response.spheres, "internal"), figures
 
     def inspect_mesh(self, mesh: _inscribe.Mesh, *, skip_self_intersections: bool = False,
-                     fill_holes: bool = False, timeout: Optional[float] = None) -> dict:
+                     fill_holes: bool = False, weld_tolerance: float = 0.0,
+                     timeout: Optional[float] = None) -> dict:
         """The server's validation of `mesh` (nothing stored): {"mesh_sha256": ..., "report":
         the MeshReport's fields as a dict, its "issues" a list of dicts}."""
         request = service_pb2.InspectMeshRequest(
             mesh=mesh_pb2.Mesh(vertices=mesh.vertices.ravel(), triangles=mesh.triangles.ravel()),
-            skip_self_intersections=skip_self_intersections, fill_holes=fill_holes)
+            skip_self_intersections=skip_self_intersections, fill_holes=fill_holes,
+            weld_tolerance=weld_tolerance)
         response = self._unary(_inscribe._route_key(mesh.sha256), "InspectMesh", request, timeout)
         return _fields(response)
 

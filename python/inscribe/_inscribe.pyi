@@ -39,6 +39,8 @@ class MeshReport:
     flipped_triangles: int
     self_intersections_checked: bool
     self_intersecting_pairs: int
+    welded_vertices: int
+    weld_collapsed_triangles: int
     holes_filled: int
     hole_triangles_added: int
     volume: float
@@ -62,7 +64,7 @@ class Mesh:
     @property
     def sha256(self) -> str: ...
     def validate(self, *, check_self_intersections: bool = True,
-                 fill_holes: bool = False) -> MeshReport: ...
+                 fill_holes: bool = False, weld_tolerance: float = 0.0) -> MeshReport: ...
 
 class Solid:
     @property

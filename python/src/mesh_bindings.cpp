@@ -102,6 +102,8 @@ void BindMesh(py::module_& m) {
       .def_readonly("flipped_triangles", &MeshReport::flipped_triangles)
       .def_readonly("self_intersections_checked", &MeshReport::self_intersections_checked)
       .def_readonly("self_intersecting_pairs", &MeshReport::self_intersecting_pairs)
+      .def_readonly("welded_vertices", &MeshReport::welded_vertices)
+      .def_readonly("weld_collapsed_triangles", &MeshReport::weld_collapsed_triangles)
       .def_readonly("holes_filled", &MeshReport::holes_filled)
       .def_readonly("hole_triangles_added", &MeshReport::hole_triangles_added)
       .def_readonly("volume", &MeshReport::volume,
@@ -144,16 +146,20 @@ void BindMesh(py::module_& m) {
           "the hash of the validated, re-oriented mesh: see Solid.sha256)")
       .def(
           "validate",
-          [](const Mesh& mesh, bool check_self_intersections, bool fill_holes) {
+          [](const Mesh& mesh, bool check_self_intersections, bool fill_holes,
+             double weld_tolerance) {
             ValidateOptions options;
             options.check_self_intersections = check_self_intersections;
             options.fill_holes = fill_holes;
+            options.weld_tolerance = weld_tolerance;
             py::gil_scoped_release release;
             return ValidateMesh(mesh, options).report;
           },
           py::kw_only(), py::arg("check_self_intersections") = true, py::arg("fill_holes") = false,
+          py::arg("weld_tolerance") = 0.0,
           "The validation report (MeshReport) of this mesh; never raises for a bad mesh. "
-          "Cost O(T log T).")
+          "Coincident vertices are welded first (within weld_tolerance, mesh units; 0: "
+          "identical positions only). Cost O(T log T + V log V).")
       .def("__repr__", [](const Mesh& mesh) {
         return absl::StrCat("Mesh(vertices=", mesh.num_vertices(),
                             ", triangles=", mesh.num_triangles(), ")");
@@ -170,7 +176,9 @@ void BindMesh(py::module_& m) {
         return std::make_shared<Mesh>(ValueOrRaise(std::move(mesh)));
       },
       py::arg("path"),
-      "Reads an OFF, OBJ, STL or PLY file (by extension) into a Mesh, polygons triangulated. "
+      "Reads an OFF, OBJ, STL, PLY, COLLADA (.dae) or glTF (.gltf, .glb) file (by extension) "
+      "into a Mesh, polygons triangulated (COLLADA and glTF: every node's mesh placed by its "
+      "transform, in metres, in the file's own axes). "
       "FileNotFoundError for a missing file, ValueError for a malformed one. Not validated.");
 
   m.def(

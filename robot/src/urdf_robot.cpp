@@ -26,6 +26,10 @@ namespace fs = std::filesystem;
 
 using tinyxml2::XMLElement;
 
+// How to turn a .xacro file into the URDF inscribe reads.
+constexpr absl::string_view kExpandXacro =
+    "expand the xacro file first: xacro robot.urdf.xacro > robot.urdf";
+
 absl::Status ErrorAt(int line, absl::string_view what) {
   return absl::InvalidArgumentError(absl::StrCat("URDF line ", line, ": ", what));
 }
@@ -53,7 +57,7 @@ absl::StatusOr<std::vector<double>> ParseNumbers(const XMLElement& element, cons
                                                          text, "\">: ", why, InOwner(link)));
   };
   if (absl::StrContains(text, "${") || absl::StrContains(text, "$(")) {
-    return malformed("unexpanded xacro expression; run xacro first");
+    return malformed(absl::StrCat("unexpanded xacro expression; ", kExpandXacro));
   }
   const std::vector<absl::string_view> tokens =
       absl::StrSplit(text, absl::ByAnyChar(" \t\r\n"), absl::SkipEmpty());
@@ -289,12 +293,25 @@ absl::StatusOr<UrdfJoint> ParseJoint(const XMLElement& element) {
   return joint;
 }
 
-// The first element, in document order, whose name is in the xacro namespace.
-const XMLElement* FindXacro(const XMLElement& element) {
-  if (absl::StartsWith(element.Name(), "xacro:")) return &element;
+// The prefix ("xacro:", or whatever the root binds to the xacro namespace URI) that marks
+// xacro elements.
+std::string XacroPrefix(const XMLElement& root) {
+  for (const tinyxml2::XMLAttribute* a = root.FirstAttribute(); a != nullptr; a = a->Next()) {
+    if (absl::StartsWith(a->Name(), "xmlns:") && absl::StrContains(a->Value(), "wiki/xacro")) {
+      return absl::StrCat(absl::StripPrefix(a->Name(), "xmlns:"), ":");
+    }
+  }
+  return "xacro:";
+}
+
+// The first element, in document order, whose name has the xacro `prefix`.
+const XMLElement* FindXacro(const XMLElement& element, const std::string& prefix) {
+  if (absl::StartsWith(element.Name(), prefix) || absl::StartsWith(element.Name(), "xacro:")) {
+    return &element;
+  }
   for (const XMLElement* child = element.FirstChildElement(); child != nullptr;
        child = child->NextSiblingElement()) {
-    if (const XMLElement* found = FindXacro(*child); found != nullptr) return found;
+    if (const XMLElement* found = FindXacro(*child, prefix); found != nullptr) return found;
   }
   return nullptr;
 }
@@ -510,10 +527,9 @@ absl::StatusOr<UrdfRobot> ParseUrdf(absl::string_view bytes) {
                    absl::StrCat("the root element is <", root->Name(), ">, not <robot>"));
   }
   if (absl::Status strict = CheckStrictXml(bytes); !strict.ok()) return strict;
-  if (const XMLElement* xacro = FindXacro(*root); xacro != nullptr) {
+  if (const XMLElement* xacro = FindXacro(*root, XacroPrefix(*root)); xacro != nullptr) {
     return ErrorAt(xacro->GetLineNum(),
-                   absl::StrCat("<", xacro->Name(),
-                                "> is unexpanded xacro; run xacro to produce the URDF first"));
+                   absl::StrCat("<", xacro->Name(), "> is unexpanded xacro; ", kExpandXacro));
   }
   UrdfRobot robot;
   if (const char* name = root->Attribute("name"); name != nullptr) robot.name = name;

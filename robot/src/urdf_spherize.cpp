@@ -5,7 +5,6 @@
 #include <cmath>
 #include <deque>
 #include <exception>
-#include <filesystem>
 #include <map>
 #include <numeric>
 #include <optional>
@@ -13,7 +12,6 @@
 #include <utility>
 
 #include "absl/status/status.h"
-#include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
 #include "inscribe/certified_distance.h"
 #include "inscribe/mesh_clip.h"
@@ -497,14 +495,6 @@ absl::StatusOr<Mesh> ElementMeshInLinkFrame(const UrdfElement& element,
   Vector3 scale = Vector3::Ones();
   switch (geometry.shape) {
     case UrdfShape::kMesh: {
-      const std::string extension =
-          absl::AsciiStrToLower(std::filesystem::path(geometry.filename).extension().string());
-      if (extension == ".dae") {
-        return absl::InvalidArgumentError(absl::StrCat(
-            "mesh '", geometry.filename,
-            "' is Collada (.dae), which inscribe cannot read; convert it to .stl, .obj, .ply "
-            "or .off and point the URDF at that"));
-      }
       absl::StatusOr<std::string> path =
           ResolveMeshFilename(geometry.filename, options.urdf_dir, options.packages);
       if (!path.ok()) return path.status();

@@ -27,6 +27,7 @@ absl::Status RunInspectMesh(const v1::InspectMeshRequest& request,
   ValidateOptions options;
   options.check_self_intersections = !request.skip_self_intersections();
   options.fill_holes = request.fill_holes();
+  options.weld_tolerance = request.weld_tolerance();
   const ValidatedMesh validated = ValidateMesh(*std::move(mesh), options);
   const MeshReport& report = validated.report;
   // As the CLI does: a hash over NaNs or dangling indices would key nothing usable.

@@ -50,8 +50,11 @@ grpc::ServerUnaryReactor* InscribeService::PutMesh(grpc::CallbackServerContext* 
                     absl::StatusOr<Mesh> mesh = wire::MeshFromProto(request->mesh());
                     if (!mesh.ok()) return mesh.status();
                     bool already = false;
+                    ValidateOptions repair;
+                    repair.fill_holes = request->fill_holes();
+                    repair.weld_tolerance = request->weld_tolerance();
                     absl::StatusOr<std::shared_ptr<const StoredMeshEntry>> stored =
-                        store_->PutMesh(*std::move(mesh), request->fill_holes(), &already);
+                        store_->PutMesh(*std::move(mesh), repair, &already);
                     if (!stored.ok()) return stored.status();
                     RecordMeshSize(**stored);
                     response->set_mesh_sha256((*stored)->key);

@@ -114,11 +114,8 @@ absl::StatusOr<CachedValue> DecodeHierarchy(std::string bytes) {
 ResultStore::ResultStore(ResultCache* cache, const StoreLimits& limits)
     : cache_(cache), limits_(limits) {}
 
-absl::StatusOr<std::shared_ptr<const StoredMeshEntry>> ResultStore::PutMesh(Mesh mesh,
-                                                                            bool fill_holes,
-                                                                            bool* already_stored) {
-  ValidateOptions options;
-  options.fill_holes = fill_holes;
+absl::StatusOr<std::shared_ptr<const StoredMeshEntry>> ResultStore::PutMesh(
+    Mesh mesh, const ValidateOptions& options, bool* already_stored) {
   ValidatedMesh validated = ValidateMesh(std::move(mesh), options);
   if (validated.report.non_finite_vertices > 0 || validated.report.out_of_range_indices > 0) {
     // Not hashable; refused before hashing, with the error MakeSolid would give.

@@ -82,9 +82,11 @@ class ResultStore {
  public:
   ResultStore(ResultCache* cache, const StoreLimits& limits);
 
-  // Validates `mesh` and stores it under its hash. FAILED_PRECONDITION when it is unusable
-  // (naming the first error). *already_stored: the key was held before.
-  absl::StatusOr<std::shared_ptr<const StoredMeshEntry>> PutMesh(Mesh mesh, bool fill_holes,
+  // Validates `mesh` with `options` (its repairs: welding, hole filling) and stores it under
+  // the hash of the validated mesh. FAILED_PRECONDITION when it is unusable (naming the first
+  // error). *already_stored: the key was held before.
+  absl::StatusOr<std::shared_ptr<const StoredMeshEntry>> PutMesh(Mesh mesh,
+                                                                 const ValidateOptions& options,
                                                                  bool* already_stored);
   // NOT_FOUND for a key the cache does not hold (in memory or on disk).
   absl::StatusOr<std::shared_ptr<const StoredMeshEntry>> GetMesh(const std::string& key);

@@ -4,6 +4,7 @@
 #include <sys/wait.h>
 
 #include <array>
+#include <assimp/Exporter.hpp>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -12,6 +13,10 @@
 #include <string>
 
 #include "client/cli_run.h"
+#include "inscribe/mesh_io.h"
+#include "support/assimp_scenes.h"
+#include "support/cgal_mesh_writer.h"
+#include "support/synthetic_meshes.h"
 #include "support/test_meshes.h"
 
 namespace inscribe {
@@ -124,6 +129,92 @@ TEST(CliInfo, BadFilesFailWithOneLineReason) {
   const CliRun missing = RunCli("info " + Quote((dir / "missing.off").string()));
   EXPECT_EQ(missing.exit_code, 2);
   EXPECT_THAT(missing.err, HasSubstr("no such file"));
+  fs::remove_all(dir);
+}
+
+// An OBJ as MeshLab writes it, each vertex repeated per face: welded, it is eight.off again,
+// and info says so.
+TEST(CliInfo, RepeatedVerticesAreWeldedAndReported) {
+  INSCRIBE_REQUIRE_MESH("eight.off");
+  const fs::path dir =
+      fs::temp_directory_path() / ("inscribe_cli_weld_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  absl::StatusOr<Mesh> eight = ReadMesh(testing::TestMeshPath("eight.off"));
+  ASSERT_TRUE(eight.ok()) << eight.status();
+  const std::string obj = (dir / "eight_per_face.obj").string();
+  ASSERT_TRUE(testing::WriteMeshWithCgal(obj, testing::PerFaceVertices(*eight), false));
+
+  const CliRun run = RunCli("info --json " + Quote(obj));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const nlohmann::json j = nlohmann::json::parse(run.out);
+  EXPECT_EQ(j.at("vertices").get<int>(), 3 * 634);  // as given
+  EXPECT_EQ(j.at("counts").at("welded_vertices").get<int>(), 3 * 634 - 315);
+  EXPECT_EQ(j.at("counts").at("weld_collapsed_triangles").get<int>(), 0);
+  EXPECT_TRUE(j.at("closed").get<bool>());
+  const nlohmann::json original =
+      nlohmann::json::parse(RunCli("info --json " + Quote(testing::TestMeshPath("eight.off"))).out);
+  EXPECT_DOUBLE_EQ(j.at("volume").get<double>(), original.at("volume").get<double>());
+  bool reported = false;
+  for (const auto& issue : j.at("issues")) {
+    if (issue.at("code") == "welded_vertices") {
+      EXPECT_EQ(issue.at("severity"), "fixed");
+      EXPECT_EQ(issue.at("count").get<int>(), 3 * 634 - 315);
+      EXPECT_THAT(issue.at("message").get<std::string>(), HasSubstr("welded 1587 vertices"));
+      reported = true;
+    }
+  }
+  EXPECT_TRUE(reported) << run.out;
+  const CliRun text = RunCli("info " + Quote(obj));
+  EXPECT_THAT(text.out, HasSubstr("vertices             1902 (1587 welded: 315 left)"));
+  EXPECT_THAT(text.out, HasSubstr("fixed    welded 1587 vertices at identical positions"));
+
+  // Copies up to 2e-9 apart: refused with a hint, welded with --weld-tolerance.
+  Mesh near = testing::PerFaceVertices(*eight);
+  for (Eigen::Index v = 0; v < near.num_vertices(); ++v) {
+    near.vertices(v, 0) += 1e-12 * static_cast<double>(v + 1);  // every copy apart, < 2e-9
+  }
+  const std::string near_obj = (dir / "eight_near.obj").string();
+  ASSERT_TRUE(testing::WriteMeshWithCgal(near_obj, near, false));
+  const CliRun refused = RunCli("info " + Quote(near_obj));
+  EXPECT_EQ(refused.exit_code, 1);
+  EXPECT_THAT(refused.err, HasSubstr("weld them with a weld tolerance"));
+  const CliRun welded = RunCli("info --json --weld-tolerance 1e-6 " + Quote(near_obj));
+  ASSERT_EQ(welded.exit_code, 0) << welded.err;
+  EXPECT_EQ(nlohmann::json::parse(welded.out).at("counts").at("welded_vertices").get<int>(),
+            3 * 634 - 315);
+  EXPECT_NE(RunCli("info --weld-tolerance -1 " + Quote(near_obj)).exit_code, 0);
+  fs::remove_all(dir);
+}
+
+TEST(CliInfo, ColladaAndGltfFiles) {
+  INSCRIBE_REQUIRE_MESH("eight.off");
+  const fs::path dir =
+      fs::temp_directory_path() / ("inscribe_cli_scene_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  Eigen::Matrix4d lifted = Eigen::Matrix4d::Identity();
+  lifted(2, 3) = 5.0;
+  const std::unique_ptr<aiScene> scene =
+      testing::MakeScene({testing::LoadTestMesh("eight.off")}, {{0, lifted}});
+  for (const auto& [format_id, name] :
+       {std::pair{"collada", "eight.dae"}, std::pair{"glb2", "eight.glb"}}) {
+    const std::string path = (dir / name).string();
+    Assimp::Exporter exporter;
+    ASSERT_EQ(exporter.Export(scene.get(), format_id, path), AI_SUCCESS)
+        << exporter.GetErrorString();
+    const CliRun run = RunCli("info --json " + Quote(path));
+    ASSERT_EQ(run.exit_code, 0) << name << ": " << run.err;
+    const nlohmann::json j = nlohmann::json::parse(run.out);
+    EXPECT_EQ(j.at("triangles").get<int>(), 634) << name;
+    EXPECT_TRUE(j.at("usable").get<bool>()) << name;
+    EXPECT_NEAR(j.at("bbox").at("min")[2].get<double>(),
+                5.0 + testing::LoadTestMesh("eight.off").vertices.col(2).minCoeff(), 1e-5)
+        << name;
+  }
+  std::ofstream(dir / "garbage.glb") << "glTF but not really";
+  const CliRun garbage = RunCli("info " + Quote((dir / "garbage.glb").string()));
+  EXPECT_EQ(garbage.exit_code, 2);
+  EXPECT_THAT(garbage.err, HasSubstr("assimp"));
+  EXPECT_EQ(std::count(garbage.err.begin(), garbage.err.end(), '\n'), 1) << garbage.err;
   fs::remove_all(dir);
 }
 

@@ -51,9 +51,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   inscribe::ValidateOptions options;
   options.fill_holes = fill_holes;
   const inscribe::ValidatedMesh validated = inscribe::ValidateMesh(*std::move(mesh), options);
-  if (validated.report.triangles !=
+  // As given, less what welding collapsed, plus what hole filling added.
+  if (validated.report.triangles - validated.report.weld_collapsed_triangles !=
       validated.mesh.num_triangles() - validated.report.hole_triangles_added) {
     Fail("the report's triangle count does not match the returned mesh");
+  }
+  if (validated.report.vertices - validated.report.welded_vertices !=
+      validated.mesh.num_vertices()) {
+    Fail("the report's vertex count does not match the returned mesh");
   }
   if (broken && validated.report.usable()) Fail("a mesh with bad coordinates or indices is usable");
   if (!validated.report.usable() && validated.report.first_error().empty()) {

@@ -75,6 +75,21 @@ def test_validate_reports_an_open_mesh_and_prepare_refuses_it_with_the_cli_messa
     assert report.first_error.split(":")[0] in cli.stdout + cli.stderr
 
 
+def test_validate_welds_vertices_repeated_per_face_and_within_a_tolerance():
+    v, t = cube()
+    per_face = np.ascontiguousarray(v[t.ravel()])  # each triangle with its own 3 vertices
+    faces = np.arange(len(per_face), dtype=np.int32).reshape(-1, 3)
+    report = inscribe.Mesh(per_face, faces).validate()
+    assert report.usable and report.welded_vertices == 36 - 8
+    assert report.weld_collapsed_triangles == 0
+    assert any(i.code == "welded_vertices" and i.severity == inscribe.Severity.FIXED
+               for i in report.issues)
+    apart = per_face + 1e-9 * np.arange(len(per_face))[:, None]
+    assert not inscribe.Mesh(apart, faces).validate().usable
+    welded = inscribe.Mesh(apart, faces).validate(weld_tolerance=1e-6)
+    assert welded.usable and welded.welded_vertices == 36 - 8
+
+
 def test_sha256_of_the_solid_is_the_cli_mesh_hash():
     import json
     solid = inscribe.prepare(inscribe.load_mesh(mesh_path("eight.off")))

@@ -18,6 +18,7 @@
 namespace inscribe::robot {
 namespace {
 
+using ::testing::AllOf;
 using ::testing::HasSubstr;
 namespace fs = std::filesystem;
 
@@ -155,6 +156,20 @@ TEST(UrdfParse, ErrorsNameTheLineTheLinkAndTheProblem) {
               HasSubstr("line 2: not well-formed XML: a second top-level element <robot>"));
   EXPECT_THAT(ParseError("<robot>\n<xacro:include filename=\"x.xacro\"/>\n</robot>"),
               HasSubstr("line 2: <xacro:include> is unexpanded xacro"));
+  // A robot.urdf.xacro as distributed: the namespace declared on <robot>, xacro elements inside.
+  EXPECT_THAT(ParseError("<?xml version=\"1.0\"?>\n"
+                         "<robot xmlns:xacro=\"http://www.ros.org/wiki/xacro\" name=\"arm\">\n"
+                         "  <xacro:property name=\"width\" value=\"0.2\"/>\n"
+                         "  <xacro:macro name=\"leg\" params=\"prefix\"><link name=\"${prefix}\"/>"
+                         "</xacro:macro>\n"
+                         "  <xacro:leg prefix=\"right\"/>\n</robot>"),
+              AllOf(HasSubstr("line 3: <xacro:property> is unexpanded xacro"),
+                    HasSubstr("xacro robot.urdf.xacro > robot.urdf")));
+  EXPECT_THAT(
+      ParseError("<robot xmlns:x=\"http://ros.org/wiki/xacro\">\n<x:include filename=\"a\"/>"
+                 "\n</robot>"),
+      AllOf(HasSubstr("line 2: <x:include> is unexpanded xacro"),
+            HasSubstr("xacro robot.urdf.xacro > robot.urdf")));
   EXPECT_THAT(ParseError("<robot>\n<link/>\n</robot>"),
               HasSubstr("line 2: <link> has no name attribute"));
   EXPECT_THAT(ParseError("<robot>\n<link name=\"a\"/>\n<link name=\"a\"/>\n</robot>"),
@@ -165,7 +180,7 @@ TEST(UrdfParse, ErrorsNameTheLineTheLinkAndTheProblem) {
               HasSubstr("expected 3 numbers, found 2"));
   EXPECT_THAT(
       ParseError(OneLink(MeshCollision("filename=\"m.off\"", "<origin xyz=\"0 ${l} 0\"/>"))),
-      HasSubstr("unexpanded xacro expression"));
+      AllOf(HasSubstr("unexpanded xacro expression"), HasSubstr("xacro robot.urdf.xacro")));
   EXPECT_THAT(ParseError(OneLink(MeshCollision("filename=\"m.off\" scale=\"1 0 1\""))),
               HasSubstr("zero component"));
   EXPECT_THAT(ParseError(OneLink(MeshCollision("filename=\"m.off\" scale=\"1 x 1\""))),

@@ -5,14 +5,20 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <tinyxml2.h>
+#include <unistd.h>
 
+#include <assimp/Exporter.hpp>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <numeric>
+#include <sstream>
 #include <string>
 
 #include "inscribe/mesh_validation.h"
 #include "inscribe/robot/primitive_meshes.h"
 #include "inscribe/robot/spherized_urdf.h"
+#include "support/assimp_scenes.h"
 #include "support/synthetic_meshes.h"
 
 namespace inscribe::robot {
@@ -268,6 +274,53 @@ TEST(UrdfSpherizeRobot, ARobotBudgetGoesWhereTheEstimatedDeltaIsLargest) {
   for (const LinkSpherizeResult& link : result->links) EXPECT_LE(*link.delta, 0.03);
 }
 
+// A link whose collision mesh is COLLADA in centimetres, its box placed by a node: read through
+// assimp, welded by validation (the importer gives each face corner its own vertex), spherized
+// in the link's frame in metres.
+TEST(UrdfSpherizeRobot, ColladaMeshesAreReadInMetresWithTheirNodeTransforms) {
+  namespace fs = std::filesystem;
+  const fs::path dir =
+      fs::temp_directory_path() / ("inscribe_urdf_dae_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  Eigen::Matrix4d node = Eigen::Matrix4d::Identity();
+  node(0, 3) = 100.0;  // cm
+  const std::unique_ptr<aiScene> scene =
+      testing::MakeScene({testing::Box(Vector3::Zero(), Vector3(10, 20, 40))}, {{0, node}});
+  const std::string exported = (dir / "exported.dae").string();
+  Assimp::Exporter exporter;
+  ASSERT_EQ(exporter.Export(scene.get(), "collada", exported), AI_SUCCESS)
+      << exporter.GetErrorString();
+  std::stringstream dae;
+  dae << std::ifstream(exported).rdbuf();
+  std::string text = dae.str();
+  const std::size_t unit = text.find("<unit ");
+  ASSERT_NE(unit, std::string::npos);
+  text.replace(unit, text.find("/>", unit) + 2 - unit,
+               "<unit name=\"centimeter\" meter=\"0.01\"/>");
+  std::ofstream(dir / "box.DAE") << text;
+
+  UrdfLink link;
+  link.name = "arm";
+  UrdfElement mesh = Element(UrdfShape::kMesh);
+  mesh.geometry.filename = "box.DAE";
+  mesh.origin.xyz = Vector3(0, 0, 0.5);
+  link.elements = {mesh};
+  UrdfSpherizeOptions options;
+  options.kind = SphereSetKind::kInternal;
+  options.max_spheres_per_link = 16;
+  options.urdf_dir = dir.string();
+  const LinkSpherizeResult result = SpherizeOne(link, options);
+  fs::remove_all(dir);
+  ASSERT_EQ(result.status, LinkStatus::kSpherized) << result.error;
+  ASSERT_FALSE(result.spheres.empty());
+  for (const Sphere& s : result.spheres) {
+    const Vector3 lo = s.center - Vector3::Constant(s.radius),
+                  hi = s.center + Vector3::Constant(s.radius);
+    EXPECT_TRUE((lo.array() >= Vector3(1.0, 0.0, 0.5).array() - 1e-6).all()) << lo.transpose();
+    EXPECT_TRUE((hi.array() <= Vector3(1.1, 0.2, 0.9).array() + 1e-6).all()) << hi.transpose();
+  }
+}
+
 TEST(UrdfSpherizeRobot, BadOptionsAreRefusedNamingTheProblem) {
   const UrdfRobot robot = RobotOf({LinkOf("a", {BoxAt(Vector3::Ones(), Vector3::Zero())})});
   const auto refused = [&](const UrdfSpherizeOptions& options, const char* what) {
@@ -331,6 +384,15 @@ TEST(UrdfSpherizeRobot, BadOptionsAreRefusedNamingTheProblem) {
   ASSERT_TRUE(result.ok());
   EXPECT_EQ(result->links[0].status, LinkStatus::kSkipped);
   EXPECT_THAT(result->links[0].error, HasSubstr("voxels"));
+
+  UrdfLink collada = LinkOf("arm", {});
+  UrdfElement dae = Element(UrdfShape::kMesh);
+  dae.geometry.filename = "package://arm/meshes/Link.DAE";
+  collada.elements = {dae};
+  result = SpherizeRobot(RobotOf({collada}), UrdfSpherizeOptions{});
+  ASSERT_TRUE(result.ok());
+  EXPECT_EQ(result->links[0].status, LinkStatus::kSkipped);
+  EXPECT_THAT(result->links[0].error, HasSubstr("package 'arm'"));  // read like any mesh, once found
 }
 
 TEST(SpherizedUrdf, ReplacesCollisionsOfSpherizedLinksAndAnnotatesSkippedOnes) {

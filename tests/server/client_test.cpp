@@ -79,8 +79,10 @@ std::vector<UnaryRpc> UnaryRpcs() {
            return s.Answer(d, PutMeshOk());
          });
        },
-       [with](const Client& client, std::optional<milliseconds> timeout) {
-         return client.PutMesh(testing::UnitCube(), false, with(timeout)).status();
+       [](const Client& client, std::optional<milliseconds> timeout) {
+         PutMeshOptions options;
+         options.timeout = timeout;
+         return client.PutMesh(testing::UnitCube(), options).status();
        }},
       {"Generate",
        [](MockConnection& c, int calls, Script s) {

@@ -89,4 +89,17 @@ Mesh Inverted(Mesh mesh) {
   return mesh;
 }
 
+Mesh PerFaceVertices(const Mesh& mesh) {
+  Mesh out;
+  out.vertices.resize(3 * mesh.num_triangles(), 3);
+  out.triangles.resize(mesh.num_triangles(), 3);
+  for (Eigen::Index t = 0; t < mesh.num_triangles(); ++t) {
+    for (int k = 0; k < 3; ++k) {
+      out.vertices.row(3 * t + k) = mesh.vertices.row(mesh.triangles(t, k));
+      out.triangles(t, k) = static_cast<std::int32_t>(3 * t + k);
+    }
+  }
+  return out;
+}
+
 }  // namespace inscribe::testing

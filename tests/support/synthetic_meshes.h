@@ -22,4 +22,7 @@ Mesh Concatenate(const Mesh& a, const Mesh& b);
 // Every triangle reversed.
 Mesh Inverted(Mesh mesh);
 
+// Each triangle with three vertices of its own (3 #T vertices), as MeshLab writes OBJ.
+Mesh PerFaceVertices(const Mesh& mesh);
+
 }  // namespace inscribe::testing

@@ -96,6 +96,19 @@ TEST(MeshReportConvert, RoundTripOfAnInvertedOpenMesh) {
   }
 }
 
+// The weld's counts travel with the report (info prints them from the service's answer).
+TEST(MeshReportConvert, AWeldedReportKeepsItsCounts) {
+  const MeshReport report = ValidateMesh(testing::PerFaceVertices(testing::UnitCube())).report;
+  ASSERT_EQ(report.welded_vertices, 36 - 8);
+  v1::MeshReport wire;
+  wire::MeshReportToProto(report, &wire);
+  absl::StatusOr<MeshReport> back = wire::MeshReportFromProto(wire);
+  ASSERT_TRUE(back.ok()) << back.status();
+  EXPECT_EQ(back->welded_vertices, report.welded_vertices);
+  EXPECT_EQ(back->weld_collapsed_triangles, report.weld_collapsed_triangles);
+  EXPECT_TRUE(back->usable());
+}
+
 // Found by the CLI's remote --fill-holes: the repair's counts were not on the wire, so a
 // repaired mesh's report came back "not closed".
 TEST(MeshReportConvert, AHoleFilledReportStaysClosed) {

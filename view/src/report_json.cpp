@@ -24,6 +24,8 @@ nlohmann::json MeshReportJson(const MeshReport& report, const std::string& sha25
   j["components"] = report.components;
   j["counts"] = {{"non_finite_vertices", report.non_finite_vertices},
                  {"out_of_range_indices", report.out_of_range_indices},
+                 {"welded_vertices", report.welded_vertices},
+                 {"weld_collapsed_triangles", report.weld_collapsed_triangles},
                  {"degenerate_triangles", report.degenerate_triangles},
                  {"duplicate_triangles", report.duplicate_triangles},
                  {"unreferenced_vertices", report.unreferenced_vertices},

@@ -97,6 +97,8 @@ void MeshReportToProto(const MeshReport& report, v1::MeshReport* out) {
   out->set_usable(report.usable());
   out->set_non_finite_vertices(report.non_finite_vertices);
   out->set_out_of_range_indices(report.out_of_range_indices);
+  out->set_welded_vertices(report.welded_vertices);
+  out->set_weld_collapsed_triangles(report.weld_collapsed_triangles);
   out->set_degenerate_triangles(report.degenerate_triangles);
   out->set_duplicate_triangles(report.duplicate_triangles);
   out->set_unreferenced_vertices(report.unreferenced_vertices);
@@ -136,6 +138,8 @@ absl::StatusOr<MeshReport> MeshReportFromProto(const v1::MeshReport& report) {
   out.triangles = report.triangles();
   out.non_finite_vertices = report.non_finite_vertices();
   out.out_of_range_indices = report.out_of_range_indices();
+  out.welded_vertices = report.welded_vertices();
+  out.weld_collapsed_triangles = report.weld_collapsed_triangles();
   out.degenerate_triangles = report.degenerate_triangles();
   out.duplicate_triangles = report.duplicate_triangles();
   out.unreferenced_vertices = report.unreferenced_vertices();

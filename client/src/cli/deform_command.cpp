@@ -106,6 +106,15 @@ absl::StatusOr<DeformInputs> ReadInputs(const DeformCliOptions& options) {
   if (!solid.ok()) {
     return UnusableMeshError(options.reference_path + ": " + std::string(solid.status().message()));
   }
+  // The deformed file moves the reference's vertices as the file numbers them; once welded,
+  // the solid's vertices are no longer those.
+  if (solid->report.welded_vertices > 0 || solid->report.weld_collapsed_triangles > 0) {
+    return BadInputError(absl::StrCat(
+        options.reference_path, " repeats vertices at one position (",
+        solid->report.welded_vertices,
+        " welded); deform needs a reference and deformed meshes whose triangles share their "
+        "vertices: export them with vertices merged (welded)"));
+  }
   in.reference_sha256 = FormatSha256(MeshSha256(solid->mesh));
   if (!file->mesh_sha256.empty() && file->mesh_sha256 != in.reference_sha256) {
     return BadInputError(options.spheres_path + " was made for mesh " + file->mesh_sha256 +
@@ -118,6 +127,7 @@ absl::StatusOr<DeformInputs> ReadInputs(const DeformCliOptions& options) {
   in.deformed = Mesh{deformed_file->vertices, solid->mesh.triangles};
   ValidateOptions check;
   check.fix_orientation = false;
+  check.weld_vertices = false;  // the reference's triangles, on the file's vertices
   in.deformed_self_intersecting_pairs =
       ValidateMesh(in.deformed, check).report.self_intersecting_pairs;
   in.deformed_sha256 = FormatSha256(MeshSha256(in.deformed));
@@ -135,8 +145,9 @@ absl::StatusOr<DeformInputs> ReadInputs(const DeformCliOptions& options) {
 absl::StatusOr<client::DeformationResult> Deform(const client::Client& client,
                                                  const DeformCliOptions& options,
                                                  const DeformInputs& in) {
-  absl::StatusOr<client::PutMeshResult> mesh =
-      client.PutMesh(in.reference_file, options.fill_holes);
+  client::PutMeshOptions put;
+  put.fill_holes = options.fill_holes;
+  absl::StatusOr<client::PutMeshResult> mesh = client.PutMesh(in.reference_file, put);
   if (!mesh.ok()) return mesh.status();
   if (mesh->mesh_sha256 != in.reference_sha256) {
     return absl::InternalError(absl::StrCat("the service stored ", options.reference_path, " as ",

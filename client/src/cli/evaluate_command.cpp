@@ -34,6 +34,7 @@ struct EvaluateCliOptions {
   CoverCertifyOptions certify_options;
   bool json = false;
   bool fill_holes = false;
+  double weld_tolerance = 0.0;
   RemoteOptions remote;
 };
 
@@ -78,7 +79,8 @@ void PrintText(const EvaluateCliOptions& options, const QualityReport& r) {
 // PutMesh, then Evaluate with the spheres sent inline.
 absl::StatusOr<Evaluated> Evaluate(const client::Client& client, const EvaluateCliOptions& options,
                                    const SphereFile& file, const QualityOptions& quality) {
-  absl::StatusOr<StoredSolid> solid = StoreSolid(client, options.mesh_path, {options.fill_holes});
+  absl::StatusOr<StoredSolid> solid =
+      StoreSolid(client, options.mesh_path, {options.fill_holes, options.weld_tolerance});
   if (!solid.ok()) return solid.status();
   absl::StatusOr<QualityReport> report = client.Evaluate(solid->sha256, file.set, quality);
   if (!report.ok()) return report.status();
@@ -128,7 +130,8 @@ void PrintCertificate(const EvaluateCliOptions& options, const SphereFile& file,
 // --certify: PutMesh, then CertifyCover with the spheres sent inline. Not a cover is exit 1.
 absl::Status RunCertify(const client::Client& client, const EvaluateCliOptions& options,
                         const SphereFile& file) {
-  absl::StatusOr<StoredSolid> solid = StoreSolid(client, options.mesh_path, {options.fill_holes});
+  absl::StatusOr<StoredSolid> solid =
+      StoreSolid(client, options.mesh_path, {options.fill_holes, options.weld_tolerance});
   if (!solid.ok()) return solid.status();
   absl::StatusOr<CoverCertificate> certificate =
       client.CertifyCover(solid->sha256, file.set, options.certify_options);
@@ -209,6 +212,7 @@ void AddEvaluateCommand(CLI::App& app, CommandOutcome* outcome) {
                   "Voxel size for the fatness test (default: the file's, if it has one)");
   cmd->add_flag("--fill-holes", options->fill_holes,
                 "Close the mesh's holes first (see inscribe info --fill-holes)");
+  AddWeldToleranceOption(cmd, &options->weld_tolerance);
   cmd->add_flag("--certify", options->certify,
                 "Instead of the quality report: prove that the spheres contain the whole solid "
                 "(a cover), or give a point of the solid in no sphere; with delta, a sound bound "

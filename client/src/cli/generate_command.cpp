@@ -34,6 +34,7 @@ struct GenerateCliOptions {
   std::string link;  // cuRobo YAML link name
   bool json = false;
   bool fill_holes = false;
+  double weld_tolerance = 0.0;
   RemoteOptions remote;
 };
 
@@ -132,12 +133,14 @@ SphereFile MakeSphereFile(const GenerateCliOptions& options, const Generated& g)
 // PutMesh, then Generate with the progress bar fed by the service's messages.
 absl::StatusOr<Generated> Generate(const client::Client& client,
                                    const GenerateCliOptions& options) {
-  absl::StatusOr<StoredSolid> solid = StoreSolid(client, options.mesh_path, {options.fill_holes});
+  absl::StatusOr<StoredSolid> solid =
+      StoreSolid(client, options.mesh_path, {options.fill_holes, options.weld_tolerance});
   if (!solid.ok()) return solid.status();
 
   client::GenerateSettings settings;
   settings.parameters = options.parameters;
   settings.fill_holes = options.fill_holes;
+  settings.weld_tolerance = options.weld_tolerance;
   ProgressBar progress("generating");
   client::GenerateOptions call;
   call.on_progress = [&progress](double fraction) { progress.Update(fraction); };
@@ -313,6 +316,7 @@ void AddGenerateCommand(CLI::App& app, CommandOutcome* outcome) {
       ->capture_default_str();
   cmd->add_flag("--fill-holes", options->fill_holes,
                 "Close the mesh's holes first (see inscribe info --fill-holes)");
+  AddWeldToleranceOption(cmd, &options->weld_tolerance);
   cmd->add_flag("--json", options->json,
                 "Print one JSON summary on stdout (spheres, voxel_size, seconds, volumes, nerr, "
                 "quality figures)");

@@ -13,6 +13,7 @@
 #include "inscribe/view/report_json.h"
 #include "remote_options.h"
 #include "service_session.h"
+#include "solid_loading.h"
 
 namespace inscribe::cli {
 
@@ -24,6 +25,7 @@ struct InfoOptions {
   bool json = false;
   bool skip_self_intersections = false;
   bool fill_holes = false;
+  double weld_tolerance = 0.0;
   RemoteOptions remote;
 };
 
@@ -44,7 +46,11 @@ void PrintText(const std::string& path, const InfoResult& result) {
   };
   line("mesh", path);
   line("sha256", sha256.empty() ? "-" : sha256);
-  line("vertices", std::to_string(report.vertices));
+  line("vertices",
+       report.welded_vertices > 0
+           ? absl::StrFormat("%d (%d welded: %d left)", report.vertices, report.welded_vertices,
+                             report.vertices - report.welded_vertices)
+           : std::to_string(report.vertices));
   std::string triangles = std::to_string(report.triangles);
   if (read.polygons_triangulated > 0) {
     triangles += absl::StrFormat(" (%d polygons triangulated)", read.polygons_triangulated);
@@ -89,6 +95,7 @@ absl::Status RunInfo(const InfoOptions& options) {
   client::InspectMeshOptions inspect;
   inspect.skip_self_intersections = options.skip_self_intersections;
   inspect.fill_holes = options.fill_holes;
+  inspect.weld_tolerance = options.weld_tolerance;
   absl::StatusOr<client::InspectMeshResult> inspected =
       (*session)->client().InspectMesh(*mesh, inspect);
   if (!inspected.ok()) return inspected.status();
@@ -122,13 +129,15 @@ void AddInfoCommand(CLI::App& app, CommandOutcome* outcome) {
   auto options = std::make_shared<InfoOptions>();
   CLI::App* cmd = app.add_subcommand(
       "info", "Validate a mesh and print its report, content hash, volume and bounding box");
-  cmd->add_option("MESH", options->path, "Mesh file (.off, .obj, .stl, .ply)")->required();
+  cmd->add_option("MESH", options->path, "Mesh file (.off, .obj, .stl, .ply, .dae, .gltf, .glb)")
+      ->required();
   cmd->add_flag("--json", options->json, "Print one JSON object on stdout");
   cmd->add_flag("--skip-self-intersections", options->skip_self_intersections,
                 "Skip the exact self-intersection test (faster on huge meshes)");
   cmd->add_flag("--fill-holes", options->fill_holes,
                 "Close every hole (border loop) with triangles between its border vertices, "
                 "then validate, hash and describe the repaired mesh");
+  AddWeldToleranceOption(cmd, &options->weld_tolerance);
   AddRemoteOptions(cmd, &options->remote, 60.0);
   cmd->callback([options, outcome] {
     *outcome = CommandOutcome{RunInfo(*options), options->remote.server};

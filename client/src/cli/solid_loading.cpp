@@ -13,7 +13,8 @@ namespace {
 // The solid is no longer the file's: say so, since hashes and results now differ from it.
 void NoteRepairs(const std::string& path, const MeshReport& report) {
   for (const MeshIssue& issue : report.issues) {
-    if (issue.code == "holes_filled") {
+    if (issue.code == "holes_filled" ||
+        (issue.code == "welded_vertices" && report.weld_collapsed_triangles > 0)) {
       std::cerr << "inscribe: " << path << ": " << issue.message << "\n";
     }
   }
@@ -25,12 +26,22 @@ double SecondsSince(std::chrono::steady_clock::time_point start) {
 
 }  // namespace
 
+void AddWeldToleranceOption(CLI::App* cmd, double* weld_tolerance) {
+  cmd->add_option("--weld-tolerance", *weld_tolerance,
+                  "Also weld vertices this close (mesh units), for files that repeat each vertex "
+                  "per face with slightly different coordinates; exactly coincident vertices are "
+                  "always welded")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+}
+
 absl::StatusOr<LoadedSolid> LoadSolid(const std::string& path, const SolidLoadOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   absl::StatusOr<Mesh> mesh = ReadMesh(path, nullptr);
   if (!mesh.ok()) return BadInputError(mesh.status().message());
   SolidOptions solid_options;
   solid_options.validate.fill_holes = options.fill_holes;
+  solid_options.validate.weld_tolerance = options.weld_tolerance;
   absl::StatusOr<Solid> solid = PrepareSolid(*std::move(mesh), solid_options);
   if (!solid.ok()) return UnusableMeshError(path + ": " + std::string(solid.status().message()));
   NoteRepairs(path, solid->report);
@@ -42,7 +53,10 @@ absl::StatusOr<StoredSolid> StoreSolid(const client::Client& client, const std::
   const auto start = std::chrono::steady_clock::now();
   absl::StatusOr<Mesh> mesh = ReadMesh(path, nullptr);
   if (!mesh.ok()) return BadInputError(mesh.status().message());
-  absl::StatusOr<client::PutMeshResult> stored = client.PutMesh(*mesh, options.fill_holes);
+  client::PutMeshOptions put;
+  put.fill_holes = options.fill_holes;
+  put.weld_tolerance = options.weld_tolerance;
+  absl::StatusOr<client::PutMeshResult> stored = client.PutMesh(*mesh, put);
   if (!stored.ok()) {
     if (stored.status().code() == absl::StatusCode::kFailedPrecondition) {
       return WithContext(path, stored.status());

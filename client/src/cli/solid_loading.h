@@ -3,6 +3,7 @@
 // (StoreSolid), where it is validated.
 #pragma once
 
+#include <CLI/CLI.hpp>
 #include <string>
 
 #include "absl/status/statusor.h"
@@ -16,7 +17,14 @@ struct SolidLoadOptions {
   // Close the mesh's holes before use (ValidateOptions::fill_holes, `--fill-holes`); the hash
   // and the oracle are then those of the repaired mesh, and one line on stderr says so.
   bool fill_holes = false;
+  // Weld vertices within this distance too (ValidateOptions::weld_tolerance,
+  // `--weld-tolerance`, mesh units); exactly coincident ones always are.
+  double weld_tolerance = 0.0;
 };
+
+// Registers `--weld-tolerance D` (a finite distance >= 0, mesh units) on `cmd`, the one
+// definition every command that validates a mesh shares.
+void AddWeldToleranceOption(CLI::App* cmd, double* weld_tolerance);
 
 struct LoadedSolid {
   Solid solid;

@@ -42,6 +42,7 @@ struct ViewCliOptions {
   std::int64_t samples = 100'000;
   std::uint64_t seed = 1;
   bool fill_holes = false;
+  double weld_tolerance = 0.0;
   std::string title;
   std::vector<std::string> package_paths;  // robots: where package:// URIs are looked for
   // Options given that only the mesh form reads, by name, to refuse them for a robot.
@@ -152,7 +153,8 @@ absl::Status RunView(const ViewCliOptions& options) {
   if (!page_path.ok()) return page_path.status();
   const std::string& output = *page_path;
 
-  absl::StatusOr<LoadedSolid> solid = LoadSolid(options.mesh_path, {options.fill_holes});
+  absl::StatusOr<LoadedSolid> solid =
+      LoadSolid(options.mesh_path, {options.fill_holes, options.weld_tolerance});
   if (!solid.ok()) return solid.status();
   if (!file->mesh_sha256.empty() && file->mesh_sha256 != solid->solid.sha256) {
     std::cerr << "inscribe: warning: " << options.spheres_path << " was made for mesh "
@@ -221,6 +223,7 @@ void AddViewCommand(CLI::App& app, CommandOutcome* outcome) {
   cmd->add_option("--seed", options->seed, "Seed of the samples")->capture_default_str();
   cmd->add_flag("--fill-holes", options->fill_holes,
                 "Close the mesh's holes first (see inscribe info --fill-holes)");
+  AddWeldToleranceOption(cmd, &options->weld_tolerance);
   cmd->add_option("--title", options->title,
                   "Heading of the page (default: the mesh and sphere file names)");
   cmd->add_option("--package-path", options->package_paths,

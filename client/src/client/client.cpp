@@ -157,6 +157,7 @@ absl::StatusOr<InspectMeshResult> Client::InspectMesh(const Mesh& mesh,
   wire::MeshToProto(mesh, request.mutable_mesh());
   request.set_skip_self_intersections(options.skip_self_intersections);
   request.set_fill_holes(options.fill_holes);
+  request.set_weld_tolerance(options.weld_tolerance);
   absl::StatusOr<v1::InspectMeshResponse> response =
       Retried(options_.retry, DeadlineAfter(options.timeout, options_),
               [&](Deadline d) { return connection_->InspectMesh(request, d); });
@@ -166,11 +167,12 @@ absl::StatusOr<InspectMeshResult> Client::InspectMesh(const Mesh& mesh,
   return InspectMeshResult{std::move(*response->mutable_mesh_sha256()), *std::move(report)};
 }
 
-absl::StatusOr<PutMeshResult> Client::PutMesh(const Mesh& mesh, bool fill_holes,
-                                              const CallOptions& options) const {
+absl::StatusOr<PutMeshResult> Client::PutMesh(const Mesh& mesh,
+                                              const PutMeshOptions& options) const {
   v1::PutMeshRequest request;
   wire::MeshToProto(mesh, request.mutable_mesh());
-  request.set_fill_holes(fill_holes);
+  request.set_fill_holes(options.fill_holes);
+  request.set_weld_tolerance(options.weld_tolerance);
   return PutMeshUntil(*connection_, options_.retry, request,
                       DeadlineAfter(options.timeout, options_));
 }
@@ -198,6 +200,7 @@ absl::StatusOr<GenerateResult> Client::Generate(const Mesh& mesh, const Generate
   v1::PutMeshRequest put;
   wire::MeshToProto(mesh, put.mutable_mesh());
   put.set_fill_holes(settings.fill_holes);
+  put.set_weld_tolerance(settings.weld_tolerance);
   absl::StatusOr<PutMeshResult> stored = PutMeshUntil(*connection_, options_.retry, put, deadline);
   if (!stored.ok()) return stored.status();
   v1::GenerateRequest request = GenerateRequestFor(stored->mesh_sha256, settings, options);

@@ -30,7 +30,8 @@ namespace inscribe::client {
 namespace {
 
 // The route key of a mesh as sent: the hash the server stores it under unless it fixes the
-// orientation or fills holes (PutMesh then puts it twice, see RoutedConnection::PutMesh).
+// orientation, welds vertices or fills holes (PutMesh then puts it twice, see
+// RoutedConnection::PutMesh).
 // O(#V + #T): a copy and one SHA-256 pass, small beside sending the mesh. A malformed mesh
 // routes anywhere: every replica answers INVALID_ARGUMENT.
 std::string MeshRouteKey(const v1::Mesh& mesh) {
@@ -246,8 +247,8 @@ class RoutedConnection final : public Connection {
   }
 
   // Routed by the hash of the mesh as sent; when the server stored it under another key
-  // (orientation fixed, holes filled), it is put on that key's replica too, so that the calls
-  // naming the key find it. The answer is then that replica's.
+  // (vertices welded, orientation fixed, holes filled), it is put on that key's replica too, so
+  // that the calls naming the key find it. The answer is then that replica's.
   absl::StatusOr<v1::PutMeshResponse> PutMesh(const v1::PutMeshRequest& request,
                                               Deadline deadline) override {
     return PutTwiceIfKeyMoved<v1::PutMeshResponse>(

@@ -23,13 +23,22 @@ struct MeshIssue {
   std::int64_t count = 0;
 };
 
-// Counts found by ValidateMesh. Every count is about the mesh as given (before any fix), except
-// where a field says otherwise.
+// Counts found by ValidateMesh. `vertices`, `triangles`, `non_finite_vertices` and
+// `out_of_range_indices` are about the mesh as given; the weld's two counts say what welding
+// changed; every count after them (and every index an issue names) is about the welded mesh,
+// before the orientation and hole fixes, except where a field says otherwise. Without a weld
+// (nothing coincident, or ValidateOptions::weld_vertices off) the welded mesh is the mesh as
+// given.
 struct MeshReport {
   std::int64_t vertices = 0;
   std::int64_t triangles = 0;
-  std::int64_t non_finite_vertices = 0;    // a coordinate is NaN or infinite
-  std::int64_t out_of_range_indices = 0;   // triangle corners naming no vertex
+  std::int64_t non_finite_vertices = 0;   // a coordinate is NaN or infinite
+  std::int64_t out_of_range_indices = 0;  // triangle corners naming no vertex
+  // ValidateOptions::weld_vertices: the vertices merged into an earlier one (the welded mesh
+  // has vertices - welded_vertices), and the triangles removed because welding left them with
+  // a repeated corner (the welded mesh has triangles - weld_collapsed_triangles).
+  std::int64_t welded_vertices = 0;
+  std::int64_t weld_collapsed_triangles = 0;
   std::int64_t degenerate_triangles = 0;   // repeated corner or zero area (exact predicate)
   std::int64_t duplicate_triangles = 0;    // same three corners as an earlier triangle
   std::int64_t unreferenced_vertices = 0;  // in no triangle (harmless)
@@ -42,7 +51,7 @@ struct MeshReport {
   bool self_intersections_checked = false;
   std::int64_t self_intersecting_pairs = 0;  // pairs of triangles that cross (exact predicates)
   // ValidateOptions::fill_holes: the border loops closed (all of them or none) and the
-  // triangles that took, beyond `triangles`, in the returned mesh.
+  // triangles that took, beyond the welded mesh's, in the returned mesh.
   std::int64_t holes_filled = 0;
   std::int64_t hole_triangles_added = 0;
 
@@ -67,6 +76,17 @@ struct MeshReport {
 inline constexpr double kMaxMeshCoordinate = 1e100;
 
 struct ValidateOptions {
+  // Merge coincident vertices first: exporters (MeshLab's OBJ, STL by its nature) repeat each
+  // vertex once per face, which leaves every edge a border. With weld_tolerance 0 only
+  // vertices with identical coordinates are merged; with weld_tolerance > 0 (mesh units) a
+  // vertex within that distance of an earlier kept vertex is merged into the first such one,
+  // in index order (deterministic; clusters span at most twice the tolerance). Triangles left
+  // with a repeated corner are removed. Coincident vertices of separate shells or sheets stay
+  // apart: a merge is made only where the triangles around the vertex form one fan, so a
+  // mesh that was usable stays so. Kept vertices keep their order and coordinates. Reported
+  // as the fixed issue "welded_vertices". Cost O(#V log #V + #T log #T).
+  bool weld_vertices = true;
+  double weld_tolerance = 0.0;
   // Self-intersection testing costs O(#T log #T) with exact predicates; it is skipped (and
   // reported as unchecked) for meshes that are not closed 2-manifolds, where it means little.
   bool check_self_intersections = true;
@@ -89,14 +109,16 @@ struct ValidateOptions {
 };
 
 struct ValidatedMesh {
-  // The input, with orientation fixed when options.fix_orientation and, when
-  // options.fill_holes closed them, the patches' triangles appended (same vertices).
+  // The input, welded when options.weld_vertices found coincident vertices, with orientation
+  // fixed when options.fix_orientation and, when options.fill_holes closed them, the patches'
+  // triangles appended (same vertices).
   Mesh mesh;
   MeshReport report;
 };
 
-// Validates `mesh` and returns it (possibly re-oriented, possibly with its holes filled) with
-// the report. Never fails: every problem becomes an issue in the report, including
+// Validates `mesh` and returns it (possibly welded, re-oriented, with its holes filled) with
+// the report. A negative or non-finite options.weld_tolerance is the error
+// "invalid_weld_tolerance". Never fails: every problem becomes an issue in the report, including
 // out-of-range indices and NaN coordinates. Cost O(#T log #T), plus hole filling's when asked
 // for: O(n log n) for a near-planar loop of n edges, up to O(n^2) for another (at most 1,000
 // edges), all loops' searches together within a fixed budget (under 3 s on hostile input).

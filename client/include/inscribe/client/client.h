@@ -54,14 +54,16 @@ struct InspectMeshOptions {
   bool skip_self_intersections = false;
   // Close the mesh's holes first; the report and hash are the repaired mesh's.
   bool fill_holes = false;
+  // Weld vertices within this distance too (mesh units); exactly coincident ones always are.
+  double weld_tolerance = 0.0;
   // Overrides ClientOptions::default_timeout for this call.
   std::optional<std::chrono::milliseconds> timeout;
 };
 
 struct InspectMeshResult {
-  // "sha256:<64 hex digits>" of the mesh after the server's orientation fixes (equal to
-  // FormatSha256(MeshSha256(ValidateMesh(mesh).mesh))); empty when the mesh has non-finite
-  // coordinates or out-of-range indices.
+  // "sha256:<64 hex digits>" of the mesh after the server's welding and orientation fixes
+  // (equal to FormatSha256(MeshSha256(ValidateMesh(mesh).mesh)) with the same options); empty when
+  // the mesh has non-finite coordinates or out-of-range indices.
   std::string mesh_sha256;
   // The server's validation report, as ValidateMesh would return it locally.
   MeshReport report;
@@ -70,6 +72,13 @@ struct InspectMeshResult {
 // Options every call takes: overrides ClientOptions::default_timeout for this call.
 struct CallOptions {
   std::optional<std::chrono::milliseconds> timeout;
+};
+
+// The repairs PutMesh asks the server for; the stored mesh and its key are the repaired mesh's.
+struct PutMeshOptions : CallOptions {
+  bool fill_holes = false;
+  // Weld vertices within this distance too (mesh units); exactly coincident ones always are.
+  double weld_tolerance = 0.0;
 };
 
 struct PutMeshResult {
@@ -83,6 +92,7 @@ struct PutMeshResult {
 struct GenerateSettings {
   SphereSetParameters parameters;
   bool fill_holes = false;
+  double weld_tolerance = 0.0;  // PutMeshOptions::weld_tolerance, for Generate(mesh, ...)
 };
 
 struct GenerateOptions : CallOptions {
@@ -262,15 +272,14 @@ class Client {
   // come back unchanged (codes and messages as service.proto documents them).
 
   // Validates and stores `mesh` on the server. FAILED_PRECONDITION for an unusable mesh.
-  absl::StatusOr<PutMeshResult> PutMesh(const Mesh& mesh, bool fill_holes = false,
-                                        const CallOptions& options = {}) const;
+  absl::StatusOr<PutMeshResult> PutMesh(const Mesh& mesh, const PutMeshOptions& options = {}) const;
 
   // Spheres for a stored mesh (cached on the server by content).
   absl::StatusOr<GenerateResult> Generate(const std::string& mesh_sha256,
                                           const GenerateSettings& settings,
                                           const GenerateOptions& options = {}) const;
-  // Uploads `mesh` (PutMesh, with settings.fill_holes) and generates; if the server lost the
-  // mesh in between (NOT_FOUND: evicted), uploads it once more.
+  // Uploads `mesh` (PutMesh, with settings.fill_holes and weld_tolerance) and generates; if the
+  // server lost the mesh in between (NOT_FOUND: evicted), uploads it once more.
   absl::StatusOr<GenerateResult> Generate(const Mesh& mesh, const GenerateSettings& settings,
                                           const GenerateOptions& options = {}) const;
 

@@ -113,7 +113,8 @@ struct UrdfRobot {
 // Parses a URDF document: its links and joints. INVALID_ARGUMENT, naming the line and, where
 // there is one, the link or joint and the attribute, for: bytes that are not XML (text or a
 // second element beside the root included, which tinyxml2 alone accepts), a root that is not
-// <robot>, unexpanded xacro (xacro: elements), a link without a name or with a name used
+// <robot>, unexpanded xacro (elements in the xacro namespace, ${...} or $(...) values:
+// the message says to run `xacro robot.urdf.xacro > robot.urdf`), a link without a name or with a name used
 // before, a missing or malformed number (xyz, rpy, scale: 3 finite numbers; size: 3 positive;
 // radius, length: one positive; limit lower/upper, mimic multiplier/offset: one finite), a
 // zero scale component, a <mesh> without filename; a joint without a name, without a type or

@@ -85,9 +85,11 @@ UrdfSpherizeOptions WithDefaultMode(UrdfSpherizeOptions options);
 // per axis (mirrored, with the triangles turned to keep them outward, when the scale has an odd
 // number of negative components) and then moved by the element's origin, p -> R(rpy) (s . p) +
 // xyz; for <box> and <cylinder>, BoxMesh and CylinderMesh moved by the origin. Metres.
-// Not validated. Errors: the file's resolution (ResolveMeshFilename) or reading (ReadMesh)
-// errors; INVALID_ARGUMENT for Collada (.dae) files, which cannot be read, and for <sphere>
-// and unsupported geometry, which have no mesh.
+// A mesh file is read by ReadMesh (.stl, .obj, .ply, .off, and COLLADA .dae and glTF
+// .gltf/.glb with every node's transform and COLLADA's <unit> applied and <up_axis> not: the
+// file's own axes, as ROS's loaders take them). Not validated (welding is validation's).
+// Errors: the file's resolution (ResolveMeshFilename) or reading (ReadMesh) errors;
+// INVALID_ARGUMENT for <sphere> and unsupported geometry, which have no mesh.
 absl::StatusOr<Mesh> ElementMeshInLinkFrame(const UrdfElement& element,
                                             const UrdfSpherizeOptions& options);
 

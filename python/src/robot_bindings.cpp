@@ -14,6 +14,9 @@
 
 #include "absl/strings/str_cat.h"
 #include "bindings.h"
+#include "inscribe/robot/kinematics.h"
+#include "inscribe/robot/self_collision.h"
+#include "inscribe/robot/self_collision_srdf.h"
 #include "inscribe/robot/spherized_urdf.h"
 #include "inscribe/robot/urdf_robot.h"
 #include "inscribe/robot/urdf_spherize.h"
@@ -48,6 +51,12 @@ py::array_t<double> SphereArray(const std::vector<Sphere>& spheres) {
   }
   return result;
 }
+
+// A self-collision matrix and the robot it is about (for its SRDF).
+struct PySelfCollision {
+  robot::SelfCollisionMatrix matrix;
+  std::string robot_name;
+};
 
 struct SpherizedRobot {
   std::string name;
@@ -102,17 +111,89 @@ void BindRobot(py::module_& m) {
           },
           "The URDF text with one sphere <collision> per sphere in spherized links.")
       .def(
+          "self_collision",
+          [](const SpherizedRobot& r, std::int64_t samples, std::uint64_t seed,
+             double always_fraction, const py::object& progress) {
+            absl::StatusOr<robot::UrdfRobot> parsed = robot::ParseUrdf(ReadText(r.urdf_path));
+            if (!parsed.ok()) RaiseStatus(parsed.status());
+            const robot::Kinematics kinematics = ValueOrRaise(robot::Kinematics::Create(*parsed));
+            robot::SelfCollisionOptions options;
+            options.samples = samples;
+            options.seed = seed;
+            options.always_fraction = always_fraction;
+            absl::StatusOr<robot::SelfCollisionMatrix> matrix;
+            OkOrRaise(RunInterruptible(progress, [&](const GenerationControl& control) {
+              options.control = control;
+              matrix = robot::ComputeSelfCollisionMatrix(
+                  kinematics, robot::LinkCollisionGeometries(r.links), options);
+              return matrix.status();
+            }));
+            return PySelfCollision{*std::move(matrix), r.name};
+          },
+          py::kw_only(), py::arg("samples") = robot::SelfCollisionOptions{}.samples,
+          py::arg("seed") = robot::SelfCollisionOptions{}.seed,
+          py::arg("always_fraction") = robot::SelfCollisionOptions{}.always_fraction,
+          py::arg("progress") = py::none(),
+          "The self-collision matrix as `inscribe urdf` computes it: every pair of links with "
+          "spheres classified Adjacent, Default, Always, Never or Sometimes from `samples` "
+          "joint configurations drawn from `seed`, with certified distance bounds when the "
+          "links are covers. Ctrl-C cancels.")
+      .def(
           "curobo_yaml",
-          [](const SpherizedRobot& r) {
+          [](const SpherizedRobot& r, const PySelfCollision* self_collision) {
             std::vector<std::string> left_out;
-            std::string yaml = robot::SpherizedCuroboYaml(r.links, r.name, &left_out);
+            std::string yaml;
+            if (self_collision != nullptr) {
+              yaml = ValueOrRaise(robot::SpherizedCuroboYaml(
+                  r.links, r.name, self_collision->matrix, {}, &left_out));
+            } else {
+              yaml = robot::SpherizedCuroboYaml(r.links, r.name, &left_out);
+            }
             if (!left_out.empty()) {
               RaiseStatus(absl::InvalidArgumentError(
                   "links whose names cuRobo's YAML cannot carry: " + left_out.front()));
             }
             return yaml;
           },
-          "cuRobo's collision_spheres YAML of the spherized links.");
+          py::arg("self_collision") = py::none(),
+          "cuRobo's collision_spheres YAML of the spherized links; with a SelfCollision "
+          "(self_collision()), followed by self_collision_ignore and self_collision_buffer "
+          "(0: padding is in the radii), as `inscribe urdf` writes it.");
+
+  py::class_<PySelfCollision>(m, "SelfCollision", "A robot's self-collision matrix.")
+      .def_property_readonly("samples", [](const PySelfCollision& c) { return c.matrix.samples; })
+      .def_property_readonly("seed", [](const PySelfCollision& c) { return c.matrix.seed; })
+      .def_property_readonly(
+          "certified", [](const PySelfCollision& c) { return c.matrix.certified; },
+          "every link with spheres is a certified cover: the bounds hold for the solids")
+      .def_property_readonly("seconds", [](const PySelfCollision& c) { return c.matrix.seconds; })
+      .def_property_readonly(
+          "pairs",
+          [](const PySelfCollision& c) {
+            py::list pairs;
+            for (const robot::LinkPairCollision& pair : c.matrix.pairs) {
+              py::dict entry;
+              entry["link1"] = c.matrix.links[static_cast<std::size_t>(pair.link_a)];
+              entry["link2"] = c.matrix.links[static_cast<std::size_t>(pair.link_b)];
+              entry["class"] = robot::CollisionPairClassName(pair.type);
+              entry["disabled"] = robot::CollisionDisabled(pair.type);
+              entry["colliding_at_default"] = pair.colliding_at_default;
+              if (pair.sampled) {
+                entry["colliding_fraction"] = pair.colliding_fraction;
+                entry["min_lower"] = pair.min_lower;
+                entry["min_upper"] = pair.min_upper;
+              }
+              pairs.append(std::move(entry));
+            }
+            return pairs;
+          },
+          "one dict per pair of links with spheres: link1, link2, class ('Adjacent', "
+          "'Default', 'Always', 'Never', 'Sometimes'), disabled, colliding_at_default and, "
+          "when sampled, colliding_fraction, min_lower, min_upper (metres)")
+      .def(
+          "srdf",
+          [](const PySelfCollision& c) { return robot::SelfCollisionSrdf(c.matrix, c.robot_name); },
+          "MoveIt's SRDF with the disabled pairs, as `inscribe urdf --srdf` writes it.");
 
   m.def(
       "spherize_urdf",

@@ -357,6 +357,73 @@ TEST_F(CliUrdf, ARobotBudgetIsSharedAndPaddingAndProtrusionBoundsHold) {
   EXPECT_THAT(tiny.err, HasSubstr("fewer than"));
 }
 
+// The self-collision matrix: MoveIt's SRDF and cuRobo's self_collision_ignore, the same for the
+// same seed; a robot that is not one tree has none, and --srdf then fails.
+TEST_F(CliUrdf, TheSrdfAndTheYamlCarryTheSelfCollisionMatrix) {
+  REQUIRE_MESHES();
+  const CliRun forest =
+      RunCli(Args() + " --srdf " + Quote(Out("forest.srdf")) + " -o " + Quote(Out("forest.urdf")));
+  EXPECT_EQ(forest.exit_code, 2) << forest.err;
+  EXPECT_THAT(forest.err, HasSubstr("no self-collision matrix"));
+
+  // Attach the loose links: one tree.
+  std::string text = Slurp(Urdf());
+  text.replace(text.rfind("</robot>"), 8, R"(
+  <joint name="j3" type="revolute"><parent link="mirrored"/><child link="camera"/>
+    <origin xyz="0 0 0.3"/><axis xyz="0 1 0"/><limit lower="-2" upper="2"/></joint>
+  <joint name="j4" type="prismatic"><parent link="base"/><child link="plate"/>
+    <origin xyz="0.4 0 0"/><axis xyz="1 0 0"/><limit lower="0" upper="0.3"/></joint>
+  <joint name="j5" type="fixed"><parent link="base"/><child link="gripper"/></joint>
+  <joint name="j6" type="fixed"><parent link="base"/><child link="broken_link"/></joint>
+</robot>)");
+  const std::string tree = (fs::path(Urdf()).parent_path() / "tree.urdf").string();
+  std::ofstream(tree) << text;
+  const std::string args = "urdf " + Quote(tree) + " --package-path " +
+                           Quote((root_ / "ws").string()) + " --samples 2000 --seed 7";
+  const CliRun run = RunCli(args + " --srdf " + Quote(Out("tree.srdf")) + " -o " +
+                            Quote(Out("tree.urdf")) + " --json");
+  ASSERT_EQ(run.exit_code, 1) << run.err;  // the two broken links
+  const nlohmann::json report = nlohmann::json::parse(run.out);
+  const nlohmann::json& matrix = report.at("self_collision");
+  EXPECT_EQ(matrix.at("samples"), 2000);
+  EXPECT_EQ(matrix.at("seed"), 7);
+  EXPECT_TRUE(matrix.at("certified").get<bool>());
+  EXPECT_EQ(matrix.at("pairs").size(), 6u);  // the 4 spherized links
+  std::map<std::pair<std::string, std::string>, std::string> classes;
+  for (const nlohmann::json& pair : matrix.at("pairs")) {
+    std::string a = pair.at("link1"), b = pair.at("link2");
+    if (b < a) std::swap(a, b);
+    classes[{a, b}] = pair.at("class");
+  }
+  EXPECT_EQ((classes[{"base", "mirrored"}]), "Adjacent");
+  EXPECT_EQ((classes[{"camera", "mirrored"}]), "Adjacent");
+  EXPECT_EQ((classes[{"base", "plate"}]), "Adjacent");
+
+  tinyxml2::XMLDocument srdf;
+  ASSERT_EQ(srdf.LoadFile(Out("tree.srdf").c_str()), tinyxml2::XML_SUCCESS);
+  int disabled = 0;
+  for (const tinyxml2::XMLElement* e = srdf.RootElement()->FirstChildElement("disable_collisions");
+       e != nullptr; e = e->NextSiblingElement("disable_collisions"), ++disabled) {
+    std::string a = e->Attribute("link1"), b = e->Attribute("link2");
+    EXPECT_LT(a, b);
+    EXPECT_EQ(e->Attribute("reason"), (classes[{a, b}]));
+    EXPECT_NE((classes[{a, b}]), "Sometimes");
+  }
+  EXPECT_EQ(disabled, matrix.at("disabled").get<int>());
+  EXPECT_GE(disabled, 3);
+  const std::string yaml = Slurp(Out("tree.yml"));
+  EXPECT_THAT(yaml, HasSubstr("self_collision_ignore:"));
+  EXPECT_THAT(yaml, HasSubstr("self_collision_buffer:"));
+
+  // The same seed, the same files.
+  const CliRun again =
+      RunCli(args + " --srdf " + Quote(Out("again.srdf")) + " -o " + Quote(Out("again.urdf")));
+  ASSERT_EQ(again.exit_code, 1) << again.err;
+  EXPECT_EQ(Slurp(Out("again.srdf")), Slurp(Out("tree.srdf")));
+  EXPECT_EQ(Slurp(Out("again.yml")), Slurp(Out("tree.yml")));
+  EXPECT_EQ(RunCli(args + " --samples 0 -o " + Quote(Out("x.urdf"))).exit_code, 64);
+}
+
 TEST_F(CliUrdf, EverythingButSphereCollisionsIsKeptAndSkippedLinksSayWhy) {
   REQUIRE_MESHES();
   const CliRun run = RunCli(Args() + " -o " + Quote(Out("kept.urdf")) + " --yaml " +

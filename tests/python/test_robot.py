@@ -93,3 +93,28 @@ def test_covers_budget_padding_and_clip_planes_are_the_clis(tmp_path):
     for link in (base, arm):
         assert np.array_equal(link.spheres, cli_yaml[link.link].spheres)
     assert robot.urdf() == out.read_text()
+
+
+def test_self_collision_matrix_srdf_and_yaml_are_the_clis(tmp_path):
+    urdf = tmp_path / "robot.urdf"
+    # One tree: the unattached "world" link would make two roots.
+    urdf.write_text(ROBOT.format(mesh=mesh_path("eight.off")).replace('<link name="world"/>', ""))
+    out = tmp_path / "matrix.urdf"
+    run_cli("urdf", urdf, "-o", out, "--srdf", tmp_path / "matrix.srdf", "--samples", "500",
+            "--seed", "3")
+    robot = inscribe.spherize_urdf(str(urdf))
+    matrix = robot.self_collision(samples=500, seed=3)
+    assert matrix.samples == 500 and matrix.seed == 3 and matrix.certified
+    assert [(p["link1"], p["link2"]) for p in matrix.pairs] == [("base", "arm")]
+    assert matrix.pairs[0]["class"] == "Adjacent" and matrix.pairs[0]["disabled"]
+    assert matrix.srdf() == (tmp_path / "matrix.srdf").read_text()
+    assert robot.curobo_yaml(matrix) == (tmp_path / "matrix.yml").read_text()
+    assert "self_collision_ignore" in yaml.safe_load(robot.curobo_yaml(matrix))
+    with pytest.raises(ValueError, match="samples"):
+        robot.self_collision(samples=0)
+
+    # Several roots: no matrix, said so.
+    two_roots = tmp_path / "two_roots.urdf"
+    two_roots.write_text(ROBOT.format(mesh=mesh_path("eight.off")))
+    with pytest.raises(ValueError, match="root"):
+        inscribe.spherize_urdf(str(two_roots)).self_collision(samples=10)

@@ -392,7 +392,8 @@ TEST(UrdfSpherizeRobot, BadOptionsAreRefusedNamingTheProblem) {
   result = SpherizeRobot(RobotOf({collada}), UrdfSpherizeOptions{});
   ASSERT_TRUE(result.ok());
   EXPECT_EQ(result->links[0].status, LinkStatus::kSkipped);
-  EXPECT_THAT(result->links[0].error, HasSubstr("package 'arm'"));  // read like any mesh, once found
+  EXPECT_THAT(result->links[0].error,
+              HasSubstr("package 'arm'"));  // read like any mesh, once found
 }
 
 TEST(SpherizedUrdf, ReplacesCollisionsOfSpherizedLinksAndAnnotatesSkippedOnes) {

@@ -190,10 +190,9 @@ std::string MatrixSummary(const robot::SelfCollisionMatrix& matrix) {
   for (const robot::LinkPairCollision& pair : matrix.pairs) {
     ++counts[robot::CollisionPairClassName(pair.type)];
   }
-  std::string text = absl::StrFormat("self-collision: %d link pairs from %d samples%s in %.3f s:",
-                                     matrix.pairs.size(), matrix.samples,
-                                     matrix.certified ? " (certified bounds)" : "",
-                                     matrix.seconds);
+  std::string text = absl::StrFormat(
+      "self-collision: %d link pairs from %d samples%s in %.3f s:", matrix.pairs.size(),
+      matrix.samples, matrix.certified ? " (certified bounds)" : "", matrix.seconds);
   for (const char* name : {"Adjacent", "Default", "Always", "Never", "Sometimes"}) {
     absl::StrAppendFormat(&text, " %d %s", counts[name], name);
   }
@@ -297,8 +296,8 @@ absl::Status RunUrdf(const UrdfCliOptions& options) {
                       "; give --yaml PATH or an -o ending in .urdf");
   }
 
-  if (!options.srdf_path.empty() &&
-      (SameFile(options.srdf_path, options.output_path) || SameFile(options.srdf_path, yaml_path))) {
+  if (!options.srdf_path.empty() && (SameFile(options.srdf_path, options.output_path) ||
+                                     SameFile(options.srdf_path, yaml_path))) {
     return UsageError("--srdf " + options.srdf_path + " would overwrite another output");
   }
   if (options.samples < 1 || options.samples > robot::kMaxSelfCollisionSamples) {
@@ -373,7 +372,7 @@ absl::Status RunUrdf(const UrdfCliOptions& options) {
               << ": cuRobo YAML link names are letters, digits and _ - . /\n";
   }
   std::vector<std::pair<std::string, std::string>> outputs = {{options.output_path, *urdf},
-                                                               {yaml_path, yaml}};
+                                                              {yaml_path, yaml}};
   if (!options.srdf_path.empty()) {
     outputs.emplace_back(options.srdf_path, robot::SelfCollisionSrdf(*matrix, robot->name));
   }
@@ -465,8 +464,9 @@ void AddUrdfCommand(CLI::App& app, CommandOutcome* outcome) {
                   "Random joint configurations the self-collision matrix is sampled at (MoveIt's "
                   "default density)")
       ->capture_default_str();
-  cmd->add_option("--seed", options->seed, "Seed of the configurations: the same seed, the same "
-                                           "matrix on every machine")
+  cmd->add_option("--seed", options->seed,
+                  "Seed of the configurations: the same seed, the same "
+                  "matrix on every machine")
       ->capture_default_str();
   cmd->add_flag("--json", options->json,
                 "Print one JSON report on stdout: per link status, spheres, budget, delta, "

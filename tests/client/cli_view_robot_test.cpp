@@ -1,6 +1,6 @@
 // `inscribe view ROBOT.urdf SPHERES`, run as users run it on a small robot made from CGAL's demo
 // meshes (revolute, prismatic, continuous, fixed and mimic joints; mesh, box, cylinder and
-// sphere links; a Collada link that cannot be read), spherized by `inscribe urdf`, and the page
+// sphere links; a Collada link whose file is missing), spherized by `inscribe urdf`, and the page
 // opened in headless Chromium: it draws, has a slider per joint variable, names the unreadable
 // link, and its forward kinematics equals robot::Kinematics::LinkPoses.
 #include <gmock/gmock.h>
@@ -109,7 +109,7 @@ class CliViewRobot : public ::testing::Test {
       fs::copy_file(testing::TestMeshPath(name), dir_ / "ws/bot/meshes" / name);
     }
     WriteText(Robot(), kRobot);
-    spherized_ = RunCli("urdf " + Quote(Robot()) + Packages() + " -o " +
+    spherized_ = RunCli("urdf " + Quote(Robot()) + Packages() + " --kind internal -o " +
                         Quote((dir_ / "spheres.urdf").string()));
     for (const char* name : {"spheres.urdf", "spheres.yml"}) {
       views_.push_back(RunCli("view " + Quote(Robot()) + " " + Quote((dir_ / name).string()) +
@@ -122,7 +122,7 @@ class CliViewRobot : public ::testing::Test {
   void SetUp() override {
     INSCRIBE_REQUIRE_MESH("elephant.off");
     INSCRIBE_REQUIRE_MESH("eight.off");
-    // The Collada camera is skipped (exit 1), everything else spherized.
+    // The Collada camera (its file is missing) is skipped (exit 1), everything else spherized.
     ASSERT_EQ(spherized_.exit_code, 1) << spherized_.err;
     ASSERT_THAT(spherized_.err, HasSubstr("camera"));
     for (const CliRun& view : views_) ASSERT_EQ(view.exit_code, 0) << view.err;

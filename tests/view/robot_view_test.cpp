@@ -165,7 +165,7 @@ TEST(RobotViewLink, UnreadableGeometryIsNamedAndProtrusionUnknown) {
   EXPECT_EQ(view.meshes.size(), 1u);  // the box is still shown
   ASSERT_EQ(view.problems.size(), 2u);
   EXPECT_THAT(view.problems[0], HasSubstr("line 5 (<visual>): "));
-  EXPECT_THAT(view.problems[0], HasSubstr("Collada"));
+  EXPECT_THAT(view.problems[0], HasSubstr("hand.dae"));
   EXPECT_THAT(view.problems[1], HasSubstr("missing.stl"));
   EXPECT_TRUE(view.protrusion.empty());
 

@@ -26,13 +26,12 @@ namespace {
 
 // An element ready for generation: a validated (clipped) solid, or a sphere kept as it is.
 struct PreparedElement {
-  int link = 0;                        // index in UrdfRobot::links
-  int element = 0;                     // index in the link's elements
-  std::optional<Solid> solid;          // mesh elements
-  std::optional<Sphere> sphere;        // <sphere> elements, in the link frame
-  double volume = -1.0;                // of the mesh (m^3); -1 for a sphere
-  std::optional<PreparedCover> cover;  // covers sharing a robot budget
-  std::int64_t budget = 0;             // budget modes
+  int link = 0;                  // index in UrdfRobot::links
+  int element = 0;               // index in the link's elements
+  std::optional<Solid> solid;    // mesh elements
+  std::optional<Sphere> sphere;  // <sphere> elements, in the link frame
+  double volume = -1.0;          // of the mesh (m^3); -1 for a sphere
+  std::int64_t budget = 0;       // budget modes
 };
 
 // "line 12 (<collision> 'tool')", to start a skipped link's reason.
@@ -101,19 +100,16 @@ absl::StatusOr<ElementSpheres> GenerateElement(const PreparedElement& element,
   }
   const Solid& solid = *element.solid;
   if (options.kind == SphereSetKind::kCover) {
-    absl::StatusOr<GeneratedCover> cover;
-    if (element.cover) {
-      cover = element.cover->Generate(element.budget, control);
+    CoverParameters parameters;
+    parameters.certify.resolution = options.cover_resolution;
+    if (options.max_protrusion) {
+      parameters.max_protrusion = *options.max_protrusion - options.padding;
     } else {
-      CoverParameters parameters;
-      parameters.certify.resolution = options.cover_resolution;
-      if (options.max_protrusion) {
-        parameters.max_protrusion = *options.max_protrusion - options.padding;
-      } else {
-        parameters.max_spheres = element.budget;
-      }
-      cover = GenerateCover(solid, parameters, control);
+      parameters.max_spheres = element.budget;
     }
+    // Made for its own budget (not the estimate's larger one): candidates and samples sized
+    // for what it gets.
+    absl::StatusOr<GeneratedCover> cover = GenerateCover(solid, parameters, control);
     if (!cover.ok()) return cover.status();
     absl::StatusOr<std::vector<Sphere>> cores =
         UpperBoundSpheres({}, cover->set.spheres, cover->certificate.protrusions);
@@ -215,7 +211,6 @@ absl::Status ShareBudgets(const UrdfRobot& robot, const UrdfSpherizeOptions& opt
       absl::StatusOr<PreparedCover> cover = PreparedCover::Prepare(*e->solid, parameters, control);
       if (!cover.ok()) return cover.status();
       estimates.push_back(cover->EstimatedDeltas(most));
-      e->cover.emplace(*std::move(cover));
       link_seconds[static_cast<std::size_t>(e->link)] += Seconds(start);
     }
     budgets = RobotSphereBudgets(pool, estimates);
@@ -375,7 +370,7 @@ absl::StatusOr<RobotSpherizeResult> SpherizeRobot(const UrdfRobot& robot,
   RobotSpherizeResult out;
   out.links.resize(robot.links.size());
   std::vector<double> link_seconds(robot.links.size(), 0.0);
-  std::deque<PreparedElement> elements;  // stable addresses: covers point at their solids
+  std::deque<PreparedElement> elements;  // stable addresses: budgets point at them
   for (std::size_t l = 0; l < robot.links.size(); ++l) {
     const UrdfLink& link = robot.links[l];
     LinkSpherizeResult& result = out.links[l];

@@ -256,6 +256,12 @@ int Kinematics::parent(int link) const { return tree_->parent[link]; }
 int Kinematics::parent_joint(int link) const { return tree_->parent_joint[link]; }
 const std::vector<JointVariable>& Kinematics::variables() const { return tree_->variables; }
 
+Kinematics::JointDrive Kinematics::drive(int link) const {
+  const Tree::Motion& m = tree_->motion[link];
+  if (tree_->parent_joint[link] < 0 || m.variable < 0) return {};
+  return {m.variable, m.multiplier, m.offset};
+}
+
 int Kinematics::variable(const std::string& joint) const {
   const auto found = tree_->variable_index.find(joint);
   return found == tree_->variable_index.end() ? -1 : found->second;

@@ -509,6 +509,13 @@ Eigen::Matrix3d RotationFromRpy(const Vector3& rpy) {
       .toRotationMatrix();
 }
 
+std::string DescribeUrdfElement(const UrdfElement& element, bool from_visual) {
+  std::string text =
+      absl::StrCat("line ", element.line, " (<", from_visual ? "visual" : "collision", ">");
+  if (!element.name.empty()) absl::StrAppend(&text, " '", element.name, "'");
+  return text + ")";
+}
+
 absl::StatusOr<UrdfRobot> ParseUrdf(absl::string_view bytes) {
   if (const std::size_t nul = bytes.find('\0'); nul != absl::string_view::npos) {
     return absl::InvalidArgumentError(

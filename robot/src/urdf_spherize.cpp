@@ -34,14 +34,6 @@ struct PreparedElement {
   std::int64_t budget = 0;       // budget modes
 };
 
-// "line 12 (<collision> 'tool')", to start a skipped link's reason.
-std::string DescribeElement(const UrdfElement& element, bool from_visual) {
-  std::string text =
-      absl::StrCat("line ", element.line, " (<", from_visual ? "visual" : "collision", ">");
-  if (!element.name.empty()) absl::StrAppend(&text, " '", element.name, "'");
-  return text + ")";
-}
-
 // The element's geometry in its link frame, cut by the link's clip planes (unit normals).
 // Nothing (no solid, no sphere) when it lies wholly beyond a plane.
 absl::Status PrepareElement(const UrdfElement& element, const UrdfSpherizeOptions& options,
@@ -394,7 +386,7 @@ absl::StatusOr<RobotSpherizeResult> SpherizeRobot(const UrdfRobot& robot,
       }
       if (!status.ok()) {
         result.status = LinkStatus::kSkipped;
-        result.error = absl::StrCat(DescribeElement(link.elements[k], link.from_visual), ": ",
+        result.error = absl::StrCat(DescribeUrdfElement(link.elements[k], link.from_visual), ": ",
                                     status.message());
         elements.resize(first);
         break;
@@ -434,8 +426,8 @@ absl::StatusOr<RobotSpherizeResult> SpherizeRobot(const UrdfRobot& robot,
       const UrdfLink& link = robot.links[static_cast<std::size_t>(element.link)];
       result.status = LinkStatus::kSkipped;
       result.error =
-          absl::StrCat(DescribeElement(link.elements[static_cast<std::size_t>(element.element)],
-                                       link.from_visual),
+          absl::StrCat(DescribeUrdfElement(link.elements[static_cast<std::size_t>(element.element)],
+                                           link.from_visual),
                        ": ", generated.status().message());
       result.spheres.clear();
       result.cores.clear();

@@ -16,31 +16,6 @@ namespace {
 
 nlohmann::json Triple(const Vector3& v) { return {v.x(), v.y(), v.z()}; }
 
-// value(joint) = multiplier * q[variable] + offset, through the joint's chain of mimics.
-// Kinematics::Create refused chains that loop or end on a joint without a variable.
-struct ResolvedJoint {
-  int variable = -1;
-  double multiplier = 1.0;
-  double offset = 0.0;
-};
-
-ResolvedJoint Resolve(const robot::UrdfRobot& robot, const std::map<std::string, int>& by_name,
-                      const robot::Kinematics& kinematics, int joint) {
-  ResolvedJoint resolved;
-  const robot::UrdfJoint* at = &robot.joints[joint];
-  for (std::size_t step = 0; at->mimic && step <= robot.joints.size(); ++step) {
-    const auto leader = by_name.find(at->mimic->joint);
-    if (leader == by_name.end()) return {};
-    // value(at) = m * value(leader) + o, and the value so far is M * value(at) + O.
-    resolved.offset += resolved.multiplier * at->mimic->offset;
-    resolved.multiplier *= at->mimic->multiplier;
-    at = &robot.joints[leader->second];
-  }
-  resolved.variable = at->mimic ? -1 : kinematics.variable(at->name);
-  if (resolved.variable < 0) return {};
-  return resolved;
-}
-
 std::vector<double> RoundedXyzr(const std::vector<Sphere>& spheres) {
   std::vector<double> xyzr;
   xyzr.reserve(spheres.size() * 4);
@@ -104,18 +79,13 @@ nlohmann::json KinematicsJson(const robot::UrdfRobot& robot, const robot::Kinema
     for (int child : children[order[i]]) order.push_back(child);
   }
 
-  std::map<std::string, int> by_name;
-  for (std::size_t j = 0; j < robot.joints.size(); ++j) {
-    by_name.emplace(robot.joints[j].name, static_cast<int>(j));
-  }
+  std::map<std::string, int> link_index;
+  for (int l = 0; l < kinematics.links(); ++l) link_index.emplace(kinematics.link_name(l), l);
   nlohmann::json joints = nlohmann::json::array();
   for (std::size_t j = 0; j < robot.joints.size(); ++j) {
     const robot::UrdfJoint& joint = robot.joints[j];
-    const bool moves = joint.type == robot::UrdfJointType::kRevolute ||
-                       joint.type == robot::UrdfJointType::kContinuous ||
-                       joint.type == robot::UrdfJointType::kPrismatic;
-    const ResolvedJoint resolved =
-        moves ? Resolve(robot, by_name, kinematics, static_cast<int>(j)) : ResolvedJoint{};
+    // Kinematics::Create accepted the tree: every joint's child is a link.
+    const robot::Kinematics::JointDrive resolved = kinematics.drive(link_index.at(joint.child));
     joints.push_back({{"name", joint.name},
                       {"type", robot::UrdfJointTypeName(joint.type)},
                       {"xyz", Triple(joint.origin.xyz)},

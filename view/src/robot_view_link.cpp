@@ -13,14 +13,6 @@
 namespace inscribe::view {
 namespace {
 
-// "line 12 (<collision> 'tool')", as `inscribe urdf` names an element.
-std::string DescribeElement(const robot::UrdfElement& element, bool from_visual) {
-  std::string text =
-      absl::StrCat("line ", element.line, " (<", from_visual ? "visual" : "collision", ">");
-  if (!element.name.empty()) absl::StrAppend(&text, " '", element.name, "'");
-  return text + ")";
-}
-
 // How far `sphere` reaches outside the ball `shape`: max(0, |c - c'| + r - r').
 double ProtrusionFromBall(const Sphere& sphere, const Sphere& shape) {
   return std::max(0.0, (sphere.center - shape.center).norm() + sphere.radius - shape.radius);
@@ -47,7 +39,7 @@ RobotViewLink MakeRobotViewLink(const robot::UrdfLink& link, std::vector<Sphere>
   bool measurable = !link.elements.empty();
   std::optional<BoundingBox> box;
   for (const robot::UrdfElement& element : link.elements) {
-    const std::string where = DescribeElement(element, link.from_visual);
+    const std::string where = robot::DescribeUrdfElement(element, link.from_visual);
     if (element.geometry.shape == robot::UrdfShape::kSphere) {
       const Sphere shape{element.origin.xyz, element.geometry.radius};
       view.shapes.push_back(shape);

@@ -49,6 +49,15 @@ class Kinematics {
   // -1 for the root.
   int parent(int link) const;
   int parent_joint(int link) const;
+  // How the joint into `link` moves: its value is multiplier * q[variable] + offset, a mimic's
+  // chain resolved to the variable at its end. variable -1 (value 0) for the root and for
+  // fixed, floating and planar joints. The one place mimics are resolved.
+  struct JointDrive {
+    int variable = -1;
+    double multiplier = 1.0;
+    double offset = 0.0;
+  };
+  JointDrive drive(int link) const;
   // The configuration's coordinates, in UrdfRobot::joints order.
   const std::vector<JointVariable>& variables() const;
   // Index of the named variable, or -1.

@@ -59,6 +59,10 @@ struct UrdfElement {
   int line = 0;  // of the element in the file, 1-based
 };
 
+// "line 12 (<collision> 'tool')": how messages name an element (its line in the URDF, its
+// kind, and its name when it has one).
+std::string DescribeUrdfElement(const UrdfElement& element, bool from_visual);
+
 struct UrdfLink {
   std::string name;
   int line = 0;
@@ -114,18 +118,18 @@ struct UrdfRobot {
 // there is one, the link or joint and the attribute, for: bytes that are not XML (text or a
 // second element beside the root included, which tinyxml2 alone accepts), a root that is not
 // <robot>, unexpanded xacro (elements in the xacro namespace, ${...} or $(...) values:
-// the message says to run `xacro robot.urdf.xacro > robot.urdf`), a link without a name or with a name used
-// before, a missing or malformed number (xyz, rpy, scale: 3 finite numbers; size: 3 positive;
-// radius, length: one positive; limit lower/upper, mimic multiplier/offset: one finite), a
-// zero scale component, a <mesh> without filename; a joint without a name, without a type or
-// with a type URDF does not define, without <parent link> or <child link>, with a zero <axis>
-// (revolute, continuous, prismatic, planar; the axis is normalised), with lower > upper
-// (revolute, prismatic), or with a <mimic> without joint. Geometry URDF does not define is not
-// an error here (kUnsupported). Unlike ROS's urdfdom, a revolute or prismatic joint without
-// <limit> is accepted (lower = upper = 0: it stays at 0), as some exported files need. What
-// needs the whole tree (joint names used twice, links that do not exist, cycles, mimics) is
-// checked by Kinematics::Create. <calibration>, <dynamics>, <safety_controller>, effort and
-// velocity are ignored. Cost O(size of the document).
+// the message says to run `xacro robot.urdf.xacro > robot.urdf`), a link without a name or with a
+// name used before, a missing or malformed number (xyz, rpy, scale: 3 finite numbers; size: 3
+// positive; radius, length: one positive; limit lower/upper, mimic multiplier/offset: one finite),
+// a zero scale component, a <mesh> without filename; a joint without a name, without a type or with
+// a type URDF does not define, without <parent link> or <child link>, with a zero <axis> (revolute,
+// continuous, prismatic, planar; the axis is normalised), with lower > upper (revolute, prismatic),
+// or with a <mimic> without joint. Geometry URDF does not define is not an error here
+// (kUnsupported). Unlike ROS's urdfdom, a revolute or prismatic joint without <limit> is accepted
+// (lower = upper = 0: it stays at 0), as some exported files need. What needs the whole tree (joint
+// names used twice, links that do not exist, cycles, mimics) is checked by Kinematics::Create.
+// <calibration>, <dynamics>, <safety_controller>, effort and velocity are ignored. Cost O(size of
+// the document).
 absl::StatusOr<UrdfRobot> ParseUrdf(absl::string_view bytes);
 
 // Where package://PKG/... URIs are looked for, in this order: for each directory D of

@@ -52,7 +52,7 @@ class Search {
         yes_no_(std::isfinite(request.closer_than)),
         rss_a_(a.volume() == HierarchyVolume::kRss),
         rss_b_(b.volume() == HierarchyVolume::kRss),
-        threshold_(request.closer_than) {}
+        threshold_(std::min(request.closer_than, request.max_distance)) {}
 
   DistanceResult Run() {
     DistanceResult out;
@@ -122,7 +122,7 @@ class Search {
     best_a_ = sphere_a;
     best_b_ = sphere_b;
     const double tolerance = std::max(request_.abs_err, request_.rel_err * std::abs(d));
-    threshold_ = std::min(d - tolerance, request_.closer_than);
+    threshold_ = std::min({d - tolerance, request_.closer_than, request_.max_distance});
   }
 
   // Every sphere below a against every sphere below b (at most kAllPairs pairs). A pair is
@@ -194,6 +194,10 @@ absl::Status CheckRequest(const DistanceRequest& request) {
   if (std::isnan(request.closer_than) || request.closer_than == -HUGE_VAL) {
     return absl::InvalidArgumentError(
         absl::StrCat("closer_than must be a number or +infinity, got ", request.closer_than));
+  }
+  if (std::isnan(request.max_distance) || request.max_distance == -HUGE_VAL) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("max_distance must be a number or +infinity, got ", request.max_distance));
   }
   return absl::OkStatus();
 }
@@ -299,11 +303,13 @@ absl::StatusOr<DistanceResult> BruteForceSeparationDistance(const std::vector<Sp
   DistanceResult out;
   const bool yes_no = std::isfinite(request.closer_than);
   double best = std::numeric_limits<double>::infinity();
+  // Pairs at or above max_distance are not answers.
+  const double wanted = request.max_distance;
   for (std::size_t i = 0; i < a.size() && !(yes_no && best < request.closer_than); ++i) {
     for (std::size_t j = 0; j < b.size(); ++j) {
       ++out.sphere_tests;
       const double d = (a[i].center - moved[j]).norm() - a[i].radius - b[j].radius;
-      if (d < best) {
+      if (d < best && d < wanted) {
         best = d;
         out.sphere_a = static_cast<std::int32_t>(i);
         out.sphere_b = static_cast<std::int32_t>(j);

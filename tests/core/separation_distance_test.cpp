@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <random>
 #include <string>
 #include <tuple>
@@ -140,6 +141,45 @@ TEST_P(AgainstBruteForce, CloserThanAgreesWithFullQuery) {
   }
 }
 
+// max_distance gives the full query's answer when it is below the limit and "none" (+infinity,
+// no pair) otherwise; the hierarchy and the brute force agree, and pruning saves work.
+TEST_P(AgainstBruteForce, MaxDistanceKeepsOnlyAnswersBelowIt) {
+  SkipIfMissing();
+  const std::vector<Sphere> a = Set(0), b = Set(1);
+  const SphereHierarchy ha = Build(a, std::get<1>(GetParam()));
+  const SphereHierarchy hb = Build(b, std::get<1>(GetParam()));
+  std::mt19937_64 rng(29);
+  std::uniform_real_distribution<double> offset(-0.3, 0.3);
+  int below = 0;
+  std::int64_t full_work = 0, limited_work = 0;
+  for (int trial = 0; trial < 1000; ++trial) {
+    const RigidPose pose = RandomPose(rng, 3.0);
+    absl::StatusOr<DistanceResult> full = SeparationDistance(ha, {}, hb, pose);
+    ASSERT_TRUE(full.ok());
+    DistanceRequest request;
+    request.max_distance = full->distance + (trial % 7 == 0 ? 0.0 : offset(rng));
+    absl::StatusOr<DistanceResult> fast = SeparationDistance(ha, {}, hb, pose, request);
+    absl::StatusOr<DistanceResult> slow = BruteForceSeparationDistance(a, {}, b, pose, request);
+    ASSERT_TRUE(fast.ok() && slow.ok());
+    full_work += full->volume_tests;
+    limited_work += fast->volume_tests;
+    if (full->distance < request.max_distance) {
+      ++below;
+      ASSERT_NEAR(fast->distance, full->distance, 1e-9) << "trial " << trial;
+      ASSERT_NEAR(slow->distance, full->distance, 1e-9) << "trial " << trial;
+      ExpectWitnesses(*fast, a, {}, b, pose);
+    } else {
+      ASSERT_EQ(fast->distance, std::numeric_limits<double>::infinity()) << "trial " << trial;
+      ASSERT_EQ(slow->distance, std::numeric_limits<double>::infinity()) << "trial " << trial;
+      EXPECT_EQ(fast->sphere_a, -1);
+      EXPECT_EQ(slow->sphere_a, -1);
+    }
+  }
+  EXPECT_GT(below, 200);
+  EXPECT_LT(below, 800);
+  EXPECT_LT(limited_work, full_work);
+}
+
 INSTANTIATE_TEST_SUITE_P(
     Sets, AgainstBruteForce,
     ::testing::Combine(::testing::Values("random", "eight.off", "knot1.off", "fandisk.off"),
@@ -197,6 +237,11 @@ TEST(SeparationDistance, RefusesBadPosesAndTolerances) {
   DistanceRequest nan_threshold;
   nan_threshold.closer_than = std::nan("");
   EXPECT_FALSE(SeparationDistance(a, {}, a, {}, nan_threshold).ok());
+  DistanceRequest nan_limit;
+  nan_limit.max_distance = std::nan("");
+  absl::StatusOr<DistanceResult> refused = SeparationDistance(a, {}, a, {}, nan_limit);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.status().message().find("max_distance"), std::string::npos);
   absl::StatusOr<std::vector<DistanceResult>> batch =
       SeparationDistances(a, a, {RigidPose{}, nan_pose});
   ASSERT_FALSE(batch.ok());

@@ -24,12 +24,19 @@ struct DistanceRequest {
   // "do they overlap by more than -closer_than")? The search stops at the first pair that
   // is, and never opens node pairs that cannot be. Unset (infinity): a distance query.
   double closer_than = std::numeric_limits<double>::infinity();
+  // Only distances below this are wanted (mesh units; may be negative): pairs of volumes
+  // bounded at or above it are never opened, and when no sphere pair is below it the result
+  // has distance +infinity and no pair (sphere_a = sphere_b = -1). The broad phase of a scene
+  // asks this for "every pair closer than the threshold, with its distance". Unset
+  // (infinity): no limit. Combined with closer_than, the smaller of the two prunes.
+  double max_distance = std::numeric_limits<double>::infinity();
 };
 
 struct DistanceResult {
   // min over sphere pairs of |c_a - c_b| - r_a - r_b: positive = gap between the unions,
   // negative = the deepest overlap of two spheres. With closer_than set, the value of the pair
-  // found closer than it when `closer`, else closer_than itself (no claim beyond >=).
+  // found closer than it when `closer`, else closer_than itself (no claim beyond >=). With
+  // max_distance set and no pair below it: +infinity.
   double distance = std::numeric_limits<double>::infinity();
   // The pair realising `distance` (-1 when none, i.e. a closer_than query answered no).
   std::int32_t sphere_a = -1, sphere_b = -1;
@@ -77,7 +84,7 @@ absl::StatusOr<std::vector<DistanceResult>> PairSeparationDistances(
 
 // The same answer by comparing every sphere pair: O(#a #b), the reference the hierarchies are
 // tested against, and the `--hierarchy none` of the CLI. Tolerances are ignored (exact);
-// closer_than is honoured.
+// closer_than and max_distance are honoured.
 absl::StatusOr<DistanceResult> BruteForceSeparationDistance(const std::vector<Sphere>& a,
                                                             const RigidPose& pose_a,
                                                             const std::vector<Sphere>& b,

@@ -1,0 +1,148 @@
+// Scenes: many posed objects (a simulator's frame), a broad phase over their bounding spheres,
+// and per frame every pair of objects closer than a threshold, with its distance and witnesses
+// (a certified interval when both objects carry covers).
+//
+// Each object is a sphere set's hierarchy (shared, immutable; many objects may share one) at a
+// world pose, with a collision group and mask: a pair is considered only when each object's
+// group meets the other's mask, and it is not on the ignore list (a robot's adjacent links).
+// The broad phase sweeps the objects' world bounding spheres, sorted along one axis and kept
+// sorted between frames (few swaps when objects move a little), so a frame costs about
+// O(n + k) for n objects and k candidate pairs; the narrow phase then runs a pruned distance
+// query per candidate (DistanceRequest::max_distance = the threshold).
+#pragma once
+
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <utility>
+#include <vector>
+
+#include "absl/container/flat_hash_map.h"
+#include "absl/container/flat_hash_set.h"
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "inscribe/certified_distance.h"
+#include "inscribe/rigid_pose.h"
+#include "inscribe/separation_distance.h"
+#include "inscribe/sphere_hierarchy.h"
+
+namespace inscribe {
+
+// Chosen by the caller, unique within a scene.
+using SceneObjectId = std::uint64_t;
+
+// Every group bit: the default mask (an object is checked against every group).
+inline constexpr std::uint32_t kAllSceneGroups = 0xffffffffu;
+
+struct SceneObject {
+  SceneObjectId id = 0;
+  // The spheres whose distance the scene reports (required).
+  std::shared_ptr<const SphereHierarchy> spheres;
+  // Optional, both or neither: the solid's internal spheres (best its cover's cores,
+  // UpperBoundSpheres) and its certified cover, reaching at most cover_delta outside the solid.
+  // A pair of two such objects is answered with a certified interval (CertifiedDistances).
+  std::shared_ptr<const SphereHierarchy> internal, cover;
+  double cover_delta = 0.0;
+  RigidPose pose;
+  // Pair (a, b) is considered when (a.group & b.mask) != 0 and (b.group & a.mask) != 0.
+  std::uint32_t group = 1;
+  std::uint32_t mask = kAllSceneGroups;
+
+  bool certified() const { return cover != nullptr; }
+};
+
+// OK, or INVALID_ARGUMENT naming the problem: missing spheres, only one of internal and cover,
+// a cover delta that is negative or not finite, a pose that is not finite or whose quaternion
+// is not within 1e-3 of unit length. O(1).
+absl::Status CheckSceneObject(const SceneObject& object);
+
+struct SceneQuery {
+  // Pairs closer than this are reported (mesh units; negative asks for overlaps deeper than
+  // -threshold; +infinity for every pair). A certified pair is reported when its lower bound
+  // is below it (it may be closer).
+  double threshold = 0.0;
+  // Tolerances of the plain distances (DistanceRequest::abs_err, rel_err); certified intervals
+  // are always computed exactly.
+  double abs_err = 0.0;
+  double rel_err = 0.0;
+  // At most this many pairs are returned: the nearest ones (by distance, or by lower bound for
+  // certified pairs), with SceneFrame::truncated set when more were close.
+  std::size_t max_pairs = 100'000;
+};
+
+// OK, or INVALID_ARGUMENT naming the field: a NaN or -infinite threshold, bad tolerances,
+// max_pairs of 0.
+absl::Status CheckSceneQuery(const SceneQuery& query);
+
+struct ScenePair {
+  SceneObjectId a = 0, b = 0;  // a < b
+  // The spheres' distance and world witnesses (DistanceResult; the covers' query for a
+  // certified pair, whose witnesses are where the covers come closest).
+  DistanceResult result;
+  // Both objects certified: lower <= exact distance between the solids <= upper.
+  bool certified = false;
+  double lower = 0.0;
+  double upper = std::numeric_limits<double>::infinity();
+};
+
+struct SceneFrame {
+  // Sorted by (a, b).
+  std::vector<ScenePair> pairs;
+  // Pairs that passed the filters and whose bounding spheres are closer than the threshold
+  // (the narrow phase's work), and pairs found close before max_pairs applied.
+  std::int64_t candidate_pairs = 0;
+  std::int64_t close_pairs = 0;
+  bool truncated = false;
+};
+
+// Not thread-safe: one thread at a time may change or query a scene. The hierarchies are only
+// read, so scenes on other threads may share them.
+class Scene {
+ public:
+  Scene() = default;
+
+  // Errors: CheckSceneObject's, ALREADY_EXISTS for an id in the scene.
+  absl::Status Add(SceneObject object);
+  // NOT_FOUND for an unknown id. Its ignore-list entries go with it.
+  absl::Status Remove(SceneObjectId id);
+  // New poses for some objects: all or nothing (the first unknown id or bad pose fails the
+  // call, naming its index, and changes nothing).
+  absl::Status SetPoses(const std::vector<std::pair<SceneObjectId, RigidPose>>& poses);
+  absl::Status SetPose(SceneObjectId id, const RigidPose& pose);
+  // Never report the pair (in either order). NOT_FOUND for an unknown id, INVALID_ARGUMENT for
+  // a == b.
+  absl::Status Ignore(SceneObjectId a, SceneObjectId b);
+
+  std::size_t size() const { return objects_.size(); }
+  bool contains(SceneObjectId id) const { return index_.count(id) != 0; }
+
+  // Every considered pair closer than query.threshold. Pairs are answered in parallel (TBB)
+  // when there are many, polling `cancel` (may be null): CANCELLED once it is set. Errors:
+  // CheckSceneQuery's; INVALID_ARGUMENT for a certified pair whose coordinates are beyond
+  // kCertifiedDistanceMaxScale.
+  absl::StatusOr<SceneFrame> ClosePairs(const SceneQuery& query,
+                                        const std::atomic<bool>* cancel = nullptr);
+
+ private:
+  struct Entry {
+    SceneObject object;
+    CertifiedObject certified;  // points into object's hierarchies when certified
+    Vector3 local_center;       // the bounding sphere in the object's frame
+    double radius = 0.0;
+    Vector3 world_center;  // updated with the pose
+  };
+  // The ignore list's key: the two ids, smaller first.
+  static std::pair<SceneObjectId, SceneObjectId> PairKey(SceneObjectId a, SceneObjectId b) {
+    return a < b ? std::make_pair(a, b) : std::make_pair(b, a);
+  }
+  static void Place(Entry* entry);
+
+  std::vector<Entry> objects_;                                // dense; Remove moves the last in
+  absl::flat_hash_map<SceneObjectId, std::size_t> index_;     // id -> position in objects_
+  absl::flat_hash_set<std::pair<SceneObjectId, SceneObjectId>> ignored_;  // PairKey
+  std::vector<std::uint32_t> order_;  // objects_ positions sorted along the sweep axis
+};
+
+}  // namespace inscribe

@@ -227,6 +227,7 @@ absl::StatusOr<SceneFrame> Scene::ClosePairs(const SceneQuery& query,
   plain.abs_err = query.abs_err;
   plain.rel_err = query.rel_err;
   plain.max_distance = query.threshold;
+  if (query.stop_at_first && std::isfinite(query.threshold)) plain.closer_than = query.threshold;
 
   // One candidate: the smaller id is a. A plain pair's distance is pruned at the threshold; a
   // certified pair's covers at the threshold plus the margin (lower < threshold needs no
@@ -249,7 +250,8 @@ absl::StatusOr<SceneFrame> Scene::ClosePairs(const SceneQuery& query,
         return;
       }
       out.result = *std::move(r);
-      rank[c] = out.result.distance;
+      // A closer_than query that found no pair answers closer_than itself: not close.
+      if (out.result.sphere_a >= 0) rank[c] = out.result.distance;
       return;
     }
     absl::StatusOr<double> margin =

@@ -68,6 +68,11 @@ struct SceneQuery {
   // are always computed exactly.
   double abs_err = 0.0;
   double rel_err = 0.0;
+  // Only whether each pair is closer than the threshold (collision checking): a plain pair's
+  // search stops at the first sphere pair below it (DistanceRequest::closer_than), so
+  // result.distance is that pair's value, below the threshold but not always the minimum.
+  // The same pairs are reported; certified pairs are answered in full either way.
+  bool stop_at_first = false;
   // At most this many pairs are returned: the nearest ones (by distance, or by the covers'
   // distance for certified pairs), with SceneFrame::truncated set when more were close.
   std::size_t max_pairs = 100'000;

@@ -291,8 +291,10 @@ absl::StatusOr<SceneFrame> Scene::ClosePairs(const SceneQuery& query,
     if (cancelled()) return;
     for (std::size_t c = begin; c < end; ++c) answer(c);
   };
-  if (candidates.size() <= kNarrowChunk) {
-    run(0, candidates.size());
+  if (candidates.size() <= kNarrowChunk || !query.parallel) {
+    for (std::size_t begin = 0; begin < candidates.size(); begin += kNarrowChunk) {
+      run(begin, std::min(candidates.size(), begin + kNarrowChunk));
+    }
   } else {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, candidates.size(), kNarrowChunk),
                       [&](const tbb::blocked_range<std::size_t>& r) { run(r.begin(), r.end()); });

@@ -205,6 +205,7 @@ TEST(Scene, EveryFrameEqualsBruteForce) {
     const double threshold = thresholds[frame % 5];
     SceneQuery query;
     query.threshold = threshold;
+    query.parallel = frame % 2 == 0;
     absl::StatusOr<SceneFrame> got = scene.ClosePairs(query);
     ASSERT_TRUE(got.ok()) << got.status();
     ExpectEqual(*got, BruteForce(objects, ignored, threshold),

@@ -8,15 +8,13 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "sphere_pair_search.h"
 
 namespace inscribe {
 namespace {
 
 // b's frame seen from a's: x_a = rotation * x_b + translation.
-struct Relative {
-  Eigen::Matrix3d rotation;
-  Vector3 translation;
-};
+using Relative = internal::RelativeFrame;
 
 Relative RelativePose(const RigidPose& pose_a, const RigidPose& pose_b) {
   const RigidPose t = pose_a.Inverse() * pose_b;
@@ -219,7 +217,10 @@ void AddWitnesses(const std::vector<Sphere>& a, const std::vector<Sphere>& b,
 DistanceResult Query(const SphereHierarchy& a, const RigidPose& pose_a, const SphereHierarchy& b,
                      const RigidPose& pose_b, const DistanceRequest& request) {
   const Relative relative = RelativePose(pose_a, pose_b);
-  DistanceResult out = Search(a, b, relative, request).Run();
+  DistanceResult out;
+  if (!internal::FloatFilteredSearch(a, b, relative, request, &out)) {
+    out = Search(a, b, relative, request).Run();
+  }
   if (!out.closer && std::isfinite(request.closer_than)) out.distance = request.closer_than;
   AddWitnesses(a.spheres(), b.spheres(), pose_a, relative, &out);
   return out;

@@ -119,8 +119,7 @@ class Search {
     best_ = d;
     best_a_ = sphere_a;
     best_b_ = sphere_b;
-    const double tolerance = std::max(request_.abs_err, request_.rel_err * std::abs(d));
-    threshold_ = std::min({d - tolerance, request_.closer_than, request_.max_distance});
+    threshold_ = internal::PruneThreshold(request_, d);
   }
 
   // Every sphere below a against every sphere below b (at most kAllPairs pairs). A pair is

@@ -144,8 +144,7 @@ class FloatSearch {
     best_ = d;
     best_a_ = sphere_a;
     best_b_ = sphere_b;
-    const double tolerance = std::max(request_.abs_err, request_.rel_err * std::abs(d));
-    threshold_ = std::min({d - tolerance, request_.closer_than, request_.max_distance});
+    threshold_ = PruneThreshold(request_, d);
     UpdateFloatReach();
   }
 
@@ -228,8 +227,8 @@ class FloatSearch {
     }
   }
 
-  // Every sphere below a against every sphere below b through the float filter, four b spheres
-  // at a time; the pairs it passes go to ComparePair.
+  // Every sphere below a against every sphere below b through the float filter, four at a time;
+  // the pairs it passes go to ComparePair.
   void CompareAll(const SphereHierarchy::Slot& sa, const SphereHierarchy::Slot& sb,
                   DistanceResult* out) {
     const std::int32_t na = sa.count, nb = sb.count;
@@ -244,38 +243,66 @@ class FloatSearch {
       s_.z[at] = static_cast<float>(c.z());
     }
     const auto fa = static_cast<std::size_t>(sa.first), fb = static_cast<std::size_t>(sb.first);
-    const float *ax = a_.float_x() + fa, *ay = a_.float_y() + fa, *az = a_.float_z() + fa,
-                *ar = a_.float_radius() + fa;
-    const float *bx = s_.x.data() + fb, *by = s_.y.data() + fb, *bz = s_.z.data() + fb,
-                *br = b_.float_radius() + fb;
-    for (std::int32_t i = 0; i < na; ++i) {
-      const float reach_i = float_reach_ + ar[i];
+    const Side side_a{a_.float_x() + fa,      a_.float_y() + fa, a_.float_z() + fa,
+                      a_.float_radius() + fa, sa.first,          na};
+    const Side side_b{s_.x.data() + fb,       s_.y.data() + fb, s_.z.data() + fb,
+                      b_.float_radius() + fb, sb.first,         nb};
+    // The longer range fills the SIMD lanes.
+    if (nb >= na) {
+      Filter(side_a, side_b, true);
+    } else {
+      Filter(side_b, side_a, false);
+    }
+  }
+
+  // A range of spheres in float (centres in a's frame) and its first position in the ordered
+  // arrays; readable for kFloatPadding entries past its end.
+  struct Side {
+    const float *x, *y, *z, *radius;
+    std::int32_t first, count;
+  };
+
+  // Each row sphere against the lane spheres, four lanes at a time; rows_are_a tells which
+  // side is a's.
+  void Filter(const Side& rows, const Side& lanes, bool rows_are_a) {
+    const std::int32_t nl = lanes.count;
+    for (std::int32_t i = 0; i < rows.count; ++i) {
+      const float reach_i = float_reach_ + rows.radius[i];
+      const auto pass_pair = [&](std::int32_t j) {
+        if (rows_are_a) {
+          ComparePair(rows.first + i, lanes.first + j);
+        } else {
+          ComparePair(lanes.first + j, rows.first + i);
+        }
+      };
 #if defined(__SSE2__)
-      const __m128 x = _mm_set1_ps(ax[i]), y = _mm_set1_ps(ay[i]), z = _mm_set1_ps(az[i]);
-      const __m128 reach_a = _mm_set1_ps(reach_i), zero = _mm_setzero_ps();
-      for (std::int32_t j = 0; j < nb; j += 4) {
-        const __m128 dx = _mm_sub_ps(x, _mm_loadu_ps(bx + j));
-        const __m128 dy = _mm_sub_ps(y, _mm_loadu_ps(by + j));
-        const __m128 dz = _mm_sub_ps(z, _mm_loadu_ps(bz + j));
+      const __m128 x = _mm_set1_ps(rows.x[i]), y = _mm_set1_ps(rows.y[i]),
+                   z = _mm_set1_ps(rows.z[i]);
+      const __m128 reach_row = _mm_set1_ps(reach_i), zero = _mm_setzero_ps();
+      for (std::int32_t j = 0; j < nl; j += 4) {
+        const __m128 dx = _mm_sub_ps(x, _mm_loadu_ps(lanes.x + j));
+        const __m128 dy = _mm_sub_ps(y, _mm_loadu_ps(lanes.y + j));
+        const __m128 dz = _mm_sub_ps(z, _mm_loadu_ps(lanes.z + j));
         const __m128 squared =
             _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
-        const __m128 reach = _mm_add_ps(reach_a, _mm_loadu_ps(br + j));
+        const __m128 reach = _mm_add_ps(reach_row, _mm_loadu_ps(lanes.radius + j));
         const __m128 pass =
             _mm_and_ps(_mm_cmpgt_ps(reach, zero), _mm_cmplt_ps(squared, _mm_mul_ps(reach, reach)));
         auto mask = static_cast<unsigned>(_mm_movemask_ps(pass));
-        if (nb - j < 4) mask &= (1u << (nb - j)) - 1u;
+        if (nl - j < 4) mask &= (1u << (nl - j)) - 1u;
         while (mask != 0) {
           const int k = __builtin_ctz(mask);
           mask &= mask - 1;
-          ComparePair(sa.first + i, sb.first + j + k);
+          pass_pair(j + k);
         }
       }
 #else
-      for (std::int32_t j = 0; j < nb; ++j) {
-        const float dx = ax[i] - bx[j], dy = ay[i] - by[j], dz = az[i] - bz[j];
+      for (std::int32_t j = 0; j < nl; ++j) {
+        const float dx = rows.x[i] - lanes.x[j], dy = rows.y[i] - lanes.y[j],
+                    dz = rows.z[i] - lanes.z[j];
         const float squared = dx * dx + dy * dy + dz * dz;
-        const float reach = reach_i + br[j];
-        if (reach > 0.0f && squared < reach * reach) ComparePair(sa.first + i, sb.first + j);
+        const float reach = reach_i + lanes.radius[j];
+        if (reach > 0.0f && squared < reach * reach) pass_pair(j);
       }
 #endif
     }

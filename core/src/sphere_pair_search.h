@@ -3,6 +3,8 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
 
 #include "inscribe/separation_distance.h"
 #include "inscribe/sphere_hierarchy.h"
@@ -15,6 +17,13 @@ struct RelativeFrame {
   Eigen::Matrix3d rotation;
   Vector3 translation;
 };
+
+// The pruning threshold once a pair of value d is the best found: pairs bounded at or above it
+// cannot improve the answer beyond the request's tolerance, or cannot answer closer_than yes.
+inline double PruneThreshold(const DistanceRequest& request, double d) {
+  const double tolerance = std::max(request.abs_err, request.rel_err * std::abs(d));
+  return std::min({d - tolerance, request.closer_than, request.max_distance});
+}
 
 // The exact answer of SeparationDistance (without witnesses) by a depth-first branch and
 // bound over the hierarchies' Quads (up to four children per step, their bounds computed four

@@ -59,7 +59,7 @@ class SphereHierarchy {
   }
   // A sphere around the node's volume: the volume itself for kSphere, the sphere around the
   // RSS (centred on its rectangle, radius = half its diagonal plus its radius) for kRss. The
-  // query's cheap first test; derived, not serialised.
+  // double-precision search's cheap first test; derived, not serialised.
   const Sphere& outer_sphere(std::int32_t node) const {
     return outer_spheres_[static_cast<std::size_t>(node)];
   }
@@ -78,7 +78,8 @@ class SphereHierarchy {
   // count). Derived, not serialised.
   const std::vector<Sphere>& ordered_spheres() const { return ordered_spheres_; }
 
-  // What the distance query reads at each step about one node or leaf, in one record: the
+  // What the double-precision distance search (used when a query's magnitudes rule out the
+  // float one) reads at each step about one node or leaf, in one record: the
   // sphere around it (outer_sphere(), or the leaf's own), its range in ordered_spheres(), and
   // a node's children (0 for a leaf). Derived, not serialised.
   struct Slot {

@@ -8,15 +8,13 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "sphere_pair_search.h"
 
 namespace inscribe {
 namespace {
 
 // b's frame seen from a's: x_a = rotation * x_b + translation.
-struct Relative {
-  Eigen::Matrix3d rotation;
-  Vector3 translation;
-};
+using Relative = internal::RelativeFrame;
 
 Relative RelativePose(const RigidPose& pose_a, const RigidPose& pose_b) {
   const RigidPose t = pose_a.Inverse() * pose_b;
@@ -121,8 +119,7 @@ class Search {
     best_ = d;
     best_a_ = sphere_a;
     best_b_ = sphere_b;
-    const double tolerance = std::max(request_.abs_err, request_.rel_err * std::abs(d));
-    threshold_ = std::min({d - tolerance, request_.closer_than, request_.max_distance});
+    threshold_ = internal::PruneThreshold(request_, d);
   }
 
   // Every sphere below a against every sphere below b (at most kAllPairs pairs). A pair is
@@ -219,7 +216,10 @@ void AddWitnesses(const std::vector<Sphere>& a, const std::vector<Sphere>& b,
 DistanceResult Query(const SphereHierarchy& a, const RigidPose& pose_a, const SphereHierarchy& b,
                      const RigidPose& pose_b, const DistanceRequest& request) {
   const Relative relative = RelativePose(pose_a, pose_b);
-  DistanceResult out = Search(a, b, relative, request).Run();
+  DistanceResult out;
+  if (!internal::FloatFilteredSearch(a, b, relative, request, &out)) {
+    out = Search(a, b, relative, request).Run();
+  }
   if (!out.closer && std::isfinite(request.closer_than)) out.distance = request.closer_than;
   AddWitnesses(a.spheres(), b.spheres(), pose_a, relative, &out);
   return out;

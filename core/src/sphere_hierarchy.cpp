@@ -5,6 +5,7 @@
 #include <CGAL/Simple_cartesian.h>
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -73,6 +74,64 @@ std::size_t Split(const std::vector<Sphere>& spheres, std::vector<std::int32_t>&
   const Vector3 axis = solver.eigenvectors().col(2);
   const auto first = indices.begin() + static_cast<std::ptrdiff_t>(begin);
   const auto last = indices.begin() + static_cast<std::ptrdiff_t>(end);
+  const std::size_t n = end - begin;
+  const auto projection_on = [&](const Vector3& direction) {
+    return [&spheres, direction](std::int32_t i) {
+      return spheres[static_cast<std::size_t>(i)].center.dot(direction);
+    };
+  };
+  const auto by = [](auto key) {
+    return [key](std::int32_t a, std::int32_t b) {
+      const double pa = key(a), pb = key(b);
+      return pa < pb || (pa == pb && a < b);
+    };
+  };
+  // Candidates: every split of the centres sorted along the principal axis or a coordinate
+  // axis, keeping at least an eighth of them on each side (depth stays O(log n)). Cost: the
+  // children's sizes times their squared radii, the radius taken as half the diagonal of the
+  // box around their spheres: the chance that a distance query opens a node grows with its
+  // size, and small, tight children prune early.
+  const Vector3 axes[4] = {axis, Vector3::UnitX(), Vector3::UnitY(), Vector3::UnitZ()};
+  const std::size_t least = std::max<std::size_t>(1, n / 8);
+  std::vector<std::int32_t> order(first, last);
+  std::vector<double> prefix(n + 1), suffix(n + 1);
+  double best = std::numeric_limits<double>::infinity();
+  int best_axis = -1;
+  std::size_t best_k = 0;
+  for (int a = 0; a < 4; ++a) {
+    std::sort(order.begin(), order.end(), by(projection_on(axes[a])));
+    Eigen::AlignedBox3d box;
+    for (std::size_t k = 0; k < n; ++k) {
+      const Sphere& s = spheres[static_cast<std::size_t>(order[k])];
+      box.extend(s.center - Vector3::Constant(s.radius));
+      box.extend(s.center + Vector3::Constant(s.radius));
+      prefix[k + 1] = box.diagonal().squaredNorm();
+    }
+    box.setEmpty();
+    for (std::size_t k = n; k-- > 0;) {
+      const Sphere& s = spheres[static_cast<std::size_t>(order[k])];
+      box.extend(s.center - Vector3::Constant(s.radius));
+      box.extend(s.center + Vector3::Constant(s.radius));
+      suffix[k] = box.diagonal().squaredNorm();
+    }
+    for (std::size_t k = least; k + least <= n; ++k) {
+      const double cost =
+          static_cast<double>(k) * prefix[k] + static_cast<double>(n - k) * suffix[k];
+      const auto off_centre = [n](std::size_t i) {
+        return std::max(2 * i, n) - std::min(2 * i, n);
+      };
+      if (cost < best || (cost == best && off_centre(k) < off_centre(best_k))) {
+        best = cost;
+        best_axis = a;
+        best_k = k;
+      }
+    }
+  }
+  const bool coincident = (covariance.array() == 0.0).all();
+  if (best_axis >= 0 && !coincident) {
+    std::sort(first, last, by(projection_on(axes[best_axis])));
+    return begin + best_k;
+  }
   auto projection = [&](std::int32_t i) {
     return (spheres[static_cast<std::size_t>(i)].center - mean).dot(axis);
   };
@@ -149,6 +208,13 @@ double DistanceToRectangle(const Rss& rss, const Vector3& p) {
   point.origin = p;
   Vector3 a, b;
   return RectangleDistance(rss, point, &a, &b);
+}
+
+// Nearest float, saturated: a double beyond float's range would be undefined behaviour. The
+// query never uses the floats of such a set (its magnitudes disable the float filter).
+float ToFloat(double v) {
+  constexpr double kMax = std::numeric_limits<float>::max();
+  return static_cast<float>(std::clamp(v, -kMax, kMax));
 }
 
 }  // namespace
@@ -249,6 +315,53 @@ void SphereHierarchy::ComputeDerived() {
   ordered_spheres_.resize(spheres_.size());
   for (std::size_t i = 0; i < spheres_.size(); ++i) {
     ordered_spheres_[i] = spheres_[static_cast<std::size_t>(leaf_order_[i])];
+  }
+  const std::size_t padded = spheres_.size() + kFloatPadding;
+  float_x_.resize(padded);
+  float_y_.resize(padded);
+  float_z_.resize(padded);
+  float_r_.resize(padded);
+  for (std::size_t i = 0; i < padded; ++i) {
+    const Sphere& s = ordered_spheres_[std::min(i, spheres_.size() - 1)];
+    float_x_[i] = ToFloat(s.center.x());
+    float_y_[i] = ToFloat(s.center.y());
+    float_z_[i] = ToFloat(s.center.z());
+    float_r_[i] = ToFloat(s.radius);
+  }
+  query_spheres_.resize(nodes + spheres_.size());
+  for (std::size_t i = 0; i < nodes; ++i) {
+    query_spheres_[i] =
+        volume_ == HierarchyVolume::kSphere
+            ? bounding_spheres_[i]
+            : EnclosingSphere(spheres_, &leaf_order_[static_cast<std::size_t>(first_[i])],
+                              static_cast<std::size_t>(count_[i]));
+  }
+  std::copy(spheres_.begin(), spheres_.end(),
+            query_spheres_.begin() + static_cast<std::ptrdiff_t>(nodes));
+  max_abs_coordinate_ = max_radius_ = max_center_norm_ = 0.0;
+  for (const Sphere& s : query_spheres_) {
+    max_abs_coordinate_ = std::max(max_abs_coordinate_, s.center.cwiseAbs().maxCoeff());
+    max_radius_ = std::max(max_radius_, s.radius);
+    max_center_norm_ = std::max(max_center_norm_, s.center.norm());
+  }
+  quads_.assign(nodes, Quad{});
+  for (std::size_t i = 0; i < nodes; ++i) {
+    Quad& q = quads_[i];
+    for (const HierarchyRef child : {left_[i], right_[i]}) {
+      const bool expand = !IsLeaf(child);
+      const HierarchyRef grandchildren[2] = {
+          expand ? left_[static_cast<std::size_t>(child)] : child,
+          expand ? right_[static_cast<std::size_t>(child)] : 0};
+      for (int k = 0; k < (expand ? 2 : 1); ++k) {
+        const Sphere& s = query_sphere(grandchildren[k]);
+        q.x[q.size] = ToFloat(s.center.x());
+        q.y[q.size] = ToFloat(s.center.y());
+        q.z[q.size] = ToFloat(s.center.z());
+        q.radius[q.size] = ToFloat(s.radius);
+        q.child[q.size] = grandchildren[k];
+        ++q.size;
+      }
+    }
   }
   if (volume_ == HierarchyVolume::kSphere) {
     outer_spheres_ = bounding_spheres_;

@@ -318,3 +318,107 @@ TEST(PairSeparationDistances, RefusesBadPairsAndStopsWhenCancelled) {
 
 }  // namespace
 }  // namespace inscribe
+
+namespace inscribe {
+namespace {
+
+// Queries b (posed by each pose) against a with both hierarchies and checks the exact answer:
+// the same double as the brute force, bit for bit, since every pair the float filters pass is
+// evaluated by the brute force's expression.
+void ExpectExact(const std::vector<Sphere>& a, const std::vector<Sphere>& b,
+                 const std::vector<RigidPose>& poses, const std::string& what) {
+  for (HierarchyVolume volume : {HierarchyVolume::kRss, HierarchyVolume::kSphere}) {
+    const SphereHierarchy ha = Build(a, volume), hb = Build(b, volume);
+    for (std::size_t i = 0; i < poses.size(); ++i) {
+      absl::StatusOr<DistanceResult> fast = SeparationDistance(ha, {}, hb, poses[i]);
+      absl::StatusOr<DistanceResult> slow = BruteForceSeparationDistance(a, {}, b, poses[i]);
+      ASSERT_TRUE(fast.ok() && slow.ok()) << what;
+      EXPECT_EQ(fast->distance, slow->distance)
+          << what << " pose " << i << " " << HierarchyVolumeName(volume);
+    }
+  }
+}
+
+std::vector<RigidPose> RandomPoses(std::mt19937_64& rng, int n, double spread) {
+  std::vector<RigidPose> poses;
+  for (int i = 0; i < n; ++i) poses.push_back(RandomPose(rng, spread));
+  return poses;
+}
+
+// A set scaled by `scale` and shifted by `offset`: the float filters' margins grow with the
+// magnitudes; outside 2^-40..2^60 the double search answers.
+std::vector<Sphere> Scaled(std::vector<Sphere> spheres, double scale, const Vector3& offset) {
+  for (Sphere& s : spheres) {
+    s.center = scale * s.center + offset;
+    s.radius *= scale;
+  }
+  return spheres;
+}
+
+TEST(SeparationDistanceFloatFilter, ExactAcrossScalesAndOffsets) {
+  const std::vector<Sphere> a = RandomSpheres(300, 41), b = RandomSpheres(200, 42);
+  std::mt19937_64 rng(43);
+  for (const double scale : {1e-14, 1e-9, 1e-3, 1.0, 1e3, 1e9, 1e15, 1e19, 1e25}) {
+    for (const double offset : {0.0, 1e3, 1e7}) {
+      const Vector3 shift = Vector3(offset, -offset, 0.5 * offset) * scale;
+      const std::vector<Sphere> sa = Scaled(a, scale, shift), sb = Scaled(b, scale, shift);
+      std::vector<RigidPose> poses = RandomPoses(rng, 20, 2.0);
+      for (RigidPose& pose : poses) pose.translation *= scale;
+      ExpectExact(sa, sb, poses,
+                  "scale " + std::to_string(scale) + " offset " + std::to_string(offset));
+    }
+  }
+}
+
+TEST(SeparationDistanceFloatFilter, ExactOnDegenerateSets) {
+  std::mt19937_64 rng(47);
+  std::vector<Sphere> identical(200, Sphere{Vector3(0.3, 0.2, 0.1), 0.25});
+  std::vector<Sphere> collinear, huge_and_tiny, near_ties;
+  for (int i = 0; i < 300; ++i) {
+    collinear.push_back({Vector3(0.01 * i, 0.0, 0.0), 0.004 + 0.001 * (i % 3)});
+    huge_and_tiny.push_back(
+        {Vector3(0.001 * i, std::sin(i), std::cos(i)), i % 10 == 0 ? 50.0 : 1e-12 * (1 + i)});
+    // Centres on a sphere of radius 1 with equal radii: many pairs tie within rounding.
+    const double t = 0.1 * i, p = 0.037 * i;
+    near_ties.push_back(
+        {Vector3(std::cos(t) * std::sin(p), std::sin(t) * std::sin(p), std::cos(p)), 0.05});
+  }
+  const std::vector<Sphere> one = {{Vector3(1, 2, 3), 0.5}};
+  const std::vector<std::pair<std::string, std::vector<Sphere>>> sets = {
+      {"one", one},
+      {"identical", identical},
+      {"collinear", collinear},
+      {"huge and tiny radii", huge_and_tiny},
+      {"near ties", near_ties},
+      {"random", RandomSpheres(150, 48)}};
+  for (const auto& [name_a, a] : sets) {
+    for (const auto& [name_b, b] : sets) {
+      std::vector<RigidPose> poses = RandomPoses(rng, 10, 1.5);
+      poses.push_back(RigidPose{});
+      ExpectExact(a, b, poses, name_a + " vs " + name_b);
+    }
+  }
+  // A quaternion off unit by as much as CheckPose allows: the rotation matrix then stretches
+  // distances, and the node bounds' margin must cover it.
+  std::vector<RigidPose> stretched = RandomPoses(rng, 50, 1.5);
+  for (std::size_t i = 0; i < stretched.size(); ++i) {
+    stretched[i].rotation.coeffs() *= 1.0 + (i % 2 ? 9e-7 : -9e-7);
+  }
+  ExpectExact(RandomSpheres(200, 49), near_ties, stretched, "quaternion off unit");
+}
+
+// Real medial spheres in touching and near poses, where the answer is decided among many
+// pairs within float rounding of each other.
+TEST(SeparationDistanceFloatFilter, ExactOnRealSetsInContact) {
+  for (const char* name : {"eight.off", "knot1.off", "fandisk.off"}) {
+    INSCRIBE_REQUIRE_MESH(name);
+    const std::vector<Sphere>& spheres = RealSphereSet(name);
+    ASSERT_FALSE(spheres.empty());
+    std::mt19937_64 rng(53);
+    ExpectExact(spheres, spheres, RandomPoses(rng, 100, 0.3), std::string(name) + " touching");
+    ExpectExact(spheres, spheres, RandomPoses(rng, 100, 1.0), std::string(name) + " near");
+  }
+}
+
+}  // namespace
+}  // namespace inscribe

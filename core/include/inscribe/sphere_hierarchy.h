@@ -32,9 +32,11 @@ using HierarchyRef = std::int32_t;
 inline bool IsLeaf(HierarchyRef ref) { return ref < 0; }
 inline std::int32_t LeafSphere(HierarchyRef ref) { return -1 - ref; }
 
-// A binary hierarchy built top down: each internal node splits its spheres by the plane
-// through their centres' mean, normal to their principal axis (the least-squares line fit of
-// the centres), falling back to the median when one side would be empty. Flat arrays linked
+// A binary hierarchy built top down: each internal node splits its spheres, sorted along
+// their principal axis (the least-squares line fit of the centres) or a coordinate axis, where
+// the children's sizes times their squared extents (half the diagonal of the box around their
+// spheres) sum to the least, with at least an eighth of the spheres on each side; coincident
+// centres are split at the median. Flat arrays linked
 // by index: n spheres give n - 1 internal nodes (none for one sphere), each holding its two
 // children and one bounding volume of the chosen kind. Immutable once built; cheap to move,
 // copyable; safe to query from many threads at once.
@@ -57,7 +59,7 @@ class SphereHierarchy {
   }
   // A sphere around the node's volume: the volume itself for kSphere, the sphere around the
   // RSS (centred on its rectangle, radius = half its diagonal plus its radius) for kRss. The
-  // query's cheap first test; derived, not serialised.
+  // double-precision search's cheap first test; derived, not serialised.
   const Sphere& outer_sphere(std::int32_t node) const {
     return outer_spheres_[static_cast<std::size_t>(node)];
   }
@@ -76,7 +78,8 @@ class SphereHierarchy {
   // count). Derived, not serialised.
   const std::vector<Sphere>& ordered_spheres() const { return ordered_spheres_; }
 
-  // What the distance query reads at each step about one node or leaf, in one record: the
+  // What the double-precision distance search (used when a query's magnitudes rule out the
+  // float one) reads at each step about one node or leaf, in one record: the
   // sphere around it (outer_sphere(), or the leaf's own), its range in ordered_spheres(), and
   // a node's children (0 for a leaf). Derived, not serialised.
   struct Slot {
@@ -91,6 +94,35 @@ class SphereHierarchy {
                     : left_.size() + static_cast<std::size_t>(LeafSphere(ref));
   }
   const Slot& slot(HierarchyRef ref) const { return slots_[slot_index(ref)]; }
+  // The distance query's wide view of the tree: a node's children, with each child that is a
+  // node replaced by its own two children (2 to 4 entries), and the sphere around each entry
+  // (query_sphere()) rounded to float. Unused lanes hold zeros. Derived, not serialised.
+  struct Quad {
+    float x[4], y[4], z[4], radius[4];
+    HierarchyRef child[4];
+    std::int32_t size;
+  };
+  const Quad& quad(std::int32_t node) const { return quads_[static_cast<std::size_t>(node)]; }
+  // The tightest sphere known around a node or leaf: the bounding sphere for kSphere, the
+  // smallest sphere around the node's spheres (padded as Build pads) for kRss, the sphere
+  // itself for a leaf. Indexed like slot(). Derived, not serialised.
+  const Sphere& query_sphere(HierarchyRef ref) const { return query_spheres_[slot_index(ref)]; }
+
+  // ordered_spheres() in single precision, one array per coordinate and one of radii (each
+  // rounded to nearest), padded with kFloatPadding copies of the last sphere so that a query
+  // may read whole SIMD packets past a range's end. Only ever used to prune with margins that
+  // cover float rounding (separation_distance.cpp). Derived, not serialised.
+  static constexpr std::size_t kFloatPadding = 4;
+  const float* float_x() const { return float_x_.data(); }
+  const float* float_y() const { return float_y_.data(); }
+  const float* float_z() const { return float_z_.data(); }
+  const float* float_radius() const { return float_r_.data(); }
+  // Over the spheres and every query_sphere(): the largest |coordinate| of a centre, the
+  // largest radius, and the largest distance of a centre from the origin: what bounds the
+  // magnitudes a query meets.
+  double max_abs_coordinate() const { return max_abs_coordinate_; }
+  double max_radius() const { return max_radius_; }
+  double max_center_norm() const { return max_center_norm_; }
   // Longest path from the root to a leaf, in edges.
   int depth() const { return depth_; }
 
@@ -121,6 +153,10 @@ class SphereHierarchy {
   std::vector<std::int32_t> leaf_order_, leaf_position_, first_, count_;
   std::vector<Sphere> ordered_spheres_;
   std::vector<Slot> slots_;
+  std::vector<Quad> quads_;
+  std::vector<Sphere> query_spheres_;
+  std::vector<float> float_x_, float_y_, float_z_, float_r_;
+  double max_abs_coordinate_ = 0.0, max_radius_ = 0.0, max_center_norm_ = 0.0;
   int depth_ = 0;
 };
 

@@ -1,0 +1,354 @@
+#include "sphere_pair_search.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+namespace inscribe::internal {
+namespace {
+
+using Quad = SphereHierarchy::Quad;
+
+// Node pairs with at most this many sphere pairs below them are compared pair by pair (the
+// float filter rejects four pairs in a few instructions, much less than a step of the tree):
+// 128 beat 64 and 256 in bench/separation_distance_bench (eight and knot1).
+constexpr std::int64_t kAllPairs = 128;
+
+// Float rounding. Let M be a power of two bounding every |coordinate| and radius the search
+// reads in a's frame (the hierarchies' query spheres and spheres, b's moved by the relative
+// pose) and u = 2^-24. Every float read is within u M of its double (rounded to nearest; b's
+// centres are moved in double, then rounded), so a float centre distance is within 7 u M of
+// the double one, its float square within a relative 3.01 u, its float square root within
+// 16 u M (|d| <= 2 sqrt(3) M); sums and differences of radii and thresholds (magnitudes below
+// 6 M) add at most 22 u M. A margin of 128 u M thus makes
+//  - a node pair's float bound (centre distance - radii - margin) at least 90 u M below the
+//    double one, itself below every sphere pair under the two nodes, up to the rotation's
+//    departure from orthonormality s (|R x| <= (1 + s) |x|), which can shrink a moved child's
+//    distance to the node centre by s times a radius (at most 2 M); the margin adds 4 s M;
+//  - the sphere-pair filter (reject when the float squared centre distance is at least the
+//    square of threshold + margin + r_a + r_b, the threshold clamped to [-4 M, 4 M] since no
+//    pair's value leaves [-2 M, 3.5 M]) pass every pair whose double value is below the
+//    threshold: its float reach exceeds its float distance by 99 u M, more than the 4.02 u |d|
+//    and 2^-114 M^2 that rounding and underflow of the squares can add.
+// Bounding spheres accepted by Deserialize may leave a sphere out by 1e-10 of their radius,
+// far below the margin. The search runs only when 2^-40 <= M <= 2^60: nothing overflows and
+// denormals' absolute error (2^-149) stays far below the margin.
+constexpr int kFloatMarginExponent = 7 - 24;  // 128 u M
+constexpr int kFloatMinExponent = -40, kFloatMaxExponent = 60;
+
+// Per-thread scratch kept between queries: b's ordered centres and b's Quads moved into a's
+// frame in float, filled lazily; an entry is valid when its stamp equals the query's epoch.
+struct Scratch {
+  std::vector<float> x, y, z;
+  std::vector<std::uint32_t> sphere_stamp;
+  struct MovedQuad {
+    float x[4], y[4], z[4];
+  };
+  std::vector<MovedQuad> quads;
+  std::vector<std::uint32_t> quad_stamp;
+  std::uint32_t epoch = 0;
+  struct Pair {
+    HierarchyRef a, b;
+    float bound;  // a lower bound on the pairs below (conservative in float)
+  };
+  std::vector<Pair> stack;
+
+  void Begin(std::size_t spheres, std::size_t nodes) {
+    if (x.size() < spheres) {
+      x.resize(spheres, 0.0f);
+      y.resize(spheres, 0.0f);
+      z.resize(spheres, 0.0f);
+      sphere_stamp.resize(spheres, 0);
+    }
+    if (quads.size() < nodes) {
+      quads.resize(nodes, MovedQuad{});
+      quad_stamp.resize(nodes, 0);
+    }
+    if (++epoch == 0) {  // wrapped: forget every stamp
+      std::fill(sphere_stamp.begin(), sphere_stamp.end(), 0);
+      std::fill(quad_stamp.begin(), quad_stamp.end(), 0);
+      epoch = 1;
+    }
+    stack.clear();
+  }
+};
+
+// Nearest float above or at v (v finite, within float's range).
+float FloatAtLeast(double v) {
+  float f = static_cast<float>(v);
+  if (static_cast<double>(f) < v) f = std::nextafter(f, std::numeric_limits<float>::infinity());
+  return f;
+}
+
+class FloatSearch {
+ public:
+  FloatSearch(const SphereHierarchy& a, const SphereHierarchy& b, const RelativeFrame& relative,
+              const DistanceRequest& request, double scale, double margin, Scratch& scratch)
+      : a_(a),
+        b_(b),
+        rel_(relative),
+        request_(request),
+        yes_no_(std::isfinite(request.closer_than)),
+        threshold_(std::min(request.closer_than, request.max_distance)),
+        scale_(scale),
+        margin_(FloatAtLeast(margin)),
+        s_(scratch) {
+    s_.Begin(b.ordered_spheres().size() + SphereHierarchy::kFloatPadding, b.num_nodes());
+    UpdateFloatReach();
+  }
+
+  void Run(DistanceResult* out) {
+    s_.stack.push_back({a_.root(), b_.root(), -std::numeric_limits<float>::infinity()});
+    while (!s_.stack.empty()) {
+      const Scratch::Pair p = s_.stack.back();
+      s_.stack.pop_back();
+      if (static_cast<double>(p.bound) >= threshold_) continue;
+      const SphereHierarchy::Slot& sa = a_.slot(p.a);
+      const SphereHierarchy::Slot& sb = b_.slot(p.b);
+      if (std::int64_t{sa.count} * sb.count <= kAllPairs) {
+        CompareAll(sa, sb, out);
+        if (yes_no_ && best_ < request_.closer_than) break;
+        continue;
+      }
+      const Sphere& qa = a_.query_sphere(p.a);
+      const Sphere& qb = b_.query_sphere(p.b);
+      const bool split_a = sa.count > 1 && (sb.count == 1 || qa.radius >= qb.radius);
+      if (split_a) {
+        const Vector3 cb = Move(qb.center);
+        const Quad& q = a_.quad(p.a);
+        Expand(q, q.x, q.y, q.z, cb, qb.radius, p, true, out);
+      } else {
+        const Quad& q = b_.quad(p.b);
+        const Scratch::MovedQuad& m = MovedQuad(p.b, q);
+        Expand(q, m.x, m.y, m.z, qa.center, qa.radius, p, false, out);
+      }
+    }
+    if (best_a_ >= 0) {
+      out->distance = best_;
+      out->sphere_a = best_a_;
+      out->sphere_b = best_b_;
+    }
+    out->closer = best_ < request_.closer_than;
+  }
+
+ private:
+  Vector3 Move(const Vector3& p) const { return rel_.rotation * p + rel_.translation; }
+
+  void Improve(double d, std::int32_t sphere_a, std::int32_t sphere_b) {
+    best_ = d;
+    best_a_ = sphere_a;
+    best_b_ = sphere_b;
+    threshold_ = PruneThreshold(request_, d);
+    UpdateFloatReach();
+  }
+
+  // The sphere-pair filter's threshold + margin, the threshold clamped to [-4 M, 4 M].
+  void UpdateFloatReach() {
+    const double clamped = std::clamp(threshold_, -4.0 * scale_, 4.0 * scale_);
+    float_reach_ = static_cast<float>(clamped) + margin_;
+  }
+
+  // b's Quad of node `node` moved into a's frame (cached for the query).
+  const Scratch::MovedQuad& MovedQuad(HierarchyRef node, const Quad& q) {
+    const auto at = static_cast<std::size_t>(node);
+    Scratch::MovedQuad& m = s_.quads[at];
+    if (s_.quad_stamp[at] != s_.epoch) {
+      s_.quad_stamp[at] = s_.epoch;
+      for (int k = 0; k < 4; ++k) {
+        if (k < q.size) {
+          const Vector3 c = Move(b_.query_sphere(q.child[k]).center);
+          m.x[k] = static_cast<float>(c.x());
+          m.y[k] = static_cast<float>(c.y());
+          m.z[k] = static_cast<float>(c.z());
+        } else {
+          m.x[k] = m.y[k] = m.z[k] = 0.0f;
+        }
+      }
+    }
+    return m;
+  }
+
+  // Bounds of the Quad's entries (centres x, y, z in a's frame, radii q.radius) against the
+  // other side's sphere (centre `other` in a's frame, radius other_radius), four at once;
+  // pushes the entries bounded below the threshold, the nearest last (searched first).
+  void Expand(const Quad& q, const float* x, const float* y, const float* z, const Vector3& other,
+              double other_radius, const Scratch::Pair& parent, bool split_a, DistanceResult* out) {
+    out->volume_tests += q.size;
+    alignas(16) float bound[4];
+    const float ox = static_cast<float>(other.x()), oy = static_cast<float>(other.y()),
+                oz = static_cast<float>(other.z());
+    const float shift = static_cast<float>(other_radius) + margin_;
+#if defined(__SSE2__)
+    const __m128 dx = _mm_sub_ps(_mm_loadu_ps(x), _mm_set1_ps(ox));
+    const __m128 dy = _mm_sub_ps(_mm_loadu_ps(y), _mm_set1_ps(oy));
+    const __m128 dz = _mm_sub_ps(_mm_loadu_ps(z), _mm_set1_ps(oz));
+    const __m128 squared =
+        _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
+    const __m128 gap = _mm_sub_ps(_mm_sqrt_ps(squared), _mm_loadu_ps(q.radius));
+    _mm_store_ps(bound, _mm_sub_ps(gap, _mm_set1_ps(shift)));
+#else
+    for (int k = 0; k < 4; ++k) {
+      const float dx = x[k] - ox, dy = y[k] - oy, dz = z[k] - oz;
+      bound[k] = (std::sqrt(dx * dx + dy * dy + dz * dz) - q.radius[k]) - shift;
+    }
+#endif
+    Scratch::Pair kept[4];
+    int n = 0;
+    for (int k = 0; k < q.size; ++k) {
+      if (!(static_cast<double>(bound[k]) < threshold_)) continue;
+      Scratch::Pair pair = split_a ? Scratch::Pair{q.child[k], parent.b, bound[k]}
+                                   : Scratch::Pair{parent.a, q.child[k], bound[k]};
+      // Insertion by decreasing bound: the nearest ends last.
+      int at = n++;
+      while (at > 0 && kept[at - 1].bound < pair.bound) {
+        kept[at] = kept[at - 1];
+        --at;
+      }
+      kept[at] = pair;
+    }
+    for (int k = 0; k < n; ++k) s_.stack.push_back(kept[k]);
+  }
+
+  // The double value of one sphere pair (positions in the ordered arrays), computed as the
+  // brute force does; a new best pair when below the threshold.
+  void ComparePair(std::int32_t i, std::int32_t j) {
+    const Sphere& s = a_.ordered_spheres()[static_cast<std::size_t>(i)];
+    const Sphere& t = b_.ordered_spheres()[static_cast<std::size_t>(j)];
+    const double d = (s.center - Move(t.center)).norm() - s.radius - t.radius;
+    if (d < threshold_) {
+      Improve(d, a_.leaf_order()[static_cast<std::size_t>(i)],
+              b_.leaf_order()[static_cast<std::size_t>(j)]);
+    }
+  }
+
+  // Every sphere below a against every sphere below b through the float filter, four at a time;
+  // the pairs it passes go to ComparePair.
+  void CompareAll(const SphereHierarchy::Slot& sa, const SphereHierarchy::Slot& sb,
+                  DistanceResult* out) {
+    const std::int32_t na = sa.count, nb = sb.count;
+    out->sphere_tests += std::int64_t{na} * nb;
+    for (std::int32_t j = sb.first; j < sb.first + nb; ++j) {
+      const auto at = static_cast<std::size_t>(j);
+      if (s_.sphere_stamp[at] == s_.epoch) continue;
+      s_.sphere_stamp[at] = s_.epoch;
+      const Vector3 c = Move(b_.ordered_spheres()[at].center);
+      s_.x[at] = static_cast<float>(c.x());
+      s_.y[at] = static_cast<float>(c.y());
+      s_.z[at] = static_cast<float>(c.z());
+    }
+    const auto fa = static_cast<std::size_t>(sa.first), fb = static_cast<std::size_t>(sb.first);
+    const Side side_a{a_.float_x() + fa,      a_.float_y() + fa, a_.float_z() + fa,
+                      a_.float_radius() + fa, sa.first,          na};
+    const Side side_b{s_.x.data() + fb,       s_.y.data() + fb, s_.z.data() + fb,
+                      b_.float_radius() + fb, sb.first,         nb};
+    // The longer range fills the SIMD lanes.
+    if (nb >= na) {
+      Filter(side_a, side_b, true);
+    } else {
+      Filter(side_b, side_a, false);
+    }
+  }
+
+  // A range of spheres in float (centres in a's frame) and its first position in the ordered
+  // arrays; readable for kFloatPadding entries past its end.
+  struct Side {
+    const float *x, *y, *z, *radius;
+    std::int32_t first, count;
+  };
+
+  // Each row sphere against the lane spheres, four lanes at a time; rows_are_a tells which
+  // side is a's.
+  void Filter(const Side& rows, const Side& lanes, bool rows_are_a) {
+    const std::int32_t nl = lanes.count;
+    for (std::int32_t i = 0; i < rows.count; ++i) {
+      const float reach_i = float_reach_ + rows.radius[i];
+      const auto pass_pair = [&](std::int32_t j) {
+        if (rows_are_a) {
+          ComparePair(rows.first + i, lanes.first + j);
+        } else {
+          ComparePair(lanes.first + j, rows.first + i);
+        }
+      };
+#if defined(__SSE2__)
+      const __m128 x = _mm_set1_ps(rows.x[i]), y = _mm_set1_ps(rows.y[i]),
+                   z = _mm_set1_ps(rows.z[i]);
+      const __m128 reach_row = _mm_set1_ps(reach_i), zero = _mm_setzero_ps();
+      for (std::int32_t j = 0; j < nl; j += 4) {
+        const __m128 dx = _mm_sub_ps(x, _mm_loadu_ps(lanes.x + j));
+        const __m128 dy = _mm_sub_ps(y, _mm_loadu_ps(lanes.y + j));
+        const __m128 dz = _mm_sub_ps(z, _mm_loadu_ps(lanes.z + j));
+        const __m128 squared =
+            _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
+        const __m128 reach = _mm_add_ps(reach_row, _mm_loadu_ps(lanes.radius + j));
+        const __m128 pass =
+            _mm_and_ps(_mm_cmpgt_ps(reach, zero), _mm_cmplt_ps(squared, _mm_mul_ps(reach, reach)));
+        auto mask = static_cast<unsigned>(_mm_movemask_ps(pass));
+        if (nl - j < 4) mask &= (1u << (nl - j)) - 1u;
+        while (mask != 0) {
+          const int k = __builtin_ctz(mask);
+          mask &= mask - 1;
+          pass_pair(j + k);
+        }
+      }
+#else
+      for (std::int32_t j = 0; j < nl; ++j) {
+        const float dx = rows.x[i] - lanes.x[j], dy = rows.y[i] - lanes.y[j],
+                    dz = rows.z[i] - lanes.z[j];
+        const float squared = dx * dx + dy * dy + dz * dz;
+        const float reach = reach_i + lanes.radius[j];
+        if (reach > 0.0f && squared < reach * reach) pass_pair(j);
+      }
+#endif
+    }
+  }
+
+  const SphereHierarchy& a_;
+  const SphereHierarchy& b_;
+  const RelativeFrame& rel_;
+  const DistanceRequest& request_;
+  const bool yes_no_;  // a closer_than query: stop at the first pair below it
+  double best_ = std::numeric_limits<double>::infinity();
+  double threshold_;  // pairs bounded at or above this are pruned
+  std::int32_t best_a_ = -1, best_b_ = -1;
+  const double scale_;  // M
+  const float margin_;
+  float float_reach_ = 0.0f;  // the sphere-pair filter's clamped threshold + margin
+  Scratch& s_;
+};
+
+}  // namespace
+
+bool FloatFilteredSearch(const SphereHierarchy& a, const SphereHierarchy& b,
+                         const RelativeFrame& relative, const DistanceRequest& request,
+                         DistanceResult* out) {
+  // M bounds a's magnitudes, and b's moved ones through the rotation's rows as computed (with a
+  // relative slack for the double rounding of the move).
+  const Eigen::Matrix3d& r = relative.rotation;
+  double row_norm = 0.0;
+  for (int k = 0; k < 3; ++k) row_norm = std::max(row_norm, r.row(k).norm());
+  const double moved =
+      (row_norm * b.max_center_norm() + relative.translation.cwiseAbs().maxCoeff()) * (1.0 + 1e-9);
+  const double bound = std::max({a.max_abs_coordinate(), a.max_radius(), moved, b.max_radius()});
+  // The rotation's departure from orthonormality: |R x| <= sqrt(1 + e) |x| <= (1 + e) |x|, e
+  // the largest absolute row sum of R^T R - I.
+  const double departure =
+      (r.transpose() * r - Eigen::Matrix3d::Identity()).cwiseAbs().rowwise().sum().maxCoeff();
+  if (!std::isfinite(bound) || !(bound > 0.0) || !std::isfinite(departure) || departure > 1e-3) {
+    return false;
+  }
+  const int exponent = std::ilogb(bound) + 1;  // M = 2^exponent > bound
+  if (exponent < kFloatMinExponent || exponent > kFloatMaxExponent) return false;
+  const double scale = std::ldexp(1.0, exponent);
+  const double margin = std::ldexp(1.0, exponent + kFloatMarginExponent) + 4.0 * departure * scale;
+  thread_local Scratch scratch;
+  FloatSearch(a, b, relative, request, scale, margin, scratch).Run(out);
+  return true;
+}
+
+}  // namespace inscribe::internal

@@ -1,0 +1,41 @@
+// The float-filtered branch and bound behind SeparationDistance (separation_distance.h): the
+// fast path for sets whose magnitudes let float rounding be bounded.
+#pragma once
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+
+#include "inscribe/separation_distance.h"
+#include "inscribe/sphere_hierarchy.h"
+
+namespace inscribe::internal {
+
+// b's frame seen from a's: x_a = rotation * x_b + translation (rotation as computed from the
+// poses, unit to rounding).
+struct RelativeFrame {
+  Eigen::Matrix3d rotation;
+  Vector3 translation;
+};
+
+// The pruning threshold once a pair of value d is the best found: pairs bounded at or above it
+// cannot improve the answer beyond the request's tolerance, or cannot answer closer_than yes.
+inline double PruneThreshold(const DistanceRequest& request, double d) {
+  const double tolerance = std::max(request.abs_err, request.rel_err * std::abs(d));
+  return std::min({d - tolerance, request.closer_than, request.max_distance});
+}
+
+// The exact answer of SeparationDistance (without witnesses) by a depth-first branch and
+// bound over the hierarchies' Quads (up to four children per step, their bounds computed four
+// at a time in float) and float-filtered comparisons of the sphere pairs below small node
+// pairs; every pair the filters let through is evaluated in double exactly as
+// BruteForceSeparationDistance does. Returns false, leaving *out alone, when the sets' and
+// the pose's magnitudes fall outside the range where the float margins are proven
+// (kFloatMinExponent, kFloatMaxExponent in the .cpp): the caller then runs the double search.
+// Cost: about O(log n) steps per query on separated sets; memory: per-thread scratch of
+// O(b's spheres), kept between queries.
+bool FloatFilteredSearch(const SphereHierarchy& a, const SphereHierarchy& b,
+                         const RelativeFrame& relative, const DistanceRequest& request,
+                         DistanceResult* out);
+
+}  // namespace inscribe::internal

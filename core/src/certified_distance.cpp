@@ -68,6 +68,34 @@ CloserAnswer DecideCloser(double lower, double upper, double closer_than) {
   return CloserAnswer::kUndecided;
 }
 
+absl::StatusOr<double> CertifiedDistanceMargin(const CertifiedObject& a, const RigidPose& pose_a,
+                                               const CertifiedObject& b, const RigidPose& pose_b) {
+  const double scale =
+      Extent(a) + Extent(b) + pose_a.translation.norm() + pose_b.translation.norm();
+  if (!(scale <= kCertifiedDistanceMaxScale)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("coordinates reach ", scale, " mesh units, beyond the ",
+                     kCertifiedDistanceMaxScale, " that certified distances support"));
+  }
+  return kCertifiedDistanceMargin * scale + kCertifiedDistanceFloor;
+}
+
+CertifiedDistanceResult CertifiedInterval(DistanceResult internal, DistanceResult cover,
+                                          double deltas, double margin, double closer_than) {
+  CertifiedDistanceResult r;
+  const double covers = cover.distance;
+  r.lower = std::max(0.0, covers - margin);
+  r.upper = std::max(0.0, std::min(internal.distance, std::max(0.0, covers) + deltas) + margin);
+  // Covers that are no closer than the internal sets, less the margins, can only come from
+  // sets that are not what they claim: keep the interval ordered regardless.
+  r.upper = std::max(r.upper, r.lower);
+  r.closer = std::isfinite(closer_than) ? DecideCloser(r.lower, r.upper, closer_than)
+                                        : CloserAnswer::kUndecided;
+  r.internal = std::move(internal);
+  r.cover = std::move(cover);
+  return r;
+}
+
 absl::StatusOr<std::vector<CertifiedDistanceResult>> CertifiedDistances(
     const std::vector<CertifiedPair>& pairs, double closer_than, const std::atomic<bool>* cancel) {
   if (std::isnan(closer_than)) return absl::InvalidArgumentError("closer_than is NaN");
@@ -87,14 +115,9 @@ absl::StatusOr<std::vector<CertifiedDistanceResult>> CertifiedDistances(
     if (!pose_b.ok()) return PairError(i, pose_b.status());
     internal[i] = PosedPair{p.a->internal, p.b->internal, *pose_a, *pose_b};
     cover[i] = PosedPair{p.a->cover, p.b->cover, *pose_a, *pose_b};
-    const double scale =
-        Extent(*p.a) + Extent(*p.b) + pose_a->translation.norm() + pose_b->translation.norm();
-    if (!(scale <= kCertifiedDistanceMaxScale)) {
-      return PairError(i, absl::InvalidArgumentError(absl::StrCat(
-                              "coordinates reach ", scale, " mesh units, beyond the ",
-                              kCertifiedDistanceMaxScale, " that certified distances support")));
-    }
-    margin[i] = kCertifiedDistanceMargin * scale + kCertifiedDistanceFloor;
+    absl::StatusOr<double> m = CertifiedDistanceMargin(*p.a, *pose_a, *p.b, *pose_b);
+    if (!m.ok()) return PairError(i, m.status());
+    margin[i] = *m;
   }
   // Exact sphere distances (no tolerance): a bound that stopped early would not be sound.
   absl::StatusOr<std::vector<DistanceResult>> inner = PairSeparationDistances(internal, {}, cancel);
@@ -102,21 +125,12 @@ absl::StatusOr<std::vector<CertifiedDistanceResult>> CertifiedDistances(
   absl::StatusOr<std::vector<DistanceResult>> outer = PairSeparationDistances(cover, {}, cancel);
   if (!outer.ok()) return outer.status();
 
-  std::vector<CertifiedDistanceResult> out(pairs.size());
+  std::vector<CertifiedDistanceResult> out;
+  out.reserve(pairs.size());
   for (std::size_t i = 0; i < pairs.size(); ++i) {
-    CertifiedDistanceResult& r = out[i];
-    const double covers = (*outer)[i].distance;
-    const double deltas = pairs[i].a->cover_delta + pairs[i].b->cover_delta;
-    r.lower = std::max(0.0, covers - margin[i]);
-    r.upper =
-        std::max(0.0, std::min((*inner)[i].distance, std::max(0.0, covers) + deltas) + margin[i]);
-    // Covers that are no closer than the internal sets, less the margins, can only come from
-    // sets that are not what they claim: keep the interval ordered regardless.
-    r.upper = std::max(r.upper, r.lower);
-    r.closer = std::isfinite(closer_than) ? DecideCloser(r.lower, r.upper, closer_than)
-                                          : CloserAnswer::kUndecided;
-    r.internal = std::move((*inner)[i]);
-    r.cover = std::move((*outer)[i]);
+    out.push_back(CertifiedInterval(std::move((*inner)[i]), std::move((*outer)[i]),
+                                    pairs[i].a->cover_delta + pairs[i].b->cover_delta, margin[i],
+                                    closer_than));
   }
   return out;
 }

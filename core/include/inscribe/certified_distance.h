@@ -90,6 +90,20 @@ struct CertifiedPair {
   RigidPose pose_a, pose_b;
 };
 
+// The margin on a posed pair's bounds (kCertifiedDistanceMargin times its coordinate scale,
+// plus kCertifiedDistanceFloor), for poses already normalised. INVALID_ARGUMENT for a scale
+// above kCertifiedDistanceMaxScale. O(1).
+absl::StatusOr<double> CertifiedDistanceMargin(const CertifiedObject& a, const RigidPose& pose_a,
+                                               const CertifiedObject& b, const RigidPose& pose_b);
+
+// The interval from the two exact sphere queries of a pair: `cover` between the covers,
+// `internal` between the internal sets (it may have been limited to max_distance =
+// max(0, cover distance) + the two deltas: a distance of +infinity then means "no closer",
+// which gives the same upper bound). `deltas` is the sum of the covers' deltas, `margin`
+// CertifiedDistanceMargin's. O(1).
+CertifiedDistanceResult CertifiedInterval(DistanceResult internal, DistanceResult cover,
+                                          double deltas, double margin, double closer_than);
+
 // The interval for every pair (entry i answers pairs[i]), and the closer-than answer when
 // closer_than is finite. Poses are normalised first (NormalizedPose): the exact distance is
 // that of the solids under the rotation of the unit quaternion. Parallel (TBB) like

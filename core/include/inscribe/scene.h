@@ -60,15 +60,16 @@ absl::Status CheckSceneObject(const SceneObject& object);
 
 struct SceneQuery {
   // Pairs closer than this are reported (mesh units; negative asks for overlaps deeper than
-  // -threshold; +infinity for every pair). A certified pair is reported when its lower bound
-  // is below it (it may be closer).
+  // -threshold; +infinity for every pair). A certified pair is reported when its solids may be
+  // closer: when its covers' distance less the margin (its lower bound before clamping at 0)
+  // is below the threshold; a pair left out is certainly no closer.
   double threshold = 0.0;
   // Tolerances of the plain distances (DistanceRequest::abs_err, rel_err); certified intervals
   // are always computed exactly.
   double abs_err = 0.0;
   double rel_err = 0.0;
-  // At most this many pairs are returned: the nearest ones (by distance, or by lower bound for
-  // certified pairs), with SceneFrame::truncated set when more were close.
+  // At most this many pairs are returned: the nearest ones (by distance, or by the covers'
+  // distance for certified pairs), with SceneFrame::truncated set when more were close.
   std::size_t max_pairs = 100'000;
 };
 
@@ -127,22 +128,33 @@ class Scene {
 
  private:
   struct Entry {
-    SceneObject object;
-    CertifiedObject certified;  // points into object's hierarchies when certified
-    Vector3 local_center;       // the bounding sphere in the object's frame
+    SceneObject object;         // pose normalised
+    CertifiedObject certified;  // points into object's internal and cover when certified
+    // A sphere around everything the object's queries read (spheres, internal, cover), in its
+    // own frame and at its pose.
+    Vector3 local_center = Vector3::Zero();
     double radius = 0.0;
-    Vector3 world_center;  // updated with the pose
+    Vector3 world_center = Vector3::Zero();
+    // |translation| + |local_center| + radius: the coordinate scale of the broad phase's
+    // rounding slack.
+    double scale = 0.0;
   };
   // The ignore list's key: the two ids, smaller first.
   static std::pair<SceneObjectId, SceneObjectId> PairKey(SceneObjectId a, SceneObjectId b) {
     return a < b ? std::make_pair(a, b) : std::make_pair(b, a);
   }
-  static void Place(Entry* entry);
+  // The pairs the broad phase keeps, as positions in objects_.
+  void Sweep(double threshold, std::vector<std::pair<std::uint32_t, std::uint32_t>>* out);
 
-  std::vector<Entry> objects_;                                // dense; Remove moves the last in
-  absl::flat_hash_map<SceneObjectId, std::size_t> index_;     // id -> position in objects_
+  std::vector<Entry> objects_;                             // dense; Remove moves the last in
+  absl::flat_hash_map<SceneObjectId, std::size_t> index_;  // id -> position in objects_
   absl::flat_hash_set<std::pair<SceneObjectId, SceneObjectId>> ignored_;  // PairKey
-  std::vector<std::uint32_t> order_;  // objects_ positions sorted along the sweep axis
+  // objects_ positions sorted by the low end of their bounding spheres along sweep_axis_;
+  // re-sorted from scratch after Add or Remove (order_valid_ false) or an axis change, else by
+  // insertion from the last frame's order.
+  std::vector<std::uint32_t> order_;
+  int sweep_axis_ = 0;
+  bool order_valid_ = false;
 };
 
 }  // namespace inscribe

@@ -1,0 +1,475 @@
+// Simulator scenes (issue 25): N objects drawn from the CGAL demo meshes move randomly inside a
+// box; every frame sets all their poses and asks for every pair closer than a threshold, with
+// its distance. Timed in-process (core's Scene on TBB's threads, and on one thread) next to
+// FCL's broad-phase manager on the same poses and the same meshes: DynamicAABBTreeCollisionManager
+// over AABBs grown by the threshold, then fcl::distance on every pair it hands over (the same
+// answer: every pair closer than the threshold, with its distance), and collision alone
+// (fcl::collide on the pairs whose AABBs overlap). Optional rows with certified objects
+// (covers and their cores: intervals instead of distances).
+//
+// Every model is scaled so that its bounding box's largest side is 1; the box's side is chosen
+// so that each object has a few neighbours within reach (`--spacing` object sizes between
+// neighbouring centres). Each frame every object moves by up to `--step` of its size and turns
+// by up to `--turn` radians, bouncing off the box's walls.
+//
+//   scene_bench [--models eight,cow,...] [--objects 16,64,256] [--frames N] [--fcl-frames N]
+//               [--spheres N] [--threshold T] [--certified] [--check-every K] [--seed S]
+//
+// Exit status: 0 every check passed (targets are reported, not enforced); 1 a frame (every
+// K-th) differs from the brute force over all pairs of objects and all pairs of spheres; 2 a
+// model could not be prepared.
+#include <fcl/fcl.h>
+#include <tbb/global_control.h>
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <map>
+#include <memory>
+#include <random>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "absl/strings/str_format.h"
+#include "absl/strings/str_join.h"
+#include "inscribe/certified_distance.h"
+#include "inscribe/mesh_io.h"
+#include "inscribe/scene.h"
+#include "inscribe/solid.h"
+#include "inscribe/sphere_cover.h"
+#include "inscribe/sphere_set_generation.h"
+#include "support/fcl_solid_distance.h"
+
+namespace {
+
+using namespace inscribe;
+using Clock = std::chrono::steady_clock;
+using testing::BuildFclMesh;
+using testing::FclMesh;
+using testing::ToFcl;
+
+constexpr double kTargetFps = 1000.0;     // a 64-object scene
+constexpr double kTargetSpeedup = 30.0;   // against FCL's broad plus narrow phase
+constexpr double kAgreement = 1e-9;
+
+struct Options {
+  std::vector<std::string> models = {"eight", "cow", "elephant", "knot1", "fandisk", "pig"};
+  std::vector<int> objects = {16, 64, 256};
+  int frames = 2000;
+  int fcl_frames = 100;
+  std::int64_t spheres = 200;
+  double threshold = 0.05;  // object sizes
+  double spacing = 1.6;     // object sizes between neighbouring centres
+  double step = 0.01;       // object sizes per frame
+  double turn = 0.02;       // radians per frame
+  bool certified = false;
+  int check_every = 100;
+  std::uint64_t seed = 1;
+  std::string data_dir;
+};
+
+// One model: its sphere sets' hierarchies and FCL's tree over the same (scaled) mesh.
+struct Model {
+  std::string name;
+  std::int64_t triangles = 0;
+  std::shared_ptr<const SphereHierarchy> spheres, internal, cover;
+  double cover_delta = 0.0;
+  std::shared_ptr<FclMesh> fcl;
+};
+
+Mesh ScaledToUnitBox(Mesh mesh) {
+  const BoundingBox box = ComputeBoundingBox(mesh.vertices);
+  const Vector3 centre = 0.5 * (box.min + box.max);
+  const double scale = 1.0 / box.extent().maxCoeff();
+  for (Eigen::Index i = 0; i < mesh.vertices.rows(); ++i) {
+    mesh.vertices.row(i) = ((mesh.vertices.row(i).transpose() - centre) * scale).transpose();
+  }
+  return mesh;
+}
+
+absl::StatusOr<std::shared_ptr<const SphereHierarchy>> Share(std::vector<Sphere> spheres) {
+  absl::StatusOr<SphereHierarchy> h =
+      SphereHierarchy::Build(std::move(spheres), HierarchyVolume::kSphere);
+  if (!h.ok()) return h.status();
+  return std::make_shared<const SphereHierarchy>(*std::move(h));
+}
+
+absl::StatusOr<Model> PrepareModel(const std::string& name, const Options& options) {
+  absl::StatusOr<Mesh> read = ReadMesh(options.data_dir + "/" + name + ".off");
+  if (!read.ok()) return read.status();
+  SolidOptions solid_options;
+  solid_options.validate.fill_holes = true;  // pig.off is open
+  absl::StatusOr<Solid> solid = PrepareSolid(ScaledToUnitBox(*std::move(read)), solid_options);
+  if (!solid.ok()) return solid.status();
+  Model model;
+  model.name = name;
+  model.triangles = solid->mesh().num_triangles();
+  model.fcl = BuildFclMesh(solid->mesh());
+  SphereSetParameters parameters;
+  parameters.kind = SphereSetKind::kDilated;
+  parameters.max_spheres = options.spheres;
+  parameters.evaluate = false;
+  absl::StatusOr<GeneratedSphereSet> dilated = GenerateSphereSet(*solid, parameters);
+  if (!dilated.ok()) return dilated.status();
+  absl::StatusOr<std::shared_ptr<const SphereHierarchy>> spheres = Share(dilated->set.spheres);
+  if (!spheres.ok()) return spheres.status();
+  model.spheres = *spheres;
+  if (options.certified) {
+    parameters.kind = SphereSetKind::kCover;
+    absl::StatusOr<GeneratedSphereSet> cover = GenerateSphereSet(*solid, parameters);
+    if (!cover.ok()) return cover.status();
+    absl::StatusOr<std::vector<Sphere>> cores = UpperBoundSpheres(
+        {}, cover->set.spheres, cover->cover->certificate.protrusions);
+    if (!cores.ok()) return cores.status();
+    absl::StatusOr<std::shared_ptr<const SphereHierarchy>> internal = Share(*cores);
+    if (!internal.ok()) return internal.status();
+    absl::StatusOr<std::shared_ptr<const SphereHierarchy>> covering = Share(cover->set.spheres);
+    if (!covering.ok()) return covering.status();
+    model.internal = *internal;
+    model.cover = *covering;
+    model.cover_delta = cover->cover->certificate.delta;
+  }
+  return model;
+}
+
+// Every object's pose at every frame: a random walk inside a box, the same for every run.
+struct Motion {
+  std::vector<std::size_t> model;           // per object
+  std::vector<std::vector<RigidPose>> pose;  // [frame][object]
+  double box = 0.0;
+};
+
+Motion MakeMotion(int objects, int frames, std::size_t models, const Options& options,
+                  std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::normal_distribution<double> normal;
+  Motion m;
+  m.box = options.spacing * std::cbrt(static_cast<double>(objects));
+  std::vector<RigidPose> now(static_cast<std::size_t>(objects));
+  std::vector<Vector3> velocity(now.size());
+  const auto random_direction = [&] {
+    Vector3 v(normal(rng), normal(rng), normal(rng));
+    return Vector3(v.normalized());
+  };
+  for (std::size_t i = 0; i < now.size(); ++i) {
+    m.model.push_back(i % models);
+    now[i].rotation = Eigen::Quaterniond(normal(rng), normal(rng), normal(rng), normal(rng));
+    now[i].rotation.normalize();
+    now[i].translation = Vector3(unit(rng), unit(rng), unit(rng)) * m.box;
+    velocity[i] = random_direction() * options.step * unit(rng);
+  }
+  for (int f = 0; f < frames; ++f) {
+    for (std::size_t i = 0; i < now.size(); ++i) {
+      // The velocity drifts; walls reflect it.
+      velocity[i] = (velocity[i] + 0.2 * options.step * random_direction()).normalized() *
+                    options.step;
+      Vector3& t = now[i].translation;
+      t += velocity[i];
+      for (int k = 0; k < 3; ++k) {
+        if (t[k] < 0.0 || t[k] > m.box) {
+          velocity[i][k] = -velocity[i][k];
+          t[k] = std::clamp(t[k], 0.0, m.box);
+        }
+      }
+      const Eigen::Quaterniond spin(Eigen::AngleAxisd(options.turn * unit(rng), random_direction()));
+      now[i].rotation = (spin * now[i].rotation).normalized();
+    }
+    m.pose.push_back(now);
+  }
+  return m;
+}
+
+struct Timing {
+  double fps = 0.0, p50_us = 0.0, p99_us = 0.0;
+  double candidates = 0.0, close = 0.0;  // per frame, means
+};
+
+Timing Summarise(std::vector<double> seconds, double candidates, double close) {
+  Timing t;
+  double total = 0.0;
+  for (double s : seconds) total += s;
+  t.fps = static_cast<double>(seconds.size()) / total;
+  std::sort(seconds.begin(), seconds.end());
+  t.p50_us = 1e6 * seconds[seconds.size() / 2];
+  t.p99_us = 1e6 * seconds[std::min(seconds.size() - 1, seconds.size() * 99 / 100)];
+  t.candidates = candidates / static_cast<double>(seconds.size());
+  t.close = close / static_cast<double>(seconds.size());
+  return t;
+}
+
+// The scene for a motion: object i has id i.
+Scene MakeScene(const Motion& motion, const std::vector<Model>& models, bool certified) {
+  Scene scene;
+  for (std::size_t i = 0; i < motion.model.size(); ++i) {
+    const Model& m = models[motion.model[i]];
+    SceneObject o;
+    o.id = i;
+    o.spheres = m.spheres;
+    if (certified) {
+      o.internal = m.internal;
+      o.cover = m.cover;
+      o.cover_delta = m.cover_delta;
+    }
+    o.pose = motion.pose[0][i];
+    if (!scene.Add(std::move(o)).ok()) std::abort();
+  }
+  return scene;
+}
+
+// The brute force over all pairs of objects and spheres (CertifiedDistances for certified
+// pairs) at one frame; true when the scene's frame equals it.
+bool MatchesBruteForce(const SceneFrame& frame, const Motion& motion, int f,
+                       const std::vector<Model>& models, bool certified, double threshold) {
+  std::map<std::pair<SceneObjectId, SceneObjectId>, ScenePair> expected;
+  const auto& poses = motion.pose[static_cast<std::size_t>(f)];
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    for (std::size_t j = i + 1; j < poses.size(); ++j) {
+      const Model& a = models[motion.model[i]];
+      const Model& b = models[motion.model[j]];
+      ScenePair p;
+      p.a = i;
+      p.b = j;
+      if (certified) {
+        const CertifiedObject ca{a.internal.get(), a.cover.get(), a.cover_delta};
+        const CertifiedObject cb{b.internal.get(), b.cover.get(), b.cover_delta};
+        absl::StatusOr<double> margin = CertifiedDistanceMargin(ca, poses[i], cb, poses[j]);
+        absl::StatusOr<DistanceResult> covers = BruteForceSeparationDistance(
+            a.cover->spheres(), poses[i], b.cover->spheres(), poses[j]);
+        if (!margin.ok() || !covers.ok()) return false;
+        if (!(covers->distance - *margin < threshold)) continue;
+        absl::StatusOr<std::vector<CertifiedDistanceResult>> interval =
+            CertifiedDistances({CertifiedPair{&ca, &cb, poses[i], poses[j]}});
+        if (!interval.ok()) return false;
+        p.certified = true;
+        p.lower = (*interval)[0].lower;
+        p.upper = (*interval)[0].upper;
+        p.result = *covers;
+      } else {
+        absl::StatusOr<DistanceResult> r = BruteForceSeparationDistance(
+            a.spheres->spheres(), poses[i], b.spheres->spheres(), poses[j]);
+        if (!r.ok()) return false;
+        if (!(r->distance < threshold)) continue;
+        p.result = *r;
+      }
+      expected[{p.a, p.b}] = p;
+    }
+  }
+  if (expected.size() != frame.pairs.size()) {
+    std::fprintf(stderr, "frame %d: %zu close pairs, brute force %zu\n", f, frame.pairs.size(),
+                 expected.size());
+    return false;
+  }
+  for (const ScenePair& p : frame.pairs) {
+    const auto it = expected.find({p.a, p.b});
+    const bool same =
+        it != expected.end() &&
+        std::abs(it->second.result.distance - p.result.distance) <= kAgreement &&
+        (!certified || (std::abs(it->second.lower - p.lower) <= kAgreement &&
+                        std::abs(it->second.upper - p.upper) <= kAgreement));
+    if (!same) {
+      std::fprintf(stderr, "frame %d: pair (%llu, %llu) differs from the brute force\n", f,
+                   static_cast<unsigned long long>(p.a), static_cast<unsigned long long>(p.b));
+      return false;
+    }
+  }
+  return true;
+}
+
+// Core's scene: every frame sets every pose and asks for the close pairs.
+Timing RunScene(const Motion& motion, const std::vector<Model>& models, bool certified,
+                const Options& options, int frames, bool check, int* failures) {
+  Scene scene = MakeScene(motion, models, certified);
+  SceneQuery query;
+  query.threshold = options.threshold;
+  std::vector<std::pair<SceneObjectId, RigidPose>> moves(motion.model.size());
+  std::vector<double> seconds;
+  double candidates = 0.0, close = 0.0;
+  for (int f = 0; f < frames; ++f) {
+    const auto& poses = motion.pose[static_cast<std::size_t>(f)];
+    const Clock::time_point start = Clock::now();
+    for (std::size_t i = 0; i < poses.size(); ++i) moves[i] = {i, poses[i]};
+    if (!scene.SetPoses(moves).ok()) std::abort();
+    absl::StatusOr<SceneFrame> frame = scene.ClosePairs(query);
+    seconds.push_back(std::chrono::duration<double>(Clock::now() - start).count());
+    if (!frame.ok()) std::abort();
+    candidates += static_cast<double>(frame->candidate_pairs);
+    close += static_cast<double>(frame->close_pairs);
+    if (check && f % options.check_every == 0 &&
+        !MatchesBruteForce(*frame, motion, f, models, certified, options.threshold)) {
+      ++*failures;
+    }
+  }
+  return Summarise(std::move(seconds), candidates, close);
+}
+
+// FCL's manager: every frame sets every transform, updates the tree and runs `collide` with a
+// callback doing the narrow phase. `distance`: AABBs grown by half the threshold each side,
+// fcl::distance on every pair handed over, counted when closer than the threshold; else
+// fcl::collide on every pair whose AABBs overlap.
+Timing RunFcl(const Motion& motion, const std::vector<Model>& models, const Options& options,
+              int frames, bool distance) {
+  // FCL keeps an object's world AABB protected; a subclass grows it after computeAABB.
+  struct Object : fcl::CollisionObjectd {
+    using fcl::CollisionObjectd::CollisionObjectd;
+    void Grow(double by) {
+      aabb.min_ -= fcl::Vector3d::Constant(by);
+      aabb.max_ += fcl::Vector3d::Constant(by);
+    }
+  };
+  std::vector<std::unique_ptr<Object>> objects;
+  for (std::size_t i = 0; i < motion.model.size(); ++i) {
+    objects.push_back(std::make_unique<Object>(models[motion.model[i]].fcl));
+  }
+  fcl::DynamicAABBTreeCollisionManagerd manager;
+  std::vector<fcl::CollisionObjectd*> raw;
+  for (auto& o : objects) raw.push_back(o.get());
+  const double grow = distance ? 0.5 * options.threshold : 0.0;
+  const auto place = [&](int f) {
+    const auto& poses = motion.pose[static_cast<std::size_t>(f)];
+    for (std::size_t i = 0; i < objects.size(); ++i) {
+      objects[i]->setTransform(ToFcl(poses[i]));
+      objects[i]->computeAABB();
+      objects[i]->Grow(grow);
+    }
+  };
+  place(0);
+  manager.registerObjects(raw);
+  manager.setup();
+  struct Data {
+    double threshold;
+    bool distance;
+    std::int64_t candidates = 0, close = 0;
+  } data{options.threshold, distance};
+  const auto callback = [](fcl::CollisionObjectd* a, fcl::CollisionObjectd* b, void* p) {
+    Data& d = *static_cast<Data*>(p);
+    ++d.candidates;
+    if (d.distance) {
+      fcl::DistanceRequestd request;
+      request.rel_err = 0.0;
+      request.abs_err = 0.0;
+      fcl::DistanceResultd result;
+      d.close += fcl::distance(a, b, request, result) < d.threshold;
+    } else {
+      fcl::CollisionRequestd request;
+      fcl::CollisionResultd result;
+      d.close += fcl::collide(a, b, request, result) > 0;
+    }
+    return false;  // go on
+  };
+  std::vector<double> seconds;
+  for (int f = 0; f < frames; ++f) {
+    const Clock::time_point start = Clock::now();
+    place(f);
+    manager.update();
+    manager.collide(&data, callback);
+    seconds.push_back(std::chrono::duration<double>(Clock::now() - start).count());
+  }
+  return Summarise(std::move(seconds), static_cast<double>(data.candidates),
+                   static_cast<double>(data.close));
+}
+
+std::vector<std::string> SplitNames(const std::string& list) {
+  std::vector<std::string> out;
+  std::size_t start = 0;
+  while (start <= list.size()) {
+    const std::size_t comma = list.find(',', start);
+    const std::size_t end = comma == std::string::npos ? list.size() : comma;
+    if (end > start) out.push_back(list.substr(start, end - start));
+    start = end + 1;
+  }
+  return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options options;
+  options.data_dir = INSCRIBE_SOURCE_DIR "/data";
+  if (const char* env = std::getenv("INSCRIBE_DATA_DIR")) options.data_dir = env;
+  CLI::App app{"Scenes of many moving objects: core's Scene against FCL's broad-phase manager"};
+  std::string models = absl::StrJoin(options.models, ",");
+  std::string objects = "16,64,256";
+  app.add_option("--models", models, "meshes of the data directory, comma-separated");
+  app.add_option("--objects", objects, "scene sizes, comma-separated");
+  app.add_option("--frames", options.frames, "frames per scene (core)")->check(CLI::PositiveNumber);
+  app.add_option("--fcl-frames", options.fcl_frames, "frames per scene (FCL)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--spheres", options.spheres, "sphere budget per model")->check(CLI::PositiveNumber);
+  app.add_option("--threshold", options.threshold, "pairs closer than this, object sizes");
+  app.add_option("--spacing", options.spacing, "object sizes between neighbouring centres");
+  app.add_option("--step", options.step, "largest move per frame, object sizes");
+  app.add_flag("--certified", options.certified, "also run scenes of certified objects");
+  app.add_option("--check-every", options.check_every, "brute-force check every K-th frame")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--seed", options.seed, "random seed");
+  app.add_option("--data", options.data_dir, "directory of the .off meshes");
+  CLI11_PARSE(app, argc, argv);
+  options.models = SplitNames(models);
+  options.objects.clear();
+  for (const std::string& n : SplitNames(objects)) options.objects.push_back(std::stoi(n));
+
+  std::vector<Model> prepared;
+  for (const std::string& name : options.models) {
+    const Clock::time_point start = Clock::now();
+    absl::StatusOr<Model> m = PrepareModel(name, options);
+    if (!m.ok()) {
+      std::fprintf(stderr, "%s: %s\n", name.c_str(), std::string(m.status().message()).c_str());
+      return 2;
+    }
+    std::fprintf(stderr, "%s: %lld triangles, %zu spheres%s (%.1f s)\n", name.c_str(),
+                 static_cast<long long>(m->triangles), m->spheres->spheres().size(),
+                 options.certified
+                     ? absl::StrFormat(", cover %zu, delta %.4f", m->cover->spheres().size(),
+                                       m->cover_delta)
+                           .c_str()
+                     : "",
+                 std::chrono::duration<double>(Clock::now() - start).count());
+    prepared.push_back(*std::move(m));
+  }
+
+  int failures = 0;
+  std::printf("Scenes: %s; threshold %.3g object sizes; %zu models; frames: core %d, FCL %d\n\n",
+              absl::StrJoin(options.objects, ", ").c_str(), options.threshold, prepared.size(),
+              options.frames, options.fcl_frames);
+  std::printf(
+      "| objects | kind | close pairs / frame | FCL close pairs / frame | candidates / frame | core fps | core p99 us | "
+      "core 1-thread fps | FCL distance fps | FCL collide fps | core / FCL distance | core / FCL "
+      "collide | >= %.0fx | >= %.0f fps |\n",
+      kTargetSpeedup, kTargetFps);
+  std::printf("|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---|\n");
+  for (const int n : options.objects) {
+    const int frames = std::max(options.frames, options.fcl_frames);
+    const Motion motion =
+        MakeMotion(n, frames, prepared.size(), options, options.seed + static_cast<unsigned>(n));
+    const Timing fcl_distance = RunFcl(motion, prepared, options, options.fcl_frames, true);
+    const Timing fcl_collide = RunFcl(motion, prepared, options, options.fcl_frames, false);
+    for (const bool certified : {false, true}) {
+      if (certified && !options.certified) continue;
+      const Timing core =
+          RunScene(motion, prepared, certified, options, options.frames, true, &failures);
+      Timing single;
+      {
+        tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+        single = RunScene(motion, prepared, certified, options, options.frames, false, &failures);
+      }
+      const double ratio = core.fps / fcl_distance.fps;
+      std::printf(
+          "| %d | %s | %.1f | %.1f | %.1f | %.0f | %.0f | %.0f | %.1f | %.1f | %.1f | %.1f | %s | "
+          "%s |\n",
+          n, certified ? "certified" : "distance", core.close, fcl_distance.close, core.candidates,
+          core.fps,
+          core.p99_us, single.fps, fcl_distance.fps, fcl_collide.fps, ratio,
+          core.fps / fcl_collide.fps, ratio >= kTargetSpeedup ? "pass" : "FAIL",
+          n != 64 ? "-" : (core.fps >= kTargetFps ? "pass" : "FAIL"));
+      std::fflush(stdout);
+    }
+  }
+  std::printf("\nFrames checked against the brute force (every %d-th): %d failed\n",
+              options.check_every, failures);
+  return failures == 0 ? 0 : 1;
+}

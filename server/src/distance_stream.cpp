@@ -13,11 +13,11 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "drainable_stream.h"
 #include "inscribe/certified_distance.h"
 #include "inscribe/separation_distance.h"
 #include "inscribe/server/inscribe_service.h"
 #include "inscribe/wire/convert.h"
-#include "drainable_stream.h"
 #include "memory_budget.h"
 #include "result_store.h"
 #include "service_checks.h"

@@ -203,9 +203,8 @@ absl::StatusOr<std::unique_ptr<InscribeServer>> InscribeServer::Start(
                               options.limits, std::move(observe), *std::move(authenticate));
   if (!options.metrics_listen.empty()) {
     // Set before the server starts, so call threads read it without a lock.
-    absl::StatusOr<std::unique_ptr<ServiceMetrics>> started =
-        ServiceMetrics::Start(options.metrics_listen, parts->cache.get(), &parts->pool,
-                              &parts->service);
+    absl::StatusOr<std::unique_ptr<ServiceMetrics>> started = ServiceMetrics::Start(
+        options.metrics_listen, parts->cache.get(), &parts->pool, &parts->service);
     if (!started.ok()) return started.status();
     parts->metrics_port = (*started)->port();
     *metrics = *std::move(started);

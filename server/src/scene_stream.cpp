@@ -15,10 +15,10 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "drainable_stream.h"
 #include "inscribe/scene.h"
 #include "inscribe/server/inscribe_service.h"
 #include "inscribe/wire/convert.h"
-#include "drainable_stream.h"
 #include "memory_budget.h"
 #include "result_store.h"
 #include "service_checks.h"
@@ -75,7 +75,8 @@ class SceneStreamReactor final : public grpc::ServerBidiReactor<v1::SceneMessage
       return;
     }
     if (absl::Status s = Admit(); !s.ok()) {
-      FinishLocked(absl::Status(s.code(), absl::StrCat("frame ", message_.frame(), " ", s.message())));
+      FinishLocked(
+          absl::Status(s.code(), absl::StrCat("frame ", message_.frame(), " ", s.message())));
       return;
     }
     state_ = State::kBusy;
@@ -136,8 +137,8 @@ class SceneStreamReactor final : public grpc::ServerBidiReactor<v1::SceneMessage
           "volume: only the first message chooses the hierarchy volume");
     }
     if (message_.has_query()) {
-      absl::StatusOr<SceneQuery> query = wire::SceneQueryFromProto(
-          message_.query(), limits.max_scene_pairs, "--max-scene-pairs");
+      absl::StatusOr<SceneQuery> query =
+          wire::SceneQueryFromProto(message_.query(), limits.max_scene_pairs, "--max-scene-pairs");
       if (!query.ok()) return query.status();
       pending_query_ = *query;
     } else {
@@ -152,10 +153,9 @@ class SceneStreamReactor final : public grpc::ServerBidiReactor<v1::SceneMessage
                        limits.max_scene_objects, " per scene"));
     }
     if (message_.pose_ids_size() > limits.max_scene_objects) {
-      return absl::ResourceExhaustedError(
-          absl::StrCat("has ", message_.pose_ids_size(),
-                       " poses; this server's limit (--max-scene-objects) is ",
-                       limits.max_scene_objects, " per scene"));
+      return absl::ResourceExhaustedError(absl::StrCat(
+          "has ", message_.pose_ids_size(), " poses; this server's limit (--max-scene-objects) is ",
+          limits.max_scene_objects, " per scene"));
     }
     const std::int64_t ignored = ignored_sent_ + message_.ignore_size() / 2;
     if (ignored > limits.max_scene_ignored) {
@@ -182,10 +182,9 @@ class SceneStreamReactor final : public grpc::ServerBidiReactor<v1::SceneMessage
   // Hands the message to the job pool (refused: RESOURCE_EXHAUSTED naming --max-queue). The
   // small-job lane takes scenes whose objects and last frame's candidate pairs are small.
   void Dispatch(ServiceClock::time_point arrived) {
-    const std::int64_t work =
-        static_cast<std::int64_t>(scene_.size() + message_.add_size()) *
-            MemoryCosts::kPerSceneObject +
-        last_candidates_ * MemoryCosts::kPerScenePair;
+    const std::int64_t work = static_cast<std::int64_t>(scene_.size() + message_.add_size()) *
+                                  MemoryCosts::kPerSceneObject +
+                              last_candidates_ * MemoryCosts::kPerScenePair;
     const JobSize size = work <= MemoryCosts::kSmallJob ? JobSize::kSmall : JobSize::kLarge;
     if (!service_->pool_->TrySubmit([this, arrived] { RunMessage(arrived); }, size)) {
       FinishLocked(service_->QueueFullError());
@@ -209,8 +208,8 @@ class SceneStreamReactor final : public grpc::ServerBidiReactor<v1::SceneMessage
     reply_.set_seconds(seconds);
     std::lock_guard<std::mutex> lock(mutex_);
     if (!status.ok()) {
-      FinishLocked(
-          absl::Status(status.code(), absl::StrCat("frame ", message_.frame(), " ", status.message())));
+      FinishLocked(absl::Status(status.code(),
+                                absl::StrCat("frame ", message_.frame(), " ", status.message())));
       return;
     }
     StartWrite(&reply_);
@@ -245,8 +244,8 @@ class SceneStreamReactor final : public grpc::ServerBidiReactor<v1::SceneMessage
     if (!poses.ok()) return poses.status();
     for (std::size_t i = 0; i < poses->size(); ++i) {
       if (!scene_.contains((*poses)[i].first)) {
-        return absl::NotFoundError(absl::StrCat("pose_ids[", i, "]: no object ",
-                                                (*poses)[i].first, " in the scene"));
+        return absl::NotFoundError(
+            absl::StrCat("pose_ids[", i, "]: no object ", (*poses)[i].first, " in the scene"));
       }
     }
     if (absl::Status s = scene_.SetPoses(*poses); !s.ok()) return Named("poses", s);

@@ -127,8 +127,8 @@ class StateCollector {
         MetricType::Gauge, {Sample(pool.max_jobs, {}, MetricType::Gauge)});
     add("inscribe_jobs_concurrency", "Jobs run at the same time (--jobs)", MetricType::Gauge,
         {Sample(pool.concurrency, {}, MetricType::Gauge)});
-    add("inscribe_scenes_open", "SceneStream calls open, each holding its scene",
-        MetricType::Gauge, {Sample(service_->open_scenes(), {}, MetricType::Gauge)});
+    add("inscribe_scenes_open", "SceneStream calls open, each holding its scene", MetricType::Gauge,
+        {Sample(service_->open_scenes(), {}, MetricType::Gauge)});
     return families;
   }
 
@@ -338,10 +338,9 @@ struct ServiceMetrics::Impl {
   std::unique_ptr<MetricsEndpoint> endpoint;  // last: its thread stops before the rest goes
 };
 
-absl::StatusOr<std::unique_ptr<ServiceMetrics>> ServiceMetrics::Start(const std::string& listen,
-                                                                      const ResultCache* cache,
-                                                                      const JobPool* pool,
-                                                                      const InscribeService* service) {
+absl::StatusOr<std::unique_ptr<ServiceMetrics>> ServiceMetrics::Start(
+    const std::string& listen, const ResultCache* cache, const JobPool* pool,
+    const InscribeService* service) {
   const std::size_t colon = listen.rfind(':');
   if (colon == std::string::npos || colon + 1 == listen.size()) {
     return absl::InvalidArgumentError(

@@ -19,8 +19,8 @@ namespace inscribe::server {
 class ServiceMetrics {
  public:
   // Serves the metrics on `listen` ("HOST:PORT"; port 0 picks a free one, see port()). `cache`,
-  // `pool` and `service` (its open scenes) are read at each scrape and must outlive this object. UNAVAILABLE when the
-  // address cannot be bound, INVALID_ARGUMENT when it is not HOST:PORT.
+  // `pool` and `service` (its open scenes) are read at each scrape and must outlive this object.
+  // UNAVAILABLE when the address cannot be bound, INVALID_ARGUMENT when it is not HOST:PORT.
   static absl::StatusOr<std::unique_ptr<ServiceMetrics>> Start(const std::string& listen,
                                                                const ResultCache* cache,
                                                                const JobPool* pool,

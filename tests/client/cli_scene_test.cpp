@@ -154,8 +154,7 @@ TEST_F(CliScene, ServerAnswersAsEmbedded) {
   ASSERT_FALSE(address.empty());
   server.DrainLogInBackground();
   std::map<std::int64_t, RigidPose> poses_2;
-  const std::string args =
-      Quote(Scene()) + " " + Quote(PoseLog(&poses_2)) + " --server " + address;
+  const std::string args = Quote(Scene()) + " " + Quote(PoseLog(&poses_2)) + " --server " + address;
   CheckAgainstBruteForce(RunCli("scene " + args), RunCli("scene " + args + " --json"), spheres_,
                          poses_2);
 }

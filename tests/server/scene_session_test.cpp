@@ -120,9 +120,7 @@ TEST(SceneSession, AnErrorOrAMismatchedReplyEndsTheSession) {
   // A reply for another frame: INTERNAL, the call cancelled at once, and the error kept.
   auto owned = std::make_unique<MockSceneStream>();
   MockSceneStream& stream = *owned;
-  EXPECT_CALL(stream, RoundTrip(_, _))
-      .WillOnce(Return(Reply(0)))
-      .WillOnce(Return(Reply(7)));
+  EXPECT_CALL(stream, RoundTrip(_, _)).WillOnce(Return(Reply(0))).WillOnce(Return(Reply(7)));
   EXPECT_CALL(stream, Destroyed());
   SceneSession session(std::move(owned), SceneSessionOptions{});
   ASSERT_TRUE(session.Update(SceneChanges{}).ok());

@@ -14,11 +14,13 @@
 #include <thread>
 #include <vector>
 
+#include "inscribe/client/client.h"
 #include "inscribe/scene.h"
 #include "inscribe/separation_distance.h"
 #include "inscribe/sphere_hierarchy.h"
 #include "spheres_rpc_fixture.h"
 #include "support/sphere_sets.h"
+#include "support/synthetic_meshes.h"
 
 namespace inscribe::server {
 namespace {
@@ -96,7 +98,8 @@ TEST_F(SceneStreamTest, EveryReplyEqualsCoreAndBruteForce) {
   for (int k = 0; k < 3; ++k) {
     sets.push_back(testing::RandomSpheres(30 + 10 * k, 100 + k));
     set_keys.push_back(PutSet(sets.back()));
-    absl::StatusOr<SphereHierarchy> h = SphereHierarchy::Build(sets.back(), HierarchyVolume::kSphere);
+    absl::StatusOr<SphereHierarchy> h =
+        SphereHierarchy::Build(sets.back(), HierarchyVolume::kSphere);
     ASSERT_TRUE(h.ok()) << h.status();
     hierarchies.push_back(std::make_shared<const SphereHierarchy>(*std::move(h)));
   }
@@ -148,7 +151,8 @@ TEST_F(SceneStreamTest, EveryReplyEqualsCoreAndBruteForce) {
     message.set_frame(frame);
     std::vector<std::pair<SceneObjectId, RigidPose>> moved;
     for (int m = 0; m < 4; ++m) {
-      const SceneObjectId id = std::next(poses.begin(), static_cast<long>(rng() % poses.size()))->first;
+      const SceneObjectId id =
+          std::next(poses.begin(), static_cast<long>(rng() % poses.size()))->first;
       if (std::any_of(moved.begin(), moved.end(), [&](const auto& p) { return p.first == id; })) {
         continue;
       }
@@ -158,9 +162,9 @@ TEST_F(SceneStreamTest, EveryReplyEqualsCoreAndBruteForce) {
       message.add_remove(12);
       ASSERT_TRUE(local.Remove(12).ok());
       poses.erase(12);
-      moved.erase(std::remove_if(moved.begin(), moved.end(),
-                                 [](const auto& p) { return p.first == 12; }),
-                  moved.end());
+      moved.erase(
+          std::remove_if(moved.begin(), moved.end(), [](const auto& p) { return p.first == 12; }),
+          moved.end());
       SceneObject added;
       added.id = 99;
       added.pose = testing::RandomPose(rng, 1.2);
@@ -188,7 +192,9 @@ TEST_F(SceneStreamTest, EveryReplyEqualsCoreAndBruteForce) {
     std::map<std::pair<SceneObjectId, SceneObjectId>, double> distance;
     for (auto i = poses.begin(); i != poses.end(); ++i) {
       for (auto j = std::next(i); j != poses.end(); ++j) {
-        const auto group = [&](SceneObjectId id) { return (id - 10) % 4 == 3 && id != 99 ? 2u : 1u; };
+        const auto group = [&](SceneObjectId id) {
+          return (id - 10) % 4 == 3 && id != 99 ? 2u : 1u;
+        };
         const auto mask = [&](SceneObjectId id) {
           return (id - 10) % 4 == 3 && id != 99 ? 1u : kAllSceneGroups;
         };
@@ -218,6 +224,90 @@ TEST_F(SceneStreamTest, EveryReplyEqualsCoreAndBruteForce) {
   const grpc::Status s = stream->Finish();
   EXPECT_TRUE(s.ok()) << s.error_message();
   EXPECT_TRUE(OpenScenesReach(0));
+}
+
+// Objects with covers: a pair of two is reported with the certified interval Distance gives
+// for the same sets and poses (and left out only when its lower bound is at least the
+// threshold); a pair with a plain object gets the internal sets' plain distance.
+TEST_F(SceneStreamTest, CertifiedPairsGetDistancesIntervals) {
+  client::Client client(client::MakeGrpcConnection(server_->address()));
+  std::string internal[2], cover[2];
+  for (int k = 0; k < 2; ++k) {
+    const Mesh box = testing::Box(Vector3::Zero(), k == 0 ? Vector3(2.0, 1.0, 0.5)
+                                                          : Vector3(1.0, 0.4, 0.4));
+    client::GenerateSettings settings;
+    settings.parameters.max_spheres = 30;
+    settings.parameters.evaluate = false;
+    absl::StatusOr<client::GenerateResult> made = client.Generate(box, settings);
+    ASSERT_TRUE(made.ok()) << made.status();
+    internal[k] = made->sphere_set_key;
+    settings.parameters.kind = SphereSetKind::kCover;
+    made = client.Generate(box, settings);
+    ASSERT_TRUE(made.ok()) << made.status();
+    cover[k] = made->sphere_set_key;
+  }
+  // Objects 1, 2: the slab, certified; 3: the bar, certified; 4: the bar, plain.
+  const int solid[] = {0, 0, 1, 1};
+  std::vector<client::SceneSessionObject> objects(4);
+  std::mt19937_64 rng(9);
+  for (int i = 0; i < 4; ++i) {
+    objects[i].object.id = i + 1;
+    objects[i].sphere_set_key = internal[solid[i]];
+    if (i < 3) objects[i].cover_key = cover[solid[i]];
+  }
+  client::SceneSessionOptions options;
+  options.query.threshold = 0.3;
+  absl::StatusOr<client::SceneSession> session = client.OpenSceneSession(objects, options);
+  ASSERT_TRUE(session.ok()) << session.status();
+  int certified_reported = 0, plain_reported = 0;
+  for (int frame = 0; frame < 12; ++frame) {
+    SCOPED_TRACE(frame);
+    std::vector<std::pair<SceneObjectId, RigidPose>> poses;
+    for (auto& object : objects) {
+      object.object.pose = testing::RandomPose(rng, 1.5);
+      poses.emplace_back(object.object.id, object.object.pose);
+    }
+    absl::StatusOr<client::SceneFrameResult> result = session->Frame(poses);
+    ASSERT_TRUE(result.ok()) << result.status();
+    for (int i = 0; i < 4; ++i) {
+      for (int j = i + 1; j < 4; ++j) {
+        const auto reported = std::find_if(
+            result->pairs.begin(), result->pairs.end(), [&](const ScenePair& p) {
+              return p.a == objects[i].object.id && p.b == objects[j].object.id;
+            });
+        client::DistanceOptions query;
+        if (j < 3) {
+          query.cover_a = cover[solid[i]];
+          query.cover_b = cover[solid[j]];
+        }
+        absl::StatusOr<client::DistanceBatchResult> batch =
+            client.Distance(internal[solid[i]], internal[solid[j]], {objects[i].object.pose},
+                            {objects[j].object.pose}, query);
+        ASSERT_TRUE(batch.ok()) << batch.status();
+        if (j < 3) {
+          const CertifiedDistanceResult& interval = batch->certified[0];
+          if (reported == result->pairs.end()) {
+            EXPECT_GE(interval.lower, options.query.threshold) << i << " " << j;
+            continue;
+          }
+          ++certified_reported;
+          EXPECT_TRUE(reported->certified);
+          EXPECT_EQ(reported->lower, interval.lower) << i << " " << j;
+          EXPECT_EQ(reported->upper, interval.upper) << i << " " << j;
+        } else {
+          const double distance = batch->results[0].distance;
+          EXPECT_EQ(reported != result->pairs.end(), distance < options.query.threshold);
+          if (reported == result->pairs.end()) continue;
+          ++plain_reported;
+          EXPECT_FALSE(reported->certified);
+          EXPECT_NEAR(reported->result.distance, distance, 1e-9) << i << " " << j;
+        }
+      }
+    }
+  }
+  EXPECT_GT(certified_reported, 3);
+  EXPECT_GT(plain_reported, 0);
+  EXPECT_TRUE(session->Close().ok());
 }
 
 // max_pairs keeps the nearest pairs and says the frame was truncated, as core does.
@@ -277,7 +367,9 @@ TEST_F(SceneStreamTest, ErrorsEndTheStreamNamingTheObject) {
        "frame 1 add[0] (object 7).sphere_set"},
       {add(2, key), grpc::StatusCode::ALREADY_EXISTS, "add[0] (object 2)"},
       {add(8, "not a key"), grpc::StatusCode::INVALID_ARGUMENT, "add[0] (object 8)"},
-      {[](v1::SceneMessage& m) { wire::ScenePosesToProto({{99, RigidPose{}}}, &m); },
+      {[](v1::SceneMessage& m) {
+         wire::ScenePosesToProto({{99, RigidPose{}}}, &m);
+       },
        grpc::StatusCode::NOT_FOUND, "pose_ids[0]: no object 99"},
       {[](v1::SceneMessage& m) {
          wire::ScenePosesToProto({{1, RigidPose{}}}, &m);
@@ -289,7 +381,9 @@ TEST_F(SceneStreamTest, ErrorsEndTheStreamNamingTheObject) {
       {[](v1::SceneMessage& m) { m.add_remove(5); }, grpc::StatusCode::NOT_FOUND, "remove[0]"},
       {[](v1::SceneMessage& m) { m.add_ignore(1); }, grpc::StatusCode::INVALID_ARGUMENT,
        "ignore has 1 ids"},
-      {[](v1::SceneMessage& m) { wire::SceneIgnoredToProto({{1, 1}}, &m); },
+      {[](v1::SceneMessage& m) {
+         wire::SceneIgnoredToProto({{1, 1}}, &m);
+       },
        grpc::StatusCode::INVALID_ARGUMENT, "ignore pair 0 (1, 1)"},
       {[](v1::SceneMessage& m) { m.set_volume(v1::RSS); }, grpc::StatusCode::INVALID_ARGUMENT,
        "only the first message"},
@@ -349,7 +443,9 @@ TEST_F(SceneStreamTest, LimitsAreRefusedNamingTheFlag) {
        },
        "--max-scene-objects"},
       {[](v1::SceneMessage& m) { m.mutable_query()->set_max_pairs(11); }, "--max-scene-pairs"},
-      {[](v1::SceneMessage& m) { wire::SceneIgnoredToProto({{0, 1}, {1, 2}, {2, 3}}, &m); },
+      {[](v1::SceneMessage& m) {
+         wire::SceneIgnoredToProto({{0, 1}, {1, 2}, {2, 3}}, &m);
+       },
        "--max-scene-ignored"},
       {[](v1::SceneMessage& m) {
          for (int i = 0; i < 200; ++i) {

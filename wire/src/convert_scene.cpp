@@ -116,8 +116,8 @@ absl::StatusOr<SceneQuery> SceneQueryFromProto(const v1::SceneQuery& query,
     }
     if (query.max_pairs() > max_pairs_limit) {
       return absl::ResourceExhaustedError(absl::StrCat("query: max_pairs ", query.max_pairs(),
-                                                       " is over this server's limit (",
-                                                       limit_name, ") of ", max_pairs_limit));
+                                                       " is over this server's limit (", limit_name,
+                                                       ") of ", max_pairs_limit));
     }
     out.max_pairs = static_cast<std::size_t>(query.max_pairs());
   } else if (static_cast<std::int64_t>(out.max_pairs) > max_pairs_limit) {
@@ -162,10 +162,9 @@ absl::StatusOr<SceneFrame> SceneFrameFromProto(const v1::SceneReply& reply) {
       p.spheres_b_size() != n || p.points_a_size() != kPerRow * n ||
       p.points_b_size() != kPerRow * n || p.certified_size() != n || p.lower_size() != n ||
       p.upper_size() != n) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("scene pairs: arrays disagree in length (", n, " ids a, ", p.b_size(),
-                     " ids b, ", p.distances_size(), " distances, ", p.points_a_size(),
-                     " point coordinates)"));
+    return absl::InvalidArgumentError(absl::StrCat(
+        "scene pairs: arrays disagree in length (", n, " ids a, ", p.b_size(), " ids b, ",
+        p.distances_size(), " distances, ", p.points_a_size(), " point coordinates)"));
   }
   SceneFrame frame;
   frame.pairs.resize(static_cast<std::size_t>(n));

@@ -82,7 +82,8 @@ absl::StatusOr<RigidPose> PoseField(const json& object, const std::string& where
     v[k] = value[static_cast<std::size_t>(k)].get<double>();
   }
   absl::StatusOr<RigidPose> pose = PoseOf(v);
-  if (!pose.ok()) return absl::InvalidArgumentError(absl::StrCat(where, ": pose: ", pose.status().message()));
+  if (!pose.ok())
+    return absl::InvalidArgumentError(absl::StrCat(where, ": pose: ", pose.status().message()));
   return pose;
 }
 
@@ -115,7 +116,7 @@ absl::StatusOr<SceneFileObject> ParseObject(const json& j, std::size_t index,
     if (!j.contains(key)) continue;
     absl::StatusOr<std::string> value = Field<std::string>(j, key, where, "a path");
     if (!value.ok()) return value.status();
-    std::string& field = key[0] == 's' ? out.spheres_path
+    std::string& field = key[0] == 's'   ? out.spheres_path
                          : key[0] == 'm' ? out.mesh_path
                                          : out.cover_path;
     field = Resolve(path, *value);
@@ -128,8 +129,9 @@ absl::StatusOr<SceneFileObject> ParseObject(const json& j, std::size_t index,
   if (j.contains("voxel_size") || j.contains("max_spheres")) {
     if (!generated) {
       return absl::InvalidArgumentError(
-          absl::StrCat(where, ": voxel_size and max_spheres generate spheres from mesh; this "
-                              "object has a sphere file"));
+          absl::StrCat(where,
+                       ": voxel_size and max_spheres generate spheres from mesh; this "
+                       "object has a sphere file"));
     }
     if (j.contains("voxel_size") == j.contains("max_spheres")) {
       return absl::InvalidArgumentError(
@@ -194,7 +196,8 @@ absl::Status ParseQuery(const json& j, const std::string& path, SceneFile* out) 
     return absl::InvalidArgumentError(absl::StrCat(path, ": ", s.message()));
   }
   if (j.contains("hierarchy")) {
-    absl::StatusOr<std::string> name = Field<std::string>(j, "hierarchy", where, "\"sphere\" or \"rss\"");
+    absl::StatusOr<std::string> name =
+        Field<std::string>(j, "hierarchy", where, "\"sphere\" or \"rss\"");
     if (!name.ok()) return name.status();
     if (*name != "sphere" && *name != "rss") {
       return absl::InvalidArgumentError(
@@ -212,9 +215,9 @@ absl::StatusOr<SceneFile> ParseSceneFile(absl::string_view bytes, const std::str
   try {
     j = json::parse(bytes.begin(), bytes.end());
   } catch (const json::parse_error& e) {
-    return absl::InvalidArgumentError(
-        absl::StrCat(path, ": line ", LineOf(bytes, e.byte > 0 ? e.byte - 1 : 0),
-                     ": not JSON (", e.what(), ")"));
+    return absl::InvalidArgumentError(absl::StrCat(path, ": line ",
+                                                   LineOf(bytes, e.byte > 0 ? e.byte - 1 : 0),
+                                                   ": not JSON (", e.what(), ")"));
   }
   if (!j.is_object()) return absl::InvalidArgumentError(absl::StrCat(path, ": not a JSON object"));
   for (const auto& [key, value] : j.items()) {
@@ -239,8 +242,8 @@ absl::StatusOr<SceneFile> ParseSceneFile(absl::string_view bytes, const std::str
     absl::StatusOr<SceneFileObject> object = ParseObject(j["objects"][i], i, path);
     if (!object.ok()) return object.status();
     if (!ids.insert(object->object.id).second) {
-      return absl::InvalidArgumentError(absl::StrCat(path, ": objects[", i, "]: id ",
-                                                     object->object.id, " is used twice"));
+      return absl::InvalidArgumentError(
+          absl::StrCat(path, ": objects[", i, "]: id ", object->object.id, " is used twice"));
     }
     out.objects.push_back(*std::move(object));
   }
@@ -304,8 +307,8 @@ absl::StatusOr<std::vector<PoseLogFrame>> ParsePoseLog(
     content = true;
     const std::vector<absl::string_view> fields = absl::StrSplit(text, ',');
     if (fields.size() != 9) {
-      return fail(absl::StrCat("expected 9 fields frame,id,qw,qx,qy,qz,tx,ty,tz, found ",
-                               fields.size()));
+      return fail(
+          absl::StrCat("expected 9 fields frame,id,qw,qx,qy,qz,tx,ty,tz, found ", fields.size()));
     }
     std::int64_t frame = 0;
     SceneObjectId id = 0;
@@ -317,8 +320,10 @@ absl::StatusOr<std::vector<PoseLogFrame>> ParsePoseLog(
     }
     double v[kPoseNumbers];
     for (int k = 0; k < kPoseNumbers; ++k) {
-      const absl::string_view field = absl::StripAsciiWhitespace(fields[static_cast<std::size_t>(k) + 2]);
-      if (!absl::SimpleAtod(field, &v[k])) return fail(absl::StrCat("'", field, "' is not a number"));
+      const absl::string_view field =
+          absl::StripAsciiWhitespace(fields[static_cast<std::size_t>(k) + 2]);
+      if (!absl::SimpleAtod(field, &v[k]))
+        return fail(absl::StrCat("'", field, "' is not a number"));
     }
     if (!ids.contains(id)) return fail(absl::StrCat("no object with id ", id, " in the scene"));
     absl::StatusOr<RigidPose> pose = PoseOf(v);
@@ -336,8 +341,8 @@ absl::StatusOr<std::vector<PoseLogFrame>> ParsePoseLog(
     frames.back().poses.emplace_back(id, *pose);
   }
   if (frames.empty()) {
-    return absl::InvalidArgumentError(
-        absl::StrCat(name, ": no frames (one line per moved object: frame,id,qw,qx,qy,qz,tx,ty,tz)"));
+    return absl::InvalidArgumentError(absl::StrCat(
+        name, ": no frames (one line per moved object: frame,id,qw,qx,qy,qz,tx,ty,tz)"));
   }
   return frames;
 }

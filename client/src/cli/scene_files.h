@@ -57,11 +57,11 @@ struct PoseLogFrame {
 // and `#` comments ignored. `ids` are the scene's objects. INVALID_ARGUMENT naming `name` and
 // the line: a wrong field count, a field that is not a number, a frame number going back, an
 // id not in the scene or repeated within a frame, a quaternion not within 1e-3 of unit length.
-absl::StatusOr<std::vector<PoseLogFrame>> ParsePoseLog(absl::string_view bytes,
-                                                       const std::string& name,
-                                                       const absl::flat_hash_set<SceneObjectId>& ids);
+absl::StatusOr<std::vector<PoseLogFrame>> ParsePoseLog(
+    absl::string_view bytes, const std::string& name,
+    const absl::flat_hash_set<SceneObjectId>& ids);
 // Reads `path` whole and parses it; NOT_FOUND when it cannot be opened.
-absl::StatusOr<std::vector<PoseLogFrame>> ReadPoseLog(const std::string& path,
-                                                      const absl::flat_hash_set<SceneObjectId>& ids);
+absl::StatusOr<std::vector<PoseLogFrame>> ReadPoseLog(
+    const std::string& path, const absl::flat_hash_set<SceneObjectId>& ids);
 
 }  // namespace inscribe::cli

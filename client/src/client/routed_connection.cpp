@@ -360,8 +360,7 @@ class RoutedConnection final : public Connection {
       Deadline deadline) override {
     // Every pair of a frame must be held by one replica: the first pair's set A routes it.
     return std::make_unique<RoutedFrameStream<v1::DistanceFrame, v1::DistanceFrameResult>>(
-        replicas_, deadline,
-        [](Connection& c, Deadline d) { return c.OpenDistanceStream(d); },
+        replicas_, deadline, [](Connection& c, Deadline d) { return c.OpenDistanceStream(d); },
         [](const v1::DistanceFrame& frame) {
           return frame.pairs_size() > 0 ? wire::RouteKey(frame.pairs(0).sphere_set_a()) : "";
         },

@@ -4,9 +4,11 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <random>
@@ -69,15 +71,23 @@ class CliScene : public ::testing::Test {
     return Write("scene.json", scene.dump(1));
   }
 
-  // Object 2 walks towards object 1 along x and back; object 3 spins in place. The poses of
-  // object 2, by frame.
+  // Object 2 walks towards object 1 along x, from 1.25 to 0.8 times the set's extent and back;
+  // object 3 spins in place. The poses of object 2, by frame.
   std::string PoseLog(std::map<std::int64_t, RigidPose>* poses_2) {
+    absl::StatusOr<SphereFile> file = ReadSphereFile(spheres_);
+    EXPECT_TRUE(file.ok()) << file.status();
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (const Sphere& s : file->set.spheres) {
+      lo = std::min(lo, s.center.x() - s.radius);
+      hi = std::max(hi, s.center.x() + s.radius);
+    }
+    const double extent = hi - lo;
     std::ostringstream log;
     log << "frame,id,qw,qx,qy,qz,tx,ty,tz\n# object 2 approaches\n";
     std::mt19937_64 rng(3);
     std::uniform_real_distribution<double> jitter(-0.02, 0.02);
     for (int frame = 0; frame < 30; ++frame) {
-      const double x = 1.6 - 0.05 * std::abs(frame - 15) + jitter(rng);
+      const double x = extent * (0.8 + 0.03 * std::abs(frame - 15) + jitter(rng));
       const double angle = 0.1 * frame;
       log << frame << ",2,1,0,0,0," << x << ",0.1,0\n";
       (*poses_2)[frame] = RigidPose{Eigen::Quaterniond::Identity(), Vector3(x, 0.1, 0)};
@@ -162,8 +172,7 @@ TEST_F(CliScene, ServerAnswersAsEmbedded) {
 // Bad files end with a clear error naming the file and line (or object) and a nonzero exit.
 TEST_F(CliScene, BadFilesAreNamedWithTheirLine) {
   const std::string scene = Scene();
-  std::map<std::int64_t, RigidPose> unused;
-  const std::string poses = PoseLog(&unused);
+  const std::string poses = Write("one.csv", "0,1,1,0,0,0,0,0,0\n");
   struct Case {
     std::string scene, poses, says;
   };

@@ -127,8 +127,8 @@ class StreamWatchdog {
 template <typename Message, typename Reply>
 class GrpcFrameStream final : public FrameStream<Message, Reply> {
  public:
-  using Opener = std::unique_ptr<grpc::ClientReaderWriter<Message, Reply>> (Stub::*)(
-      grpc::ClientContext*);
+  using Opener =
+      std::unique_ptr<grpc::ClientReaderWriter<Message, Reply>> (Stub::*)(grpc::ClientContext*);
 
   GrpcFrameStream(Stub& stub, Opener open, const char* rpc, const std::string& token,
                   Deadline deadline)

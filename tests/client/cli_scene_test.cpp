@@ -8,6 +8,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -83,7 +84,7 @@ class CliScene : public ::testing::Test {
     }
     const double extent = hi - lo;
     std::ostringstream log;
-    log << "frame,id,qw,qx,qy,qz,tx,ty,tz\n# object 2 approaches\n";
+    log << std::setprecision(17) << "frame,id,qw,qx,qy,qz,tx,ty,tz\n# object 2 approaches\n";
     std::mt19937_64 rng(3);
     std::uniform_real_distribution<double> jitter(-0.02, 0.02);
     for (int frame = 0; frame < 30; ++frame) {

@@ -2,13 +2,26 @@
 // linking the core.
 //   1. Distance RPC with batches of 1, 100 and 10,000 pose pairs against the same queries
 //      in-process (SeparationDistances on the same hierarchies): throughput ratio.
-//   2. DistanceStream round trip per frame (10 object pairs), p50 / p99 / max over 10,000
-//      frames, with 1, 4 and 16 clients each on its own channel and session.
-//   3. Generate answered from the cache (memory hit): p50 / p99 with 1, 4 and 16 clients.
+//   2. DistanceStream round trip per frame (10 object pairs), p50 / p99 / max, with 1, 4 and
+//      16 clients each on its own channel and session: closed loop (each client sends its next
+//      frame the moment the reply arrives; 10,000 frames shared by the clients) and paced
+//      (each client sends at a fixed --frame-rates rate for --paced-seconds, as a simulator
+//      does; the round trip counts from the frame's scheduled time, so a client that fell
+//      behind is charged for it). With the process's CPU time and context switches per frame.
+//   3. What a frame's round trip is made of: the frame's compute in-process, a TCP round trip
+//      on loopback, and an empty frame's round trip (gRPC and the client library's cost).
+//   4. Generate answered from the cache (memory hit): p50 / p99 with 1, 4 and 16 clients.
 // Every answer is checked (distances against the in-process ones, cache hits as hits); any
 // mismatch or failed call counts as an error and makes the exit status 1.
 //
-//   service_bench [--server HOST:PORT] [--frames N] [--quick] ...   (bench/run-service)
+//   service_bench [--server HOST:PORT] [--frames N] [--frame-rates 100,1000]
+//                 [--sections batch,stream,floor,generate] [--quick] ...   (bench/run-service)
+#include <netinet/in.h>
+#include <netinet/tcp.h>
+#include <sys/resource.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <atomic>
@@ -47,6 +60,9 @@ struct Options {
   int frames = 10'000;                   // per client count, shared among the clients
   int pairs = 10;                        // object pairs per frame
   std::vector<int> clients = {1, 4, 16};
+  std::vector<double> frame_rates = {100, 1000};  // paced rows, frames/s per client
+  double paced_seconds = 5.0;                     // length of each paced row
+  std::vector<std::string> sections = {"batch", "stream", "floor", "generate"};
   int generate_calls = 2'000;  // per client count
   int jobs = 0;                // in-process server's pool; 0 = one per core
   bool quick = false;          // smoke: small counts, same checks
@@ -195,42 +211,92 @@ void OnClients(const std::string& address, int count,
   for (std::thread& t : threads) t.join();
 }
 
+// The process's CPU time (all threads: the clients and, in-process, the server) and context
+// switches, for per-frame costs.
+struct ProcessUsage {
+  double cpu_seconds = 0.0;
+  std::int64_t switches = 0;
+
+  static ProcessUsage Now() {
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    const auto seconds = [](const timeval& t) { return t.tv_sec + 1e-6 * t.tv_usec; };
+    return {seconds(usage.ru_utime) + seconds(usage.ru_stime),
+            static_cast<std::int64_t>(usage.ru_nvcsw + usage.ru_nivcsw)};
+  }
+};
+
+// Checks a frame's answers against the core, pair by pair.
+void CheckFrame(const std::vector<const Model*>& models, const std::vector<client::PosePair>& frame,
+                const std::vector<DistanceResult>& results, int f) {
+  const auto model = [&](const std::string& key) {
+    return *std::find_if(models.begin(), models.end(),
+                         [&](const Model* m) { return m->key == key; });
+  };
+  for (std::size_t p = 0; p < frame.size(); ++p) {
+    absl::StatusOr<DistanceResult> want =
+        SeparationDistance(*model(frame[p].sphere_set_a)->hierarchy, frame[p].pose_a,
+                           *model(frame[p].sphere_set_b)->hierarchy, frame[p].pose_b);
+    if (!want.ok() || !SameDistance(results[p], *want)) {
+      Error(absl::StrFormat("stream frame %d pair %d differs from the core", f, p));
+    }
+  }
+}
+
+// One row of the stream table: `clients` sessions, closed loop (`rate` 0) or each paced at
+// `rate` frames/s (phases spread evenly over one period). Round trips of frames after each
+// client's 50 warm-up frames.
 void StreamRow(const std::string& address, const std::vector<const Model*>& models,
-               const Options& options, int clients) {
+               const Options& options, int clients, double rate, int pairs) {
   const double diagonal = std::max(models[0]->diagonal, models.back()->diagonal);
   const std::vector<RigidPose> pool = PoseSet(2 * 4096, diagonal, 99);
-  const int frames_each = std::max(1, options.frames / clients);
+  const int frames_each = rate > 0 ? std::max(1, static_cast<int>(rate * options.paced_seconds))
+                                   : std::max(1, options.frames / clients);
+  constexpr int kWarmUp = 50;
   std::mutex mutex;
   std::vector<double> round_trips;
-  const Clock::time_point start = Clock::now();
+  std::atomic<int> warm{0};
+  ProcessUsage before;
+  Clock::time_point start;
   OnClients(address, clients, [&](const client::Client& client, int c) {
     absl::StatusOr<client::DistanceSession> session = client.OpenDistanceSession();
     if (!session.ok()) return Error(std::string(session.status().message()));
     std::vector<double> mine;
     mine.reserve(static_cast<std::size_t>(frames_each));
-    for (int f = 0; f < frames_each + 50; ++f) {  // the first 50 warm the path up
+    const auto query = [&](int f) -> absl::StatusOr<std::vector<DistanceResult>> {
       const std::vector<client::PosePair> frame =
-          Frame(models, pool, options.pairs, f + c * frames_each);
-      const Clock::time_point sent = Clock::now();
+          Frame(models, pool, pairs, f + c * (frames_each + kWarmUp));
       absl::StatusOr<std::vector<DistanceResult>> results = session->Query(frame);
-      const double seconds = Seconds(Clock::now() - sent);
-      if (!results.ok()) return Error(std::string(results.status().message()));
-      if (f >= 50) mine.push_back(seconds);
-      if (f % 97 == 0) {  // spot checks against the core
-        for (std::size_t p = 0; p < frame.size(); ++p) {
-          const Model* a = *std::find_if(models.begin(), models.end(), [&](const Model* m) {
-            return m->key == frame[p].sphere_set_a;
-          });
-          const Model* b = *std::find_if(models.begin(), models.end(), [&](const Model* m) {
-            return m->key == frame[p].sphere_set_b;
-          });
-          absl::StatusOr<DistanceResult> want =
-              SeparationDistance(*a->hierarchy, frame[p].pose_a, *b->hierarchy, frame[p].pose_b);
-          if (!want.ok() || !SameDistance((*results)[p], *want)) {
-            Error(absl::StrFormat("stream frame %d pair %d differs from the core", f, p));
-          }
-        }
+      if (results.ok() && f % 97 == 0) CheckFrame(models, frame, *results, f);
+      return results;
+    };
+    for (int f = 0; f < kWarmUp; ++f) {
+      if (absl::Status s = query(f).status(); !s.ok()) return Error(std::string(s.message()));
+    }
+    // Every client starts measuring together, once all are warm.
+    {
+      std::unique_lock<std::mutex> lock(mutex);
+      if (++warm == clients) {
+        before = ProcessUsage::Now();
+        start = Clock::now();
       }
+    }
+    while (warm.load() < clients) std::this_thread::sleep_for(std::chrono::microseconds(200));
+    const Clock::duration period =
+        rate > 0
+            ? std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1 / rate))
+            : Clock::duration::zero();
+    const Clock::time_point first = Clock::now() + period * c / clients;
+    for (int f = 0; f < frames_each; ++f) {
+      Clock::time_point sent = first + period * f;
+      if (rate > 0) {
+        std::this_thread::sleep_until(sent);
+      } else {
+        sent = Clock::now();
+      }
+      absl::StatusOr<std::vector<DistanceResult>> results = query(kWarmUp + f);
+      mine.push_back(Seconds(Clock::now() - sent));
+      if (!results.ok()) return Error(std::string(results.status().message()));
     }
     if (absl::Status closed = session->Close(); !closed.ok()) {
       Error(std::string(closed.message()));
@@ -239,12 +305,104 @@ void StreamRow(const std::string& address, const std::vector<const Model*>& mode
     round_trips.insert(round_trips.end(), mine.begin(), mine.end());
   });
   const double wall = Seconds(Clock::now() - start);
+  const ProcessUsage after = ProcessUsage::Now();
+  const double frames = static_cast<double>(round_trips.size());
   const double p99 = Percentile(round_trips, 0.99);
   std::cout << absl::StrFormat(
-      "| %d | %d | %d | %.0f | %.0f | %.0f | %.0f |%s\n", clients,
-      static_cast<int>(round_trips.size()), options.pairs, 1e6 * Percentile(round_trips, 0.5),
-      1e6 * p99, 1e6 * Percentile(round_trips, 1.0), static_cast<double>(round_trips.size()) / wall,
+      "| %d | %s | %d | %d | %.0f | %.0f | %.0f | %.0f | %.0f | %.1f |%s\n", clients,
+      rate > 0 ? absl::StrFormat("paced %.0f Hz", rate) : std::string("closed loop"),
+      static_cast<int>(round_trips.size()), pairs, 1e6 * Percentile(round_trips, 0.5), 1e6 * p99,
+      1e6 * Percentile(round_trips, 1.0), frames / wall,
+      1e6 * (after.cpu_seconds - before.cpu_seconds) / frames,
+      static_cast<double>(after.switches - before.switches) / frames,
       p99 < 1e-3 ? " pass" : " MISS");
+}
+
+// A TCP round trip on loopback: one byte each way between two threads, TCP_NODELAY, as gRPC
+// sets it. Median of `count`, seconds; 0 if a socket call failed.
+double LoopbackRoundTrip(int count) {
+  const int listener = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  socklen_t length = sizeof(address);
+  if (bind(listener, reinterpret_cast<sockaddr*>(&address), sizeof(address)) != 0 ||
+      listen(listener, 1) != 0 ||
+      getsockname(listener, reinterpret_cast<sockaddr*>(&address), &length) != 0) {
+    close(listener);
+    return 0.0;
+  }
+  const int client = socket(AF_INET, SOCK_STREAM, 0);
+  if (connect(client, reinterpret_cast<sockaddr*>(&address), sizeof(address)) != 0) {
+    close(client);
+    close(listener);
+    return 0.0;
+  }
+  const int server = accept(listener, nullptr, nullptr);
+  const int one = 1;
+  setsockopt(client, IPPROTO_TCP, TCP_NODELAY, &one, sizeof(one));
+  setsockopt(server, IPPROTO_TCP, TCP_NODELAY, &one, sizeof(one));
+  std::thread echo([server, count] {
+    char byte = 0;
+    for (int i = 0; i < count; ++i) {
+      if (read(server, &byte, 1) != 1 || write(server, &byte, 1) != 1) return;
+    }
+  });
+  std::vector<double> times;
+  char byte = 1;
+  for (int i = 0; i < count; ++i) {
+    const Clock::time_point sent = Clock::now();
+    if (write(client, &byte, 1) != 1 || read(client, &byte, 1) != 1) break;
+    times.push_back(Seconds(Clock::now() - sent));
+  }
+  echo.join();
+  close(client);
+  close(server);
+  close(listener);
+  return Percentile(times, 0.5);
+}
+
+// What one client's frame round trip is made of (medians): the frame's queries in-process on
+// the same hierarchies, a bare TCP round trip on loopback, and the round trip of an empty frame
+// (gRPC's per-message cost both ways and the client library's).
+void FloorRows(const std::string& address, const std::vector<const Model*>& models,
+               const Options& options) {
+  const double diagonal = std::max(models[0]->diagonal, models.back()->diagonal);
+  const std::vector<RigidPose> pool = PoseSet(2 * 4096, diagonal, 99);
+  std::vector<double> compute;
+  for (int f = 0; f < 2000; ++f) {
+    const std::vector<client::PosePair> frame = Frame(models, pool, options.pairs, f);
+    std::vector<PosedPair> pairs;
+    for (const client::PosePair& p : frame) {
+      const auto model = [&](const std::string& key) {
+        return *std::find_if(models.begin(), models.end(),
+                             [&](const Model* m) { return m->key == key; });
+      };
+      pairs.push_back({model(p.sphere_set_a)->hierarchy.get(),
+                       model(p.sphere_set_b)->hierarchy.get(), p.pose_a, p.pose_b});
+    }
+    const Clock::time_point start = Clock::now();
+    absl::StatusOr<std::vector<DistanceResult>> results = PairSeparationDistances(pairs);
+    compute.push_back(Seconds(Clock::now() - start));
+    if (!results.ok()) return Error(std::string(results.status().message()));
+  }
+  std::cout << absl::StrFormat("| frame of %d pairs computed in-process | %.1f |\n", options.pairs,
+                               1e6 * Percentile(compute, 0.5));
+  std::cout << absl::StrFormat("| TCP round trip on loopback (1 byte each way) | %.1f |\n",
+                               1e6 * LoopbackRoundTrip(5000));
+  const client::Client client(client::MakeGrpcConnection(address));
+  absl::StatusOr<client::DistanceSession> session = client.OpenDistanceSession();
+  if (!session.ok()) return Error(std::string(session.status().message()));
+  std::vector<double> empty;
+  for (int f = 0; f < 5050; ++f) {
+    const Clock::time_point start = Clock::now();
+    absl::StatusOr<std::vector<DistanceResult>> results = session->Query({});
+    if (f >= 50) empty.push_back(Seconds(Clock::now() - start));
+    if (!results.ok()) return Error(std::string(results.status().message()));
+  }
+  std::cout << absl::StrFormat("| DistanceStream round trip of an empty frame | %.1f |\n",
+                               1e6 * Percentile(empty, 0.5));
+  if (absl::Status closed = session->Close(); !closed.ok()) Error(std::string(closed.message()));
 }
 
 void GenerateRow(const std::string& address, const Model& model, const Options& options,
@@ -310,22 +468,51 @@ int Run(const Options& options) {
       std::thread::hardware_concurrency(), absl::StrJoin(options.models, ", "),
       static_cast<int>(models[0].hierarchy->spheres().size()));
 
-  std::cout << "## Distance RPC vs in-process (" << models[0].name << " vs " << models.back().name
-            << ", median per call; target: batch 10,000 at >= 50% of in-process)\n\n"
-            << "| batch | calls | RPC us | in-process us | RPC queries/s | in-process queries/s "
-               "| ratio |\n|---:|---:|---:|---:|---:|---:|---:|\n";
-  for (const int size : options.batches) {
-    BatchRow(client, models[0], models.back(), size, options.batch_queries);
+  const auto section = [&](const char* name) {
+    return std::find(options.sections.begin(), options.sections.end(), name) !=
+           options.sections.end();
+  };
+  if (section("batch")) {
+    std::cout << "## Distance RPC vs in-process (" << models[0].name << " vs " << models.back().name
+              << ", median per call; target: batch 10,000 at >= 50% of in-process)\n\n"
+              << "| batch | calls | RPC us | in-process us | RPC queries/s | in-process queries/s "
+                 "| ratio |\n|---:|---:|---:|---:|---:|---:|---:|\n";
+    for (const int size : options.batches) {
+      BatchRow(client, models[0], models.back(), size, options.batch_queries);
+    }
+    std::cout << "\n";
   }
 
-  std::cout << "\n## DistanceStream round trip per frame (target: p99 < 1 ms)\n\n"
-            << "| clients | frames | pairs/frame | p50 us | p99 us | max us | frames/s |\n"
-               "|---:|---:|---:|---:|---:|---:|---:|\n";
-  for (const int clients : options.clients) StreamRow(address, pointers, options, clients);
+  if (section("stream")) {
+    std::cout << "## DistanceStream round trip per frame (target: p99 < 1 ms)\n\n"
+              << "CPU and context switches are the whole process's per frame"
+              << (local ? " (clients and server)" : " (the clients only)") << ".\n\n"
+              << "| clients | mode | frames | pairs/frame | p50 us | p99 us | max us | frames/s "
+                 "| CPU us/frame | switches/frame |\n"
+                 "|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+    for (const int clients : options.clients) {
+      StreamRow(address, pointers, options, clients, 0.0, options.pairs);
+    }
+    for (const double rate : options.frame_rates) {
+      for (const int clients : options.clients) {
+        StreamRow(address, pointers, options, clients, rate, options.pairs);
+      }
+    }
+    std::cout << "\n";
+  }
 
-  std::cout << "\n## Generate answered from the cache (target: p50 < 2 ms)\n\n"
-            << "| clients | calls | p50 us | p99 us | max us |\n|---:|---:|---:|---:|---:|\n";
-  for (const int clients : options.clients) GenerateRow(address, models[0], options, clients);
+  if (section("floor")) {
+    std::cout << "## What one frame's round trip is made of (1 client, medians)\n\n"
+              << "| part | us |\n|---|---:|\n";
+    FloorRows(address, pointers, options);
+    std::cout << "\n";
+  }
+
+  if (section("generate")) {
+    std::cout << "## Generate answered from the cache (target: p50 < 2 ms)\n\n"
+              << "| clients | calls | p50 us | p99 us | max us |\n|---:|---:|---:|---:|---:|\n";
+    for (const int clients : options.clients) GenerateRow(address, models[0], options, clients);
+  }
 
   absl::StatusOr<client::ServerCacheStats> stats = client.CacheStats();
   if (stats.ok()) {
@@ -357,6 +544,12 @@ int main(int argc, char** argv) {
   app.add_option("--frames", options.frames, "Stream frames per client count");
   app.add_option("--pairs", options.pairs, "Object pairs per frame");
   app.add_option("--clients", options.clients, "Concurrent client counts")->delimiter(',');
+  app.add_option("--frame-rates", options.frame_rates,
+                 "Paced stream rows: frames/s each client sends (closed loop is always run)")
+      ->delimiter(',');
+  app.add_option("--paced-seconds", options.paced_seconds, "Length of each paced stream row");
+  app.add_option("--sections", options.sections, "What to run, of batch, stream, floor, generate")
+      ->delimiter(',');
   app.add_option("--generate-calls", options.generate_calls, "Cache-hit Generates per count");
   app.add_option("--jobs", options.jobs, "In-process server's job pool (0 = one per core)");
   app.add_flag("--quick", options.quick, "Smoke run: small counts, the same checks");
@@ -365,6 +558,7 @@ int main(int argc, char** argv) {
     options.max_spheres = 200;
     options.batch_queries = 2'000;
     options.frames = 200;
+    options.paced_seconds = 0.2;
     options.generate_calls = 40;
     options.clients = {1, 4};
   }

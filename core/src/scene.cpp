@@ -21,6 +21,14 @@ Sphere RootSphere(const SphereHierarchy& h) {
   return Sphere{root.center, root.radius};
 }
 
+// The box around a set's spheres, in its frame: min and max corners.
+void GrowBox(const std::vector<Sphere>& spheres, Vector3* lo, Vector3* hi) {
+  for (const Sphere& s : spheres) {
+    *lo = lo->cwiseMin(s.center - Vector3::Constant(s.radius));
+    *hi = hi->cwiseMax(s.center + Vector3::Constant(s.radius));
+  }
+}
+
 // A sphere holding both.
 Sphere Enclose(const Sphere& a, const Sphere& b) {
   const double reach = (b.center - a.center).norm() + b.radius;
@@ -91,6 +99,14 @@ absl::Status Scene::Add(SceneObject object) {
   }
   entry.local_center = bound.center;
   entry.radius = bound.radius;
+  Vector3 lo = Vector3::Constant(HUGE_VAL), hi = Vector3::Constant(-HUGE_VAL);
+  GrowBox(object.spheres->spheres(), &lo, &hi);
+  if (object.certified()) {
+    GrowBox(object.cover->spheres(), &lo, &hi);
+    GrowBox(object.internal->spheres(), &lo, &hi);
+  }
+  entry.local_box_center = 0.5 * (lo + hi);
+  entry.local_half = 0.5 * (hi - lo);
   entry.object = std::move(object);
   index_.emplace(entry.object.id, objects_.size());
   objects_.push_back(std::move(entry));
@@ -137,7 +153,11 @@ absl::Status Scene::SetPoses(const std::vector<std::pair<SceneObjectId, RigidPos
     Entry& e = objects_[position];
     e.object.pose = pose;
     e.world_center = pose * e.local_center;
-    e.scale = pose.translation.norm() + e.local_center.norm() + e.radius;
+    const Eigen::Matrix3d rotation = pose.rotation.toRotationMatrix();
+    e.box_center = rotation * e.local_box_center + pose.translation;
+    e.half = rotation.cwiseAbs() * e.local_half;
+    e.scale = pose.translation.norm() + std::max(e.local_center.norm() + e.radius,
+                                                 e.local_box_center.norm() + e.local_half.norm());
   }
   return absl::OkStatus();
 }
@@ -173,7 +193,7 @@ void Scene::Sweep(double threshold, std::vector<std::pair<std::uint32_t, std::ui
   int axis = 0;
   spread.maxCoeff(&axis);
   const auto low = [this, axis](std::uint32_t i) {
-    return objects_[i].world_center[axis] - objects_[i].radius;
+    return objects_[i].box_center[axis] - objects_[i].half[axis];
   };
   if (!order_valid_ || axis != sweep_axis_) {
     order_.resize(n);
@@ -194,13 +214,18 @@ void Scene::Sweep(double threshold, std::vector<std::pair<std::uint32_t, std::ui
   }
   for (std::size_t k = 0; k < n; ++k) {
     const Entry& a = objects_[order_[k]];
-    const double high = a.world_center[axis] + a.radius;
+    const double high = a.box_center[axis] + a.half[axis];
     for (std::size_t m = k + 1; m < n; ++m) {
       const Entry& b = objects_[order_[m]];
       const double slack = kBroadPhaseSlack * (a.scale + b.scale) + kCertifiedDistanceFloor;
       // Sorted by low end: every later object's gap along the axis is at least this one's.
       if (low(order_[m]) - high >= threshold + slack) break;
       if ((a.object.group & b.object.mask) == 0 || (b.object.group & a.object.mask) == 0) continue;
+      // Two lower bounds on the distance between the objects' spheres: the boxes' largest gap
+      // along an axis, and the bounding spheres' gap.
+      const double box_gap =
+          ((a.box_center - b.box_center).cwiseAbs() - a.half - b.half).maxCoeff();
+      if (!(box_gap < threshold + slack)) continue;
       const double gap = (a.world_center - b.world_center).norm() - a.radius - b.radius;
       if (!(gap < threshold + slack)) continue;
       if (!ignored_.empty() && ignored_.count(PairKey(a.object.id, b.object.id)) != 0) continue;
@@ -227,6 +252,7 @@ absl::StatusOr<SceneFrame> Scene::ClosePairs(const SceneQuery& query,
   plain.abs_err = query.abs_err;
   plain.rel_err = query.rel_err;
   plain.max_distance = query.threshold;
+  if (query.stop_at_first && std::isfinite(query.threshold)) plain.closer_than = query.threshold;
 
   // One candidate: the smaller id is a. A plain pair's distance is pruned at the threshold; a
   // certified pair's covers at the threshold plus the margin (lower < threshold needs no
@@ -249,7 +275,8 @@ absl::StatusOr<SceneFrame> Scene::ClosePairs(const SceneQuery& query,
         return;
       }
       out.result = *std::move(r);
-      rank[c] = out.result.distance;
+      // A closer_than query that found no pair answers closer_than itself: not close.
+      if (out.result.sphere_a >= 0) rank[c] = out.result.distance;
       return;
     }
     absl::StatusOr<double> margin =
@@ -289,8 +316,10 @@ absl::StatusOr<SceneFrame> Scene::ClosePairs(const SceneQuery& query,
     if (cancelled()) return;
     for (std::size_t c = begin; c < end; ++c) answer(c);
   };
-  if (candidates.size() <= kNarrowChunk) {
-    run(0, candidates.size());
+  if (candidates.size() <= kNarrowChunk || !query.parallel) {
+    for (std::size_t begin = 0; begin < candidates.size(); begin += kNarrowChunk) {
+      run(begin, std::min(candidates.size(), begin + kNarrowChunk));
+    }
   } else {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, candidates.size(), kNarrowChunk),
                       [&](const tbb::blocked_range<std::size_t>& r) { run(r.begin(), r.end()); });

@@ -1,8 +1,8 @@
 """inscribe: unions of spheres approximating closed triangle meshes.
 
 In-process (the C++ core, bound with pybind11): load_mesh, write_mesh, Mesh, prepare, generate, evaluate,
-certify, read_spheres, write_spheres, write_mesh, Hierarchy, distance, certified_distance, Deformer,
-spherize_urdf. Over the service (grpcio): Client, DistanceSession.
+certify, read_spheres, write_spheres, write_mesh, Hierarchy, distance, certified_distance, Scene,
+Deformer, spherize_urdf. Over the service (grpcio): Client, DistanceSession.
 
 Units and frames: every length is in the mesh's own units, every point in the mesh's own frame
 unless a docstring says "world frame"; poses are rows [qw, qx, qy, qz, tx, ty, tz] (unit
@@ -25,6 +25,8 @@ from ._inscribe import (
     MeshIssue,
     MeshReport,
     QualityReport,
+    Scene,
+    SceneFrame,
     Severity,
     Solid,
     SphereSet,
@@ -50,7 +52,7 @@ __all__ = [
     "DistanceReply", "GenerateResult",
     "CoverCertificate", "DeformationErrorBounds", "Deformer", "DistanceBatch", "DistanceResult",
     "DistanceSession", "Error", "Hierarchy", "LinkSpheres", "Mesh", "MeshIssue", "MeshReport",
-    "QualityReport", "RetryPolicy", "Severity", "Solid", "SphereSet", "SpherizedRobot",
+    "QualityReport", "RetryPolicy", "Scene", "SceneFrame", "Severity", "Solid", "SphereSet", "SpherizedRobot",
     "certified_distance", "certify", "distance", "evaluate", "format_curobo_yaml", "generate",
     "load_mesh", "parse_curobo_yaml", "prepare", "read_spheres", "spherize_urdf",
     "write_mesh", "write_spheres",

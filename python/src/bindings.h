@@ -20,6 +20,7 @@ void BindDistance(py::module_& m);
 void BindDeformation(py::module_& m);
 void BindRobot(py::module_& m);
 void BindRouting(py::module_& m);
+void BindScene(py::module_& m);
 
 // PrepareSolid without the GIL; raises as RaiseStatus.
 std::shared_ptr<Solid> PrepareSolidReleasingGil(const Mesh& mesh, bool fill_holes,

@@ -12,6 +12,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "bindings.h"
+#include "distance_types.h"
 #include "inscribe/certified_distance.h"
 #include "inscribe/rigid_pose.h"
 #include "inscribe/separation_distance.h"
@@ -22,8 +23,6 @@
 
 namespace inscribe::python {
 namespace {
-
-using HierarchyPtr = std::shared_ptr<const SphereHierarchy>;
 
 HierarchyVolume VolumeOf(const std::string& name) {
   for (HierarchyVolume volume : {HierarchyVolume::kSphere, HierarchyVolume::kRss}) {
@@ -43,60 +42,19 @@ HierarchyPtr BuildHierarchy(py::handle spheres, const std::string& volume) {
   return std::make_shared<const SphereHierarchy>(ValueOrRaise(std::move(built)));
 }
 
-// A Hierarchy as given, or one built (sphere volumes, the service's default) from a SphereSet
-// or an (N, 4) array.
-HierarchyPtr HierarchyOf(py::handle value) {
-  if (py::isinstance<SphereHierarchy>(value)) return value.cast<HierarchyPtr>();
-  return BuildHierarchy(value, HierarchyVolumeName(HierarchyVolume::kSphere));
-}
-
-// Poses as (N, 7) float64 rows [qw, qx, qy, qz, tx, ty, tz] (a (7,) array is one row), each
-// normalised by core's rule (NormalizedPose); ValueError naming the row otherwise.
-std::vector<RigidPose> PosesOf(py::handle value, const char* name) {
-  py::array_t<double> array = RequireRowOrMatrix<double>(value, 7, name);
-  auto rows = array.unchecked<2>();
-  std::vector<RigidPose> poses(static_cast<std::size_t>(rows.shape(0)));
-  for (py::ssize_t i = 0; i < rows.shape(0); ++i) {
-    RigidPose pose;
-    pose.rotation = Eigen::Quaterniond(rows(i, 0), rows(i, 1), rows(i, 2), rows(i, 3));
-    pose.translation = Vector3(rows(i, 4), rows(i, 5), rows(i, 6));
-    absl::StatusOr<RigidPose> normalized = NormalizedPose(pose);
-    if (!normalized.ok()) {
-      throw py::value_error(absl::StrCat(name, "[", i, "]: ", normalized.status().message()));
-    }
-    poses[static_cast<std::size_t>(i)] = *normalized;
-  }
-  return poses;
-}
-
 // Results of a batch, owned here and shown to Python as strided views (no copies).
 struct DistanceBatch {
   std::vector<DistanceResult> results;
 };
-
-template <typename T>
-py::array FieldView(py::object owner, const T* first, py::ssize_t n, py::ssize_t cols) {
-  const py::ssize_t stride = sizeof(DistanceResult);
-  py::array view = cols == 0
-                       ? py::array(py::dtype::of<T>(), {n}, {stride}, first, owner)
-                       : py::array(py::dtype::of<T>(), {n, cols},
-                                   {stride, static_cast<py::ssize_t>(sizeof(T))}, first, owner);
-  view.attr("flags").attr("writeable") = false;
-  return view;
-}
 
 template <typename T, typename Field>
 py::array BatchField(py::object self, Field field, py::ssize_t cols) {
   const std::vector<DistanceResult>& results = self.cast<const DistanceBatch&>().results;
   static const DistanceResult kEmpty;
   const DistanceResult& first = results.empty() ? kEmpty : results.front();
-  return FieldView<T>(self, field(first), static_cast<py::ssize_t>(results.size()), cols);
+  return ReadOnlyView<T>(field(first), static_cast<py::ssize_t>(results.size()), cols,
+                         static_cast<py::ssize_t>(sizeof(DistanceResult)), self);
 }
-
-struct CertifiedObjectHandle {
-  HierarchyPtr internal, cover;
-  CertifiedObject object;
-};
 
 struct CertifiedBatch {
   std::vector<double> lower, upper;
@@ -123,6 +81,28 @@ bool IsOnePose(py::handle poses) {
 }
 
 }  // namespace
+
+HierarchyPtr HierarchyOf(py::handle value) {
+  if (py::isinstance<SphereHierarchy>(value)) return value.cast<HierarchyPtr>();
+  return BuildHierarchy(value, HierarchyVolumeName(HierarchyVolume::kSphere));
+}
+
+std::vector<RigidPose> PosesOf(py::handle value, const char* name) {
+  py::array_t<double> array = RequireRowOrMatrix<double>(value, 7, name);
+  auto rows = array.unchecked<2>();
+  std::vector<RigidPose> poses(static_cast<std::size_t>(rows.shape(0)));
+  for (py::ssize_t i = 0; i < rows.shape(0); ++i) {
+    RigidPose pose;
+    pose.rotation = Eigen::Quaterniond(rows(i, 0), rows(i, 1), rows(i, 2), rows(i, 3));
+    pose.translation = Vector3(rows(i, 4), rows(i, 5), rows(i, 6));
+    absl::StatusOr<RigidPose> normalized = NormalizedPose(pose);
+    if (!normalized.ok()) {
+      throw py::value_error(absl::StrCat(name, "[", i, "]: ", normalized.status().message()));
+    }
+    poses[static_cast<std::size_t>(i)] = *normalized;
+  }
+  return poses;
+}
 
 void BindDistance(py::module_& m) {
   py::class_<SphereHierarchy, std::shared_ptr<SphereHierarchy>>(

@@ -13,4 +13,5 @@ PYBIND11_MODULE(_inscribe, m) {
   inscribe::python::BindDeformation(m);
   inscribe::python::BindRobot(m);
   inscribe::python::BindRouting(m);
+  inscribe::python::BindScene(m);
 }

@@ -91,8 +91,10 @@ py::array_t<T> RequireRowOrMatrix(py::handle value, py::ssize_t length, const ch
 template <typename T>
 py::array ReadOnlyView(const T* data, py::ssize_t rows, py::ssize_t cols, py::ssize_t row_bytes,
                        py::handle owner) {
-  py::array view(py::dtype::of<T>(), {rows, cols}, {row_bytes, static_cast<py::ssize_t>(sizeof(T))},
-                 data, owner);
+  py::array view = cols == 0
+                       ? py::array(py::dtype::of<T>(), {rows}, {row_bytes}, data, owner)
+                       : py::array(py::dtype::of<T>(), {rows, cols},
+                                   {row_bytes, static_cast<py::ssize_t>(sizeof(T))}, data, owner);
   view.attr("flags").attr("writeable") = false;
   return view;
 }
@@ -105,5 +107,9 @@ template py::array ReadOnlyView<double>(const double*, py::ssize_t, py::ssize_t,
                                         py::handle);
 template py::array ReadOnlyView<std::int32_t>(const std::int32_t*, py::ssize_t, py::ssize_t,
                                               py::ssize_t, py::handle);
+template py::array ReadOnlyView<std::uint64_t>(const std::uint64_t*, py::ssize_t, py::ssize_t,
+                                               py::ssize_t, py::handle);
+template py::array ReadOnlyView<bool>(const bool*, py::ssize_t, py::ssize_t, py::ssize_t,
+                                      py::handle);
 
 }  // namespace inscribe::python

@@ -17,7 +17,8 @@ namespace py = pybind11;
 
 // Raises the Python exception for a non-OK `status`, with its message unchanged:
 // INVALID_ARGUMENT -> ValueError, NOT_FOUND -> FileNotFoundError (in-process, only paths are
-// looked up), anything else -> inscribe.Error whose `.code` is the code's name
+// looked up; inscribe.Scene raises KeyError for its unknown ids itself), anything else ->
+// inscribe.Error whose `.code` is the code's name
 // ("FAILED_PRECONDITION"). Never returns.
 [[noreturn]] void RaiseStatus(const absl::Status& status);
 
@@ -44,8 +45,8 @@ py::array_t<T> RequireMatrix(py::handle value, py::ssize_t cols, const char* nam
 template <typename T>
 py::array_t<T> RequireRowOrMatrix(py::handle value, py::ssize_t length, const char* name);
 
-// A read-only numpy view of `rows` x `cols` values of T at `data`, row stride `row_bytes`,
-// that keeps `owner` alive: no copy.
+// A read-only numpy view of `rows` x `cols` values of T at `data` (`rows` values when cols is
+// 0: a 1-D view), row stride `row_bytes`, that keeps `owner` alive: no copy.
 template <typename T>
 py::array ReadOnlyView(const T* data, py::ssize_t rows, py::ssize_t cols, py::ssize_t row_bytes,
                        py::handle owner);

@@ -1,9 +1,12 @@
 // DistanceStream: one request per simulator frame, one response per frame, in order, over one
-// long-lived bidirectional call. One frame is in the reactor at a time (read, compute on the
-// pool, write, read the next), so frames can never be reordered and a slow client slows only
-// itself. The hierarchies a stream names are resolved once and held for the stream's life.
+// long-lived bidirectional call. One frame is in the reactor at a time (read, compute, write,
+// read the next), so frames can never be reordered and a slow client slows only itself. A frame
+// is computed where the FrameDispatcher says: on the gRPC thread that read it when it is small
+// and its cost known, else on the pool. The hierarchies a stream names are resolved once and
+// held for the stream's life.
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <memory>
 #include <mutex>
@@ -14,6 +17,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "drainable_stream.h"
+#include "frame_dispatch.h"
 #include "inscribe/certified_distance.h"
 #include "inscribe/separation_distance.h"
 #include "inscribe/server/inscribe_service.h"
@@ -75,37 +79,48 @@ class DistanceStreamReactor final
   }
 
   void OnReadDone(bool ok) override {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (state_ == State::kFinished) return;
-    if (!ok) {
-      // The client half-closed (done sending) or the call was cancelled; either way every
-      // frame read has been answered.
-      FinishLocked(absl::OkStatus());
-      return;
-    }
-    if (frame_.pairs_size() > service_->limits_.max_poses) {
-      FinishLocked(absl::ResourceExhaustedError(
-          absl::StrCat("frame ", frame_.frame(), " has ", frame_.pairs_size(),
-                       " pairs; this server's limit (--max-poses) is ", service_->limits_.max_poses,
-                       " per frame")));
-      return;
-    }
-    // Held from here until the frame's reply has been written (or the stream ends).
-    absl::StatusOr<MemoryBudget::Reservation> reserved =
-        service_->memory_->Reserve(frame_.pairs_size() * MemoryCosts::kPerFramePair,
-                                   absl::StrCat("DistanceStream frame ", frame_.frame(), " of ",
-                                                frame_.pairs_size(), " pairs"));
-    if (!reserved.ok()) {
-      FinishLocked(reserved.status());
-      return;
-    }
-    frame_reservation_ = *std::move(reserved);
-    record_.memory_bytes = std::max(record_.memory_bytes, frame_reservation_.bytes());
-    state_ = State::kBusy;
     const ServiceClock::time_point arrived = ServiceClock::now();
-    const JobSize size =
-        frame_reservation_.bytes() <= MemoryCosts::kSmallJob ? JobSize::kSmall : JobSize::kLarge;
-    if (!service_->pool_->TrySubmit([this, arrived] { RunFrame(arrived); }, size)) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (state_ == State::kFinished) return;
+      if (!ok) {
+        // The client half-closed (done sending) or the call was cancelled; either way every
+        // frame read has been answered.
+        FinishLocked(absl::OkStatus());
+        return;
+      }
+      if (frame_.pairs_size() > service_->limits_.max_poses) {
+        FinishLocked(absl::ResourceExhaustedError(
+            absl::StrCat("frame ", frame_.frame(), " has ", frame_.pairs_size(),
+                         " pairs; this server's limit (--max-poses) is ",
+                         service_->limits_.max_poses, " per frame")));
+        return;
+      }
+      // Held from here until the frame's reply has been written (or the stream ends).
+      absl::StatusOr<MemoryBudget::Reservation> reserved =
+          service_->memory_->Reserve(frame_.pairs_size() * MemoryCosts::kPerFramePair,
+                                     absl::StrCat("DistanceStream frame ", frame_.frame(), " of ",
+                                                  frame_.pairs_size(), " pairs"));
+      if (!reserved.ok()) {
+        FinishLocked(reserved.status());
+        return;
+      }
+      frame_reservation_ = *std::move(reserved);
+      record_.memory_bytes = std::max(record_.memory_bytes, frame_reservation_.bytes());
+      // kBusy: a drain now waits for this frame's reply, and nothing else touches the frame.
+      state_ = State::kBusy;
+    }
+    const std::int64_t pairs = frame_.pairs_size();
+    FrameWork work;
+    work.items = certified_frame() ? 2 * pairs : pairs;
+    work.resolved = FindHeld();
+    work.serial = pairs <= kSerialFrameQueries;
+    work.memory_bytes = frame_reservation_.bytes();
+    // After a true return the reply may be written and the next frame running: no member may
+    // be touched here.
+    if (!service_->frames_->Run(work, cost_.Estimate(work.items),
+                                [this, arrived](FramePlace place) { RunFrame(arrived, place); })) {
+      std::lock_guard<std::mutex> lock(mutex_);
       FinishLocked(service_->QueueFullError());
     }
   }
@@ -149,10 +164,11 @@ class DistanceStreamReactor final
     Finish(wire::ToGrpcStatus(status));
   }
 
-  // On the pool: answers frame_ into result_, then writes it (or ends the stream).
-  void RunFrame(ServiceClock::time_point arrived) {
-    record_.queued_seconds += SecondsSince(arrived);
+  // Where the dispatcher put it (inline on the gRPC thread, or on the pool): answers frame_
+  // into result_, then writes it (or ends the stream).
+  void RunFrame(ServiceClock::time_point arrived, FramePlace place) {
     const ServiceClock::time_point started = ServiceClock::now();
+    record_.queued_seconds += std::chrono::duration<double>(started - arrived).count();
     absl::Status status;
     try {
       status = ComputeFrame();
@@ -160,7 +176,13 @@ class DistanceStreamReactor final
       status = absl::ResourceExhaustedError("server ran out of memory in DistanceStream");
     }
     if (status.ok() && cancelled_.load()) status = absl::CancelledError("client went away");
-    record_.run_seconds += SecondsSince(started);
+    const double seconds = SecondsSince(started);
+    record_.run_seconds += seconds;
+    if (status.ok()) {
+      cost_.Record(certified_frame() ? 2 * frame_.pairs_size() : frame_.pairs_size(), seconds);
+      ++record_.frames;
+      if (place == FramePlace::kInline) ++record_.inline_frames;
+    }
     std::lock_guard<std::mutex> lock(mutex_);
     if (!status.ok()) {
       FinishLocked(status);
@@ -178,8 +200,9 @@ class DistanceStreamReactor final
     if (frame_.pairs_size() > 0 && !frame_.pairs(0).cover_a().empty()) {
       return ComputeCertifiedFrame(*tolerance, volume);
     }
+    // pairs_ holds what FindHeld found; the rest is looked up here, off the gRPC thread when
+    // anything was missing (the dispatcher runs unresolved frames on the pool).
     const std::size_t n = static_cast<std::size_t>(frame_.pairs_size());
-    std::vector<PosedPair> pairs(n);
     for (std::size_t i = 0; i < n; ++i) {
       const v1::DistancePair& pair = frame_.pairs(static_cast<int>(i));
       if (!pair.cover_a().empty() || !pair.cover_b().empty()) {
@@ -192,20 +215,25 @@ class DistanceStreamReactor final
                 "cover_a, cover_b: a frame's pairs are all certified (covers named) or none, and "
                 "pairs[0] names none"));
       }
-      absl::StatusOr<const SphereHierarchy*> a =
-          Hierarchy(pair.sphere_set_a(), volume, "sphere_set_a");
-      if (!a.ok()) return InPair(i, a.status());
-      absl::StatusOr<const SphereHierarchy*> b =
-          Hierarchy(pair.sphere_set_b(), volume, "sphere_set_b");
-      if (!b.ok()) return InPair(i, b.status());
-      pairs[i].a = *a;
-      pairs[i].b = *b;
-      if (absl::Status s = ReadPoses(i, pair, &pairs[i].pose_a, &pairs[i].pose_b); !s.ok()) {
+      PosedPair& posed = pairs_[i];
+      if (posed.a == nullptr) {
+        absl::StatusOr<const SphereHierarchy*> a =
+            Hierarchy(pair.sphere_set_a(), volume, "sphere_set_a");
+        if (!a.ok()) return InPair(i, a.status());
+        posed.a = *a;
+      }
+      if (posed.b == nullptr) {
+        absl::StatusOr<const SphereHierarchy*> b =
+            Hierarchy(pair.sphere_set_b(), volume, "sphere_set_b");
+        if (!b.ok()) return InPair(i, b.status());
+        posed.b = *b;
+      }
+      if (absl::Status s = ReadPoses(i, pair, &posed.pose_a, &posed.pose_b); !s.ok()) {
         return s;
       }
     }
     absl::StatusOr<std::vector<DistanceResult>> results =
-        PairSeparationDistances(pairs, *tolerance, &cancelled_);
+        PairSeparationDistances(pairs_, *tolerance, &cancelled_);
     if (absl::Status s = Answered(results.status()); !s.ok()) return s;
     wire::AppendDistanceResults(*results, result_.mutable_results());
     return absl::OkStatus();
@@ -244,7 +272,6 @@ class DistanceStreamReactor final
   absl::Status ComputeCertifiedFrame(const DistanceRequest& tolerance, HierarchyVolume volume) {
     if (absl::Status s = CheckCertifiedTolerance(tolerance); !s.ok()) return s;
     const std::size_t n = static_cast<std::size_t>(frame_.pairs_size());
-    std::vector<CertifiedPair> pairs(n);
     for (std::size_t i = 0; i < n; ++i) {
       const v1::DistancePair& pair = frame_.pairs(static_cast<int>(i));
       if (pair.cover_a().empty()) {
@@ -255,24 +282,86 @@ class DistanceStreamReactor final
       if (absl::Status s = CheckCovers(pair.cover_a(), pair.cover_b()); !s.ok()) {
         return InPair(i, s);
       }
-      absl::StatusOr<const CertifiedObject*> a =
-          Certified(pair.sphere_set_a(), pair.cover_a(), volume, "sphere_set_a");
-      if (!a.ok()) return InPair(i, a.status());
-      absl::StatusOr<const CertifiedObject*> b =
-          Certified(pair.sphere_set_b(), pair.cover_b(), volume, "sphere_set_b");
-      if (!b.ok()) return InPair(i, b.status());
-      pairs[i].a = *a;
-      pairs[i].b = *b;
-      if (absl::Status s = ReadPoses(i, pair, &pairs[i].pose_a, &pairs[i].pose_b); !s.ok()) {
+      CertifiedPair& posed = certified_pairs_[i];
+      if (posed.a == nullptr) {
+        absl::StatusOr<const CertifiedObject*> a =
+            Certified(pair.sphere_set_a(), pair.cover_a(), volume, "sphere_set_a");
+        if (!a.ok()) return InPair(i, a.status());
+        posed.a = *a;
+      }
+      if (posed.b == nullptr) {
+        absl::StatusOr<const CertifiedObject*> b =
+            Certified(pair.sphere_set_b(), pair.cover_b(), volume, "sphere_set_b");
+        if (!b.ok()) return InPair(i, b.status());
+        posed.b = *b;
+      }
+      if (absl::Status s = ReadPoses(i, pair, &posed.pose_a, &posed.pose_b); !s.ok()) {
         return s;
       }
     }
     absl::StatusOr<std::vector<CertifiedDistanceResult>> results =
-        inscribe::CertifiedDistances(pairs, tolerance.closer_than, &cancelled_);
+        inscribe::CertifiedDistances(certified_pairs_, tolerance.closer_than, &cancelled_);
     if (absl::Status s = Answered(results.status()); !s.ok()) return s;
     wire::AppendCertifiedDistanceResults(*results, std::isfinite(tolerance.closer_than),
                                          result_.mutable_results());
     return absl::OkStatus();
+  }
+
+  // Whether the frame's pairs name covers (then all must): a certified frame.
+  bool certified_frame() const {
+    return frame_.pairs_size() > 0 && !frame_.pairs(0).cover_a().empty();
+  }
+
+  // The key of a held object in held_ or certified_: "volume/key", or "volume/internal|cover";
+  // built in slot_, whose capacity stays, so a lookup allocates nothing.
+  const std::string& Slot(HierarchyVolume volume, const std::string& key,
+                          const std::string* cover = nullptr) {
+    slot_.assign(HierarchyVolumeName(volume));
+    slot_ += '/';
+    slot_ += key;
+    if (cover != nullptr) {
+      slot_ += '|';
+      slot_ += *cover;
+    }
+    return slot_;
+  }
+
+  // Fills pairs_ (certified_pairs_ for a certified frame) with the objects of frame_ that this
+  // stream already holds, null for the others; true when it holds them all, so that running
+  // the frame looks nothing up in the cache. O(pairs) lookups in the stream's own tables.
+  bool FindHeld() {
+    const HierarchyVolume volume = wire::VolumeFromProto(frame_.volume());
+    const std::size_t n = static_cast<std::size_t>(frame_.pairs_size());
+    bool all = true;
+    if (certified_frame()) {
+      certified_pairs_.assign(n, CertifiedPair{});
+      for (std::size_t i = 0; i < n; ++i) {
+        const v1::DistancePair& pair = frame_.pairs(static_cast<int>(i));
+        certified_pairs_[i].a = HeldCertified(volume, pair.sphere_set_a(), pair.cover_a());
+        certified_pairs_[i].b = HeldCertified(volume, pair.sphere_set_b(), pair.cover_b());
+        all = all && certified_pairs_[i].a != nullptr && certified_pairs_[i].b != nullptr;
+      }
+      return all;
+    }
+    pairs_.assign(n, PosedPair{});
+    for (std::size_t i = 0; i < n; ++i) {
+      const v1::DistancePair& pair = frame_.pairs(static_cast<int>(i));
+      pairs_[i].a = HeldHierarchy(volume, pair.sphere_set_a());
+      pairs_[i].b = HeldHierarchy(volume, pair.sphere_set_b());
+      all = all && pairs_[i].a != nullptr && pairs_[i].b != nullptr;
+    }
+    return all;
+  }
+
+  const SphereHierarchy* HeldHierarchy(HierarchyVolume volume, const std::string& key) {
+    auto it = held_.find(Slot(volume, key));
+    return it != held_.end() ? it->second.get() : nullptr;
+  }
+
+  const CertifiedObject* HeldCertified(HierarchyVolume volume, const std::string& internal_key,
+                                       const std::string& cover_key) {
+    auto it = certified_.find(Slot(volume, internal_key, &cover_key));
+    return it != certified_.end() ? &it->second->object : nullptr;
   }
 
   // The certified object of (internal set, cover) for this stream, from the stream's own table
@@ -280,9 +369,7 @@ class DistanceStreamReactor final
   absl::StatusOr<const CertifiedObject*> Certified(const std::string& internal_key,
                                                    const std::string& cover_key,
                                                    HierarchyVolume volume, const char* field) {
-    const std::string slot =
-        absl::StrCat(HierarchyVolumeName(volume), "/", internal_key, "|", cover_key);
-    if (auto it = certified_.find(slot); it != certified_.end()) return &it->second->object;
+    if (const CertifiedObject* held = HeldCertified(volume, internal_key, cover_key)) return held;
     if (absl::Status s = CheckKey(internal_key, field); !s.ok()) return s;
     if (held_.size() + certified_.size() >= kMaxStreamSets) {
       return absl::ResourceExhaustedError(
@@ -296,15 +383,14 @@ class DistanceStreamReactor final
                           absl::StrCat(field, ": ", entry.status().message()));
     }
     const CertifiedObject* object = &(*entry)->object;
-    certified_.emplace(slot, *std::move(entry));
+    certified_.emplace(Slot(volume, internal_key, &cover_key), *std::move(entry));
     return object;
   }
 
   // The hierarchy of `key` for this stream, from the stream's own table or the store.
   absl::StatusOr<const SphereHierarchy*> Hierarchy(const std::string& key, HierarchyVolume volume,
                                                    const char* field) {
-    const std::string slot = absl::StrCat(HierarchyVolumeName(volume), "/", key);
-    if (auto it = held_.find(slot); it != held_.end()) return it->second.get();
+    if (const SphereHierarchy* held = HeldHierarchy(volume, key)) return held;
     if (absl::Status s = CheckKey(key, field); !s.ok()) return s;
     if (held_.size() + certified_.size() >= kMaxStreamSets) {
       return absl::ResourceExhaustedError(
@@ -317,7 +403,7 @@ class DistanceStreamReactor final
       return absl::Status(h.status().code(), absl::StrCat(field, ": ", h.status().message()));
     }
     const SphereHierarchy* raw = h->get();
-    held_.emplace(slot, *std::move(h));
+    held_.emplace(Slot(volume, key), *std::move(h));
     return raw;
   }
 
@@ -333,6 +419,11 @@ class DistanceStreamReactor final
   v1::DistanceFrame frame_;
   v1::DistanceFrameResult result_;
   MemoryBudget::Reservation frame_reservation_;  // the current frame's estimate
+  FrameCostModel cost_;                          // this stream's seconds per query
+  // The current frame's queries (FindHeld, then ComputeFrame), kept to reuse their capacity.
+  std::vector<PosedPair> pairs_;
+  std::vector<CertifiedPair> certified_pairs_;
+  std::string slot_;  // Slot's buffer
   std::unordered_map<std::string, std::shared_ptr<const SphereHierarchy>> held_;
   // Certified pairs' objects by "volume/internal key|cover key".
   std::unordered_map<std::string, std::shared_ptr<const CertifiedObjectEntry>> certified_;

@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "frame_dispatch.h"
 #include "inscribe/mesh_hash.h"
 #include "inscribe/mesh_validation.h"
 #include "inscribe/wire/convert.h"
@@ -43,6 +44,7 @@ absl::Status RunInspectMesh(const v1::InspectMeshRequest& request,
 InscribeService::InscribeService(JobPool* pool, ResultCache* cache, const ServiceLimits& limits,
                                  CallObserver observer, CallAuthenticator authenticate)
     : pool_(pool),
+      frames_(std::make_unique<FrameDispatcher>(pool)),
       store_(
           std::make_unique<ResultStore>(cache, StoreLimits{limits.max_voxels, limits.max_spheres})),
       memory_(std::make_unique<MemoryBudget>(limits.memory_budget_bytes)),

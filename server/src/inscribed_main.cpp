@@ -28,10 +28,10 @@ void LogCall(const CallRecord& call) {
   const auto level = call.status.ok() ? spdlog::level::info : spdlog::level::warn;
   spdlog::log(level,
               "event=call method={} peer={} code={} triangles={} memory_mb={:.1f} queued_ms={:.3f}"
-              " run_ms={:.3f} message=\"{}\"",
+              " run_ms={:.3f} frames={} inline_frames={} message=\"{}\"",
               call.method, call.peer, absl::StatusCodeToString(call.status.code()), call.triangles,
               call.memory_bytes / 1048576.0, 1e3 * call.queued_seconds, 1e3 * call.run_seconds,
-              std::string(call.status.message()));
+              call.frames, call.inline_frames, std::string(call.status.message()));
 }
 
 // The shared Redis tier going down (lookups then skip it and compute or use the local tiers)

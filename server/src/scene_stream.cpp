@@ -7,6 +7,7 @@
 // hierarchy it holds) is freed when the call is done, however it ends.
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <mutex>
@@ -16,6 +17,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "drainable_stream.h"
+#include "frame_dispatch.h"
 #include "inscribe/scene.h"
 #include "inscribe/server/inscribe_service.h"
 #include "inscribe/wire/convert.h"
@@ -67,20 +69,24 @@ class SceneStreamReactor final : public grpc::ServerBidiReactor<v1::SceneMessage
   }
 
   void OnReadDone(bool ok) override {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (state_ == State::kFinished) return;
-    if (!ok) {
-      // The client half-closed or the call was cancelled; every message read was answered.
-      FinishLocked(absl::OkStatus());
-      return;
+    const ServiceClock::time_point arrived = ServiceClock::now();
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (state_ == State::kFinished) return;
+      if (!ok) {
+        // The client half-closed or the call was cancelled; every message read was answered.
+        FinishLocked(absl::OkStatus());
+        return;
+      }
+      if (absl::Status s = Admit(); !s.ok()) {
+        FinishLocked(
+            absl::Status(s.code(), absl::StrCat("frame ", message_.frame(), " ", s.message())));
+        return;
+      }
+      // kBusy: a drain now waits for this message's reply, and nothing else touches it.
+      state_ = State::kBusy;
     }
-    if (absl::Status s = Admit(); !s.ok()) {
-      FinishLocked(
-          absl::Status(s.code(), absl::StrCat("frame ", message_.frame(), " ", s.message())));
-      return;
-    }
-    state_ = State::kBusy;
-    Dispatch(ServiceClock::now());
+    Dispatch(arrived);
   }
 
   void OnWriteDone(bool ok) override {
@@ -179,26 +185,43 @@ class SceneStreamReactor final : public grpc::ServerBidiReactor<v1::SceneMessage
     return absl::OkStatus();
   }
 
-  // Hands the message to the job pool (refused: RESOURCE_EXHAUSTED naming --max-queue). The
-  // small-job lane takes scenes whose objects and last frame's candidate pairs are small.
+  // Runs the message inline or on the pool (FrameDispatcher, the rule every stream shares);
+  // a full pool ends the stream with RESOURCE_EXHAUSTED naming --max-queue. Its work, in the
+  // stream's cost unit (Items): the objects and the last frame's candidate pairs. It is
+  // resolved when it adds no objects (whose sets are looked up in the cache), and serial
+  // (answered on the calling thread, SceneQuery::parallel false, when inline) when the last
+  // frame had few candidates.
   void Dispatch(ServiceClock::time_point arrived) {
-    const std::int64_t work = static_cast<std::int64_t>(scene_.size() + message_.add_size()) *
-                                  MemoryCosts::kPerSceneObject +
-                              last_candidates_ * MemoryCosts::kPerScenePair;
-    const JobSize size = work <= MemoryCosts::kSmallJob ? JobSize::kSmall : JobSize::kLarge;
-    if (!service_->pool_->TrySubmit([this, arrived] { RunMessage(arrived); }, size)) {
+    FrameWork work;
+    work.items = Items();
+    work.resolved = message_.add_size() == 0;
+    work.serial = last_candidates_ <= kSerialFrameQueries;
+    // The pool's lane: by the message's working memory (the scene's own is reserved for the
+    // stream's life), so small scenes never wait behind large calls.
+    work.memory_bytes = work.items * MemoryCosts::kPerScenePair;
+    // After a true return the reply may be written and the next message running: no member may
+    // be touched here.
+    if (!service_->frames_->Run(
+            work, cost_.Estimate(work.items),
+            [this, arrived](FramePlace place) { RunMessage(arrived, place); })) {
+      std::lock_guard<std::mutex> lock(mutex_);
       FinishLocked(service_->QueueFullError());
     }
   }
 
-  // On the pool: applies message_ to the scene and answers it into reply_, then writes it (or
-  // ends the stream).
-  void RunMessage(ServiceClock::time_point arrived) {
-    record_.queued_seconds += SecondsSince(arrived);
+  std::int64_t Items() const {
+    return static_cast<std::int64_t>(scene_.size()) + message_.add_size() + last_candidates_;
+  }
+
+  // Applies message_ to the scene and answers it into reply_ (`place`: where it runs), then
+  // writes it (or ends the stream).
+  void RunMessage(ServiceClock::time_point arrived, FramePlace place) {
     const ServiceClock::time_point started = ServiceClock::now();
+    record_.queued_seconds += std::chrono::duration<double>(started - arrived).count();
+    const std::int64_t items = Items();
     absl::Status status;
     try {
-      status = ComputeMessage();
+      status = ComputeMessage(place);
     } catch (const std::bad_alloc&) {
       status = absl::ResourceExhaustedError("server ran out of memory in SceneStream");
     }
@@ -206,6 +229,11 @@ class SceneStreamReactor final : public grpc::ServerBidiReactor<v1::SceneMessage
     const double seconds = SecondsSince(started);
     record_.run_seconds += seconds;
     reply_.set_seconds(seconds);
+    if (status.ok()) {
+      cost_.Record(items, seconds);
+      ++record_.frames;
+      if (place == FramePlace::kInline) ++record_.inline_frames;
+    }
     std::lock_guard<std::mutex> lock(mutex_);
     if (!status.ok()) {
       FinishLocked(absl::Status(status.code(),
@@ -215,7 +243,7 @@ class SceneStreamReactor final : public grpc::ServerBidiReactor<v1::SceneMessage
     StartWrite(&reply_);
   }
 
-  absl::Status ComputeMessage() {
+  absl::Status ComputeMessage(FramePlace place) {
     reply_.Clear();
     reply_.set_frame(message_.frame());
     if (!created_) {
@@ -250,7 +278,9 @@ class SceneStreamReactor final : public grpc::ServerBidiReactor<v1::SceneMessage
     }
     if (absl::Status s = scene_.SetPoses(*poses); !s.ok()) return Named("poses", s);
     query_ = pending_query_;
-    absl::StatusOr<SceneFrame> frame = scene_.ClosePairs(query_, &cancelled_);
+    SceneQuery query = query_;
+    query.parallel = place == FramePlace::kPool;  // TBB loops belong in the pool's arena
+    absl::StatusOr<SceneFrame> frame = scene_.ClosePairs(query, &cancelled_);
     if (!frame.ok()) return frame.status();
     last_candidates_ = frame->candidate_pairs;
     wire::SceneFrameToProto(*frame, &reply_);
@@ -310,6 +340,7 @@ class SceneStreamReactor final : public grpc::ServerBidiReactor<v1::SceneMessage
   SceneQuery pending_query_;  // message_'s (its own, or the current one)
   std::int64_t ignored_sent_ = 0;
   std::int64_t last_candidates_ = 0;
+  FrameCostModel cost_;                          // seconds per item of this stream's messages
   MemoryBudget::Reservation scene_reservation_;  // the scene's estimate, for its life
   CallRecord record_;
 };

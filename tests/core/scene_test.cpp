@@ -205,6 +205,7 @@ TEST(Scene, EveryFrameEqualsBruteForce) {
     const double threshold = thresholds[frame % 5];
     SceneQuery query;
     query.threshold = threshold;
+    query.parallel = frame % 2 == 0;
     absl::StatusOr<SceneFrame> got = scene.ClosePairs(query);
     ASSERT_TRUE(got.ok()) << got.status();
     ExpectEqual(*got, BruteForce(objects, ignored, threshold),
@@ -245,6 +246,43 @@ TEST(Scene, BroadPhasePrunesFarPairs) {
     ExpectEqual(*got, BruteForce(objects, {}, query.threshold), "frame " + std::to_string(frame));
     EXPECT_LT(got->candidate_pairs, 300 * 299 / 2 / 50);  // under 2% of all pairs
     EXPECT_GE(got->candidate_pairs, got->close_pairs);
+  }
+}
+
+// stop_at_first reports the same pairs as the full query, each with a real sphere pair's value
+// below the threshold (not always the minimum), for less work.
+TEST(Scene, StopAtFirstReportsTheSamePairs) {
+  const auto shape = Hierarchy(RandomSpheres(150, 13), HierarchyVolume::kRss);
+  std::mt19937_64 rng(59);
+  Scene scene;
+  for (SceneObjectId id = 0; id < 40; ++id) {
+    SceneObject o;
+    o.id = id;
+    o.spheres = shape;
+    o.pose = PoseNear(rng, Vector3::Constant(1.5), 1.5);
+    ASSERT_TRUE(scene.Add(o).ok());
+  }
+  for (const double threshold : {-0.02, 0.0, 0.05}) {
+    SceneQuery full;
+    full.threshold = threshold;
+    SceneQuery first = full;
+    first.stop_at_first = true;
+    absl::StatusOr<SceneFrame> a = scene.ClosePairs(full);
+    absl::StatusOr<SceneFrame> b = scene.ClosePairs(first);
+    ASSERT_TRUE(a.ok() && b.ok());
+    ASSERT_EQ(a->pairs.size(), b->pairs.size());
+    ASSERT_GT(a->pairs.size(), 10u);
+    std::int64_t full_work = 0, first_work = 0;
+    for (std::size_t i = 0; i < a->pairs.size(); ++i) {
+      ASSERT_EQ(a->pairs[i].a, b->pairs[i].a);
+      ASSERT_EQ(a->pairs[i].b, b->pairs[i].b);
+      EXPECT_LT(b->pairs[i].result.distance, threshold);
+      EXPECT_GE(b->pairs[i].result.distance, a->pairs[i].result.distance);
+      EXPECT_GE(b->pairs[i].result.sphere_a, 0);
+      full_work += a->pairs[i].result.sphere_tests;
+      first_work += b->pairs[i].result.sphere_tests;
+    }
+    EXPECT_LT(first_work, full_work);
   }
 }
 

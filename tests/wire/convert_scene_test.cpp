@@ -63,6 +63,7 @@ TEST(SceneConvert, QueryDefaultsAndTheServersPairLimit) {
   SceneQuery query;
   query.threshold = -0.5;
   query.rel_err = 0.01;
+  query.stop_at_first = true;
   v1::SceneQuery w;
   SceneQueryToProto(query, &w);
   EXPECT_FALSE(w.has_max_pairs());
@@ -70,6 +71,7 @@ TEST(SceneConvert, QueryDefaultsAndTheServersPairLimit) {
   ASSERT_TRUE(back.ok()) << back.status();
   EXPECT_EQ(back->threshold, -0.5);
   EXPECT_EQ(back->rel_err, 0.01);
+  EXPECT_TRUE(back->stop_at_first);
   EXPECT_EQ(back->max_pairs, SceneQuery{}.max_pairs);
   // Unset: core's default capped by the limit; set above it: refused naming the flag.
   EXPECT_EQ(SceneQueryFromProto(w, 50, "--max-scene-pairs")->max_pairs, 50u);

@@ -97,6 +97,7 @@ void SceneQueryToProto(const SceneQuery& query, v1::SceneQuery* out) {
   out->set_threshold(query.threshold);
   out->set_abs_err(query.abs_err);
   out->set_rel_err(query.rel_err);
+  out->set_stop_at_first(query.stop_at_first);
   if (query.max_pairs != SceneQuery{}.max_pairs) {
     out->set_max_pairs(static_cast<std::int64_t>(query.max_pairs));
   }
@@ -109,6 +110,7 @@ absl::StatusOr<SceneQuery> SceneQueryFromProto(const v1::SceneQuery& query,
   out.threshold = query.threshold();
   out.abs_err = query.abs_err();
   out.rel_err = query.rel_err();
+  out.stop_at_first = query.stop_at_first();
   if (query.has_max_pairs()) {
     if (query.max_pairs() < 1) {
       return absl::InvalidArgumentError(

@@ -186,6 +186,13 @@ absl::Status ParseQuery(const json& j, const std::string& path, SceneFile* out) 
     if (!v.ok()) return v.status();
     out->query.rel_err = *v;
   }
+  if (j.contains("stop_at_first")) {
+    if (!j["stop_at_first"].is_boolean()) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(path, ": stop_at_first must be true or false"));
+    }
+    out->query.stop_at_first = j["stop_at_first"].get<bool>();
+  }
   if (j.contains("max_pairs")) {
     absl::StatusOr<std::uint64_t> v =
         Field<std::uint64_t>(j, "max_pairs", where, "a positive integer");
@@ -223,7 +230,7 @@ absl::StatusOr<SceneFile> ParseSceneFile(absl::string_view bytes, const std::str
   for (const auto& [key, value] : j.items()) {
     if (key != "format" && key != "version" && key != "objects" && key != "ignore" &&
         key != "threshold" && key != "abs_err" && key != "rel_err" && key != "max_pairs" &&
-        key != "hierarchy") {
+        key != "stop_at_first" && key != "hierarchy") {
       return absl::InvalidArgumentError(absl::StrCat(path, ": unknown field \"", key, "\""));
     }
   }

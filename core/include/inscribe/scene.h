@@ -5,10 +5,11 @@
 // Each object is a sphere set's hierarchy (shared, immutable; many objects may share one) at a
 // world pose, with a collision group and mask: a pair is considered only when each object's
 // group meets the other's mask, and it is not on the ignore list (a robot's adjacent links).
-// The broad phase sweeps the objects' world bounding spheres, sorted along one axis and kept
-// sorted between frames (few swaps when objects move a little), so a frame costs about
-// O(n + k) for n objects and k candidate pairs; the narrow phase then runs a pruned distance
-// query per candidate (DistanceRequest::max_distance = the threshold).
+// The broad phase sweeps the objects' world boxes (each object's box in its own frame, turned
+// with it), sorted along one axis and kept sorted between frames (few swaps when objects move a
+// little), and keeps a pair when both its boxes and its bounding spheres are within the
+// threshold, so a frame costs about O(n + k) for n objects and k candidate pairs; the narrow phase
+// then runs a pruned distance query per candidate (DistanceRequest::max_distance = the threshold).
 #pragma once
 
 #include <atomic>
@@ -68,6 +69,14 @@ struct SceneQuery {
   // are always computed exactly.
   double abs_err = 0.0;
   double rel_err = 0.0;
+  // Only whether each pair is closer than the threshold (collision checking): a plain pair's
+  // search stops at the first sphere pair below it (DistanceRequest::closer_than), so
+  // result.distance is that pair's value, below the threshold but not always the minimum.
+  // The same pairs are reported; certified pairs are answered in full either way.
+  bool stop_at_first = false;
+  // Answer the candidates on TBB's threads when there are more than a few (true), or all on
+  // the calling thread (false: a server answering a small frame on its own thread).
+  bool parallel = true;
   // At most this many pairs are returned: the nearest ones (by distance, or by the covers'
   // distance for certified pairs), with SceneFrame::truncated set when more were close.
   std::size_t max_pairs = 100'000;
@@ -120,7 +129,8 @@ class Scene {
   bool contains(SceneObjectId id) const { return index_.count(id) != 0; }
 
   // Every considered pair closer than query.threshold. Pairs are answered in parallel (TBB)
-  // when there are many, polling `cancel` (may be null): CANCELLED once it is set. Errors:
+  // when there are many and query.parallel, polling `cancel` (may be null): CANCELLED once it
+  // is set. Errors:
   // CheckSceneQuery's; INVALID_ARGUMENT for a certified pair whose coordinates are beyond
   // kCertifiedDistanceMaxScale.
   absl::StatusOr<SceneFrame> ClosePairs(const SceneQuery& query,
@@ -135,6 +145,10 @@ class Scene {
     Vector3 local_center = Vector3::Zero();
     double radius = 0.0;
     Vector3 world_center = Vector3::Zero();
+    // The box around the same spheres: in the object's frame (centre, half sides), and the
+    // world-axis box around it at its pose (centre, half sides |R| h).
+    Vector3 local_box_center = Vector3::Zero(), local_half = Vector3::Zero();
+    Vector3 box_center = Vector3::Zero(), half = Vector3::Zero();
     // |translation| + |local_center| + radius: the coordinate scale of the broad phase's
     // rounding slack.
     double scale = 0.0;
@@ -149,7 +163,7 @@ class Scene {
   std::vector<Entry> objects_;                             // dense; Remove moves the last in
   absl::flat_hash_map<SceneObjectId, std::size_t> index_;  // id -> position in objects_
   absl::flat_hash_set<std::pair<SceneObjectId, SceneObjectId>> ignored_;  // PairKey
-  // objects_ positions sorted by the low end of their bounding spheres along sweep_axis_;
+  // objects_ positions sorted by the low end of their world boxes along sweep_axis_;
   // re-sorted from scratch after Add or Remove (order_valid_ false) or an axis change, else by
   // insertion from the last frame's order.
   std::vector<std::uint32_t> order_;

@@ -26,6 +26,7 @@ namespace inscribe::server {
 class ResultStore;
 class DistanceStreamReactor;
 class DrainableStream;
+class FrameDispatcher;
 class SceneStreamReactor;
 class MemoryBudget;
 class MeshSizes;
@@ -64,13 +65,15 @@ struct ServiceLimits {
 
 // What the service did with one call, for access logs and metrics. Times in seconds.
 struct CallRecord {
-  const char* method = "";        // RPC name, e.g. "InspectMesh"
-  std::string peer;               // grpc peer string, e.g. "ipv4:127.0.0.1:53412"
-  absl::Status status;            // what the caller was sent
-  std::int64_t triangles = 0;     // size of the request's mesh
-  double queued_seconds = 0.0;    // from arrival to the start of the job (0 if never queued)
-  double run_seconds = 0.0;       // time the job ran on the pool
-  std::int64_t memory_bytes = 0;  // working memory reserved by estimate (--memory-budget)
+  const char* method = "";         // RPC name, e.g. "InspectMesh"
+  std::string peer;                // grpc peer string, e.g. "ipv4:127.0.0.1:53412"
+  absl::Status status;             // what the caller was sent
+  std::int64_t triangles = 0;      // size of the request's mesh
+  double queued_seconds = 0.0;     // from arrival to the start of the job (0 if never queued)
+  double run_seconds = 0.0;        // time the job ran (on the pool, or inline for stream frames)
+  std::int64_t memory_bytes = 0;   // working memory reserved by estimate (--memory-budget)
+  std::int64_t frames = 0;         // streams: frames answered
+  std::int64_t inline_frames = 0;  // of which on the gRPC thread that read them (FrameDispatcher)
 };
 
 // Called once per finished call, on a gRPC or pool thread, before the reply is sent; must be
@@ -84,8 +87,10 @@ using CallObserver = std::function<void(const CallRecord&)>;
 using CallAuthenticator = std::function<absl::Status(const grpc::CallbackServerContext& context)>;
 
 // Handlers check what is O(1) to check (array shapes, limits, cancellation) on the gRPC thread
-// and hand everything else to `pool`; they never compute on gRPC threads. `pool` must outlive
-// the service and be drained (JobPool::WaitIdle) before the service is destroyed.
+// and hand everything else to `pool`; they never compute on gRPC threads, with one exception:
+// stream frames of a few queries whose cost the stream has measured are answered on the gRPC
+// thread that read them (server/src/frame_dispatch.h, one rule for every stream). `pool` must
+// outlive the service and be drained (JobPool::WaitIdle) before the service is destroyed.
 class InscribeService final : public v1::Inscribe::CallbackService {
  public:
   // `cache` holds meshes and results; it must outlive the service.
@@ -207,6 +212,7 @@ class InscribeService final : public v1::Inscribe::CallbackService {
   friend class SceneStreamReactor;
 
   JobPool* const pool_;
+  std::unique_ptr<FrameDispatcher> frames_;  // inline or pool, for every stream's frames
   std::unique_ptr<ResultStore> store_;
   std::unique_ptr<MemoryBudget> memory_;   // --memory-budget
   std::unique_ptr<MeshSizes> mesh_sizes_;  // of meshes stored here, for Generate's estimate

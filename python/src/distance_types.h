@@ -1,0 +1,34 @@
+// What the distance and scene bindings share: hierarchies from Python values, (N, 7) poses,
+// and the certified object handle.
+#pragma once
+
+#include <pybind11/pybind11.h>
+
+#include <memory>
+#include <vector>
+
+#include "inscribe/certified_distance.h"
+#include "inscribe/rigid_pose.h"
+#include "inscribe/sphere_hierarchy.h"
+
+namespace inscribe::python {
+
+namespace py = pybind11;
+
+using HierarchyPtr = std::shared_ptr<const SphereHierarchy>;
+
+// A Hierarchy as given, or one built (sphere volumes, the service's default) from a SphereSet
+// or an (N, 4) array.
+HierarchyPtr HierarchyOf(py::handle value);
+
+// Poses as (N, 7) float64 rows [qw, qx, qy, qz, tx, ty, tz] (a (7,) array is one row), each
+// normalised by core's rule (NormalizedPose); ValueError naming the row otherwise.
+std::vector<RigidPose> PosesOf(py::handle value, const char* name);
+
+// inscribe.CertifiedObject: the hierarchies it owns and the core object pointing into them.
+struct CertifiedObjectHandle {
+  HierarchyPtr internal, cover;
+  CertifiedObject object;
+};
+
+}  // namespace inscribe::python

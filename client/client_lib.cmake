@@ -6,7 +6,8 @@ add_library(inscribe_client STATIC
   ${CMAKE_CURRENT_LIST_DIR}/src/client/client.cpp
   ${CMAKE_CURRENT_LIST_DIR}/src/client/distance_session.cpp
   ${CMAKE_CURRENT_LIST_DIR}/src/client/grpc_connection.cpp
-  ${CMAKE_CURRENT_LIST_DIR}/src/client/routed_connection.cpp)
+  ${CMAKE_CURRENT_LIST_DIR}/src/client/routed_connection.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/src/client/scene_session.cpp)
 add_library(inscribe::client ALIAS inscribe_client)
 target_include_directories(inscribe_client
   PUBLIC $<BUILD_INTERFACE:${CMAKE_CURRENT_LIST_DIR}/include> $<INSTALL_INTERFACE:include>)

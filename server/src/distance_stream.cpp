@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "drainable_stream.h"
 #include "frame_dispatch.h"
 #include "inscribe/certified_distance.h"
 #include "inscribe/separation_distance.h"
@@ -39,7 +40,8 @@ constexpr std::size_t kMaxStreamSets = 1024;
 // and StartRead are called under it, so a drain can never finish a stream between a state
 // change and the read it announces.
 class DistanceStreamReactor final
-    : public grpc::ServerBidiReactor<v1::DistanceFrame, v1::DistanceFrameResult> {
+    : public grpc::ServerBidiReactor<v1::DistanceFrame, v1::DistanceFrameResult>,
+      public DrainableStream {
  public:
   DistanceStreamReactor(InscribeService* service, grpc::CallbackServerContext* context)
       : service_(service) {
@@ -68,18 +70,12 @@ class DistanceStreamReactor final
   }
 
   // The service is draining: end now when waiting for a frame, else after the current one.
-  void Drain() {
+  void Drain() override {
     std::lock_guard<std::mutex> lock(mutex_);
     draining_ = true;
     if (state_ == State::kReading) {
       FinishLocked(absl::UnavailableError("server is shutting down; reconnect to another"));
     }
-  }
-
-  // Keeps the reactor alive across a Drain call made outside the service's lock.
-  void Ref() { refs_.fetch_add(1); }
-  void Unref() {
-    if (refs_.fetch_sub(1) == 1) delete this;
   }
 
   void OnReadDone(bool ok) override {
@@ -417,7 +413,6 @@ class DistanceStreamReactor final
 
   InscribeService* const service_;
   std::atomic<bool> cancelled_{false};
-  std::atomic<int> refs_{1};  // gRPC's (released in OnDone) plus each drain in progress
 
   std::mutex mutex_;
   State state_ = State::kStarting;  // guarded by mutex_
@@ -448,15 +443,15 @@ InscribeService::DistanceStream(grpc::CallbackServerContext* context) {
 
 void InscribeService::StartDraining() {
   draining_.store(true);
-  std::vector<DistanceStreamReactor*> streams;
+  std::vector<DrainableStream*> streams;
   {
     std::lock_guard<std::mutex> lock(calls_mutex_);
-    for (DistanceStreamReactor* stream : streams_) {
+    for (DrainableStream* stream : streams_) {
       stream->Ref();
       streams.push_back(stream);
     }
   }
-  for (DistanceStreamReactor* stream : streams) {
+  for (DrainableStream* stream : streams) {
     stream->Drain();
     stream->Unref();
   }

@@ -49,6 +49,11 @@ absl::Status CheckOptions(const ServerOptions& options) {
       options.limits.max_poses < 1) {
     return absl::InvalidArgumentError("--max-voxels, --max-spheres and --max-poses must be >= 1");
   }
+  if (options.limits.max_scene_objects < 1 || options.limits.max_scene_pairs < 1 ||
+      options.limits.max_scene_ignored < 0) {
+    return absl::InvalidArgumentError(
+        "--max-scene-objects and --max-scene-pairs must be >= 1, --max-scene-ignored >= 0");
+  }
   if (options.tls.cert_file.empty() != options.tls.key_file.empty()) {
     return absl::InvalidArgumentError("--tls-cert and --tls-key go together: give both or neither");
   }
@@ -198,8 +203,8 @@ absl::StatusOr<std::unique_ptr<InscribeServer>> InscribeServer::Start(
                               options.limits, std::move(observe), *std::move(authenticate));
   if (!options.metrics_listen.empty()) {
     // Set before the server starts, so call threads read it without a lock.
-    absl::StatusOr<std::unique_ptr<ServiceMetrics>> started =
-        ServiceMetrics::Start(options.metrics_listen, parts->cache.get(), &parts->pool);
+    absl::StatusOr<std::unique_ptr<ServiceMetrics>> started = ServiceMetrics::Start(
+        options.metrics_listen, parts->cache.get(), &parts->pool, &parts->service);
     if (!started.ok()) return started.status();
     parts->metrics_port = (*started)->port();
     *metrics = *std::move(started);
@@ -275,6 +280,8 @@ std::shared_ptr<grpc::Channel> InscribeServer::InProcessChannel() const {
 }
 
 std::int64_t InscribeServer::jobs_in_flight() const { return parts_->pool.jobs_in_flight(); }
+
+std::int64_t InscribeServer::open_scenes() const { return parts_->service.open_scenes(); }
 
 void InscribeServer::Wait() {
   std::unique_lock<std::mutex> lock(parts_->mutex);

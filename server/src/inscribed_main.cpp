@@ -118,6 +118,18 @@ int main(int argc, char** argv) {
   app.add_option("--max-poses", options.limits.max_poses, "pose pairs in one Distance call")
       ->check(CLI::Range(std::int64_t{1}, std::int64_t{1} << 30))
       ->capture_default_str();
+  app.add_option("--max-scene-objects", options.limits.max_scene_objects,
+                 "objects in one SceneStream's scene")
+      ->check(CLI::Range(std::int64_t{1}, std::int64_t{1} << 30))
+      ->capture_default_str();
+  app.add_option("--max-scene-pairs", options.limits.max_scene_pairs,
+                 "close pairs in one SceneStream reply (the largest max_pairs)")
+      ->check(CLI::Range(std::int64_t{1}, std::int64_t{1} << 30))
+      ->capture_default_str();
+  app.add_option("--max-scene-ignored", options.limits.max_scene_ignored,
+                 "ignored pairs one SceneStream may send")
+      ->check(CLI::Range(std::int64_t{0}, std::int64_t{1} << 30))
+      ->capture_default_str();
   app.add_option("--memory-budget", options.limits.memory_budget_bytes,
                  "bytes of working memory the calls in flight may need together, by estimate; "
                  "calls that do not fit get RESOURCE_EXHAUSTED; 0 = unlimited. Not counting "
@@ -183,12 +195,14 @@ int main(int argc, char** argv) {
   }
   spdlog::info(
       "event=serving address={} jobs={} max_queue={} max_message_bytes={} max_triangles={} "
-      "max_voxels={} max_spheres={} max_poses={} memory_budget={} cache_dir=\"{}\" "
+      "max_voxels={} max_spheres={} max_poses={} max_scene_objects={} max_scene_pairs={} "
+      "max_scene_ignored={} memory_budget={} cache_dir=\"{}\" "
       "cache_memory_bytes={} "
       "redis=\"{}\" tls={} auth={} metrics_port={}",
       (*server)->address(), (*server)->jobs(), options.max_queue, options.max_message_bytes,
       options.limits.max_triangles, options.limits.max_voxels, options.limits.max_spheres,
-      options.limits.max_poses, options.limits.memory_budget_bytes, options.cache.disk_dir,
+      options.limits.max_poses, options.limits.max_scene_objects, options.limits.max_scene_pairs,
+      options.limits.max_scene_ignored, options.limits.memory_budget_bytes, options.cache.disk_dir,
       options.cache.memory_bytes, inscribe::server::RedactRedisUrl(options.cache.redis_url),
       options.tls.enabled(), !options.auth_tokens_file.empty(), (*server)->metrics_port());
   if (!options.auth_tokens_file.empty() && !options.tls.enabled() &&

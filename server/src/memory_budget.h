@@ -42,6 +42,13 @@ struct MemoryCosts {
   // DistanceStream: per pair of a frame, the query (two pointers, two poses), result, status
   // and the reply.
   static constexpr std::int64_t kPerFramePair = 512;
+  // SceneStream, held for the stream's life: per object, core's scene entry (the object, its
+  // certified view, bounding sphere, index and sweep order; ~300 B) and the stream's id tables;
+  // per ignored pair, a hash-set slot; per reply pair (max_pairs), the core pair, its protobuf
+  // and serialised forms. Estimated from the types' sizes, not measured.
+  static constexpr std::int64_t kPerSceneObject = 512;
+  static constexpr std::int64_t kPerIgnoredPair = 64;
+  static constexpr std::int64_t kPerScenePair = 512;
   // An inline sphere set (PutSphereSet, Evaluate): the core set, its serialised copy, and the
   // exact union volume's regular triangulation (~1 KB per weighted point in CGAL).
   static constexpr std::int64_t kPerSphere = 2048;

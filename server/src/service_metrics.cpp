@@ -59,7 +59,8 @@ prometheus::ClientMetric Sample(double value, std::vector<prometheus::ClientMetr
 // The cache's and the pool's own counters, turned into metric families at each scrape.
 class StateCollector {
  public:
-  StateCollector(const ResultCache* cache, const JobPool* pool) : cache_(cache), pool_(pool) {}
+  StateCollector(const ResultCache* cache, const JobPool* pool, const InscribeService* service)
+      : cache_(cache), pool_(pool), service_(service) {}
 
   std::vector<prometheus::MetricFamily> Collect() const {
     using prometheus::MetricType;
@@ -126,12 +127,15 @@ class StateCollector {
         MetricType::Gauge, {Sample(pool.max_jobs, {}, MetricType::Gauge)});
     add("inscribe_jobs_concurrency", "Jobs run at the same time (--jobs)", MetricType::Gauge,
         {Sample(pool.concurrency, {}, MetricType::Gauge)});
+    add("inscribe_scenes_open", "SceneStream calls open, each holding its scene", MetricType::Gauge,
+        {Sample(service_->open_scenes(), {}, MetricType::Gauge)});
     return families;
   }
 
  private:
   const ResultCache* const cache_;
   const JobPool* const pool_;
+  const InscribeService* const service_;
 };
 
 // The HTTP side: one thread accepting on a listening socket, answering each connection in turn
@@ -334,16 +338,16 @@ struct ServiceMetrics::Impl {
   std::unique_ptr<MetricsEndpoint> endpoint;  // last: its thread stops before the rest goes
 };
 
-absl::StatusOr<std::unique_ptr<ServiceMetrics>> ServiceMetrics::Start(const std::string& listen,
-                                                                      const ResultCache* cache,
-                                                                      const JobPool* pool) {
+absl::StatusOr<std::unique_ptr<ServiceMetrics>> ServiceMetrics::Start(
+    const std::string& listen, const ResultCache* cache, const JobPool* pool,
+    const InscribeService* service) {
   const std::size_t colon = listen.rfind(':');
   if (colon == std::string::npos || colon + 1 == listen.size()) {
     return absl::InvalidArgumentError(
         absl::StrCat("--metrics-listen must be HOST:PORT, got \"", listen, "\""));
   }
   auto impl = std::make_unique<Impl>();
-  impl->state = std::make_unique<StateCollector>(cache, pool);
+  impl->state = std::make_unique<StateCollector>(cache, pool, service);
   const Impl* raw = impl.get();
   absl::StatusOr<std::unique_ptr<MetricsEndpoint>> endpoint =
       MetricsEndpoint::Listen(listen, [raw] { return raw->Exposition(); });

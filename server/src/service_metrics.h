@@ -1,6 +1,7 @@
 // Prometheus metrics of one inscribed process, served over HTTP at GET /metrics
 // (--metrics-listen): per-RPC call counts by status code and latency histograms, recorded as
-// calls finish; cache lookups by tier, cache sizes and errors, and the job pool's occupancy,
+// calls finish; cache lookups by tier, cache sizes and errors, the job pool's occupancy and the
+// open scenes,
 // read from the cache and the pool at scrape time (so a scrape costs two snapshots, and the
 // request path pays nothing for them). Private to the server.
 #pragma once
@@ -17,12 +18,13 @@ namespace inscribe::server {
 
 class ServiceMetrics {
  public:
-  // Serves the metrics on `listen` ("HOST:PORT"; port 0 picks a free one, see port()). `cache`
-  // and `pool` are read at each scrape and must outlive this object. UNAVAILABLE when the
-  // address cannot be bound, INVALID_ARGUMENT when it is not HOST:PORT.
+  // Serves the metrics on `listen` ("HOST:PORT"; port 0 picks a free one, see port()). `cache`,
+  // `pool` and `service` (its open scenes) are read at each scrape and must outlive this object.
+  // UNAVAILABLE when the address cannot be bound, INVALID_ARGUMENT when it is not HOST:PORT.
   static absl::StatusOr<std::unique_ptr<ServiceMetrics>> Start(const std::string& listen,
                                                                const ResultCache* cache,
-                                                               const JobPool* pool);
+                                                               const JobPool* pool,
+                                                               const InscribeService* service);
 
   // Stops the HTTP endpoint (a scrape in progress is finished first).
   ~ServiceMetrics();

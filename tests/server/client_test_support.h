@@ -45,6 +45,8 @@ class MockConnection : public Connection {
               (const v1::CacheStatsRequest& request, Deadline deadline), (override));
   MOCK_METHOD(absl::StatusOr<std::unique_ptr<DistanceStreamConnection>>, OpenDistanceStream,
               (Deadline deadline), (override));
+  MOCK_METHOD(absl::StatusOr<std::unique_ptr<SceneStreamConnection>>, OpenSceneStream,
+              (Deadline deadline), (override));
 };
 
 // What a server answers for the unit cube.
@@ -150,6 +152,16 @@ class MockDistanceStream : public DistanceStreamConnection {
   // Called by the destructor: the session let go of the call (which cancels it).
   MOCK_METHOD(void, Destroyed, ());
   ~MockDistanceStream() override { Destroyed(); }
+};
+
+class MockSceneStream : public SceneStreamConnection {
+ public:
+  MOCK_METHOD(absl::StatusOr<v1::SceneReply>, RoundTrip,
+              (const v1::SceneMessage& message, Deadline deadline), (override));
+  MOCK_METHOD(absl::Status, Finish, (), (override));
+  // Called by the destructor: the session let go of the call (which cancels it).
+  MOCK_METHOD(void, Destroyed, ());
+  ~MockSceneStream() override { Destroyed(); }
 };
 
 }  // namespace inscribe::client

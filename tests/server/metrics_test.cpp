@@ -170,6 +170,32 @@ TEST_F(MetricsTest, CacheFiguresAgreeWithCacheStats) {
   EXPECT_GT(stats->bytes, 0);
 }
 
+// inscribe_scenes_open counts SceneStream calls holding a scene, and drops when one closes.
+TEST_F(MetricsTest, OpenScenesGaugeFollowsSceneSessions) {
+  const auto scenes = [this] {
+    return Value(Parse(testing::ScrapeMetrics(server_->metrics_port())), "inscribe_scenes_open");
+  };
+  EXPECT_EQ(scenes(), 0);
+  SphereSet set;
+  set.spheres = {{Vector3::Zero(), 0.5}};
+  absl::StatusOr<client::PutSphereSetResult> stored = client_->PutSphereSet(set);
+  ASSERT_TRUE(stored.ok()) << stored.status();
+  std::vector<client::SceneSessionObject> objects(2);
+  objects[1].object.id = 1;
+  for (auto& object : objects) object.sphere_set_key = stored->sphere_set_key;
+  absl::StatusOr<client::SceneSession> session = client_->OpenSceneSession(objects);
+  ASSERT_TRUE(session.ok()) << session.status();
+  EXPECT_EQ(session->created().pairs.size(), 1u);  // two coincident balls overlap
+  EXPECT_EQ(scenes(), 1);
+  EXPECT_TRUE(session->Close().ok());
+  double open = scenes();
+  for (int i = 0; i < 100 && open != 0; ++i) {  // OnDone runs just after the status is sent
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    open = scenes();
+  }
+  EXPECT_EQ(open, 0);
+}
+
 TEST_F(MetricsTest, ConcurrentCallsAreEachCountedOnce) {
   const Mesh cube = testing::UnitCube();
   constexpr int kThreads = 4;

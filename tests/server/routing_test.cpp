@@ -514,6 +514,42 @@ TEST(RoutedConnection, DistanceStreamEndsOnOtherErrors) {
   EXPECT_EQ((*routed)->Finish(), unknown);
 }
 
+// A scene goes to the first replica up in its first object's set's order (its creating
+// message is sent again to the next when the owner is unreachable); once created, a broken
+// replica ends the scene with UNAVAILABLE: its state lived there, so nothing is resent.
+TEST(RoutedConnection, SceneStreamFollowsItsFirstObjectAndIsNotMoved) {
+  Fleet fleet(3);
+  std::mt19937_64 bits(43);
+  const std::string key = SetKeyOf(MeshKey(bits), bits);
+  const std::vector<int> order = RendezvousOrder(wire::RouteKey(key), fleet.names);
+  auto refused = std::make_unique<NiceMock<MockSceneStream>>();
+  EXPECT_CALL(*refused, RoundTrip(_, _)).WillOnce(Return(absl::UnavailableError("refused")));
+  auto second = std::make_unique<NiceMock<MockSceneStream>>();
+  EXPECT_CALL(*second, RoundTrip(_, _))
+      .WillOnce([](const v1::SceneMessage& message, Deadline) {
+        EXPECT_EQ(message.add_size(), 2);
+        v1::SceneReply reply;
+        reply.set_frame(message.frame());
+        return absl::StatusOr<v1::SceneReply>(reply);
+      })
+      .WillOnce(Return(absl::UnavailableError("Socket closed")));
+  EXPECT_CALL(*fleet.replicas[order[0]], OpenSceneStream(_))
+      .WillOnce(Return(std::unique_ptr<SceneStreamConnection>(std::move(refused))));
+  EXPECT_CALL(*fleet.replicas[order[1]], OpenSceneStream(_))
+      .WillOnce(Return(std::unique_ptr<SceneStreamConnection>(std::move(second))));
+  EXPECT_CALL(*fleet.replicas[order[2]], OpenSceneStream(_)).Times(0);
+
+  std::vector<SceneSessionObject> objects(2);
+  objects[0].sphere_set_key = key;  // routes the scene
+  objects[1].object.id = 1;
+  objects[1].sphere_set_key = SetKeyOf(MeshKey(bits), bits);
+  absl::StatusOr<SceneSession> session = Client(fleet.routed).OpenSceneSession(objects);
+  ASSERT_TRUE(session.ok()) << session.status();
+  absl::StatusOr<SceneFrameResult> frame = session->Frame({});
+  EXPECT_EQ(frame.status().code(), absl::StatusCode::kUnavailable);
+  EXPECT_EQ(session->Frame({}).status(), frame.status());
+}
+
 TEST(RoutedConnection, RoundRobinSpreadsEvenlyAndFailsOver) {
   RoutingOptions options;
   options.policy = RoutingPolicy::kRoundRobin;

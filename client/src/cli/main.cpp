@@ -14,6 +14,7 @@
 #include "generate_command.h"
 #include "health_command.h"
 #include "info_command.h"
+#include "scene_command.h"
 #include "stats_command.h"
 #include "urdf_command.h"
 #include "view_command.h"
@@ -34,6 +35,7 @@ int main(int argc, char** argv) {
   inscribe::cli::AddEvaluateCommand(app, &outcome);
   inscribe::cli::AddDeformCommand(app, &outcome);
   inscribe::cli::AddDistanceCommand(app, &outcome);
+  inscribe::cli::AddSceneCommand(app, &outcome);
   inscribe::cli::AddStatsCommand(app, &outcome);
   inscribe::cli::AddHealthCommand(app, &outcome);
   inscribe::cli::AddUrdfCommand(app, &outcome);

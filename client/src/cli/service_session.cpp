@@ -25,6 +25,9 @@ server::ServerOptions EmbeddedServerOptions() {
   options.limits.max_voxels = kUnlimited;
   options.limits.max_spheres = kUnlimited;
   options.limits.max_poses = kUnlimited;
+  options.limits.max_scene_objects = kUnlimited;
+  options.limits.max_scene_pairs = kUnlimited;
+  options.limits.max_scene_ignored = kUnlimited;
   options.limits.memory_budget_bytes = 0;
   return options;
 }

@@ -434,4 +434,17 @@ absl::StatusOr<DistanceSession> Client::OpenDistanceSession(
   return DistanceSession(*std::move(stream), options);
 }
 
+absl::StatusOr<SceneSession> Client::OpenSceneSession(
+    const std::vector<SceneSessionObject>& objects, const SceneSessionOptions& options) const {
+  const Deadline deadline = options.session_timeout
+                                ? std::chrono::system_clock::now() + *options.session_timeout
+                                : Deadline::max();
+  absl::StatusOr<std::unique_ptr<SceneStreamConnection>> stream =
+      connection_->OpenSceneStream(deadline);
+  if (!stream.ok()) return stream.status();
+  SceneSession session(*std::move(stream), options);
+  if (absl::Status s = session.Create(objects); !s.ok()) return s;
+  return session;
+}
+
 }  // namespace inscribe::client

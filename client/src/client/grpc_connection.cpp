@@ -123,17 +123,24 @@ class StreamWatchdog {
   std::thread thread_;  // last: starts after the state above exists
 };
 
-class GrpcDistanceStream final : public DistanceStreamConnection {
+// One open DistanceStream or SceneStream call (`rpc` names it in errors).
+template <typename Message, typename Reply>
+class GrpcFrameStream final : public FrameStream<Message, Reply> {
  public:
-  GrpcDistanceStream(Stub& stub, const std::string& token, Deadline deadline) {
+  using Opener =
+      std::unique_ptr<grpc::ClientReaderWriter<Message, Reply>> (Stub::*)(grpc::ClientContext*);
+
+  GrpcFrameStream(Stub& stub, Opener open, const char* rpc, const std::string& token,
+                  Deadline deadline)
+      : rpc_(rpc) {
     PrepareContext(context_, token, deadline);
-    stream_ = stub.DistanceStream(&context_);
+    stream_ = (stub.*open)(&context_);
     watchdog_ = std::make_unique<StreamWatchdog>(&context_);
   }
 
   // Cancels an unfinished call, then collects its status so that nothing is left pending;
   // after TryCancel, Finish returns at once.
-  ~GrpcDistanceStream() override {
+  ~GrpcFrameStream() override {
     watchdog_.reset();
     if (!finished_) {
       context_.TryCancel();
@@ -141,12 +148,11 @@ class GrpcDistanceStream final : public DistanceStreamConnection {
     }
   }
 
-  absl::StatusOr<v1::DistanceFrameResult> RoundTrip(const v1::DistanceFrame& frame,
-                                                    Deadline deadline) override {
+  absl::StatusOr<Reply> RoundTrip(const Message& frame, Deadline deadline) override {
     if (finished_) return ended_;
     // Armed across the error path too, so that Finish cannot outlive the frame's deadline.
     watchdog_->Arm(deadline);
-    v1::DistanceFrameResult result;
+    Reply result;
     const bool answered = stream_->Write(frame) && stream_->Read(&result);
     absl::Status status;
     if (!answered) {
@@ -154,7 +160,7 @@ class GrpcDistanceStream final : public DistanceStreamConnection {
       finished_ = true;
       if (status.ok()) {
         status = absl::InternalError(
-            absl::StrCat("DistanceStream ended without answering frame ", frame.frame()));
+            absl::StrCat(rpc_, " ended without answering frame ", frame.frame()));
       }
     }
     if (watchdog_->Disarm()) {
@@ -162,7 +168,7 @@ class GrpcDistanceStream final : public DistanceStreamConnection {
       if (!finished_) stream_->Finish().IgnoreError();
       finished_ = true;
       status = absl::DeadlineExceededError(
-          absl::StrCat("no answer to DistanceStream frame ", frame.frame(), " in time"));
+          absl::StrCat("no answer to ", rpc_, " frame ", frame.frame(), " in time"));
     }
     if (!status.ok()) {
       ended_ = status;
@@ -177,23 +183,23 @@ class GrpcDistanceStream final : public DistanceStreamConnection {
     stream_->WritesDone();
     // Finish waits for every incoming message to be read; a conforming server sends none
     // after the last answer, but draining keeps a misbehaving one from hanging us.
-    v1::DistanceFrameResult unexpected;
+    Reply unexpected;
     int extra = 0;
     while (stream_->Read(&unexpected)) ++extra;
     ended_ = wire::FromGrpcStatus(stream_->Finish());
     if (ended_.ok() && extra > 0) {
-      ended_ =
-          absl::InternalError(absl::StrCat("DistanceStream sent ", extra, " results for no frame"));
+      ended_ = absl::InternalError(absl::StrCat(rpc_, " sent ", extra, " results for no frame"));
     }
     return ended_;
   }
 
  private:
+  const char* const rpc_;
   grpc::ClientContext context_;
-  std::unique_ptr<grpc::ClientReaderWriter<v1::DistanceFrame, v1::DistanceFrameResult>> stream_;
+  std::unique_ptr<grpc::ClientReaderWriter<Message, Reply>> stream_;
   std::unique_ptr<StreamWatchdog> watchdog_;  // destroyed before context_
   bool finished_ = false;                     // stream_->Finish() has been called
-  absl::Status ended_ = absl::FailedPreconditionError("DistanceStream already finished");
+  absl::Status ended_ = absl::FailedPreconditionError(absl::StrCat(rpc_, " already finished"));
 };
 
 class GrpcConnection final : public Connection {
@@ -277,7 +283,14 @@ class GrpcConnection final : public Connection {
 
   absl::StatusOr<std::unique_ptr<DistanceStreamConnection>> OpenDistanceStream(
       Deadline deadline) override {
-    return std::make_unique<GrpcDistanceStream>(*stub_, token_, deadline);
+    return std::make_unique<GrpcFrameStream<v1::DistanceFrame, v1::DistanceFrameResult>>(
+        *stub_, &Stub::DistanceStream, "DistanceStream", token_, deadline);
+  }
+
+  absl::StatusOr<std::unique_ptr<SceneStreamConnection>> OpenSceneStream(
+      Deadline deadline) override {
+    return std::make_unique<GrpcFrameStream<v1::SceneMessage, v1::SceneReply>>(
+        *stub_, &Stub::SceneStream, "SceneStream", token_, deadline);
   }
 
  private:

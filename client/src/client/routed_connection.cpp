@@ -170,34 +170,51 @@ Answer<Response> CallInOrder(Replicas& replicas, const std::vector<int>& order, 
   return answer;
 }
 
-class RoutedDistanceStream final : public DistanceStreamConnection {
+// A DistanceStream or SceneStream over the replicas: opened with its first message on the
+// first replica of the message's route key that answers it (CallInOrder).
+template <typename Message, typename Reply>
+class RoutedFrameStream final : public FrameStream<Message, Reply> {
  public:
-  RoutedDistanceStream(std::shared_ptr<Replicas> replicas, Deadline stream_deadline)
-      : replicas_(std::move(replicas)), stream_deadline_(stream_deadline) {}
+  using Stream = FrameStream<Message, Reply>;
+  // One replica's stream.
+  using Opener =
+      std::function<absl::StatusOr<std::unique_ptr<Stream>>(Connection&, Deadline stream_deadline)>;
+  // The route key of the first message.
+  using RouteKeyOf = std::function<std::string(const Message&)>;
 
-  // A frame is a pure query, so when the stream breaks (UNAVAILABLE) it is reopened on the next
-  // replica of the route key and the same frame is sent again, with its own number: the server
-  // echoes frame numbers and does not require a new stream to start at 0.
-  absl::StatusOr<v1::DistanceFrameResult> RoundTrip(const v1::DistanceFrame& frame,
-                                                    Deadline deadline) override {
+  // `reopen`: when the stream breaks (UNAVAILABLE) after its first message, reopen it on the
+  // next replica and send the message again (a DistanceStream frame is a pure query); else the
+  // stream ends with that error (a scene lived on the replica that went away).
+  RoutedFrameStream(std::shared_ptr<Replicas> replicas, Deadline stream_deadline, Opener open,
+                    RouteKeyOf route_key_of, bool reopen)
+      : replicas_(std::move(replicas)),
+        stream_deadline_(stream_deadline),
+        open_(std::move(open)),
+        route_key_of_(std::move(route_key_of)),
+        reopen_(reopen) {}
+
+  // The server echoes frame numbers and does not require a new stream to start at 0, so a
+  // reopened DistanceStream resends the same frame with its own number.
+  absl::StatusOr<Reply> RoundTrip(const Message& frame, Deadline deadline) override {
     if (finished_) return ended_;
     if (current_ != nullptr) {
-      absl::StatusOr<v1::DistanceFrameResult> result = current_->RoundTrip(frame, deadline);
+      absl::StatusOr<Reply> result = current_->RoundTrip(frame, deadline);
       if (result.ok()) return result;
-      if (result.status().code() != absl::StatusCode::kUnavailable) return End(result.status());
+      if (result.status().code() != absl::StatusCode::kUnavailable || !reopen_) {
+        if (result.status().code() == absl::StatusCode::kUnavailable) {
+          replicas_->MarkDown(current_replica_);
+        }
+        return End(result.status());
+      }
       replicas_->MarkDown(current_replica_);
       current_.reset();
     }
-    if (!route_key_.has_value()) {
-      // Every pair of a frame must be held by one replica: the first pair's set A routes it.
-      route_key_ = frame.pairs_size() > 0 ? wire::RouteKey(frame.pairs(0).sphere_set_a()) : "";
-    }
-    std::unique_ptr<DistanceStreamConnection> opened;
-    const Answer<v1::DistanceFrameResult> answer = CallInOrder<v1::DistanceFrameResult>(
+    if (!route_key_.has_value()) route_key_ = route_key_of_(frame);
+    std::unique_ptr<Stream> opened;
+    const Answer<Reply> answer = CallInOrder<Reply>(
         *replicas_, replicas_->Order(*route_key_), deadline,
-        [&](Connection& connection) -> absl::StatusOr<v1::DistanceFrameResult> {
-          absl::StatusOr<std::unique_ptr<DistanceStreamConnection>> stream =
-              connection.OpenDistanceStream(stream_deadline_);
+        [&](Connection& connection) -> absl::StatusOr<Reply> {
+          absl::StatusOr<std::unique_ptr<Stream>> stream = open_(connection, stream_deadline_);
           if (!stream.ok()) return stream.status();
           opened = *std::move(stream);
           return opened->RoundTrip(frame, deadline);
@@ -228,11 +245,14 @@ class RoutedDistanceStream final : public DistanceStreamConnection {
 
   const std::shared_ptr<Replicas> replicas_;
   const Deadline stream_deadline_;
+  const Opener open_;
+  const RouteKeyOf route_key_of_;
+  const bool reopen_;
   std::optional<std::string> route_key_;  // set by the first frame
-  std::unique_ptr<DistanceStreamConnection> current_;
+  std::unique_ptr<Stream> current_;
   int current_replica_ = -1;
   bool finished_ = false;
-  absl::Status ended_ = absl::FailedPreconditionError("DistanceStream already finished");
+  absl::Status ended_ = absl::FailedPreconditionError("stream already finished");
 };
 
 class RoutedConnection final : public Connection {
@@ -338,7 +358,25 @@ class RoutedConnection final : public Connection {
   // Opens nothing yet: the first frame says where the stream goes.
   absl::StatusOr<std::unique_ptr<DistanceStreamConnection>> OpenDistanceStream(
       Deadline deadline) override {
-    return std::make_unique<RoutedDistanceStream>(replicas_, deadline);
+    // Every pair of a frame must be held by one replica: the first pair's set A routes it.
+    return std::make_unique<RoutedFrameStream<v1::DistanceFrame, v1::DistanceFrameResult>>(
+        replicas_, deadline, [](Connection& c, Deadline d) { return c.OpenDistanceStream(d); },
+        [](const v1::DistanceFrame& frame) {
+          return frame.pairs_size() > 0 ? wire::RouteKey(frame.pairs(0).sphere_set_a()) : "";
+        },
+        /*reopen=*/true);
+  }
+
+  // Every object's sets must be held by one replica (or reachable through the shared tier):
+  // the first object's set routes the scene.
+  absl::StatusOr<std::unique_ptr<SceneStreamConnection>> OpenSceneStream(
+      Deadline deadline) override {
+    return std::make_unique<RoutedFrameStream<v1::SceneMessage, v1::SceneReply>>(
+        replicas_, deadline, [](Connection& c, Deadline d) { return c.OpenSceneStream(d); },
+        [](const v1::SceneMessage& message) {
+          return message.add_size() > 0 ? wire::RouteKey(message.add(0).sphere_set()) : "";
+        },
+        /*reopen=*/false);
   }
 
  private:

@@ -7,6 +7,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "absl/status/statusor.h"
@@ -16,6 +17,7 @@
 #include "inscribe/mesh.h"
 #include "inscribe/mesh_validation.h"
 #include "inscribe/rigid_pose.h"
+#include "inscribe/scene.h"
 #include "inscribe/separation_distance.h"
 #include "inscribe/sphere.h"
 #include "inscribe/sphere_deformation.h"
@@ -253,6 +255,85 @@ class DistanceSession {
   absl::Status broken_;  // the error that ended the session, once one has
 };
 
+// One object of a scene session: core's object (id, pose, group, mask; its hierarchies stay
+// unset: the server resolves them from the keys) and the cached sets it names.
+struct SceneSessionObject {
+  SceneObject object;
+  std::string sphere_set_key;
+  // Optional: a cover of the same solid (sphere_set_key is then its internal set), making the
+  // object certified under the server's certificate rule (service.proto, Distance).
+  std::string cover_key;
+};
+
+struct SceneSessionOptions {
+  HierarchyVolume volume = HierarchyVolume::kSphere;
+  // The scene's query; max_pairs at most the server's --max-scene-pairs.
+  SceneQuery query;
+  // Pairs never to report.
+  std::vector<std::pair<SceneObjectId, SceneObjectId>> ignored;
+  // Time allowed for each message's round trip; a late reply ends the session with
+  // DEADLINE_EXCEEDED.
+  std::chrono::milliseconds frame_timeout{10'000};
+  // Time the whole session may stay open; nullopt = no limit.
+  std::optional<std::chrono::milliseconds> session_timeout;
+};
+
+// What one scene message may change besides poses; applied in this order (remove, add,
+// ignore, poses, query).
+struct SceneChanges {
+  std::vector<SceneObjectId> remove;
+  std::vector<SceneSessionObject> add;
+  std::vector<std::pair<SceneObjectId, SceneObjectId>> ignore;
+  std::vector<std::pair<SceneObjectId, RigidPose>> poses;
+  std::optional<SceneQuery> query;  // nullopt: keep the current one
+};
+
+// The close pairs of one scene message (SceneFrame: pairs sorted by (a, b), world
+// witnesses), and what the server adds.
+struct SceneFrameResult : SceneFrame {
+  std::int64_t objects = 0;     // in the scene after the message
+  double server_seconds = 0.0;  // the server's time on the message
+};
+
+// A scene held by the server for the life of one SceneStream call (Client::OpenSceneSession
+// creates it): one Frame per simulator frame with the poses that moved, answered with the
+// close pairs. Not thread-safe; movable, not copyable. Any error ends the session (and the
+// server's scene): later calls return the same error. Destroying an open session cancels the
+// call, which frees the scene on the server.
+class SceneSession {
+ public:
+  SceneSession(std::unique_ptr<SceneStreamConnection> stream, const SceneSessionOptions& options);
+  SceneSession(SceneSession&&) noexcept;
+  SceneSession& operator=(SceneSession&&) noexcept;
+  ~SceneSession();
+
+  // The close pairs after `poses` (new world poses of objects that moved).
+  absl::StatusOr<SceneFrameResult> Frame(
+      const std::vector<std::pair<SceneObjectId, RigidPose>>& poses);
+  // The close pairs after `changes`.
+  absl::StatusOr<SceneFrameResult> Update(const SceneChanges& changes);
+
+  // The reply to the message that created the scene (its close pairs at the initial poses).
+  const SceneFrameResult& created() const { return created_; }
+
+  // Ends the stream cleanly (the server frees the scene); the server's final status.
+  absl::Status Close();
+
+ private:
+  friend class Client;
+  // Sends the creating message: `objects`, options' ignored pairs and query.
+  absl::Status Create(const std::vector<SceneSessionObject>& objects);
+  // Sends `message` numbered next_frame_ and checks the reply; any failure ends the session.
+  absl::StatusOr<SceneFrameResult> RoundTrip(v1::SceneMessage& message);
+  absl::Status Break(absl::Status failure);
+
+  std::unique_ptr<SceneStreamConnection> stream_;
+  SceneSessionOptions options_;
+  SceneFrameResult created_;
+  std::int64_t next_frame_ = 0;
+  absl::Status broken_;  // the error that ended the session, once one has
+};
+
 // Calls the service through a Connection, adding a deadline to every call and retrying
 // idempotent calls on UNAVAILABLE (RetryPolicy: exponential backoff, or at once when the
 // connection fails over to another replica). Thread-safe; cheap to copy (shares the
@@ -341,6 +422,14 @@ class Client {
   // Opens a DistanceStream session (not retried: a stream is not idempotent as a whole).
   absl::StatusOr<DistanceSession> OpenDistanceSession(
       const DistanceSessionOptions& options = {}) const;
+
+  // Opens a SceneStream and creates its scene of `objects` (not retried). Over several
+  // replicas the scene goes to the replica of the first object's set (the first one up in
+  // its order); every other set it names must be held there too (uploaded there, or shared
+  // through --redis). Errors: the server's, naming the object (NOT_FOUND for an unknown key,
+  // ALREADY_EXISTS for a repeated id, RESOURCE_EXHAUSTED over its --max-scene-* limits).
+  absl::StatusOr<SceneSession> OpenSceneSession(const std::vector<SceneSessionObject>& objects,
+                                                const SceneSessionOptions& options = {}) const;
 
   const ClientOptions& options() const { return options_; }
 

@@ -6,7 +6,9 @@
 // connection marks it down and returns the error with kRetryElsewherePayload, so the Client's
 // next attempt goes to the next replica at once. The one exception is a DistanceStream, which
 // the Client does not retry: a routed stream that breaks is reopened on the next replica and
-// its frame resent (a frame is a pure query).
+// its frame resent (a frame is a pure query); a SceneStream, whose scene lives on one server,
+// is opened on the first replica of its route key that answers its first message and ends
+// with UNAVAILABLE if that replica goes away.
 #pragma once
 
 #include <chrono>
@@ -32,22 +34,26 @@ inline constexpr char kRetryElsewherePayload[] = "type.inscribe.dev/retry-elsewh
 // Absolute time by which a call must be answered (the clock gRPC deadlines use).
 using Deadline = std::chrono::system_clock::time_point;
 
-// One open DistanceStream call. Frames go out and come back one at a time, in order.
+// One open bidirectional call that answers each message with one reply, in order: a
+// DistanceStream (Message = DistanceFrame) or a SceneStream (Message = SceneMessage).
 // Not thread-safe: one simulator loop drives one stream.
-class DistanceStreamConnection {
+template <typename Message, typename Reply>
+class FrameStream {
  public:
   // Ends the call (cancelling it if Finish was not reached).
-  virtual ~DistanceStreamConnection() = default;
+  virtual ~FrameStream() = default;
 
-  // Sends `frame` and waits for its result until `deadline`. An error ends the stream: the
+  // Sends `message` and waits for its reply until `deadline`. An error ends the stream: the
   // server's status (NOT_FOUND, INVALID_ARGUMENT, ...), UNAVAILABLE when the connection broke,
-  // DEADLINE_EXCEEDED when the result did not come in time (the call is then cancelled).
-  virtual absl::StatusOr<v1::DistanceFrameResult> RoundTrip(const v1::DistanceFrame& frame,
-                                                            Deadline deadline) = 0;
+  // DEADLINE_EXCEEDED when the reply did not come in time (the call is then cancelled).
+  virtual absl::StatusOr<Reply> RoundTrip(const Message& message, Deadline deadline) = 0;
 
   // Half-closes the stream and returns the server's final status (OK after a clean end).
   virtual absl::Status Finish() = 0;
 };
+
+using DistanceStreamConnection = FrameStream<v1::DistanceFrame, v1::DistanceFrameResult>;
+using SceneStreamConnection = FrameStream<v1::SceneMessage, v1::SceneReply>;
 
 // One method per RPC of inscribe.v1.Inscribe. Each call is a single attempt (one RPC) with the
 // given deadline: retries, backoff and default deadlines belong to Client. Errors carry the gRPC
@@ -88,6 +94,10 @@ class Connection {
   // Opens a DistanceStream call that must end by `deadline` (Deadline::max() for none). Never
   // fails for an unreachable server: the first RoundTrip reports UNAVAILABLE.
   virtual absl::StatusOr<std::unique_ptr<DistanceStreamConnection>> OpenDistanceStream(
+      Deadline deadline) = 0;
+  // Opens a SceneStream call that must end by `deadline`, as OpenDistanceStream. A routed
+  // connection sends it to the replica of the first message's first object's set.
+  virtual absl::StatusOr<std::unique_ptr<SceneStreamConnection>> OpenSceneStream(
       Deadline deadline) = 0;
 };
 

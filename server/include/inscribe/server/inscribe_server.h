@@ -87,6 +87,9 @@ class InscribeServer {
   // Jobs queued or running on the pool now (each has released what it held once it no longer
   // counts); for tests and harnesses that wait for the server to be idle.
   std::int64_t jobs_in_flight() const;
+  // SceneStream calls open now, each holding its scene; a call's scene is freed when the call
+  // is done (finished, cancelled, or its client gone).
+  std::int64_t open_scenes() const;
 
   // Graceful stop: marks health NOT_SERVING, answers new calls with UNAVAILABLE, lets accepted
   // calls finish until `deadline`, then cancels what is left, closes every connection and waits

@@ -25,7 +25,9 @@ namespace inscribe::server {
 
 class ResultStore;
 class DistanceStreamReactor;
+class DrainableStream;
 class FrameDispatcher;
+class SceneStreamReactor;
 class MemoryBudget;
 class MeshSizes;
 struct StoredMeshEntry;
@@ -42,6 +44,14 @@ struct ServiceLimits {
   std::int64_t max_spheres = 1'000'000;
   // --max-poses: pose pairs in one Distance call, or object pairs in one stream frame.
   std::int64_t max_poses = 1'000'000;
+  // --max-scene-objects: objects in one SceneStream's scene at once. The broad phase costs
+  // O(n + k) per frame for n objects and k candidate pairs, the scene ~512 bytes per object.
+  std::int64_t max_scene_objects = 100'000;
+  // --max-scene-pairs: close pairs in one SceneStream reply (the largest SceneQuery.max_pairs;
+  // its default is the smaller of this and 100,000).
+  std::int64_t max_scene_pairs = 100'000;
+  // --max-scene-ignored: ignored pairs one SceneStream may send over its life.
+  std::int64_t max_scene_ignored = 1'000'000;
   // --memory-budget: bytes of working memory the calls in flight (queued or running) may need
   // together, by an up-front estimate from each request's sizes (server/src/memory_budget.h
   // lists the per-item costs and how they were measured); 0 = unlimited. A call whose estimate
@@ -118,6 +128,8 @@ class InscribeService final : public v1::Inscribe::CallbackService {
                                               v1::UpdateDeformationResponse* response) override;
   grpc::ServerBidiReactor<v1::DistanceFrame, v1::DistanceFrameResult>* DistanceStream(
       grpc::CallbackServerContext* context) override;
+  grpc::ServerBidiReactor<v1::SceneMessage, v1::SceneReply>* SceneStream(
+      grpc::CallbackServerContext* context) override;
   grpc::ServerUnaryReactor* Evaluate(grpc::CallbackServerContext* context,
                                      const v1::EvaluateRequest* request,
                                      v1::EvaluateResponse* response) override;
@@ -130,9 +142,12 @@ class InscribeService final : public v1::Inscribe::CallbackService {
 
   // Graceful shutdown, first half: from now on new calls get UNAVAILABLE ("server is shutting
   // down"), which clients retry, later or on another replica; calls already accepted go on.
-  // Open DistanceStreams end with UNAVAILABLE after the frame they are on (at once when
-  // waiting for one), so that long-lived simulator sessions do not hold the drain up.
+  // Open DistanceStreams and SceneStreams end with UNAVAILABLE after the frame they are on (at
+  // once when waiting for one), so that long-lived simulator sessions do not hold the drain up.
   void StartDraining();
+
+  // SceneStream calls open now, each holding its scene (metrics: inscribe_scenes_open).
+  std::int64_t open_scenes() const { return open_scenes_.load(); }
 
   // Blocks until every accepted call has been answered or `deadline` passes; true when all
   // were answered. gRPC's own Shutdown(deadline) also waits for idle client connections to
@@ -194,6 +209,7 @@ class InscribeService final : public v1::Inscribe::CallbackService {
   absl::Status Authenticate(const grpc::CallbackServerContext& context) const;
   friend class GenerateReactor;
   friend class DistanceStreamReactor;
+  friend class SceneStreamReactor;
 
   JobPool* const pool_;
   std::unique_ptr<FrameDispatcher> frames_;  // inline or pool, for every stream's frames
@@ -208,8 +224,10 @@ class InscribeService final : public v1::Inscribe::CallbackService {
   std::mutex calls_mutex_;
   std::condition_variable calls_answered_;
   std::int64_t active_calls_ = 0;  // guarded by calls_mutex_
-  // Open DistanceStreams, told when draining starts; guarded by calls_mutex_.
-  std::set<DistanceStreamReactor*> streams_;
+  // Open DistanceStreams and SceneStreams, told when draining starts; guarded by calls_mutex_.
+  std::set<DrainableStream*> streams_;
+  // Open SceneStreams (each holds one scene until its call is done).
+  std::atomic<std::int64_t> open_scenes_{0};
 };
 
 }  // namespace inscribe::server

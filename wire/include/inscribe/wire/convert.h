@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "absl/status/status.h"
@@ -17,6 +18,7 @@
 #include "inscribe/mesh.h"
 #include "inscribe/mesh_validation.h"
 #include "inscribe/rigid_pose.h"
+#include "inscribe/scene.h"
 #include "inscribe/separation_distance.h"
 #include "inscribe/sphere.h"
 #include "inscribe/sphere_deformation.h"
@@ -103,6 +105,46 @@ void AppendCertifiedDistanceResults(const std::vector<CertifiedDistanceResult>& 
 // is unknown.
 absl::StatusOr<std::vector<CertifiedDistanceResult>> CertifiedDistanceResultsFromProto(
     const v1::DistanceResults& results);
+
+// A scene object's id, pose, group and mask, and the keys of its sets (`cover` empty: not
+// certified). Group and mask are sent only when not core's defaults.
+void SceneObjectToProto(const SceneObject& object, const std::string& sphere_set,
+                        const std::string& cover, v1::SceneObject* out);
+// The object's id, pose (normalised), group and mask (core's defaults where unset), without
+// hierarchies: the receiver resolves the keys. INVALID_ARGUMENT naming `field` and the id for
+// a bad pose or an empty sphere_set key.
+absl::StatusOr<SceneObject> SceneObjectFromProto(const v1::SceneObject& object,
+                                                 absl::string_view field);
+
+// Poses of moved objects: ids into pose_ids, poses into poses (7 numbers each).
+void ScenePosesToProto(const std::vector<std::pair<SceneObjectId, RigidPose>>& poses,
+                       v1::SceneMessage* out);
+// The inverse, poses normalised: INVALID_ARGUMENT naming the index for a bad pose, or when
+// pose_ids and poses disagree in length.
+absl::StatusOr<std::vector<std::pair<SceneObjectId, RigidPose>>> ScenePosesFromProto(
+    const v1::SceneMessage& message);
+
+// Ignored pairs, two ids each, into `ignore`.
+void SceneIgnoredToProto(const std::vector<std::pair<SceneObjectId, SceneObjectId>>& pairs,
+                         v1::SceneMessage* out);
+// INVALID_ARGUMENT for an odd number of ids.
+absl::StatusOr<std::vector<std::pair<SceneObjectId, SceneObjectId>>> SceneIgnoredFromProto(
+    const v1::SceneMessage& message);
+
+// max_pairs goes only when not core's default.
+void SceneQueryToProto(const SceneQuery& query, v1::SceneQuery* out);
+// Core's query, core's max_pairs default where unset (capped at `max_pairs_limit`), then
+// CheckSceneQuery: INVALID_ARGUMENT "query: <why>". A max_pairs set above `max_pairs_limit`
+// is RESOURCE_EXHAUSTED naming `limit_name` (the server's flag).
+absl::StatusOr<SceneQuery> SceneQueryFromProto(const v1::SceneQuery& query,
+                                               std::int64_t max_pairs_limit,
+                                               absl::string_view limit_name);
+
+// A frame's pairs and counts (the reply's frame number, object count and seconds are the
+// caller's).
+void SceneFrameToProto(const SceneFrame& frame, v1::SceneReply* out);
+// The inverse; INVALID_ARGUMENT when the pair arrays' lengths disagree.
+absl::StatusOr<SceneFrame> SceneFrameFromProto(const v1::SceneReply& reply);
 
 // HIERARCHY_VOLUME_UNSPECIFIED and SPHERE are the sphere hierarchy.
 v1::HierarchyVolume VolumeToProto(HierarchyVolume volume);

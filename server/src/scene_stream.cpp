@@ -195,7 +195,7 @@ class SceneStreamReactor final : public grpc::ServerBidiReactor<v1::SceneMessage
     FrameWork work;
     work.items = Items();
     work.resolved = message_.add_size() == 0;
-    work.serial = last_candidates_ <= kSerialFrameQueries;
+    work.serial = last_candidates_ <= kSerialFramePairs;
     // The pool's lane: by the message's working memory (the scene's own is reserved for the
     // stream's life), so small scenes never wait behind large calls.
     work.memory_bytes = work.items * MemoryCosts::kPerScenePair;

@@ -1,12 +1,16 @@
 #include "inscribe/rigid_pose.h"
 
 #include <cmath>
+#include <limits>
 
 #include "absl/status/statusor.h"
 #include "absl/strings/str_cat.h"
 
 namespace inscribe {
 namespace {
+
+// |q|^2 of a quaternion normalised in double lies within a few ulps of 1.
+constexpr double kUnitQuaternionTolerance = 16.0 * std::numeric_limits<double>::epsilon();
 
 absl::Status CheckFinite(const RigidPose& pose) {
   if (!pose.rotation.coeffs().allFinite() || !pose.translation.allFinite()) {
@@ -40,6 +44,9 @@ absl::StatusOr<RigidPose> NormalizedPose(const RigidPose& pose) {
                                                    "; expected a unit quaternion (w x y z)"));
   }
   RigidPose out = pose;
+  // Already unit to rounding (a pose normalised once): unchanged, so normalising again (a
+  // service normalising what a client already did) gives the same bits.
+  if (std::abs(pose.rotation.squaredNorm() - 1.0) <= kUnitQuaternionTolerance) return out;
   out.rotation.normalize();
   return out;
 }

@@ -112,9 +112,9 @@ class DistanceStreamReactor final
     }
     const std::int64_t pairs = frame_.pairs_size();
     FrameWork work;
-    work.items = certified_frame() ? 2 * pairs : pairs;
+    work.items = FrameQueries();
     work.resolved = FindHeld();
-    work.serial = pairs <= kSerialFrameQueries;
+    work.serial = pairs <= kSerialFramePairs;
     work.memory_bytes = frame_reservation_.bytes();
     // After a true return the reply may be written and the next frame running: no member may
     // be touched here.
@@ -179,7 +179,7 @@ class DistanceStreamReactor final
     const double seconds = SecondsSince(started);
     record_.run_seconds += seconds;
     if (status.ok()) {
-      cost_.Record(certified_frame() ? 2 * frame_.pairs_size() : frame_.pairs_size(), seconds);
+      cost_.Record(FrameQueries(), seconds);
       ++record_.frames;
       if (place == FramePlace::kInline) ++record_.inline_frames;
     }
@@ -197,9 +197,7 @@ class DistanceStreamReactor final
     absl::StatusOr<DistanceRequest> tolerance = wire::ToleranceFromProto(frame_.tolerance());
     if (!tolerance.ok()) return tolerance.status();
     const HierarchyVolume volume = wire::VolumeFromProto(frame_.volume());
-    if (frame_.pairs_size() > 0 && !frame_.pairs(0).cover_a().empty()) {
-      return ComputeCertifiedFrame(*tolerance, volume);
-    }
+    if (certified_frame()) return ComputeCertifiedFrame(*tolerance, volume);
     // pairs_ holds what FindHeld found; the rest is looked up here, off the gRPC thread when
     // anything was missing (the dispatcher runs unresolved frames on the pool).
     const std::size_t n = static_cast<std::size_t>(frame_.pairs_size());
@@ -310,6 +308,12 @@ class DistanceStreamReactor final
   // Whether the frame's pairs name covers (then all must): a certified frame.
   bool certified_frame() const {
     return frame_.pairs_size() > 0 && !frame_.pairs(0).cover_a().empty();
+  }
+
+  // Distance queries the frame asks (a certified pair is two: internal sets and covers): the
+  // unit of cost_.
+  std::int64_t FrameQueries() const {
+    return (certified_frame() ? 2 : 1) * static_cast<std::int64_t>(frame_.pairs_size());
   }
 
   // The key of a held object in held_ or certified_: "volume/key", or "volume/internal|cover";

@@ -2,9 +2,9 @@
 // job pool. One rule for every streaming RPC that answers frames (DistanceStream, SceneStream).
 // Private to the server.
 //
-// A frame of a few distance queries costs tens of microseconds, about what handing it to a
-// pool thread and back costs (two wake-ups, and on a busy machine two waits for a core), so
-// such frames are answered on the gRPC thread that read them. Everything else goes to the
+// A frame of a few distance queries costs tens of microseconds, the same order as handing it to
+// a pool thread and back (two wake-ups, and on a busy machine two waits for a core), so such
+// frames are answered on the gRPC thread that read them. Everything else goes to the
 // pool as any call's work does: frames whose cost is not known yet (a stream's first frame,
 // which also looks up and may build hierarchies), frames over the time budget, frames that
 // would run parallel loops, and frames arriving while other gRPC threads are already
@@ -29,7 +29,7 @@ struct FrameWork {
   // in the cache (which may read disk or Redis, or build a hierarchy).
   bool resolved = false;
   // The work runs on the calling thread alone, never a TBB parallel loop (which belongs in the
-  // pool's arena): DistanceStream frames of at most kSerialFrameQueries queries.
+  // pool's arena): DistanceStream frames of at most kSerialFramePairs pairs.
   bool serial = false;
   // The frame's memory reservation (--memory-budget); picks the pool's lane when the frame
   // goes there (small lane up to MemoryCosts::kSmallJob, as for every call).
@@ -37,12 +37,13 @@ struct FrameWork {
 };
 
 // PairSeparationDistances answers up to 64 pairs on the calling thread (its header), so a
-// DistanceStream frame of at most this many queries is FrameWork::serial.
-inline constexpr std::int64_t kSerialFrameQueries = 64;
+// DistanceStream frame of at most this many pairs is FrameWork::serial (a certified frame makes
+// two such batches, internal sets and covers).
+inline constexpr std::int64_t kSerialFramePairs = 64;
 
-// Frames estimated at most this long run inline. The same order as the two thread hops a pool
-// frame pays, and well under the stream's 1 ms round-trip target: a frame of 10 pairs of
-// 1,000-sphere sets takes ~50 us.
+// Frames estimated at most this long run inline: a few times the two thread hops a pool frame
+// pays (tens of microseconds), and well under the stream's 1 ms round-trip target. A frame of
+// 10 pairs of 1,000-sphere sets takes 50-150 us.
 inline constexpr double kInlineFrameSeconds = 200e-6;
 
 // One stream's cost per item, learnt from its own frames: an exponential average (weight 1/4

@@ -7,6 +7,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <functional>
 #include <mutex>
 #include <random>
 #include <string>
@@ -117,38 +118,30 @@ TEST_F(StreamDispatchTest, SmallFramesAreAnsweredInlineInOrderLikeBruteForce) {
   EXPECT_GT(record.inline_frames, kFrames / 2);
 }
 
-// Frames over kSerialFrameQueries pairs would run parallel loops, and frames naming a set the
+// Frames over kSerialFramePairs pairs would run parallel loops, and frames naming a set the
 // stream does not hold yet look it up in the cache: both stay on the pool.
 TEST_F(StreamDispatchTest, BigFramesAndFramesNamingNewSetsGoToThePool) {
   const std::vector<std::string> keys = {PutSpheres(testing::RandomSpheres(20, 4))};
   std::mt19937_64 rng(5);
-  {
+  // One stream of `frames` frames of `pairs` pairs naming the sets keys(f); each answered.
+  const auto stream_frames = [&](int frames, int pairs,
+                                 const std::function<std::vector<std::string>(int)>& keys_of) {
     auto context = Context();
     auto stream = stub_->DistanceStream(context.get());
-    for (int f = 0; f < 20; ++f) {
-      ASSERT_TRUE(stream->Write(Frame(f, 65, keys, rng)));
+    for (int f = 0; f < frames; ++f) {
+      ASSERT_TRUE(stream->Write(Frame(f, pairs, keys_of(f), rng)));
       v1::DistanceFrameResult result;
       ASSERT_TRUE(stream->Read(&result));
-      ASSERT_EQ(result.results().distances_size(), 65);
+      ASSERT_EQ(result.results().distances_size(), pairs);
     }
     stream->WritesDone();
     ASSERT_TRUE(stream->Finish().ok());
-  }
-  {
-    auto context = Context();
-    auto stream = stub_->DistanceStream(context.get());
-    for (int f = 0; f < 10; ++f) {
-      // A new set each frame (and the held one, whose cost the stream knows).
-      const std::vector<std::string> fresh = {keys[0],
-                                              PutSpheres(testing::RandomSpheres(20, 100 + f))};
-      ASSERT_TRUE(stream->Write(Frame(f, 2, fresh, rng)));
-      v1::DistanceFrameResult result;
-      ASSERT_TRUE(stream->Read(&result));
-      ASSERT_EQ(result.results().distances_size(), 2);
-    }
-    stream->WritesDone();
-    ASSERT_TRUE(stream->Finish().ok());
-  }
+  };
+  stream_frames(20, 65, [&](int) { return keys; });
+  // A new set each frame (and the held one, whose cost the stream knows).
+  stream_frames(10, 2, [&](int f) {
+    return std::vector<std::string>{keys[0], PutSpheres(testing::RandomSpheres(20, 100 + f))};
+  });
   const std::vector<CallRecord> records = Streams(2);
   EXPECT_EQ(records[0].frames, 20);
   EXPECT_EQ(records[0].inline_frames, 0);
@@ -195,9 +188,9 @@ TEST_F(StreamDispatchTest, DrainAndCancelInTheMiddleOfInlineFrames) {
                                          PutSpheres(testing::RandomSpheres(30, 9))};
   configure_ = [](ServerOptions& options) { options.limits.memory_budget_bytes = 3 * 512; };
   Restart();
-  // One stream at a time fits the budget; others get "server is busy" and retry.
+  // Streams 3-pair frames until `stop` (then half-closes) or a failure; `answered` counts.
   auto stream_until_stopped = [&](std::atomic<bool>& stop, std::uint64_t seed,
-                                  grpc::ClientContext* context, int* answered) {
+                                  grpc::ClientContext* context, std::atomic<int>* answered) {
     std::mt19937_64 rng(seed);
     auto stream = stub_->DistanceStream(context);
     v1::DistanceFrameResult result;
@@ -210,17 +203,24 @@ TEST_F(StreamDispatchTest, DrainAndCancelInTheMiddleOfInlineFrames) {
     if (stop) stream->WritesDone();
     return stream->Finish();
   };
+  // Waits until `answered` passes `n` (the stream is past its first, pooled frames).
+  auto wait_for = [](const std::atomic<int>& answered, int n) {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+    while (answered.load() < n && std::chrono::steady_clock::now() < deadline) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+  };
 
   // Cancel: the client goes away mid-stream, several times.
   for (int round = 0; round < 5; ++round) {
     std::atomic<bool> stop{false};
     auto context = Context();
-    int answered = 0;
+    std::atomic<int> answered{0};
     std::thread client([&] { stream_until_stopped(stop, round, context.get(), &answered); });
-    std::this_thread::sleep_for(std::chrono::milliseconds(30 + 10 * round));
+    wait_for(answered, 5 + 20 * round);
     context->TryCancel();
     client.join();
-    EXPECT_GT(answered, 0);
+    EXPECT_GT(answered.load(), 0);
   }
   std::vector<CallRecord> records = Streams(5);
   std::int64_t inline_frames = 0;
@@ -236,29 +236,29 @@ TEST_F(StreamDispatchTest, DrainAndCancelInTheMiddleOfInlineFrames) {
   {
     std::atomic<bool> stop{false};
     auto context = Context();
-    int answered = 0;
+    std::atomic<int> answered{0};
     std::thread client([&] {
       const grpc::Status s = stream_until_stopped(stop, 50, context.get(), &answered);
       EXPECT_TRUE(s.ok()) << s.error_message();
     });
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    wait_for(answered, 20);
     stop = true;
     client.join();
-    EXPECT_GT(answered, 0);
+    EXPECT_GT(answered.load(), 0);
   }
 
   // Drain while a stream is busy with inline frames: it ends UNAVAILABLE promptly.
   std::atomic<bool> stop{false};
   auto context = Context();
-  int answered = 0;
+  std::atomic<int> answered{0};
   grpc::Status drained;
   std::thread client([&] { drained = stream_until_stopped(stop, 60, context.get(), &answered); });
-  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  wait_for(answered, 50);
   const auto start = std::chrono::steady_clock::now();
   server_->Shutdown(std::chrono::system_clock::now() + std::chrono::seconds(30));
   EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 5.0);
   client.join();
-  EXPECT_GT(answered, 0);
+  EXPECT_GT(answered.load(), 0);
   EXPECT_EQ(drained.error_code(), grpc::StatusCode::UNAVAILABLE) << drained.error_message();
   records = Streams(7);
   EXPECT_EQ(records.back().status.code(), absl::StatusCode::kUnavailable) << records.back().status;

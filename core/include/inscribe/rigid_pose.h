@@ -29,8 +29,10 @@ struct RigidPose {
 // 1 (callers that read rounded quaternions normalise first; see NormalizedPose).
 absl::Status CheckPose(const RigidPose& pose);
 
-// The pose with its quaternion scaled to unit length. INVALID_ARGUMENT for non-finite numbers
-// or a quaternion whose norm is not within 1e-3 of 1 (a typo rather than rounding).
+// The pose with its quaternion scaled to unit length; a quaternion already unit to rounding
+// (squared norm within 16 ulps of 1) is kept as it is, so normalising twice gives the same
+// bits as once. INVALID_ARGUMENT for non-finite numbers or a quaternion whose norm is not
+// within 1e-3 of 1 (a typo rather than rounding).
 absl::StatusOr<RigidPose> NormalizedPose(const RigidPose& pose);
 
 }  // namespace inscribe

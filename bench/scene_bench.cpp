@@ -5,7 +5,9 @@
 // over AABBs grown by the threshold, then fcl::distance on every pair it hands over (the same
 // answer: every pair closer than the threshold, with its distance), and collision alone
 // (fcl::collide on the pairs whose AABBs overlap). Optional rows with certified objects
-// (covers and their cores: intervals instead of distances).
+// (covers and their cores: intervals instead of distances). The same scenes run over the
+// service too: an inscribed on loopback in this process, one SceneSession (SceneStream) per
+// scene sending every pose every frame, each reply checked against core's Scene.
 //
 // Every model is scaled so that its bounding box's largest side is 1; the box's side is chosen
 // so that each object has a few neighbours within reach (`--spacing` object sizes between
@@ -13,11 +15,13 @@
 // by up to `--turn` radians, bouncing off the box's walls.
 //
 //   scene_bench [--models eight,cow,...] [--objects 16,64,256] [--frames N] [--fcl-frames N]
-//               [--spheres N] [--threshold T] [--certified] [--check-every K] [--seed S]
+//               [--spheres N] [--threshold T] [--certified] [--no-service] [--check-every K]
+//               [--seed S]
 //
 // Exit status: 0 every check passed (targets are reported, not enforced); 1 a frame (every
-// K-th) differs from the brute force over all pairs of objects and all pairs of spheres; 2 a
-// model could not be prepared.
+// K-th) differs from the brute force over all pairs of objects and all pairs of spheres, a
+// certified frame misses a pair FCL finds closer, or a service reply differs from core's
+// Scene or fails; 2 a model could not be prepared or the server not started.
 #include <fcl/fcl.h>
 #include <tbb/global_control.h>
 
@@ -29,6 +33,7 @@
 #include <cstdio>
 #include <map>
 #include <memory>
+#include <optional>
 #include <random>
 #include <string>
 #include <utility>
@@ -37,8 +42,11 @@
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
 #include "inscribe/certified_distance.h"
+#include "inscribe/client/client.h"
+#include "inscribe/client/connection.h"
 #include "inscribe/mesh_io.h"
 #include "inscribe/scene.h"
+#include "inscribe/server/inscribe_server.h"
 #include "inscribe/solid.h"
 #include "inscribe/sphere_cover.h"
 #include "inscribe/sphere_set_generation.h"
@@ -67,6 +75,7 @@ struct Options {
   double step = 0.01;       // object sizes per frame
   double turn = 0.02;       // radians per frame
   bool certified = false;
+  bool service = true;  // also over SceneStream
   int check_every = 100;
   std::uint64_t seed = 1;
   std::string data_dir;
@@ -79,6 +88,12 @@ struct Model {
   std::shared_ptr<const SphereHierarchy> spheres, internal, cover;
   double cover_delta = 0.0;
   std::shared_ptr<FclMesh> fcl;
+  // What the service rows upload: the dilated set, and with --certified the cores (the
+  // internal set of a certified object) and the cover with its certificate.
+  SphereSet dilated_set, cores_set, cover_set;
+  CoverCertificate certificate;
+  // The keys the server gave them.
+  std::string spheres_key, cores_key, cover_key;
 };
 
 Mesh ScaledToUnitBox(Mesh mesh) {
@@ -118,6 +133,7 @@ absl::StatusOr<Model> PrepareModel(const std::string& name, const Options& optio
   absl::StatusOr<std::shared_ptr<const SphereHierarchy>> spheres = Share(dilated->set.spheres);
   if (!spheres.ok()) return spheres.status();
   model.spheres = *spheres;
+  model.dilated_set = dilated->set;
   if (options.certified) {
     parameters.kind = SphereSetKind::kCover;
     absl::StatusOr<GeneratedSphereSet> cover = GenerateSphereSet(*solid, parameters);
@@ -132,6 +148,9 @@ absl::StatusOr<Model> PrepareModel(const std::string& name, const Options& optio
     model.internal = *internal;
     model.cover = *covering;
     model.cover_delta = cover->cover->certificate.delta;
+    model.cores_set.spheres = *cores;
+    model.cover_set = cover->set;
+    model.certificate = cover->cover->certificate;
   }
   return model;
 }
@@ -196,6 +215,7 @@ using FramePairs = std::vector<std::vector<std::pair<SceneObjectId, SceneObjectI
 
 Timing Summarise(std::vector<double> seconds, double candidates, double close) {
   Timing t;
+  if (seconds.empty()) return t;
   double total = 0.0;
   for (double s : seconds) total += s;
   t.fps = static_cast<double>(seconds.size()) / total;
@@ -419,6 +439,86 @@ Timing RunFcl(const Motion& motion, const std::vector<Model>& models, const Opti
                    static_cast<double>(data.close));
 }
 
+// The same scene over the service: one SceneSession (SceneStream) to an inscribed on loopback,
+// every frame sending every pose; each reply is checked against core's Scene on the same frame
+// (every K-th frame) and must be identical.
+Timing RunService(const client::Client& client, const Motion& motion,
+                  const std::vector<Model>& models, bool certified, double threshold,
+                  bool stop_at_first, const Options& options, int frames, int* failures) {
+  std::vector<client::SceneSessionObject> objects;
+  for (std::size_t i = 0; i < motion.model.size(); ++i) {
+    const Model& m = models[motion.model[i]];
+    client::SceneSessionObject o;
+    o.object.id = i;
+    o.object.pose = motion.pose[0][i];
+    o.sphere_set_key = certified ? m.cores_key : m.spheres_key;
+    if (certified) o.cover_key = m.cover_key;
+    objects.push_back(std::move(o));
+  }
+  client::SceneSessionOptions session_options;
+  session_options.volume = HierarchyVolume::kSphere;
+  session_options.query.threshold = threshold;
+  session_options.query.stop_at_first = stop_at_first;
+  absl::StatusOr<client::SceneSession> session = client.OpenSceneSession(objects, session_options);
+  if (!session.ok()) {
+    std::fprintf(stderr, "SceneStream: %s\n", std::string(session.status().message()).c_str());
+    ++*failures;
+    return Timing{};
+  }
+  Scene local = MakeScene(motion, models, certified);
+  std::vector<std::pair<SceneObjectId, RigidPose>> moves(motion.model.size());
+  std::vector<double> seconds;
+  double candidates = 0.0, close = 0.0;
+  for (int f = 0; f < frames; ++f) {
+    const auto& poses = motion.pose[static_cast<std::size_t>(f)];
+    const Clock::time_point start = Clock::now();
+    for (std::size_t i = 0; i < poses.size(); ++i) moves[i] = {i, poses[i]};
+    absl::StatusOr<client::SceneFrameResult> reply = session->Frame(moves);
+    seconds.push_back(std::chrono::duration<double>(Clock::now() - start).count());
+    if (!reply.ok()) {
+      std::fprintf(stderr, "SceneStream frame %d: %s\n", f,
+                   std::string(reply.status().message()).c_str());
+      ++*failures;
+      return Summarise(std::move(seconds), candidates, close);
+    }
+    candidates += static_cast<double>(reply->candidate_pairs);
+    close += static_cast<double>(reply->close_pairs);
+    if (f % options.check_every != 0) continue;
+    SceneQuery query = session_options.query;
+    absl::StatusOr<SceneFrame> want =
+        local.SetPoses(moves).ok() ? local.ClosePairs(query) : absl::InternalError("poses");
+    bool same = want.ok() && want->pairs.size() == reply->pairs.size();
+    for (std::size_t k = 0; same && k < want->pairs.size(); ++k) {
+      const ScenePair& x = want->pairs[k];
+      const ScenePair& y = reply->pairs[k];
+      same = x.a == y.a && x.b == y.b && x.result.distance == y.result.distance &&
+             x.lower == y.lower && x.upper == y.upper && x.certified == y.certified;
+    }
+    if (!same) {
+      std::fprintf(stderr, "SceneStream frame %d differs from core's Scene: %zu pairs, core %zu",
+                   f, reply->pairs.size(), want.ok() ? want->pairs.size() : 0);
+      for (std::size_t k = 0; want.ok() && k < std::min(want->pairs.size(), reply->pairs.size());
+           ++k) {
+        const ScenePair& x = want->pairs[k];
+        const ScenePair& y = reply->pairs[k];
+        if (x.a != y.a || x.b != y.b || x.result.distance != y.result.distance ||
+            x.lower != y.lower || x.upper != y.upper) {
+          std::fprintf(stderr, "; first difference (%llu, %llu) %.17g [%.17g, %.17g] against "
+                       "(%llu, %llu) %.17g [%.17g, %.17g]",
+                       static_cast<unsigned long long>(y.a), static_cast<unsigned long long>(y.b),
+                       y.result.distance, y.lower, y.upper, static_cast<unsigned long long>(x.a),
+                       static_cast<unsigned long long>(x.b), x.result.distance, x.lower, x.upper);
+          break;
+        }
+      }
+      std::fprintf(stderr, "\n");
+      ++*failures;
+    }
+  }
+  if (absl::Status closed = session->Close(); !closed.ok()) ++*failures;
+  return Summarise(std::move(seconds), candidates, close);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -437,6 +537,7 @@ int main(int argc, char** argv) {
   app.add_option("--spacing", options.spacing, "object sizes between neighbouring centres");
   app.add_option("--step", options.step, "largest move per frame, object sizes");
   app.add_flag("--certified", options.certified, "also run scenes of certified objects");
+  app.add_flag("!--no-service", options.service, "skip the rows over SceneStream");
   app.add_option("--check-every", options.check_every, "brute-force check every K-th frame")
       ->check(CLI::PositiveNumber);
   app.add_option("--seed", options.seed, "random seed");
@@ -461,6 +562,37 @@ int main(int argc, char** argv) {
     prepared.push_back(*std::move(m));
   }
 
+  // The service rows: an inscribed on loopback in this process, the models' sets uploaded.
+  std::unique_ptr<server::InscribeServer> local;
+  std::optional<client::Client> client;
+  if (options.service) {
+    server::ServerOptions server_options;
+    server_options.listen = "127.0.0.1:0";
+    absl::StatusOr<std::unique_ptr<server::InscribeServer>> started =
+        server::InscribeServer::Start(server_options);
+    if (!started.ok()) {
+      std::fprintf(stderr, "inscribed: %s\n", std::string(started.status().message()).c_str());
+      return 2;
+    }
+    local = *std::move(started);
+    client.emplace(client::MakeGrpcConnection(local->address()));
+    for (Model& m : prepared) {
+      absl::StatusOr<client::PutSphereSetResult> put = client->PutSphereSet(m.dilated_set);
+      if (put.ok()) m.spheres_key = put->sphere_set_key;
+      if (put.ok() && options.certified) {
+        put = client->PutSphereSet(m.cores_set);
+        if (put.ok()) m.cores_key = put->sphere_set_key;
+        if (put.ok()) put = client->PutCertifiedCover(m.cover_set, m.certificate);
+        if (put.ok()) m.cover_key = put->sphere_set_key;
+      }
+      if (!put.ok()) {
+        std::fprintf(stderr, "%s: upload: %s\n", m.name.c_str(),
+                     std::string(put.status().message()).c_str());
+        return 2;
+      }
+    }
+  }
+
   int failures = 0;
   std::printf("Scenes: %s; threshold %.3g object sizes; %zu models; frames: core %d, FCL %d\n\n",
               absl::StrJoin(options.objects, ", ").c_str(), options.threshold, prepared.size(),
@@ -469,9 +601,10 @@ int main(int argc, char** argv) {
       "| objects | query | close pairs / frame (FCL frames) | FCL close pairs / frame | candidates "
       "/ frame | "
       "core fps | core p50 us | core p99 us | core 1-thread fps | FCL fps | FCL p99 us | core / "
-      "FCL | >= %.0fx | >= %.0f fps |\n",
+      "FCL | >= %.0fx | >= %.0f fps | service fps | service p50 us | service p99 us |\n",
       kTargetSpeedup, kTargetFps);
-  std::printf("|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---|\n");
+  std::printf(
+      "|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---|---:|---:|---:|\n");
   for (const int n : options.objects) {
     const int frames = std::max(options.frames, options.fcl_frames);
     const Motion motion =
@@ -508,18 +641,25 @@ int main(int argc, char** argv) {
         single = RunScene(motion, prepared, row.certified, row.threshold, row.stop_at_first,
                           options, options.frames, false, nullptr, &unused, &failures);
       }
+      const Timing service =
+          client ? RunService(*client, motion, prepared, row.certified, row.threshold,
+                              row.stop_at_first, options, options.frames, &failures)
+                 : Timing{};
       const double ratio = core.fps / row.fcl.fps;
       std::printf(
           "| %d | %s | %.1f | %.1f | %.1f | %.0f | %.0f | %.0f | %.0f | %.1f | %.0f | %.1f | %s | "
-          "%s |\n",
+          "%s | %.0f | %.0f | %.0f |\n",
           n, row.name, close_compared, row.fcl.close, core.candidates, core.fps, core.p50_us,
           core.p99_us, single.fps, row.fcl.fps, row.fcl.p99_us, ratio,
           ratio >= kTargetSpeedup ? "pass" : "FAIL",
-          n != 64 ? "-" : (core.fps >= kTargetFps ? "pass" : "FAIL"));
+          n != 64 ? "-" : (core.fps >= kTargetFps ? "pass" : "FAIL"), service.fps, service.p50_us,
+          service.p99_us);
       std::fflush(stdout);
     }
   }
-  std::printf("\nFrames checked against the brute force (every %d-th): %d failed\n",
-              options.check_every, failures);
+  std::printf(
+      "\nFrames checked against the brute force, FCL's close pairs (certified) and core's "
+      "Scene (service) (every %d-th): %d failed\n",
+      options.check_every, failures);
   return failures == 0 ? 0 : 1;
 }

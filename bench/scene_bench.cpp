@@ -495,15 +495,16 @@ Timing RunService(const client::Client& client, const Motion& motion,
              x.lower == y.lower && x.upper == y.upper && x.certified == y.certified;
     }
     if (!same) {
-      std::fprintf(stderr, "SceneStream frame %d differs from core's Scene: %zu pairs, core %zu",
-                   f, reply->pairs.size(), want.ok() ? want->pairs.size() : 0);
+      std::fprintf(stderr, "SceneStream frame %d differs from core's Scene: %zu pairs, core %zu", f,
+                   reply->pairs.size(), want.ok() ? want->pairs.size() : 0);
       for (std::size_t k = 0; want.ok() && k < std::min(want->pairs.size(), reply->pairs.size());
            ++k) {
         const ScenePair& x = want->pairs[k];
         const ScenePair& y = reply->pairs[k];
         if (x.a != y.a || x.b != y.b || x.result.distance != y.result.distance ||
             x.lower != y.lower || x.upper != y.upper) {
-          std::fprintf(stderr, "; first difference (%llu, %llu) %.17g [%.17g, %.17g] against "
+          std::fprintf(stderr,
+                       "; first difference (%llu, %llu) %.17g [%.17g, %.17g] against "
                        "(%llu, %llu) %.17g [%.17g, %.17g]",
                        static_cast<unsigned long long>(y.a), static_cast<unsigned long long>(y.b),
                        y.result.distance, y.lower, y.upper, static_cast<unsigned long long>(x.a),

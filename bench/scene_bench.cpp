@@ -16,7 +16,7 @@
 //
 //   scene_bench [--models eight,cow,...] [--objects 16,64,256] [--frames N] [--fcl-frames N]
 //               [--spheres N] [--threshold T] [--certified] [--no-service] [--check-every K]
-//               [--seed S]
+//               [--queries distance,certified,contact] [--seed S]
 //
 // Exit status: 0 every check passed (targets are reported, not enforced); 1 a frame (every
 // K-th) differs from the brute force over all pairs of objects and all pairs of spheres, a
@@ -76,6 +76,7 @@ struct Options {
   double turn = 0.02;       // radians per frame
   bool certified = false;
   bool service = true;  // also over SceneStream
+  std::vector<std::string> queries = {"distance", "certified", "contact"};
   int check_every = 100;
   std::uint64_t seed = 1;
   std::string data_dir;
@@ -541,6 +542,9 @@ int main(int argc, char** argv) {
   app.add_flag("!--no-service", options.service, "skip the rows over SceneStream");
   app.add_option("--check-every", options.check_every, "brute-force check every K-th frame")
       ->check(CLI::PositiveNumber);
+  app.add_option("--queries", options.queries, "rows to run: distance, certified, contact")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"distance", "certified", "contact"}));
   app.add_option("--seed", options.seed, "random seed");
   app.add_option("--data", options.data_dir, "directory of the .off meshes");
   CLI11_PARSE(app, argc, argv);
@@ -610,11 +614,19 @@ int main(int argc, char** argv) {
     const int frames = std::max(options.frames, options.fcl_frames);
     const Motion motion =
         MakeMotion(n, frames, prepared.size(), options, options.seed + static_cast<unsigned>(n));
+    const auto wanted = [&](const char* query) {
+      return std::find(options.queries.begin(), options.queries.end(), query) !=
+             options.queries.end();
+    };
     FramePairs fcl_close, fcl_contacts;
     const Timing fcl_distance =
-        RunFcl(motion, prepared, options, options.fcl_frames, true, &fcl_close);
+        wanted("distance") || (wanted("certified") && options.certified)
+            ? RunFcl(motion, prepared, options, options.fcl_frames, true, &fcl_close)
+            : Timing{};
     const Timing fcl_collide =
-        RunFcl(motion, prepared, options, options.fcl_frames, false, &fcl_contacts);
+        wanted("contact")
+            ? RunFcl(motion, prepared, options, options.fcl_frames, false, &fcl_contacts)
+            : Timing{};
     // Rows: every pair closer than the threshold with its distance (against FCL's distance on
     // the pairs its grown AABBs hand over), the same with certified intervals, and the pairs
     // in contact (threshold 0, stopping at the first overlapping sphere pair as FCL's
@@ -631,7 +643,7 @@ int main(int argc, char** argv) {
                         {"certified", true, options.threshold, false, fcl_distance, fcl_close},
                         {"contact", false, 0.0, true, fcl_collide, fcl_contacts}};
     for (const Row& row : rows) {
-      if (row.certified && !options.certified) continue;
+      if ((row.certified && !options.certified) || !wanted(row.name)) continue;
       double close_compared = 0.0, unused = 0.0;
       const Timing core =
           RunScene(motion, prepared, row.certified, row.threshold, row.stop_at_first, options,

@@ -26,11 +26,12 @@ inline double PruneThreshold(const DistanceRequest& request, double d) {
 }
 
 // The exact answer of SeparationDistance (without witnesses) by a depth-first branch and
-// bound over the hierarchies' Quads (up to four children per step, their bounds computed four
-// at a time in float) and float-filtered comparisons of the sphere pairs below small node
-// pairs; every pair the filters let through is evaluated in double exactly as
-// BruteForceSeparationDistance does. Returns false, leaving *out alone, when the sets' and
-// the pose's magnitudes fall outside the range where the float margins are proven
+// bound over the hierarchies' Quads (a step bounds up to four grandchildren of one node, or
+// up to 4 x 4 of both nodes when their sizes are close, four at a time in float) and
+// float-filtered comparisons of the sphere pairs below small node pairs (each sphere first
+// tested against the other node's sphere); every pair the filters let through is evaluated in
+// double exactly as BruteForceSeparationDistance does. Returns false, leaving *out alone, when the
+// sets' and the pose's magnitudes fall outside the range where the float margins are proven
 // (kFloatMinExponent, kFloatMaxExponent in the .cpp): the caller then runs the double search.
 // Cost: about O(log n) steps per query on separated sets; memory: per-thread scratch of
 // O(b's spheres), kept between queries.

@@ -24,10 +24,14 @@ using Quad = SphereHierarchy::Quad;
 // rejects four or eight pairs in a few instructions, much less than a step of the tree. On the
 // Table II poses (eight, pig) 768-1536 were equally fast, 1.3x faster than 128.
 constexpr std::int64_t kAllPairs = 1024;
+static_assert(kAllPairs <= 64 * 64, "the shorter side of a compared pair fits a 64-bit mask");
 
 // A step splits both nodes (up to 4 x 4 Quad entries) when neither node's query sphere is more
 // than this many times the other's radius, else only the bigger one.
 constexpr double kSplitBothRatio = 2.0;
+
+// b's centres are moved into a's frame in blocks of this many (aligned in the ordered arrays).
+constexpr std::size_t kMoveBlock = 8;
 
 // Float rounding. Let M be a power of two bounding every |coordinate| and radius the search
 // reads in a's frame (the hierarchies' query spheres and spheres, b's moved by the relative
@@ -60,11 +64,12 @@ constexpr double kSplitBothRatio = 2.0;
 constexpr int kFloatMarginExponent = 7 - 24;  // 128 u M
 constexpr int kFloatMinExponent = -40, kFloatMaxExponent = 60;
 
-// Per-thread scratch kept between queries: b's ordered centres and b's Quads moved into a's
-// frame in float, filled lazily; an entry is valid when its stamp equals the query's epoch.
+// Per-thread scratch kept between queries: b's ordered centres (by blocks of kMoveBlock) and
+// b's Quads moved into a's frame in float, filled lazily; an entry is valid when its stamp
+// equals the query's epoch.
 struct Scratch {
   std::vector<float> x, y, z;
-  std::vector<std::uint32_t> sphere_stamp;
+  std::vector<std::uint32_t> block_stamp;
   struct MovedQuad {
     float x[4], y[4], z[4];
   };
@@ -82,14 +87,14 @@ struct Scratch {
       x.resize(spheres, 0.0f);
       y.resize(spheres, 0.0f);
       z.resize(spheres, 0.0f);
-      sphere_stamp.resize(spheres, 0);
+      block_stamp.resize(spheres / kMoveBlock + 1, 0);
     }
     if (quads.size() < nodes) {
       quads.resize(nodes, MovedQuad{});
       quad_stamp.resize(nodes, 0);
     }
     if (++epoch == 0) {  // wrapped: forget every stamp
-      std::fill(sphere_stamp.begin(), sphere_stamp.end(), 0);
+      std::fill(block_stamp.begin(), block_stamp.end(), 0);
       std::fill(quad_stamp.begin(), quad_stamp.end(), 0);
       epoch = 1;
     }
@@ -309,14 +314,18 @@ class FloatSearch {
                   const SphereHierarchy::Slot& sb, DistanceResult* out) {
     const std::int32_t na = sa.count, nb = sb.count;
     out->sphere_tests += std::int64_t{na} * nb;
-    for (std::int32_t j = sb.first; j < sb.first + nb; ++j) {
-      const auto at = static_cast<std::size_t>(j);
-      if (s_.sphere_stamp[at] == s_.epoch) continue;
-      s_.sphere_stamp[at] = s_.epoch;
-      const Vector3 c = Move(b_.ordered_spheres()[at].center);
-      s_.x[at] = static_cast<float>(c.x());
-      s_.y[at] = static_cast<float>(c.y());
-      s_.z[at] = static_cast<float>(c.z());
+    const std::size_t b_spheres = b_.ordered_spheres().size();
+    for (std::size_t block = static_cast<std::size_t>(sb.first) / kMoveBlock;
+         block * kMoveBlock < static_cast<std::size_t>(sb.first + nb); ++block) {
+      if (s_.block_stamp[block] == s_.epoch) continue;
+      s_.block_stamp[block] = s_.epoch;
+      const std::size_t end = std::min(block * kMoveBlock + kMoveBlock, b_spheres);
+      for (std::size_t at = block * kMoveBlock; at < end; ++at) {
+        const Vector3 c = Move(b_.ordered_spheres()[at].center);
+        s_.x[at] = static_cast<float>(c.x());
+        s_.y[at] = static_cast<float>(c.y());
+        s_.z[at] = static_cast<float>(c.z());
+      }
     }
     const auto fa = static_cast<std::size_t>(sa.first), fb = static_cast<std::size_t>(sb.first);
     const Side side_a{a_.float_x() + fa,      a_.float_y() + fa, a_.float_z() + fa,
@@ -355,11 +364,35 @@ class FloatSearch {
             static_cast<float>(center.z()), static_cast<float>(radius)};
   }
 
-  // Whether the filter rejects the row sphere i against `around` (the same test as one pair's).
-  bool RowRejected(const Side& rows, std::int32_t i, const FloatSphere& around) const {
-    const float dx = rows.x[i] - around.x, dy = rows.y[i] - around.y, dz = rows.z[i] - around.z;
-    const float reach = (float_reach_ + rows.radius[i]) + around.radius;
-    return !(reach > 0.0f && dx * dx + dy * dy + dz * dz < reach * reach);
+  // The rows the filter passes against `around` (the same test as one pair's), bit i for row
+  // i; at most 64 rows (the shorter side of at most kAllPairs pairs).
+  std::uint64_t RowsInReach(const Side& rows, const FloatSphere& around) const {
+    std::uint64_t in_reach = 0;
+#if defined(__SSE2__)
+    const __m128 cx = _mm_set1_ps(around.x), cy = _mm_set1_ps(around.y), cz = _mm_set1_ps(around.z),
+                 reach_all = _mm_set1_ps(float_reach_), radius = _mm_set1_ps(around.radius),
+                 zero = _mm_setzero_ps();
+    for (std::int32_t i = 0; i < rows.count; i += 4) {
+      const __m128 dx = _mm_sub_ps(_mm_loadu_ps(rows.x + i), cx);
+      const __m128 dy = _mm_sub_ps(_mm_loadu_ps(rows.y + i), cy);
+      const __m128 dz = _mm_sub_ps(_mm_loadu_ps(rows.z + i), cz);
+      const __m128 squared =
+          _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
+      const __m128 reach = _mm_add_ps(_mm_add_ps(reach_all, _mm_loadu_ps(rows.radius + i)), radius);
+      const __m128 pass =
+          _mm_and_ps(_mm_cmpgt_ps(reach, zero), _mm_cmplt_ps(squared, _mm_mul_ps(reach, reach)));
+      in_reach |= std::uint64_t{static_cast<unsigned>(_mm_movemask_ps(pass))} << i;
+    }
+#else
+    for (std::int32_t i = 0; i < rows.count; ++i) {
+      const float dx = rows.x[i] - around.x, dy = rows.y[i] - around.y, dz = rows.z[i] - around.z;
+      const float reach = (float_reach_ + rows.radius[i]) + around.radius;
+      if (reach > 0.0f && dx * dx + dy * dy + dz * dz < reach * reach) {
+        in_reach |= std::uint64_t{1} << i;
+      }
+    }
+#endif
+    return rows.count == 64 ? in_reach : in_reach & ((std::uint64_t{1} << rows.count) - 1);
   }
 
   // The pair of row i and lane j passed the filter.
@@ -377,8 +410,9 @@ class FloatSearch {
   // every lane pair of the row from below); rows_are_a tells which side is a's.
   void Filter(const Side& rows, const Side& lanes, const FloatSphere& around, bool rows_are_a) {
     const std::int32_t nl = lanes.count;
-    for (std::int32_t i = 0; i < rows.count; ++i) {
-      if (RowRejected(rows, i, around)) continue;
+    for (std::uint64_t in_reach = RowsInReach(rows, around); in_reach != 0;
+         in_reach &= in_reach - 1) {
+      const auto i = static_cast<std::int32_t>(__builtin_ctzll(in_reach));
       const float reach_i = float_reach_ + rows.radius[i];
       const auto pass_pair = [&](std::int32_t j) { PassPair(rows, i, lanes, j, rows_are_a); };
 #if defined(__SSE2__)
@@ -419,8 +453,9 @@ class FloatSearch {
   __attribute__((target("avx2"))) void FilterAvx2(const Side& rows, const Side& lanes,
                                                   const FloatSphere& around, bool rows_are_a) {
     const std::int32_t nl = lanes.count;
-    for (std::int32_t i = 0; i < rows.count; ++i) {
-      if (RowRejected(rows, i, around)) continue;
+    for (std::uint64_t in_reach = RowsInReach(rows, around); in_reach != 0;
+         in_reach &= in_reach - 1) {
+      const auto i = static_cast<std::int32_t>(__builtin_ctzll(in_reach));
       const __m256 x = _mm256_set1_ps(rows.x[i]), y = _mm256_set1_ps(rows.y[i]),
                    z = _mm256_set1_ps(rows.z[i]);
       const __m256 reach_row = _mm256_set1_ps(float_reach_ + rows.radius[i]);

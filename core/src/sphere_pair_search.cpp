@@ -210,7 +210,7 @@ class FloatSearch {
 
   // Bounds of the Quad's entries (centres x, y, z in a's frame, radii q.radius) against the
   // other side's sphere (centre `other` in a's frame, radius other_radius), four at once;
-  // pushes the entries bounded below the threshold, the nearest last (searched first).
+  // pushes the entries bounded below the threshold, the nearest on top (searched first).
   void Expand(const Quad& q, const float* x, const float* y, const float* z, const Vector3& other,
               double other_radius, const Scratch::Pair& parent, bool split_a, DistanceResult* out) {
     out->volume_tests += q.size;
@@ -249,9 +249,23 @@ class FloatSearch {
     for (int k = 0; k < n; ++k) s_.stack.push_back(kept[k]);
   }
 
+  // Swaps the nearest of the pairs pushed from stack position `first` on to the top, so that it
+  // is searched first; the others stay in the order found. For ExpandBoth's up to 16 pairs,
+  // sorting them all cost 12% more time on the Table II poses (Expand's up to four are sorted:
+  // slightly faster there).
+  void NearestOnTop(std::size_t first) {
+    std::vector<Scratch::Pair>& stack = s_.stack;
+    if (stack.size() <= first + 1) return;
+    std::size_t nearest = first;
+    for (std::size_t k = first + 1; k < stack.size(); ++k) {
+      if (stack[k].bound < stack[nearest].bound) nearest = k;
+    }
+    std::swap(stack[nearest], stack.back());
+  }
+
   // Both nodes' Quads against each other: up to 16 bounds, four at a time (a's entries in the
   // lanes, one of b's entries per pass); pushes the pairs bounded below the threshold, the
-  // nearest last.
+  // nearest on top.
   void ExpandBoth(const Scratch::Pair& parent, DistanceResult* out) {
     const Quad& qa = a_.quad(parent.a);
     const Quad& qb = b_.quad(parent.b);
@@ -279,21 +293,14 @@ class FloatSearch {
       }
     }
 #endif
-    Scratch::Pair kept[16];
-    int n = 0;
+    const std::size_t first = s_.stack.size();
     for (int j = 0; j < qb.size; ++j) {
       for (int k = 0; k < qa.size; ++k) {
         if (!(static_cast<double>(bound[j][k]) < threshold_)) continue;
-        const Scratch::Pair pair{qa.child[k], qb.child[j], bound[j][k]};
-        int at = n++;
-        while (at > 0 && kept[at - 1].bound < pair.bound) {
-          kept[at] = kept[at - 1];
-          --at;
-        }
-        kept[at] = pair;
+        s_.stack.push_back({qa.child[k], qb.child[j], bound[j][k]});
       }
     }
-    for (int k = 0; k < n; ++k) s_.stack.push_back(kept[k]);
+    NearestOnTop(first);
   }
 
   // The double value of one sphere pair (positions in the ordered arrays), computed as the

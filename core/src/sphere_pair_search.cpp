@@ -15,6 +15,17 @@
 #endif
 
 namespace inscribe::internal {
+
+// Set during static initialisation, hence the explicit __builtin_cpu_init.
+bool use_avx2_filter = [] {
+#if defined(INSCRIBE_AVX2_FILTER)
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx2") != 0;
+#else
+  return false;
+#endif
+}();
+
 namespace {
 
 using Quad = SphereHierarchy::Quad;
@@ -108,12 +119,6 @@ float FloatAtLeast(double v) {
   if (static_cast<double>(f) < v) f = std::nextafter(f, std::numeric_limits<float>::infinity());
   return f;
 }
-
-#if defined(INSCRIBE_AVX2_FILTER)
-// Whether the CPU runs AVX2: the sphere-pair filter then takes eight pairs per instruction
-// sequence (the same float operations per lane as the SSE2 one, no fused multiply-add).
-const bool kHasAvx2 = __builtin_cpu_supports("avx2");
-#endif
 
 class FloatSearch {
  public:
@@ -347,7 +352,7 @@ class FloatSearch {
     const Side& rows = rows_are_a ? side_a : side_b;
     const Side& lanes = rows_are_a ? side_b : side_a;
 #if defined(INSCRIBE_AVX2_FILTER)
-    if (kHasAvx2) {
+    if (use_avx2_filter) {
       FilterAvx2(rows, lanes, around, rows_are_a);
       return;
     }

@@ -25,6 +25,12 @@ inline double PruneThreshold(const DistanceRequest& request, double d) {
   return std::min({d - tolerance, request.closer_than, request.max_distance});
 }
 
+// Whether the sphere-pair filter takes eight pairs per instruction sequence with AVX2 (the
+// same float operations per lane as the SSE2 filter's four, no fused multiply-add): true when
+// the CPU and the OS support it (x86-64 builds by GCC or Clang). Tests clear it to run the
+// SSE2 filter; never changed while queries run.
+extern bool use_avx2_filter;
+
 // The exact answer of SeparationDistance (without witnesses) by a depth-first branch and
 // bound over the hierarchies' Quads (a step bounds up to four grandchildren of one node, or
 // up to 4 x 4 of both nodes when their sizes are close, four at a time in float) and

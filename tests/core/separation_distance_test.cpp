@@ -8,6 +8,7 @@
 #include <tuple>
 #include <vector>
 
+#include "sphere_pair_search.h"
 #include "support/sphere_sets.h"
 #include "support/test_meshes.h"
 
@@ -412,7 +413,7 @@ TEST(SeparationDistanceFloatFilter, ExactOnDegenerateSets) {
 // fill, and the steps split one node or both (sizes close or far apart). Both sets posed,
 // poses from overlapping to apart, magnitudes from near 2^-40 to near 2^60 (where the float
 // search still runs), rotations off unit by as much as CheckPose allows. Exact every time.
-TEST(SeparationDistanceFloatFilter, ExactForEverySetSizeMagnitudeAndPose) {
+void ExpectExactForEverySetSizeMagnitudeAndPose() {
   std::mt19937_64 rng(59);
   std::uniform_int_distribution<int> small(1, 70);
   const std::vector<Sphere> big = testing::RandomBalls(1500, 1.0, 0.001, 0.05, 60);
@@ -453,6 +454,25 @@ TEST(SeparationDistanceFloatFilter, ExactForEverySetSizeMagnitudeAndPose) {
     }
   }
   EXPECT_EQ(checked, 5 * 12 * 2 * 6 * 2);
+}
+
+TEST(SeparationDistanceFloatFilter, ExactForEverySetSizeMagnitudeAndPose) {
+  ExpectExactForEverySetSizeMagnitudeAndPose();
+}
+
+// The same with the SSE2 sphere-pair filter (the AVX2 one runs by default where the CPU has it).
+TEST(SeparationDistanceFloatFilter, ExactWithTheSse2Filter) {
+  const bool avx2 = internal::use_avx2_filter;
+  internal::use_avx2_filter = false;
+  ExpectExactForEverySetSizeMagnitudeAndPose();
+  for (const char* name : {"eight.off", "knot1.off"}) {
+    if (testing::TestMeshPath(name).empty()) continue;
+    std::mt19937_64 rng(67);
+    const std::vector<Sphere>& spheres = RealSphereSet(name);
+    ExpectExact(spheres, spheres, RandomPoses(rng, 50, 0.3), std::string(name) + " touching");
+    ExpectExact(spheres, spheres, RandomPoses(rng, 50, 1.0), std::string(name) + " near");
+  }
+  internal::use_avx2_filter = avx2;
 }
 
 // Real medial spheres in touching and near poses, where the answer is decided among many

@@ -320,12 +320,11 @@ class FloatSearch {
     }
   }
 
-  // Every sphere below a against every sphere below b through the float filter, four at a time;
-  // the pairs it passes go to ComparePair.
+  // Every sphere below a against every sphere below b through the float filter, four or eight
+  // at a time; the pairs it passes go to ComparePair.
   void CompareAll(HierarchyRef ra, const SphereHierarchy::Slot& sa, HierarchyRef rb,
                   const SphereHierarchy::Slot& sb, DistanceResult* out) {
     const std::int32_t na = sa.count, nb = sb.count;
-    out->sphere_tests += std::int64_t{na} * nb;
     const std::size_t b_spheres = b_.ordered_spheres().size();
     for (std::size_t block = static_cast<std::size_t>(sb.first) / kMoveBlock;
          block * kMoveBlock < static_cast<std::size_t>(sb.first + nb); ++block) {
@@ -344,20 +343,26 @@ class FloatSearch {
                       a_.float_radius() + fa, sa.first,          na};
     const Side side_b{s_.x.data() + fb,       s_.y.data() + fb, s_.z.data() + fb,
                       b_.float_radius() + fb, sb.first,         nb};
-    // The longer range fills the SIMD lanes; each row is first tested against the query
-    // sphere around the lanes' node.
+    // The longer range fills the SIMD lanes. Each row is first tested against the query sphere
+    // around the lanes' node, which bounds every pair of the row from below (the row test of
+    // the margins' comment).
     const bool rows_are_a = nb >= na;
     const Sphere& q = rows_are_a ? b_.query_sphere(rb) : a_.query_sphere(ra);
     const FloatSphere around = RoundedSphere(rows_are_a ? Move(q.center) : q.center, q.radius);
     const Side& rows = rows_are_a ? side_a : side_b;
     const Side& lanes = rows_are_a ? side_b : side_a;
+    const std::uint64_t rows_in_reach = RowsInReach(rows, around);
+    // A row test counts as a volume test (a sphere against a node's sphere).
+    out->volume_tests += rows.count;
+    out->sphere_tests += std::int64_t{__builtin_popcountll(rows_in_reach)} * lanes.count;
+    if (rows_in_reach == 0) return;
 #if defined(INSCRIBE_AVX2_FILTER)
     if (use_avx2_filter) {
-      FilterAvx2(rows, lanes, around, rows_are_a);
+      FilterAvx2(rows, rows_in_reach, lanes, rows_are_a);
       return;
     }
 #endif
-    Filter(rows, lanes, around, rows_are_a);
+    Filter(rows, rows_in_reach, lanes, rows_are_a);
   }
 
   // A range of spheres in float (centres in a's frame) and its first position in the ordered
@@ -417,13 +422,11 @@ class FloatSearch {
     }
   }
 
-  // Each row sphere against the lane spheres, four lanes at a time, skipping the rows that the
-  // same filter rejects against `around`, the query sphere around the lanes' node (it bounds
-  // every lane pair of the row from below); rows_are_a tells which side is a's.
-  void Filter(const Side& rows, const Side& lanes, const FloatSphere& around, bool rows_are_a) {
+  // Each row sphere in rows_in_reach (bit i for row i) against the lane spheres, four lanes at
+  // a time; rows_are_a tells which side is a's.
+  void Filter(const Side& rows, std::uint64_t rows_in_reach, const Side& lanes, bool rows_are_a) {
     const std::int32_t nl = lanes.count;
-    for (std::uint64_t in_reach = RowsInReach(rows, around); in_reach != 0;
-         in_reach &= in_reach - 1) {
+    for (std::uint64_t in_reach = rows_in_reach; in_reach != 0; in_reach &= in_reach - 1) {
       const auto i = static_cast<std::int32_t>(__builtin_ctzll(in_reach));
       const float reach_i = float_reach_ + rows.radius[i];
       const auto pass_pair = [&](std::int32_t j) { PassPair(rows, i, lanes, j, rows_are_a); };
@@ -462,11 +465,10 @@ class FloatSearch {
 
 #if defined(INSCRIBE_AVX2_FILTER)
   // Filter with eight lanes at a time.
-  __attribute__((target("avx2"))) void FilterAvx2(const Side& rows, const Side& lanes,
-                                                  const FloatSphere& around, bool rows_are_a) {
+  __attribute__((target("avx2"))) void FilterAvx2(const Side& rows, std::uint64_t rows_in_reach,
+                                                  const Side& lanes, bool rows_are_a) {
     const std::int32_t nl = lanes.count;
-    for (std::uint64_t in_reach = RowsInReach(rows, around); in_reach != 0;
-         in_reach &= in_reach - 1) {
+    for (std::uint64_t in_reach = rows_in_reach; in_reach != 0; in_reach &= in_reach - 1) {
       const auto i = static_cast<std::int32_t>(__builtin_ctzll(in_reach));
       const __m256 x = _mm256_set1_ps(rows.x[i]), y = _mm256_set1_ps(rows.y[i]),
                    z = _mm256_set1_ps(rows.z[i]);

@@ -33,12 +33,13 @@ using Quad = SphereHierarchy::Quad;
 // Node pairs with at most this many sphere pairs below them are compared pair by pair: the
 // filter first drops the rows out of reach of the other node's sphere (most of them), then
 // rejects four or eight pairs in a few instructions, much less than a step of the tree. On the
-// Table II poses (eight, pig) 768-1536 were equally fast, 1.3x faster than 128.
+// Table II poses (eight, pig) 768-2048 were equally fast; with kSplitBothRatio, 1.3x faster
+// than 128 pairs and one side split per step.
 constexpr std::int64_t kAllPairs = 1024;
 static_assert(kAllPairs <= 64 * 64, "the shorter side of a compared pair fits a 64-bit mask");
 
 // A step splits both nodes (up to 4 x 4 Quad entries) when neither node's query sphere is more
-// than this many times the other's radius, else only the bigger one.
+// than this many times the other's radius, else only the bigger one (1.5-3 were equally fast).
 constexpr double kSplitBothRatio = 2.0;
 
 // b's centres are moved into a's frame in blocks of this many (aligned in the ordered arrays).

@@ -9,16 +9,41 @@
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#include <immintrin.h>
+#define INSCRIBE_AVX2_FILTER 1
+#endif
 
 namespace inscribe::internal {
+
+// Set during static initialisation, hence the explicit __builtin_cpu_init.
+bool use_avx2_filter = [] {
+#if defined(INSCRIBE_AVX2_FILTER)
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx2") != 0;
+#else
+  return false;
+#endif
+}();
+
 namespace {
 
 using Quad = SphereHierarchy::Quad;
 
-// Node pairs with at most this many sphere pairs below them are compared pair by pair (the
-// float filter rejects four pairs in a few instructions, much less than a step of the tree):
-// 128 beat 64 and 256 in bench/separation_distance_bench (eight and knot1).
-constexpr std::int64_t kAllPairs = 128;
+// Node pairs with at most this many sphere pairs below them are compared pair by pair: the
+// filter first drops the rows out of reach of the other node's sphere (most of them), then
+// rejects four or eight pairs in a few instructions, much less than a step of the tree. On the
+// Table II poses (eight, pig) 768-2048 were equally fast; with kSplitBothRatio, 1.3x faster
+// than 128 pairs and one side split per step.
+constexpr std::int64_t kAllPairs = 1024;
+static_assert(kAllPairs <= 64 * 64, "the shorter side of a compared pair fits a 64-bit mask");
+
+// A step splits both nodes (up to 4 x 4 Quad entries) when neither node's query sphere is more
+// than this many times the other's radius, else only the bigger one (1.5-3 were equally fast).
+constexpr double kSplitBothRatio = 2.0;
+
+// b's centres are moved into a's frame in blocks of this many (aligned in the ordered arrays).
+constexpr std::size_t kMoveBlock = 8;
 
 // Float rounding. Let M be a power of two bounding every |coordinate| and radius the search
 // reads in a's frame (the hierarchies' query spheres and spheres, b's moved by the relative
@@ -27,26 +52,36 @@ constexpr std::int64_t kAllPairs = 128;
 // the double one, its float square within a relative 3.01 u, its float square root within
 // 16 u M (|d| <= 2 sqrt(3) M); sums and differences of radii and thresholds (magnitudes below
 // 6 M) add at most 22 u M. A margin of 128 u M thus makes
-//  - a node pair's float bound (centre distance - radii - margin) at least 90 u M below the
-//    double one, itself below every sphere pair under the two nodes, up to the rotation's
-//    departure from orthonormality s (|R x| <= (1 + s) |x|), which can shrink a moved child's
-//    distance to the node centre by s times a radius (at most 2 M); the margin adds 4 s M;
+//  - a node pair's float bound (centre distance - radii - margin, one side's sphere against
+//    the other's Quad entries or Quad entries against Quad entries: the same operations on
+//    the same rounded values) at least 90 u M below the double one, itself below every sphere
+//    pair under the two nodes, up to the rotation's departure from orthonormality s
+//    (|R x| <= (1 + s) |x|), which can shrink a moved child's distance to the node centre by s
+//    times a radius (at most 2 M); the margin adds 4 s M;
 //  - the sphere-pair filter (reject when the float squared centre distance is at least the
 //    square of threshold + margin + r_a + r_b, the threshold clamped to [-4 M, 4 M] since no
 //    pair's value leaves [-2 M, 3.5 M]) pass every pair whose double value is below the
 //    threshold: its float reach exceeds its float distance by 99 u M, more than the 4.02 u |d|
-//    and 2^-114 M^2 that rounding and underflow of the squares can add.
+//    and 2^-114 M^2 that rounding and underflow of the squares can add. It thus passes every
+//    pair whose double value is below threshold + 85 u M + 4 s M;
+//  - the row test (that filter applied to one sphere and the query sphere around the other
+//    node) reject a sphere only when its value against that query sphere is at least
+//    threshold + 85 u M + 4 s M; every sphere inside the query sphere (to the containment
+//    slack, 1e-10 of a radius, and the move's departure, s times a radius) is then at least
+//    the threshold away in double, so none of the row's pairs could pass.
+// The AVX2 filter runs the same float operations lane by lane (no fused multiply-add).
 // Bounding spheres accepted by Deserialize may leave a sphere out by 1e-10 of their radius,
 // far below the margin. The search runs only when 2^-40 <= M <= 2^60: nothing overflows and
 // denormals' absolute error (2^-149) stays far below the margin.
 constexpr int kFloatMarginExponent = 7 - 24;  // 128 u M
 constexpr int kFloatMinExponent = -40, kFloatMaxExponent = 60;
 
-// Per-thread scratch kept between queries: b's ordered centres and b's Quads moved into a's
-// frame in float, filled lazily; an entry is valid when its stamp equals the query's epoch.
+// Per-thread scratch kept between queries: b's ordered centres (by blocks of kMoveBlock) and
+// b's Quads moved into a's frame in float, filled lazily; an entry is valid when its stamp
+// equals the query's epoch.
 struct Scratch {
   std::vector<float> x, y, z;
-  std::vector<std::uint32_t> sphere_stamp;
+  std::vector<std::uint32_t> block_stamp;
   struct MovedQuad {
     float x[4], y[4], z[4];
   };
@@ -64,14 +99,14 @@ struct Scratch {
       x.resize(spheres, 0.0f);
       y.resize(spheres, 0.0f);
       z.resize(spheres, 0.0f);
-      sphere_stamp.resize(spheres, 0);
+      block_stamp.resize(spheres / kMoveBlock + 1, 0);
     }
     if (quads.size() < nodes) {
       quads.resize(nodes, MovedQuad{});
       quad_stamp.resize(nodes, 0);
     }
     if (++epoch == 0) {  // wrapped: forget every stamp
-      std::fill(sphere_stamp.begin(), sphere_stamp.end(), 0);
+      std::fill(block_stamp.begin(), block_stamp.end(), 0);
       std::fill(quad_stamp.begin(), quad_stamp.end(), 0);
       epoch = 1;
     }
@@ -112,12 +147,17 @@ class FloatSearch {
       const SphereHierarchy::Slot& sa = a_.slot(p.a);
       const SphereHierarchy::Slot& sb = b_.slot(p.b);
       if (std::int64_t{sa.count} * sb.count <= kAllPairs) {
-        CompareAll(sa, sb, out);
+        CompareAll(p.a, sa, p.b, sb, out);
         if (yes_no_ && best_ < request_.closer_than) break;
         continue;
       }
       const Sphere& qa = a_.query_sphere(p.a);
       const Sphere& qb = b_.query_sphere(p.b);
+      if (sa.count > 1 && sb.count > 1 && qa.radius <= kSplitBothRatio * qb.radius &&
+          qb.radius <= kSplitBothRatio * qa.radius) {
+        ExpandBoth(p, out);
+        continue;
+      }
       const bool split_a = sa.count > 1 && (sb.count == 1 || qa.radius >= qb.radius);
       if (split_a) {
         const Vector3 cb = Move(qb.center);
@@ -176,7 +216,7 @@ class FloatSearch {
 
   // Bounds of the Quad's entries (centres x, y, z in a's frame, radii q.radius) against the
   // other side's sphere (centre `other` in a's frame, radius other_radius), four at once;
-  // pushes the entries bounded below the threshold, the nearest last (searched first).
+  // pushes the entries bounded below the threshold, the nearest on top (searched first).
   void Expand(const Quad& q, const float* x, const float* y, const float* z, const Vector3& other,
               double other_radius, const Scratch::Pair& parent, bool split_a, DistanceResult* out) {
     out->volume_tests += q.size;
@@ -215,6 +255,60 @@ class FloatSearch {
     for (int k = 0; k < n; ++k) s_.stack.push_back(kept[k]);
   }
 
+  // Swaps the nearest of the pairs pushed from stack position `first` on to the top, so that it
+  // is searched first; the others stay in the order found. For ExpandBoth's up to 16 pairs,
+  // sorting them all cost 12% more time on the Table II poses (Expand's up to four are sorted:
+  // slightly faster there).
+  void NearestOnTop(std::size_t first) {
+    std::vector<Scratch::Pair>& stack = s_.stack;
+    if (stack.size() <= first + 1) return;
+    std::size_t nearest = first;
+    for (std::size_t k = first + 1; k < stack.size(); ++k) {
+      if (stack[k].bound < stack[nearest].bound) nearest = k;
+    }
+    std::swap(stack[nearest], stack.back());
+  }
+
+  // Both nodes' Quads against each other: up to 16 bounds, four at a time (a's entries in the
+  // lanes, one of b's entries per pass); pushes the pairs bounded below the threshold, the
+  // nearest on top.
+  void ExpandBoth(const Scratch::Pair& parent, DistanceResult* out) {
+    const Quad& qa = a_.quad(parent.a);
+    const Quad& qb = b_.quad(parent.b);
+    const Scratch::MovedQuad& mb = MovedQuad(parent.b, qb);
+    out->volume_tests += qa.size * qb.size;
+    alignas(16) float bound[4][4];
+#if defined(__SSE2__)
+    const __m128 ax = _mm_loadu_ps(qa.x), ay = _mm_loadu_ps(qa.y), az = _mm_loadu_ps(qa.z),
+                 ar = _mm_loadu_ps(qa.radius);
+    for (int j = 0; j < qb.size; ++j) {
+      const __m128 dx = _mm_sub_ps(ax, _mm_set1_ps(mb.x[j]));
+      const __m128 dy = _mm_sub_ps(ay, _mm_set1_ps(mb.y[j]));
+      const __m128 dz = _mm_sub_ps(az, _mm_set1_ps(mb.z[j]));
+      const __m128 squared =
+          _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
+      const __m128 gap = _mm_sub_ps(_mm_sqrt_ps(squared), ar);
+      _mm_store_ps(bound[j], _mm_sub_ps(gap, _mm_set1_ps(qb.radius[j] + margin_)));
+    }
+#else
+    for (int j = 0; j < qb.size; ++j) {
+      for (int k = 0; k < 4; ++k) {
+        const float dx = qa.x[k] - mb.x[j], dy = qa.y[k] - mb.y[j], dz = qa.z[k] - mb.z[j];
+        bound[j][k] =
+            (std::sqrt(dx * dx + dy * dy + dz * dz) - qa.radius[k]) - (qb.radius[j] + margin_);
+      }
+    }
+#endif
+    const std::size_t first = s_.stack.size();
+    for (int j = 0; j < qb.size; ++j) {
+      for (int k = 0; k < qa.size; ++k) {
+        if (!(static_cast<double>(bound[j][k]) < threshold_)) continue;
+        s_.stack.push_back({qa.child[k], qb.child[j], bound[j][k]});
+      }
+    }
+    NearestOnTop(first);
+  }
+
   // The double value of one sphere pair (positions in the ordered arrays), computed as the
   // brute force does; a new best pair when below the threshold.
   void ComparePair(std::int32_t i, std::int32_t j) {
@@ -227,32 +321,49 @@ class FloatSearch {
     }
   }
 
-  // Every sphere below a against every sphere below b through the float filter, four at a time;
-  // the pairs it passes go to ComparePair.
-  void CompareAll(const SphereHierarchy::Slot& sa, const SphereHierarchy::Slot& sb,
-                  DistanceResult* out) {
+  // Every sphere below a against every sphere below b through the float filter, four or eight
+  // at a time; the pairs it passes go to ComparePair.
+  void CompareAll(HierarchyRef ra, const SphereHierarchy::Slot& sa, HierarchyRef rb,
+                  const SphereHierarchy::Slot& sb, DistanceResult* out) {
     const std::int32_t na = sa.count, nb = sb.count;
-    out->sphere_tests += std::int64_t{na} * nb;
-    for (std::int32_t j = sb.first; j < sb.first + nb; ++j) {
-      const auto at = static_cast<std::size_t>(j);
-      if (s_.sphere_stamp[at] == s_.epoch) continue;
-      s_.sphere_stamp[at] = s_.epoch;
-      const Vector3 c = Move(b_.ordered_spheres()[at].center);
-      s_.x[at] = static_cast<float>(c.x());
-      s_.y[at] = static_cast<float>(c.y());
-      s_.z[at] = static_cast<float>(c.z());
+    const std::size_t b_spheres = b_.ordered_spheres().size();
+    for (std::size_t block = static_cast<std::size_t>(sb.first) / kMoveBlock;
+         block * kMoveBlock < static_cast<std::size_t>(sb.first + nb); ++block) {
+      if (s_.block_stamp[block] == s_.epoch) continue;
+      s_.block_stamp[block] = s_.epoch;
+      const std::size_t end = std::min(block * kMoveBlock + kMoveBlock, b_spheres);
+      for (std::size_t at = block * kMoveBlock; at < end; ++at) {
+        const Vector3 c = Move(b_.ordered_spheres()[at].center);
+        s_.x[at] = static_cast<float>(c.x());
+        s_.y[at] = static_cast<float>(c.y());
+        s_.z[at] = static_cast<float>(c.z());
+      }
     }
     const auto fa = static_cast<std::size_t>(sa.first), fb = static_cast<std::size_t>(sb.first);
     const Side side_a{a_.float_x() + fa,      a_.float_y() + fa, a_.float_z() + fa,
                       a_.float_radius() + fa, sa.first,          na};
     const Side side_b{s_.x.data() + fb,       s_.y.data() + fb, s_.z.data() + fb,
                       b_.float_radius() + fb, sb.first,         nb};
-    // The longer range fills the SIMD lanes.
-    if (nb >= na) {
-      Filter(side_a, side_b, true);
-    } else {
-      Filter(side_b, side_a, false);
+    // The longer range fills the SIMD lanes. Each row is first tested against the query sphere
+    // around the lanes' node, which bounds every pair of the row from below (the row test of
+    // the margins' comment).
+    const bool rows_are_a = nb >= na;
+    const Sphere& q = rows_are_a ? b_.query_sphere(rb) : a_.query_sphere(ra);
+    const FloatSphere around = RoundedSphere(rows_are_a ? Move(q.center) : q.center, q.radius);
+    const Side& rows = rows_are_a ? side_a : side_b;
+    const Side& lanes = rows_are_a ? side_b : side_a;
+    const std::uint64_t rows_in_reach = RowsInReach(rows, around);
+    // A row test counts as a volume test (a sphere against a node's sphere).
+    out->volume_tests += rows.count;
+    out->sphere_tests += std::int64_t{__builtin_popcountll(rows_in_reach)} * lanes.count;
+    if (rows_in_reach == 0) return;
+#if defined(INSCRIBE_AVX2_FILTER)
+    if (use_avx2_filter) {
+      FilterAvx2(rows, rows_in_reach, lanes, rows_are_a);
+      return;
     }
+#endif
+    Filter(rows, rows_in_reach, lanes, rows_are_a);
   }
 
   // A range of spheres in float (centres in a's frame) and its first position in the ordered
@@ -262,19 +373,64 @@ class FloatSearch {
     std::int32_t first, count;
   };
 
-  // Each row sphere against the lane spheres, four lanes at a time; rows_are_a tells which
-  // side is a's.
-  void Filter(const Side& rows, const Side& lanes, bool rows_are_a) {
-    const std::int32_t nl = lanes.count;
+  // A sphere in float: centre in a's frame and radius, each rounded to nearest.
+  struct FloatSphere {
+    float x, y, z, radius;
+  };
+  static FloatSphere RoundedSphere(const Vector3& center, double radius) {
+    return {static_cast<float>(center.x()), static_cast<float>(center.y()),
+            static_cast<float>(center.z()), static_cast<float>(radius)};
+  }
+
+  // The rows the filter passes against `around` (the same test as one pair's), bit i for row
+  // i; at most 64 rows (the shorter side of at most kAllPairs pairs).
+  std::uint64_t RowsInReach(const Side& rows, const FloatSphere& around) const {
+    std::uint64_t in_reach = 0;
+#if defined(__SSE2__)
+    const __m128 cx = _mm_set1_ps(around.x), cy = _mm_set1_ps(around.y), cz = _mm_set1_ps(around.z),
+                 reach_all = _mm_set1_ps(float_reach_), radius = _mm_set1_ps(around.radius),
+                 zero = _mm_setzero_ps();
+    for (std::int32_t i = 0; i < rows.count; i += 4) {
+      const __m128 dx = _mm_sub_ps(_mm_loadu_ps(rows.x + i), cx);
+      const __m128 dy = _mm_sub_ps(_mm_loadu_ps(rows.y + i), cy);
+      const __m128 dz = _mm_sub_ps(_mm_loadu_ps(rows.z + i), cz);
+      const __m128 squared =
+          _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
+      const __m128 reach = _mm_add_ps(_mm_add_ps(reach_all, _mm_loadu_ps(rows.radius + i)), radius);
+      const __m128 pass =
+          _mm_and_ps(_mm_cmpgt_ps(reach, zero), _mm_cmplt_ps(squared, _mm_mul_ps(reach, reach)));
+      in_reach |= std::uint64_t{static_cast<unsigned>(_mm_movemask_ps(pass))} << i;
+    }
+#else
     for (std::int32_t i = 0; i < rows.count; ++i) {
+      const float dx = rows.x[i] - around.x, dy = rows.y[i] - around.y, dz = rows.z[i] - around.z;
+      const float reach = (float_reach_ + rows.radius[i]) + around.radius;
+      if (reach > 0.0f && dx * dx + dy * dy + dz * dz < reach * reach) {
+        in_reach |= std::uint64_t{1} << i;
+      }
+    }
+#endif
+    return rows.count == 64 ? in_reach : in_reach & ((std::uint64_t{1} << rows.count) - 1);
+  }
+
+  // The pair of row i and lane j passed the filter.
+  void PassPair(const Side& rows, std::int32_t i, const Side& lanes, std::int32_t j,
+                bool rows_are_a) {
+    if (rows_are_a) {
+      ComparePair(rows.first + i, lanes.first + j);
+    } else {
+      ComparePair(lanes.first + j, rows.first + i);
+    }
+  }
+
+  // Each row sphere in rows_in_reach (bit i for row i) against the lane spheres, four lanes at
+  // a time; rows_are_a tells which side is a's.
+  void Filter(const Side& rows, std::uint64_t rows_in_reach, const Side& lanes, bool rows_are_a) {
+    const std::int32_t nl = lanes.count;
+    for (std::uint64_t in_reach = rows_in_reach; in_reach != 0; in_reach &= in_reach - 1) {
+      const auto i = static_cast<std::int32_t>(__builtin_ctzll(in_reach));
       const float reach_i = float_reach_ + rows.radius[i];
-      const auto pass_pair = [&](std::int32_t j) {
-        if (rows_are_a) {
-          ComparePair(rows.first + i, lanes.first + j);
-        } else {
-          ComparePair(lanes.first + j, rows.first + i);
-        }
-      };
+      const auto pass_pair = [&](std::int32_t j) { PassPair(rows, i, lanes, j, rows_are_a); };
 #if defined(__SSE2__)
       const __m128 x = _mm_set1_ps(rows.x[i]), y = _mm_set1_ps(rows.y[i]),
                    z = _mm_set1_ps(rows.z[i]);
@@ -307,6 +463,39 @@ class FloatSearch {
 #endif
     }
   }
+
+#if defined(INSCRIBE_AVX2_FILTER)
+  // Filter with eight lanes at a time.
+  __attribute__((target("avx2"))) void FilterAvx2(const Side& rows, std::uint64_t rows_in_reach,
+                                                  const Side& lanes, bool rows_are_a) {
+    const std::int32_t nl = lanes.count;
+    for (std::uint64_t in_reach = rows_in_reach; in_reach != 0; in_reach &= in_reach - 1) {
+      const auto i = static_cast<std::int32_t>(__builtin_ctzll(in_reach));
+      const __m256 x = _mm256_set1_ps(rows.x[i]), y = _mm256_set1_ps(rows.y[i]),
+                   z = _mm256_set1_ps(rows.z[i]);
+      const __m256 reach_row = _mm256_set1_ps(float_reach_ + rows.radius[i]);
+      const __m256 zero = _mm256_setzero_ps();
+      for (std::int32_t j = 0; j < nl; j += 8) {
+        const __m256 dx = _mm256_sub_ps(x, _mm256_loadu_ps(lanes.x + j));
+        const __m256 dy = _mm256_sub_ps(y, _mm256_loadu_ps(lanes.y + j));
+        const __m256 dz = _mm256_sub_ps(z, _mm256_loadu_ps(lanes.z + j));
+        const __m256 squared = _mm256_add_ps(
+            _mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy)), _mm256_mul_ps(dz, dz));
+        const __m256 reach = _mm256_add_ps(reach_row, _mm256_loadu_ps(lanes.radius + j));
+        const __m256 pass =
+            _mm256_and_ps(_mm256_cmp_ps(reach, zero, _CMP_GT_OQ),
+                          _mm256_cmp_ps(squared, _mm256_mul_ps(reach, reach), _CMP_LT_OQ));
+        auto mask = static_cast<unsigned>(_mm256_movemask_ps(pass));
+        if (nl - j < 8) mask &= (1u << (nl - j)) - 1u;
+        while (mask != 0) {
+          const int k = __builtin_ctz(mask);
+          mask &= mask - 1;
+          PassPair(rows, i, lanes, j + k, rows_are_a);
+        }
+      }
+    }
+  }
+#endif
 
   const SphereHierarchy& a_;
   const SphereHierarchy& b_;

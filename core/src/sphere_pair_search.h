@@ -25,12 +25,19 @@ inline double PruneThreshold(const DistanceRequest& request, double d) {
   return std::min({d - tolerance, request.closer_than, request.max_distance});
 }
 
+// Whether the sphere-pair filter takes eight pairs per instruction sequence with AVX2 (the
+// same float operations per lane as the SSE2 filter's four, no fused multiply-add): true when
+// the CPU and the OS support it (x86-64 builds by GCC or Clang). Tests clear it to run the
+// SSE2 filter; never changed while queries run.
+extern bool use_avx2_filter;
+
 // The exact answer of SeparationDistance (without witnesses) by a depth-first branch and
-// bound over the hierarchies' Quads (up to four children per step, their bounds computed four
-// at a time in float) and float-filtered comparisons of the sphere pairs below small node
-// pairs; every pair the filters let through is evaluated in double exactly as
-// BruteForceSeparationDistance does. Returns false, leaving *out alone, when the sets' and
-// the pose's magnitudes fall outside the range where the float margins are proven
+// bound over the hierarchies' Quads (a step bounds up to four grandchildren of one node, or
+// up to 4 x 4 of both nodes when their sizes are close, four at a time in float) and
+// float-filtered comparisons of the sphere pairs below small node pairs (each sphere first
+// tested against the other node's sphere); every pair the filters let through is evaluated in
+// double exactly as BruteForceSeparationDistance does. Returns false, leaving *out alone, when the
+// sets' and the pose's magnitudes fall outside the range where the float margins are proven
 // (kFloatMinExponent, kFloatMaxExponent in the .cpp): the caller then runs the double search.
 // Cost: about O(log n) steps per query on separated sets; memory: per-thread scratch of
 // O(b's spheres), kept between queries.

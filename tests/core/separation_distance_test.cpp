@@ -8,6 +8,7 @@
 #include <tuple>
 #include <vector>
 
+#include "sphere_pair_search.h"
 #include "support/sphere_sets.h"
 #include "support/test_meshes.h"
 
@@ -405,6 +406,73 @@ TEST(SeparationDistanceFloatFilter, ExactOnDegenerateSets) {
     stretched[i].rotation.coeffs() *= 1.0 + (i % 2 ? 9e-7 : -9e-7);
   }
   ExpectExact(RandomSpheres(200, 49), near_ties, stretched, "quaternion off unit");
+}
+
+// Sets of every size from 1 to 70 spheres against sets of 1 to 1,500: the compared ranges
+// then have every length modulo the SIMD widths (four and eight lanes), the row masks every
+// fill, and the steps split one node or both (sizes close or far apart). Both sets posed,
+// poses from overlapping to apart, magnitudes from near 2^-40 to near 2^60 (where the float
+// search still runs), rotations off unit by as much as CheckPose allows. Exact every time.
+void ExpectExactForEverySetSizeMagnitudeAndPose() {
+  std::mt19937_64 rng(59);
+  std::uniform_int_distribution<int> small(1, 70);
+  const std::vector<Sphere> big = testing::RandomBalls(1500, 1.0, 0.001, 0.05, 60);
+  const std::vector<Sphere> medium = RandomSpheres(300, 61);
+  int checked = 0;
+  for (const double scale : {0x1p-39, 1e-6, 1.0, 1e6, 0x1p57}) {
+    for (int trial = 0; trial < 12; ++trial) {
+      std::vector<Sphere> a = testing::RandomBalls(small(rng), 0.5, 0.001, 0.1, 100 + trial);
+      const std::vector<Sphere>& b =
+          trial % 3 == 0
+              ? big
+              : (trial % 3 == 1 ? medium
+                                : testing::RandomBalls(small(rng), 0.5, 0.001, 0.1, 200 + trial));
+      const std::vector<Sphere> sa = Scaled(a, scale, Vector3::Zero()),
+                                sb = Scaled(b, scale, Vector3::Zero());
+      for (HierarchyVolume volume : {HierarchyVolume::kRss, HierarchyVolume::kSphere}) {
+        const SphereHierarchy ha = Build(sa, volume), hb = Build(sb, volume);
+        for (int p = 0; p < 6; ++p) {
+          RigidPose pose_a = RandomPose(rng, 0.2 * p), pose_b = RandomPose(rng, 0.2 * p);
+          pose_a.translation *= scale;
+          pose_b.translation *= scale;
+          if (p % 2 == 1) pose_b.rotation.coeffs() *= 1.0 + (p % 4 == 1 ? 9e-7 : -9e-7);
+          // Each side in turn as a (the search moves b's spheres).
+          for (const bool swap : {false, true}) {
+            const SphereHierarchy& first = swap ? hb : ha;
+            const SphereHierarchy& second = swap ? ha : hb;
+            absl::StatusOr<DistanceResult> fast = SeparationDistance(first, pose_a, second, pose_b);
+            absl::StatusOr<DistanceResult> slow =
+                BruteForceSeparationDistance(swap ? sb : sa, pose_a, swap ? sa : sb, pose_b);
+            ASSERT_TRUE(fast.ok() && slow.ok());
+            EXPECT_EQ(fast->distance, slow->distance)
+                << "scale " << scale << " trial " << trial << " pose " << p << " swap " << swap
+                << " " << HierarchyVolumeName(volume);
+            ++checked;
+          }
+        }
+      }
+    }
+  }
+  EXPECT_EQ(checked, 5 * 12 * 2 * 6 * 2);
+}
+
+TEST(SeparationDistanceFloatFilter, ExactForEverySetSizeMagnitudeAndPose) {
+  ExpectExactForEverySetSizeMagnitudeAndPose();
+}
+
+// The same with the SSE2 sphere-pair filter (the AVX2 one runs by default where the CPU has it).
+TEST(SeparationDistanceFloatFilter, ExactWithTheSse2Filter) {
+  const bool avx2 = internal::use_avx2_filter;
+  internal::use_avx2_filter = false;
+  ExpectExactForEverySetSizeMagnitudeAndPose();
+  for (const char* name : {"eight.off", "knot1.off"}) {
+    if (testing::TestMeshPath(name).empty()) continue;
+    std::mt19937_64 rng(67);
+    const std::vector<Sphere>& spheres = RealSphereSet(name);
+    ExpectExact(spheres, spheres, RandomPoses(rng, 50, 0.3), std::string(name) + " touching");
+    ExpectExact(spheres, spheres, RandomPoses(rng, 50, 1.0), std::string(name) + " near");
+  }
+  internal::use_avx2_filter = avx2;
 }
 
 // Real medial spheres in touching and near poses, where the answer is decided among many

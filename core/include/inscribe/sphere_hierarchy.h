@@ -110,9 +110,9 @@ class SphereHierarchy {
 
   // ordered_spheres() in single precision, one array per coordinate and one of radii (each
   // rounded to nearest), padded with kFloatPadding copies of the last sphere so that a query
-  // may read whole SIMD packets past a range's end. Only ever used to prune with margins that
-  // cover float rounding (separation_distance.cpp). Derived, not serialised.
-  static constexpr std::size_t kFloatPadding = 4;
+  // may read whole SIMD packets (up to eight floats) past a range's end. Only ever used to prune
+  // with margins that cover float rounding (separation_distance.cpp). Derived, not serialised.
+  static constexpr std::size_t kFloatPadding = 8;
   const float* float_x() const { return float_x_.data(); }
   const float* float_y() const { return float_y_.data(); }
   const float* float_z() const { return float_z_.data(); }

@@ -623,10 +623,9 @@ int main(int argc, char** argv) {
         wanted("distance") || (wanted("certified") && options.certified)
             ? RunFcl(motion, prepared, options, options.fcl_frames, true, &fcl_close)
             : Timing{};
-    const Timing fcl_collide =
-        wanted("contact")
-            ? RunFcl(motion, prepared, options, options.fcl_frames, false, &fcl_contacts)
-            : Timing{};
+    const Timing fcl_collide = wanted("contact") ? RunFcl(motion, prepared, options,
+                                                          options.fcl_frames, false, &fcl_contacts)
+                                                 : Timing{};
     // Rows: every pair closer than the threshold with its distance (against FCL's distance on
     // the pairs its grown AABBs hand over), the same with certified intervals, and the pairs
     // in contact (threshold 0, stopping at the first overlapping sphere pair as FCL's

@@ -1,12 +1,9 @@
 // DistanceStream: one request per simulator frame, one response per frame, in order, over one
-// long-lived bidirectional call. One frame is in the reactor at a time (read, compute, write,
-// read the next), so frames can never be reordered and a slow client slows only itself. A frame
-// is computed where the FrameDispatcher says: on the gRPC thread that read it when it is small
-// and its cost known, else on the pool. The hierarchies a stream names are resolved once and
-// held for the stream's life.
+// long-lived bidirectional call (FrameStreamReactor: one frame in the reactor at a time,
+// computed on the gRPC thread that read it or on the pool, as the FrameDispatcher says). The
+// hierarchies a stream names are resolved once and held for the stream's life.
 #include <algorithm>
 #include <atomic>
-#include <chrono>
 #include <cmath>
 #include <memory>
 #include <mutex>
@@ -18,6 +15,7 @@
 #include "absl/strings/str_cat.h"
 #include "drainable_stream.h"
 #include "frame_dispatch.h"
+#include "frame_stream_reactor.h"
 #include "inscribe/certified_distance.h"
 #include "inscribe/separation_distance.h"
 #include "inscribe/server/inscribe_service.h"
@@ -35,174 +33,57 @@ constexpr std::size_t kMaxStreamSets = 1024;
 
 }  // namespace
 
-// States: kReading (a read is pending; nothing else), kBusy (a frame is being computed or its
-// result written), kFinished (Finish was called). Transitions happen under mutex_, and Finish
-// and StartRead are called under it, so a drain can never finish a stream between a state
-// change and the read it announces.
+// FrameStreamReactor runs the stream; a frame here is a batch of distance queries, admitted
+// against --max-poses and --memory-budget (its reservation held until its reply is written).
 class DistanceStreamReactor final
-    : public grpc::ServerBidiReactor<v1::DistanceFrame, v1::DistanceFrameResult>,
-      public DrainableStream {
+    : public FrameStreamReactor<v1::DistanceFrame, v1::DistanceFrameResult> {
  public:
   DistanceStreamReactor(InscribeService* service, grpc::CallbackServerContext* context)
-      : service_(service) {
-    record_.method = "DistanceStream";
-    record_.peer = context->peer();
+      : FrameStreamReactor(service, context, "DistanceStream") {}
+
+ private:
+  absl::Status Admit() override {
+    const v1::DistanceFrame& frame = request();
+    if (frame.pairs_size() > service()->limits_.max_poses) {
+      return absl::ResourceExhaustedError(
+          absl::StrCat("frame ", frame.frame(), " has ", frame.pairs_size(),
+                       " pairs; this server's limit (--max-poses) is ",
+                       service()->limits_.max_poses, " per frame"));
+    }
+    // Held from here until the frame's reply has been written (or the stream ends).
+    absl::StatusOr<MemoryBudget::Reservation> reserved = service()->memory_->Reserve(
+        frame.pairs_size() * MemoryCosts::kPerFramePair,
+        absl::StrCat("DistanceStream frame ", frame.frame(), " of ", frame.pairs_size(), " pairs"));
+    if (!reserved.ok()) return reserved.status();
+    frame_reservation_ = *std::move(reserved);
+    record().memory_bytes = std::max(record().memory_bytes, frame_reservation_.bytes());
+    return absl::OkStatus();
   }
 
-  // `admitted`: the service's Authenticate verdict; a refused stream ends before any read.
-  void Start(const absl::Status& admitted) {
-    service_->CallStarted();
-    {
-      std::lock_guard<std::mutex> lock(service_->calls_mutex_);
-      service_->streams_.insert(this);
-    }
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (!admitted.ok()) {
-      FinishLocked(admitted);
-      return;
-    }
-    if (service_->draining_.load()) {
-      FinishLocked(absl::UnavailableError("server is shutting down; retry"));
-      return;
-    }
-    state_ = State::kReading;
-    StartRead(&frame_);
-  }
-
-  // The service is draining: end now when waiting for a frame, else after the current one.
-  void Drain() override {
-    std::lock_guard<std::mutex> lock(mutex_);
-    draining_ = true;
-    if (state_ == State::kReading) {
-      FinishLocked(absl::UnavailableError("server is shutting down; reconnect to another"));
-    }
-  }
-
-  void OnReadDone(bool ok) override {
-    const ServiceClock::time_point arrived = ServiceClock::now();
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      if (state_ == State::kFinished) return;
-      if (!ok) {
-        // The client half-closed (done sending) or the call was cancelled; either way every
-        // frame read has been answered.
-        FinishLocked(absl::OkStatus());
-        return;
-      }
-      if (frame_.pairs_size() > service_->limits_.max_poses) {
-        FinishLocked(absl::ResourceExhaustedError(
-            absl::StrCat("frame ", frame_.frame(), " has ", frame_.pairs_size(),
-                         " pairs; this server's limit (--max-poses) is ",
-                         service_->limits_.max_poses, " per frame")));
-        return;
-      }
-      // Held from here until the frame's reply has been written (or the stream ends).
-      absl::StatusOr<MemoryBudget::Reservation> reserved =
-          service_->memory_->Reserve(frame_.pairs_size() * MemoryCosts::kPerFramePair,
-                                     absl::StrCat("DistanceStream frame ", frame_.frame(), " of ",
-                                                  frame_.pairs_size(), " pairs"));
-      if (!reserved.ok()) {
-        FinishLocked(reserved.status());
-        return;
-      }
-      frame_reservation_ = *std::move(reserved);
-      record_.memory_bytes = std::max(record_.memory_bytes, frame_reservation_.bytes());
-      // kBusy: a drain now waits for this frame's reply, and nothing else touches the frame.
-      state_ = State::kBusy;
-    }
-    const std::int64_t pairs = frame_.pairs_size();
+  FrameWork Work() override {
     FrameWork work;
     work.items = FrameQueries();
     work.resolved = FindHeld();
-    work.serial = pairs <= kSerialFramePairs;
+    work.serial = request().pairs_size() <= kSerialFramePairs;
     work.memory_bytes = frame_reservation_.bytes();
-    // After a true return the reply may be written and the next frame running: no member may
-    // be touched here.
-    if (!service_->frames_->Run(work, cost_.Estimate(work.items),
-                                [this, arrived](FramePlace place) { RunFrame(arrived, place); })) {
-      std::lock_guard<std::mutex> lock(mutex_);
-      FinishLocked(service_->QueueFullError());
-    }
+    return work;
   }
 
-  void OnWriteDone(bool ok) override {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (state_ == State::kFinished) return;
-    if (!ok) {
-      FinishLocked(absl::CancelledError("client went away"));
-      return;
-    }
-    frame_reservation_.Release();
-    if (draining_) {
-      FinishLocked(absl::UnavailableError("server is shutting down; reconnect to another"));
-      return;
-    }
-    state_ = State::kReading;
-    StartRead(&frame_);
-  }
+  void FrameEnded() override { frame_reservation_.Release(); }
 
-  void OnCancel() override { cancelled_.store(true); }
-
-  void OnDone() override {
-    {
-      std::lock_guard<std::mutex> lock(service_->calls_mutex_);
-      service_->streams_.erase(this);
-    }
-    record_.status = final_status_;
-    service_->Observe(record_);
-    service_->CallEnded();
-    Unref();
-  }
-
- private:
-  enum class State { kStarting, kReading, kBusy, kFinished };
-
-  void FinishLocked(const absl::Status& status) {
-    frame_reservation_.Release();
-    state_ = State::kFinished;
-    final_status_ = status;
-    Finish(wire::ToGrpcStatus(status));
-  }
-
-  // Where the dispatcher put it (inline on the gRPC thread, or on the pool): answers frame_
-  // into result_, then writes it (or ends the stream).
-  void RunFrame(ServiceClock::time_point arrived, FramePlace place) {
-    const ServiceClock::time_point started = ServiceClock::now();
-    record_.queued_seconds += std::chrono::duration<double>(started - arrived).count();
-    absl::Status status;
-    try {
-      status = ComputeFrame();
-    } catch (const std::bad_alloc&) {
-      status = absl::ResourceExhaustedError("server ran out of memory in DistanceStream");
-    }
-    if (status.ok() && cancelled_.load()) status = absl::CancelledError("client went away");
-    const double seconds = SecondsSince(started);
-    record_.run_seconds += seconds;
-    if (status.ok()) {
-      cost_.Record(FrameQueries(), seconds);
-      ++record_.frames;
-      if (place == FramePlace::kInline) ++record_.inline_frames;
-    }
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (!status.ok()) {
-      FinishLocked(status);
-      return;
-    }
-    StartWrite(&result_);
-  }
-
-  absl::Status ComputeFrame() {
-    result_.Clear();
-    result_.set_frame(frame_.frame());
-    absl::StatusOr<DistanceRequest> tolerance = wire::ToleranceFromProto(frame_.tolerance());
+  // The frame's distances into reply(), on whichever thread the dispatcher chose.
+  absl::Status Answer(FramePlace /*place*/) override {
+    reply().Clear();
+    reply().set_frame(request().frame());
+    absl::StatusOr<DistanceRequest> tolerance = wire::ToleranceFromProto(request().tolerance());
     if (!tolerance.ok()) return tolerance.status();
-    const HierarchyVolume volume = wire::VolumeFromProto(frame_.volume());
+    const HierarchyVolume volume = wire::VolumeFromProto(request().volume());
     if (certified_frame()) return ComputeCertifiedFrame(*tolerance, volume);
     // pairs_ holds what FindHeld found; the rest is looked up here, off the gRPC thread when
     // anything was missing (the dispatcher runs unresolved frames on the pool).
-    const std::size_t n = static_cast<std::size_t>(frame_.pairs_size());
+    const std::size_t n = static_cast<std::size_t>(request().pairs_size());
     for (std::size_t i = 0; i < n; ++i) {
-      const v1::DistancePair& pair = frame_.pairs(static_cast<int>(i));
+      const v1::DistancePair& pair = request().pairs(static_cast<int>(i));
       if (!pair.cover_a().empty() || !pair.cover_b().empty()) {
         if (absl::Status s = CheckCovers(pair.cover_a(), pair.cover_b()); !s.ok()) {
           return InPair(i, s);
@@ -231,9 +112,9 @@ class DistanceStreamReactor final
       }
     }
     absl::StatusOr<std::vector<DistanceResult>> results =
-        PairSeparationDistances(pairs_, *tolerance, &cancelled_);
+        PairSeparationDistances(pairs_, *tolerance, &cancelled());
     if (absl::Status s = Answered(results.status()); !s.ok()) return s;
-    wire::AppendDistanceResults(*results, result_.mutable_results());
+    wire::AppendDistanceResults(*results, reply().mutable_results());
     return absl::OkStatus();
   }
 
@@ -241,7 +122,7 @@ class DistanceStreamReactor final
   // frame loops are on every frame's path.
   absl::Status InPair(std::size_t i, const absl::Status& s) const {
     return absl::Status(s.code(),
-                        absl::StrCat("frame ", frame_.frame(), " pairs[", i, "].", s.message()));
+                        absl::StrCat("frame ", request().frame(), " pairs[", i, "].", s.message()));
   }
 
   // The two poses of pair `i`, normalised; INVALID_ARGUMENT naming the pair and pose.
@@ -259,19 +140,19 @@ class DistanceStreamReactor final
   // The frame's queries ended with `status`: CANCELLED when the client went away meanwhile,
   // else `status` naming the frame.
   absl::Status Answered(const absl::Status& status) const {
-    if (cancelled_.load()) return absl::CancelledError("client went away mid-frame");
+    if (cancelled().load()) return absl::CancelledError("client went away mid-frame");
     if (status.ok()) return status;
     return absl::Status(status.code(),
-                        absl::StrCat("frame ", frame_.frame(), " ", status.message()));
+                        absl::StrCat("frame ", request().frame(), " ", status.message()));
   }
 
   // A frame of certified pairs (every pair names covers): intervals from core's
   // CertifiedDistances over the objects the store certifies (ResultStore::GetCertifiedObject).
   absl::Status ComputeCertifiedFrame(const DistanceRequest& tolerance, HierarchyVolume volume) {
     if (absl::Status s = CheckCertifiedTolerance(tolerance); !s.ok()) return s;
-    const std::size_t n = static_cast<std::size_t>(frame_.pairs_size());
+    const std::size_t n = static_cast<std::size_t>(request().pairs_size());
     for (std::size_t i = 0; i < n; ++i) {
-      const v1::DistancePair& pair = frame_.pairs(static_cast<int>(i));
+      const v1::DistancePair& pair = request().pairs(static_cast<int>(i));
       if (pair.cover_a().empty()) {
         return InPair(i, absl::InvalidArgumentError(
                              "cover_a, cover_b: a frame's pairs are all certified (covers named) "
@@ -298,22 +179,22 @@ class DistanceStreamReactor final
       }
     }
     absl::StatusOr<std::vector<CertifiedDistanceResult>> results =
-        inscribe::CertifiedDistances(certified_pairs_, tolerance.closer_than, &cancelled_);
+        inscribe::CertifiedDistances(certified_pairs_, tolerance.closer_than, &cancelled());
     if (absl::Status s = Answered(results.status()); !s.ok()) return s;
     wire::AppendCertifiedDistanceResults(*results, std::isfinite(tolerance.closer_than),
-                                         result_.mutable_results());
+                                         reply().mutable_results());
     return absl::OkStatus();
   }
 
   // Whether the frame's pairs name covers (then all must): a certified frame.
   bool certified_frame() const {
-    return frame_.pairs_size() > 0 && !frame_.pairs(0).cover_a().empty();
+    return request().pairs_size() > 0 && !request().pairs(0).cover_a().empty();
   }
 
   // Distance queries the frame asks (a certified pair is two: internal sets and covers): the
-  // unit of cost_.
+  // unit of the stream's cost model.
   std::int64_t FrameQueries() const {
-    return (certified_frame() ? 2 : 1) * static_cast<std::int64_t>(frame_.pairs_size());
+    return (certified_frame() ? 2 : 1) * static_cast<std::int64_t>(request().pairs_size());
   }
 
   // The key of a held object in held_ or certified_: "volume/key", or "volume/internal|cover";
@@ -330,17 +211,17 @@ class DistanceStreamReactor final
     return slot_;
   }
 
-  // Fills pairs_ (certified_pairs_ for a certified frame) with the objects of frame_ that this
+  // Fills pairs_ (certified_pairs_ for a certified frame) with the objects of the frame that this
   // stream already holds, null for the others; true when it holds them all, so that running
   // the frame looks nothing up in the cache. O(pairs) lookups in the stream's own tables.
   bool FindHeld() {
-    const HierarchyVolume volume = wire::VolumeFromProto(frame_.volume());
-    const std::size_t n = static_cast<std::size_t>(frame_.pairs_size());
+    const HierarchyVolume volume = wire::VolumeFromProto(request().volume());
+    const std::size_t n = static_cast<std::size_t>(request().pairs_size());
     bool all = true;
     if (certified_frame()) {
       certified_pairs_.assign(n, CertifiedPair{});
       for (std::size_t i = 0; i < n; ++i) {
-        const v1::DistancePair& pair = frame_.pairs(static_cast<int>(i));
+        const v1::DistancePair& pair = request().pairs(static_cast<int>(i));
         certified_pairs_[i].a = HeldCertified(volume, pair.sphere_set_a(), pair.cover_a());
         certified_pairs_[i].b = HeldCertified(volume, pair.sphere_set_b(), pair.cover_b());
         all = all && certified_pairs_[i].a != nullptr && certified_pairs_[i].b != nullptr;
@@ -349,7 +230,7 @@ class DistanceStreamReactor final
     }
     pairs_.assign(n, PosedPair{});
     for (std::size_t i = 0; i < n; ++i) {
-      const v1::DistancePair& pair = frame_.pairs(static_cast<int>(i));
+      const v1::DistancePair& pair = request().pairs(static_cast<int>(i));
       pairs_[i].a = HeldHierarchy(volume, pair.sphere_set_a());
       pairs_[i].b = HeldHierarchy(volume, pair.sphere_set_b());
       all = all && pairs_[i].a != nullptr && pairs_[i].b != nullptr;
@@ -381,7 +262,7 @@ class DistanceStreamReactor final
                        " distinct sphere sets (per hierarchy volume); open another stream"));
     }
     absl::StatusOr<std::shared_ptr<const CertifiedObjectEntry>> entry =
-        service_->store_->GetCertifiedObject(internal_key, cover_key, volume);
+        service()->store_->GetCertifiedObject(internal_key, cover_key, volume);
     if (!entry.ok()) {
       return absl::Status(entry.status().code(),
                           absl::StrCat(field, ": ", entry.status().message()));
@@ -402,7 +283,7 @@ class DistanceStreamReactor final
                        " distinct sphere sets (per hierarchy volume); open another stream"));
     }
     absl::StatusOr<std::shared_ptr<const SphereHierarchy>> h =
-        service_->store_->GetHierarchy(key, volume);
+        service()->store_->GetHierarchy(key, volume);
     if (!h.ok()) {
       return absl::Status(h.status().code(), absl::StrCat(field, ": ", h.status().message()));
     }
@@ -411,27 +292,15 @@ class DistanceStreamReactor final
     return raw;
   }
 
-  InscribeService* const service_;
-  std::atomic<bool> cancelled_{false};
-
-  std::mutex mutex_;
-  State state_ = State::kStarting;  // guarded by mutex_
-  bool draining_ = false;           // guarded by mutex_
-  absl::Status final_status_;       // set once, by FinishLocked
-
   // Touched by one thread at a time: gRPC callbacks and the frame's job never overlap.
-  v1::DistanceFrame frame_;
-  v1::DistanceFrameResult result_;
   MemoryBudget::Reservation frame_reservation_;  // the current frame's estimate
-  FrameCostModel cost_;                          // this stream's seconds per query
-  // The current frame's queries (FindHeld, then ComputeFrame), kept to reuse their capacity.
+  // The current frame's queries (FindHeld, then Answer), kept to reuse their capacity.
   std::vector<PosedPair> pairs_;
   std::vector<CertifiedPair> certified_pairs_;
   std::string slot_;  // Slot's buffer
   std::unordered_map<std::string, std::shared_ptr<const SphereHierarchy>> held_;
   // Certified pairs' objects by "volume/internal key|cover key".
   std::unordered_map<std::string, std::shared_ptr<const CertifiedObjectEntry>> certified_;
-  CallRecord record_;
 };
 
 grpc::ServerBidiReactor<v1::DistanceFrame, v1::DistanceFrameResult>*

@@ -1,13 +1,14 @@
 // SceneStream against the real server in-process on loopback: every reply checked against
 // core's Scene::ClosePairs on the same scene and against brute force over every pair; errors
 // naming the object, the --max-scene-* limits, a client that cancels or goes away (its scene
-// freed: InscribeServer::open_scenes), and draining.
+// freed: InscribeServer::open_scenes), and draining, idle or in the middle of a message.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <chrono>
 #include <functional>
+#include <limits>
 #include <map>
 #include <random>
 #include <string>
@@ -331,6 +332,7 @@ TEST_F(SceneStreamTest, MaxPairsKeepsTheNearestPairs) {
   }
   SceneQuery query;
   query.threshold = std::numeric_limits<double>::infinity();
+  query.max_pairs = 100;
   query.max_pairs = 4;
   auto context = Context();
   std::unique_ptr<Stream> stream = stub_->SceneStream(context.get());
@@ -526,6 +528,41 @@ TEST_F(SceneStreamTest, ShutdownEndsIdleScenesPromptly) {
   const auto start = std::chrono::steady_clock::now();
   server_->Shutdown(std::chrono::system_clock::now() + std::chrono::seconds(30));
   EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 5.0);
+  EXPECT_FALSE(stream->Read(&reply));
+  EXPECT_EQ(stream->Finish().error_code(), grpc::StatusCode::UNAVAILABLE);
+  EXPECT_EQ(server_->open_scenes(), 0);
+}
+
+// Draining while a message is being answered: its reply is written first, then the stream ends
+// with UNAVAILABLE and its scene is freed.
+TEST_F(SceneStreamTest, ShutdownAnswersTheBusyMessageFirst) {
+  constexpr int kObjects = 400;
+  const std::string key = PutSet(testing::RandomSpheres(2'000, 2));
+  std::mt19937_64 rng(3);
+  std::vector<SceneObject> objects(kObjects);
+  for (int i = 0; i < kObjects; ++i) {
+    objects[i].id = i;
+    objects[i].pose = testing::RandomPose(rng, 1.0);
+  }
+  // Every pair's distance: the message takes well over the 50 ms below.
+  SceneQuery query;
+  query.threshold = std::numeric_limits<double>::infinity();
+  query.max_pairs = 100;
+  const v1::SceneMessage create = Create(objects, std::vector<std::string>(kObjects, key), query);
+
+  auto context = Context(120.0);
+  std::unique_ptr<Stream> stream = stub_->SceneStream(context.get());
+  const auto written = std::chrono::steady_clock::now();
+  ASSERT_TRUE(stream->Write(create));
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  const double drained_after =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - written).count();
+  server_->Shutdown(std::chrono::system_clock::now() + std::chrono::seconds(60));
+  v1::SceneReply reply;
+  ASSERT_TRUE(stream->Read(&reply)) << stream->Finish().error_message();
+  ASSERT_GT(reply.seconds(), drained_after + 0.05) << "the message ended before the drain began";
+  EXPECT_EQ(reply.objects(), kObjects);
+  EXPECT_EQ(reply.close_pairs(), kObjects * (kObjects - 1) / 2);
   EXPECT_FALSE(stream->Read(&reply));
   EXPECT_EQ(stream->Finish().error_code(), grpc::StatusCode::UNAVAILABLE);
   EXPECT_EQ(server_->open_scenes(), 0);

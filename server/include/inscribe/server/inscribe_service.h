@@ -27,6 +27,8 @@ class ResultStore;
 class DistanceStreamReactor;
 class DrainableStream;
 class FrameDispatcher;
+template <typename Request, typename Reply>
+class FrameStreamReactor;
 class SceneStreamReactor;
 class MemoryBudget;
 class MeshSizes;
@@ -208,6 +210,8 @@ class InscribeService final : public v1::Inscribe::CallbackService {
   // authenticate_'s verdict on the call; OK when there is none.
   absl::Status Authenticate(const grpc::CallbackServerContext& context) const;
   friend class GenerateReactor;
+  template <typename Request, typename Reply>
+  friend class FrameStreamReactor;
   friend class DistanceStreamReactor;
   friend class SceneStreamReactor;
 

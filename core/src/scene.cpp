@@ -10,6 +10,11 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "float_rounding.h"
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace inscribe {
 namespace {
@@ -42,9 +47,48 @@ Sphere Enclose(const Sphere& a, const Sphere& b) {
 constexpr double kBroadPhaseSlack = 1e-9;
 static_assert(kBroadPhaseSlack > kCertifiedDistanceMargin);
 
+// The sweep keeps its axis while that spreads the centres at least this fraction of the axis
+// that spreads them most.
+constexpr double kSweepAxisHysteresis = 0.7;
+
+// Boxes the sweep compares at a time (one SSE register of floats).
+constexpr std::size_t kSweepLanes = 4;
+
 // Pairs per parallel chunk of the narrow phase; fewer run on the calling thread (a frame of a
 // few close pairs costs microseconds, less than forking would).
 constexpr std::size_t kNarrowChunk = 16;
+
+// A lower bound on the distance between two oriented boxes (centres c, axes the columns of
+// unit rotations R, half sides h): the largest gap along the separating axes of the boxes' 6
+// faces and of the 9 pairs of their edges (0 or less when no axis separates them). An edge
+// pair's axis is used only when it is far from degenerate (|n| >= 1e-3 for near-parallel
+// edges; the face axes cover those): the gaps then err by a few ulps of the coordinates
+// over |n|, far below the broad phase's slack.
+double OrientedBoxGap(const Vector3& center_a, const Eigen::Matrix3d& axes_a, const Vector3& half_a,
+                      const Vector3& center_b, const Eigen::Matrix3d& axes_b,
+                      const Vector3& half_b) {
+  // b's axes and centre in a's frame.
+  const Eigen::Matrix3d r = axes_a.transpose() * axes_b;
+  const Eigen::Matrix3d abs_r = r.cwiseAbs();
+  const Vector3 t = axes_a.transpose() * (center_b - center_a);
+  double gap = ((t.cwiseAbs() - half_a) - abs_r * half_b).maxCoeff();
+  const Vector3 t_b = r.transpose() * t;
+  gap = std::max(gap, ((t_b.cwiseAbs() - half_b) - abs_r.transpose() * half_a).maxCoeff());
+  for (int i = 0; i < 3; ++i) {
+    const int i1 = (i + 1) % 3, i2 = (i + 2) % 3;
+    for (int j = 0; j < 3; ++j) {
+      const int j1 = (j + 1) % 3, j2 = (j + 2) % 3;
+      // The axis a_i x b_j in a's frame has length sqrt(1 - r_ij^2).
+      const double length_squared = 1.0 - r(i, j) * r(i, j);
+      if (!(length_squared >= 1e-6)) continue;
+      const double distance = std::abs(t[i2] * r(i1, j) - t[i1] * r(i2, j));
+      const double reach = half_a[i1] * abs_r(i2, j) + half_a[i2] * abs_r(i1, j) +
+                           half_b[j1] * abs_r(i, j2) + half_b[j2] * abs_r(i, j1);
+      gap = std::max(gap, (distance - reach) / std::sqrt(length_squared));
+    }
+  }
+  return gap;
+}
 
 absl::Status ObjectError(SceneObjectId id, const absl::Status& status) {
   return absl::Status(status.code(), absl::StrCat("object ", id, ": ", status.message()));
@@ -129,6 +173,9 @@ absl::Status Scene::Remove(SceneObjectId id) {
   absl::erase_if(ignored_, [id](const std::pair<SceneObjectId, SceneObjectId>& key) {
     return key.first == id || key.second == id;
   });
+  absl::erase_if(last_pair_, [id](const auto& entry) {
+    return entry.first.first == id || entry.first.second == id;
+  });
   order_valid_ = false;
   return absl::OkStatus();
 }
@@ -153,9 +200,9 @@ absl::Status Scene::SetPoses(const std::vector<std::pair<SceneObjectId, RigidPos
     Entry& e = objects_[position];
     e.object.pose = pose;
     e.world_center = pose * e.local_center;
-    const Eigen::Matrix3d rotation = pose.rotation.toRotationMatrix();
-    e.box_center = rotation * e.local_box_center + pose.translation;
-    e.half = rotation.cwiseAbs() * e.local_half;
+    e.rotation = pose.rotation.toRotationMatrix();
+    e.box_center = e.rotation * e.local_box_center + pose.translation;
+    e.half = e.rotation.cwiseAbs() * e.local_half;
     e.scale = pose.translation.norm() + std::max(e.local_center.norm() + e.radius,
                                                  e.local_box_center.norm() + e.local_half.norm());
   }
@@ -184,43 +231,103 @@ void Scene::Sweep(double threshold, std::vector<std::pair<std::uint32_t, std::ui
   if (n < 2) return;
   // Sweep along the axis where the centres spread most, so that intervals overlap least.
   Vector3 mean = Vector3::Zero(), square = Vector3::Zero();
+  double largest_scale = 0.0;
   for (const Entry& e : objects_) {
     mean += e.world_center;
     square += e.world_center.cwiseProduct(e.world_center);
+    largest_scale = std::max(largest_scale, e.scale);
   }
   mean /= static_cast<double>(n);
-  Vector3 spread = square / static_cast<double>(n) - mean.cwiseProduct(mean);
+  const Vector3 spread = square / static_cast<double>(n) - mean.cwiseProduct(mean);
   int axis = 0;
   spread.maxCoeff(&axis);
-  const auto low = [this, axis](std::uint32_t i) {
-    return objects_[i].box_center[axis] - objects_[i].half[axis];
-  };
+  // Changing the axis costs a full sort; the last frame's axis is kept while it spreads at
+  // least kSweepAxisHysteresis of the widest (in a cube of objects the three take turns).
+  if (order_valid_ && spread[sweep_axis_] >= kSweepAxisHysteresis * spread[axis]) {
+    axis = sweep_axis_;
+  }
+  lows_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    lows_[i] = objects_[i].box_center[axis] - objects_[i].half[axis];
+  }
+  const double* lows = lows_.data();
   if (!order_valid_ || axis != sweep_axis_) {
     order_.resize(n);
     for (std::size_t i = 0; i < n; ++i) order_[i] = static_cast<std::uint32_t>(i);
     std::sort(order_.begin(), order_.end(),
-              [&](std::uint32_t x, std::uint32_t y) { return low(x) < low(y); });
+              [lows](std::uint32_t x, std::uint32_t y) { return lows[x] < lows[y]; });
     sweep_axis_ = axis;
     order_valid_ = true;
   } else {
     // Objects move little between frames: insertion sort costs one pass plus the swaps.
     for (std::size_t i = 1; i < n; ++i) {
       const std::uint32_t moving = order_[i];
-      const double key = low(moving);
+      const double key = lows[moving];
       std::size_t j = i;
-      for (; j > 0 && low(order_[j - 1]) > key; --j) order_[j] = order_[j - 1];
+      for (; j > 0 && lows[order_[j - 1]] > key; --j) order_[j] = order_[j - 1];
       order_[j] = moving;
     }
   }
-  for (std::size_t k = 0; k < n; ++k) {
+  // The boxes in sweep order, high ends grown by `reach`: the threshold plus the largest
+  // rounding slack of any pair, rounded outward to floats. Boxes whose gap along some axis is
+  // at least `reach` cannot pass the exact test below (the largest gap along an axis against
+  // the threshold plus the pair's own slack), so this filter only skips pairs that test drops.
+  const double reach = threshold + 2.0 * kBroadPhaseSlack * largest_scale + kCertifiedDistanceFloor;
+  for (int d = 0; d < 3; ++d) {
+    // kSweepLanes empty boxes after the last (low +infinity, high -infinity) end every row.
+    sorted_low_[d].assign(n + kSweepLanes, std::numeric_limits<float>::infinity());
+    sorted_high_[d].assign(n + kSweepLanes, -std::numeric_limits<float>::infinity());
+    float* low = sorted_low_[d].data();
+    float* high = sorted_high_[d].data();
+    for (std::size_t k = 0; k < n; ++k) {
+      const Entry& e = objects_[order_[k]];
+      low[k] = internal::LooseRoundDown(e.box_center[d] - e.half[d]);
+      high[k] = internal::LooseRoundUp(e.box_center[d] + e.half[d] + reach);
+    }
+  }
+  const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+  const float *low_s = sorted_low_[axis].data(), *high_s = sorted_high_[axis].data();
+  const float *low_u = sorted_low_[u].data(), *high_u = sorted_high_[u].data();
+  const float *low_v = sorted_low_[v].data(), *high_v = sorted_high_[v].data();
+  survivors_.resize(n);
+  std::uint32_t* survivors = survivors_.data();
+  for (std::size_t k = 0; k + 1 < n; ++k) {
+    // Sorted by low end (rounding down keeps the order: it is monotone): once a later box starts
+    // past this one's grown high end, all later ones do. Of the rest, those whose grown boxes
+    // overlap this one's on the other two axes are kept (and on this axis's other side, which
+    // matters for a negative threshold), kSweepLanes at a time.
+    std::size_t kept = 0;
+#if defined(__SSE2__)
+    const __m128 ks_high = _mm_set1_ps(high_s[k]), ks_low = _mm_set1_ps(low_s[k]);
+    const __m128 ku_high = _mm_set1_ps(high_u[k]), ku_low = _mm_set1_ps(low_u[k]);
+    const __m128 kv_high = _mm_set1_ps(high_v[k]), kv_low = _mm_set1_ps(low_v[k]);
+    for (std::size_t m = k + 1;; m += kSweepLanes) {
+      const __m128 started = _mm_cmplt_ps(_mm_loadu_ps(low_s + m), ks_high);
+      __m128 keep = _mm_and_ps(started, _mm_cmplt_ps(ks_low, _mm_loadu_ps(high_s + m)));
+      keep = _mm_and_ps(keep, _mm_cmplt_ps(_mm_loadu_ps(low_u + m), ku_high));
+      keep = _mm_and_ps(keep, _mm_cmplt_ps(ku_low, _mm_loadu_ps(high_u + m)));
+      keep = _mm_and_ps(keep, _mm_cmplt_ps(_mm_loadu_ps(low_v + m), kv_high));
+      keep = _mm_and_ps(keep, _mm_cmplt_ps(kv_low, _mm_loadu_ps(high_v + m)));
+      for (int bits = _mm_movemask_ps(keep); bits != 0; bits &= bits - 1) {
+        survivors[kept++] = static_cast<std::uint32_t>(
+            m + static_cast<std::size_t>(__builtin_ctz(static_cast<unsigned>(bits))));
+      }
+      if (_mm_movemask_ps(started) != (1 << kSweepLanes) - 1) break;
+    }
+#else
+    for (std::size_t m = k + 1; low_s[m] < high_s[k]; ++m) {
+      survivors[kept] = static_cast<std::uint32_t>(m);
+      kept += static_cast<std::size_t>((low_s[k] < high_s[m]) & (low_u[m] < high_u[k]) &
+                                       (low_u[k] < high_u[m]) & (low_v[m] < high_v[k]) &
+                                       (low_v[k] < high_v[m]));
+    }
+#endif
     const Entry& a = objects_[order_[k]];
-    const double high = a.box_center[axis] + a.half[axis];
-    for (std::size_t m = k + 1; m < n; ++m) {
-      const Entry& b = objects_[order_[m]];
-      const double slack = kBroadPhaseSlack * (a.scale + b.scale) + kCertifiedDistanceFloor;
-      // Sorted by low end: every later object's gap along the axis is at least this one's.
-      if (low(order_[m]) - high >= threshold + slack) break;
+    for (std::size_t q = 0; q < kept; ++q) {
+      const std::uint32_t other = order_[survivors[q]];
+      const Entry& b = objects_[other];
       if ((a.object.group & b.object.mask) == 0 || (b.object.group & a.object.mask) == 0) continue;
+      const double slack = kBroadPhaseSlack * (a.scale + b.scale) + kCertifiedDistanceFloor;
       // Two lower bounds on the distance between the objects' spheres: the boxes' largest gap
       // along an axis, and the bounding spheres' gap.
       const double box_gap =
@@ -228,8 +335,12 @@ void Scene::Sweep(double threshold, std::vector<std::pair<std::uint32_t, std::ui
       if (!(box_gap < threshold + slack)) continue;
       const double gap = (a.world_center - b.world_center).norm() - a.radius - b.radius;
       if (!(gap < threshold + slack)) continue;
+      if (!(OrientedBoxGap(a.box_center, a.rotation, a.local_half, b.box_center, b.rotation,
+                           b.local_half) < threshold + slack)) {
+        continue;
+      }
       if (!ignored_.empty() && ignored_.count(PairKey(a.object.id, b.object.id)) != 0) continue;
-      out->emplace_back(order_[k], order_[m]);
+      out->emplace_back(order_[k], other);
     }
   }
 }
@@ -253,6 +364,7 @@ absl::StatusOr<SceneFrame> Scene::ClosePairs(const SceneQuery& query,
   plain.rel_err = query.rel_err;
   plain.max_distance = query.threshold;
   if (query.stop_at_first && std::isfinite(query.threshold)) plain.closer_than = query.threshold;
+  const bool try_last_pair = std::isfinite(plain.closer_than) && !last_pair_.empty();
 
   // One candidate: the smaller id is a. A plain pair's distance is pruned at the threshold; a
   // certified pair's covers at the threshold plus the margin (lower < threshold needs no
@@ -268,6 +380,20 @@ absl::StatusOr<SceneFrame> Scene::ClosePairs(const SceneQuery& query,
     const RigidPose& pose_a = a->object.pose;
     const RigidPose& pose_b = b->object.pose;
     if (!(a->object.certified() && b->object.certified())) {
+      if (try_last_pair) {
+        const auto hint = last_pair_.find(std::make_pair(out.a, out.b));
+        if (hint != last_pair_.end()) {
+          absl::StatusOr<DistanceResult> r =
+              SpherePairDistance(a->object.spheres->spheres(), pose_a, b->object.spheres->spheres(),
+                                 pose_b, hint->second.first, hint->second.second);
+          if (r.ok() && r->distance < plain.closer_than) {
+            out.result = *std::move(r);
+            out.result.closer = true;
+            rank[c] = out.result.distance;
+            return;
+          }
+        }
+      }
       absl::StatusOr<DistanceResult> r =
           SeparationDistance(*a->object.spheres, pose_a, *b->object.spheres, pose_b, plain);
       if (!r.ok()) {
@@ -348,7 +474,15 @@ absl::StatusOr<SceneFrame> Scene::ClosePairs(const SceneQuery& query,
     close.resize(query.max_pairs);
   }
   frame.pairs.reserve(close.size());
-  for (const std::size_t c : close) frame.pairs.push_back(std::move(answers[c]));
+  last_pair_.clear();
+  for (const std::size_t c : close) {
+    const ScenePair& pair = answers[c];
+    if (!pair.certified && pair.result.sphere_a >= 0) {
+      last_pair_.emplace(std::make_pair(pair.a, pair.b),
+                         std::make_pair(pair.result.sphere_a, pair.result.sphere_b));
+    }
+    frame.pairs.push_back(std::move(answers[c]));
+  }
   std::sort(frame.pairs.begin(), frame.pairs.end(), [](const ScenePair& x, const ScenePair& y) {
     return std::make_pair(x.a, x.b) < std::make_pair(y.a, y.b);
   });

@@ -287,6 +287,32 @@ absl::StatusOr<std::vector<DistanceResult>> PairSeparationDistances(
   return out;
 }
 
+absl::StatusOr<DistanceResult> SpherePairDistance(const std::vector<Sphere>& a,
+                                                  const RigidPose& pose_a,
+                                                  const std::vector<Sphere>& b,
+                                                  const RigidPose& pose_b, std::int32_t i,
+                                                  std::int32_t j) {
+  if (i < 0 || static_cast<std::size_t>(i) >= a.size() || j < 0 ||
+      static_cast<std::size_t>(j) >= b.size()) {
+    return absl::InvalidArgumentError(absl::StrCat("sphere pair (", i, ", ", j,
+                                                   ") is outside sets of ", a.size(), " and ",
+                                                   b.size(), " spheres"));
+  }
+  if (absl::Status s = CheckPose(pose_a); !s.ok()) return s;
+  if (absl::Status s = CheckPose(pose_b); !s.ok()) return s;
+  const Relative relative = RelativePose(pose_a, pose_b);
+  const Sphere& s = a[static_cast<std::size_t>(i)];
+  const Sphere& t = b[static_cast<std::size_t>(j)];
+  const Vector3 moved = relative.rotation * t.center + relative.translation;
+  DistanceResult out;
+  out.distance = (s.center - moved).norm() - s.radius - t.radius;
+  out.sphere_a = i;
+  out.sphere_b = j;
+  out.sphere_tests = 1;
+  AddWitnesses(a, b, pose_a, relative, &out);
+  return out;
+}
+
 absl::StatusOr<DistanceResult> BruteForceSeparationDistance(const std::vector<Sphere>& a,
                                                             const RigidPose& pose_a,
                                                             const std::vector<Sphere>& b,

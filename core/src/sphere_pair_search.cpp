@@ -6,6 +6,8 @@
 #include <limits>
 #include <vector>
 
+#include "float_rounding.h"
+
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
@@ -114,13 +116,6 @@ struct Scratch {
   }
 };
 
-// Nearest float above or at v (v finite, within float's range).
-float FloatAtLeast(double v) {
-  float f = static_cast<float>(v);
-  if (static_cast<double>(f) < v) f = std::nextafter(f, std::numeric_limits<float>::infinity());
-  return f;
-}
-
 class FloatSearch {
  public:
   FloatSearch(const SphereHierarchy& a, const SphereHierarchy& b, const RelativeFrame& relative,
@@ -132,7 +127,7 @@ class FloatSearch {
         yes_no_(std::isfinite(request.closer_than)),
         threshold_(std::min(request.closer_than, request.max_distance)),
         scale_(scale),
-        margin_(FloatAtLeast(margin)),
+        margin_(RoundUp(margin)),
         s_(scratch) {
     s_.Begin(b.ordered_spheres().size() + SphereHierarchy::kFloatPadding, b.num_nodes());
     UpdateFloatReach();

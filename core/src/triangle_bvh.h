@@ -8,6 +8,7 @@
 #include <limits>
 #include <vector>
 
+#include "float_rounding.h"
 #include "inscribe/boundary_oracle.h"
 #include "inscribe/mesh.h"
 
@@ -140,28 +141,6 @@ class TriangleBvh {
   std::vector<TriangleBvhSlotBox> slot_boxes_;  // #T
   double magnitude_ = 0.0;
 };
-
-// The float next to f toward -infinity / +infinity (f not NaN). Inline bit arithmetic:
-// std::nextafter is a library call, and refitting rounds every box bound.
-inline float NextFloatDown(float f) {
-  if (f == 0.0f) return -std::numeric_limits<float>::denorm_min();
-  std::uint32_t bits;
-  std::memcpy(&bits, &f, sizeof(bits));
-  bits = f > 0.0f ? bits - 1 : bits + 1;
-  std::memcpy(&f, &bits, sizeof(bits));
-  return f;
-}
-inline float NextFloatUp(float f) { return -NextFloatDown(-f); }
-
-// x rounded to a float toward -infinity / +infinity: float boxes that contain double points.
-inline float RoundDown(double x) {
-  const auto f = static_cast<float>(x);
-  return static_cast<double>(f) > x ? NextFloatDown(f) : f;
-}
-inline float RoundUp(double x) {
-  const auto f = static_cast<float>(x);
-  return static_cast<double>(f) < x ? NextFloatUp(f) : f;
-}
 
 // True when the ray origin + t direction, t > 0, crosses triangle (a, b, c): Moeller-Trumbore
 // in double precision, boundary of the triangle included, rays in its plane never crossing.

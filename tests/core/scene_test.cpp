@@ -249,6 +249,137 @@ TEST(Scene, BroadPhasePrunesFarPairs) {
   }
 }
 
+// Spheres of radius r along a line (a rod) or over a square (a plate), centred at the origin:
+// sets whose boxes are thin, so that the oriented-box test decides many pairs.
+std::vector<Sphere> Rod(double length, double r) {
+  std::vector<Sphere> out;
+  for (double x = -0.5 * length; x <= 0.5 * length + 1e-12; x += r) {
+    out.push_back(Sphere{Vector3(x, 0.0, 0.0), r});
+  }
+  return out;
+}
+std::vector<Sphere> Plate(double side, double r) {
+  std::vector<Sphere> out;
+  for (double x = -0.5 * side; x <= 0.5 * side + 1e-12; x += 2.0 * r) {
+    for (double y = -0.5 * side; y <= 0.5 * side + 1e-12; y += 2.0 * r) {
+      out.push_back(Sphere{Vector3(x, y, 0.0), r});
+    }
+  }
+  return out;
+}
+
+// Rods and plates packed densely, turned at random and by quarter turns (parallel edges, the
+// degenerate axes of the oriented-box test), each frame nudged by tiny moves so that many
+// pairs graze: the broad phase never drops a pair the brute force finds.
+TEST(Scene, ThinObjectsGrazingEqualBruteForce) {
+  const std::vector<std::shared_ptr<const SphereHierarchy>> shapes = {
+      Hierarchy(Rod(1.0, 0.02), HierarchyVolume::kRss),
+      Hierarchy(Rod(0.6, 0.05), HierarchyVolume::kSphere),
+      Hierarchy(Plate(0.8, 0.03), HierarchyVolume::kRss)};
+  std::mt19937_64 rng(71);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const auto quarter_turns = [&rng]() {
+    const Eigen::Vector3d axis = Eigen::Vector3d::Unit(static_cast<int>(rng() % 3));
+    return Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 2 * static_cast<double>(rng() % 4), axis));
+  };
+  Scene scene;
+  std::map<SceneObjectId, SceneObject> objects;
+  for (SceneObjectId id = 0; id < 60; ++id) {
+    SceneObject o;
+    o.id = id;
+    o.spheres = shapes[id % shapes.size()];
+    o.pose = PoseNear(rng, Vector3(unit(rng), unit(rng), unit(rng)) * 1.6, 0.0);
+    if (id % 2 == 0) o.pose.rotation = quarter_turns();
+    ASSERT_TRUE(scene.Add(o).ok());
+    objects[id] = o;
+  }
+  std::int64_t candidates = 0, close = 0;
+  for (int frame = 0; frame < 40; ++frame) {
+    std::vector<std::pair<SceneObjectId, RigidPose>> moves;
+    for (auto& [id, o] : objects) {
+      o.pose.translation += Vector3(unit(rng) - 0.5, unit(rng) - 0.5, unit(rng) - 0.5) * 0.02;
+      if (frame % 8 == 7)
+        o.pose.rotation = id % 2 == 0 ? quarter_turns() : RandomPose(rng, 0).rotation;
+      moves.emplace_back(id, o.pose);
+    }
+    ASSERT_TRUE(scene.SetPoses(moves).ok());
+    for (const double threshold : {-0.01, 0.0, 0.003, 0.05}) {
+      SceneQuery query;
+      query.threshold = threshold;
+      absl::StatusOr<SceneFrame> got = scene.ClosePairs(query);
+      ASSERT_TRUE(got.ok()) << got.status();
+      ExpectEqual(*got, BruteForce(objects, {}, threshold),
+                  "frame " + std::to_string(frame) + " threshold " + std::to_string(threshold));
+      candidates += got->candidate_pairs;
+      close += got->close_pairs;
+    }
+  }
+  EXPECT_GT(close, 400);
+  EXPECT_GE(candidates, close);
+}
+
+// stop_at_first over frames of small moves, with objects removed and re-added under the same
+// id with another set (a remembered sphere pair may then be out of range or stale): every
+// frame reports the brute force's pairs, each with the exact value of the sphere pair it
+// names, below the threshold.
+TEST(Scene, StopAtFirstAcrossFramesEqualsBruteForce) {
+  const std::vector<std::shared_ptr<const SphereHierarchy>> shapes = {
+      Hierarchy(RandomSpheres(200, 21), HierarchyVolume::kRss),
+      Hierarchy(RandomSpheres(12, 22), HierarchyVolume::kSphere),
+      Hierarchy(Rod(1.2, 0.04), HierarchyVolume::kRss)};
+  std::mt19937_64 rng(73);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  Scene scene;
+  std::map<SceneObjectId, SceneObject> objects;
+  for (SceneObjectId id = 0; id < 40; ++id) {
+    SceneObject o;
+    o.id = id;
+    o.spheres = shapes[id % shapes.size()];
+    o.pose = PoseNear(rng, Vector3(unit(rng), unit(rng), unit(rng)) * 2.5, 0.0);
+    ASSERT_TRUE(scene.Add(o).ok());
+    objects[id] = o;
+  }
+  for (int frame = 0; frame < 60; ++frame) {
+    std::vector<std::pair<SceneObjectId, RigidPose>> moves;
+    for (auto& [id, o] : objects) {
+      o.pose = PoseNear(rng, o.pose.translation, 0.03);
+      moves.emplace_back(id, o.pose);
+    }
+    ASSERT_TRUE(scene.SetPoses(moves).ok());
+    if (frame % 10 == 9) {
+      // The same id back with another set.
+      const SceneObjectId id = rng() % objects.size();
+      ASSERT_TRUE(scene.Remove(id).ok());
+      SceneObject& o = objects[id];
+      o.spheres = shapes[(id + 1 + rng() % 2) % shapes.size()];
+      ASSERT_TRUE(scene.Add(o).ok());
+    }
+    const double threshold = frame % 3 == 0 ? 0.0 : 0.02;
+    SceneQuery query;
+    query.threshold = threshold;
+    query.stop_at_first = true;
+    absl::StatusOr<SceneFrame> got = scene.ClosePairs(query);
+    ASSERT_TRUE(got.ok()) << got.status();
+    const Reference expected = BruteForce(objects, {}, threshold);
+    ASSERT_EQ(got->pairs.size(), expected.close.size()) << "frame " << frame;
+    ASSERT_GT(got->pairs.size(), 5u);
+    for (const ScenePair& p : got->pairs) {
+      const auto it = expected.close.find({p.a, p.b});
+      ASSERT_NE(it, expected.close.end()) << "frame " << frame;
+      const SceneObject& a = objects[p.a];
+      const SceneObject& b = objects[p.b];
+      absl::StatusOr<DistanceResult> named =
+          SpherePairDistance(a.spheres->spheres(), a.pose, b.spheres->spheres(), b.pose,
+                             p.result.sphere_a, p.result.sphere_b);
+      ASSERT_TRUE(named.ok()) << named.status();
+      EXPECT_EQ(p.result.distance, named->distance) << "frame " << frame;
+      EXPECT_LT(p.result.distance, threshold);
+      EXPECT_GE(p.result.distance, it->second.distance - 1e-12);
+      EXPECT_TRUE(p.result.closer);
+    }
+  }
+}
+
 // stop_at_first reports the same pairs as the full query, each with a real sphere pair's value
 // below the threshold (not always the minimum), for less work.
 TEST(Scene, StopAtFirstReportsTheSamePairs) {

@@ -7,9 +7,10 @@
 // group meets the other's mask, and it is not on the ignore list (a robot's adjacent links).
 // The broad phase sweeps the objects' world boxes (each object's box in its own frame, turned
 // with it), sorted along one axis and kept sorted between frames (few swaps when objects move a
-// little), and keeps a pair when both its boxes and its bounding spheres are within the
-// threshold, so a frame costs about O(n + k) for n objects and k candidate pairs; the narrow phase
-// then runs a pruned distance query per candidate (DistanceRequest::max_distance = the threshold).
+// little), and keeps a pair when its world boxes, its bounding spheres and its oriented boxes
+// are all within the threshold, so a frame costs about O(n + s) for n objects and s pairs
+// overlapping along the sweep axis; the narrow phase then runs a pruned distance query per
+// candidate (DistanceRequest::max_distance = the threshold).
 #pragma once
 
 #include <atomic>
@@ -72,7 +73,9 @@ struct SceneQuery {
   // Only whether each pair is closer than the threshold (collision checking): a plain pair's
   // search stops at the first sphere pair below it (DistanceRequest::closer_than), so
   // result.distance is that pair's value, below the threshold but not always the minimum.
-  // The same pairs are reported; certified pairs are answered in full either way.
+  // A pair reported in the scene's last frame is first tried through the sphere pair it was
+  // reported with, so which sphere pair answers may depend on earlier frames. The same pairs
+  // are reported; certified pairs are answered in full either way.
   bool stop_at_first = false;
   // Answer the candidates on TBB's threads when there are more than a few (true), or all on
   // the calling thread (false: a server answering a small frame on its own thread).
@@ -146,9 +149,11 @@ class Scene {
     double radius = 0.0;
     Vector3 world_center = Vector3::Zero();
     // The box around the same spheres: in the object's frame (centre, half sides), and the
-    // world-axis box around it at its pose (centre, half sides |R| h).
+    // world-axis box around it at its pose (centre, half sides |R| h). The local box at the
+    // pose is an oriented box: centre box_center, axes the columns of `rotation`.
     Vector3 local_box_center = Vector3::Zero(), local_half = Vector3::Zero();
     Vector3 box_center = Vector3::Zero(), half = Vector3::Zero();
+    Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
     // |translation| + |local_center| + radius: the coordinate scale of the broad phase's
     // rounding slack.
     double scale = 0.0;
@@ -169,6 +174,18 @@ class Scene {
   std::vector<std::uint32_t> order_;
   int sweep_axis_ = 0;
   bool order_valid_ = false;
+  // Sweep's scratch, kept between frames: the low ends along the sweep axis by position, and
+  // the world boxes in sweep order (low ends, and high ends grown by the threshold and slack,
+  // rounded outward to floats), one dense array per end and axis, padded by empty boxes.
+  std::vector<double> lows_;
+  std::vector<float> sorted_low_[3], sorted_high_[3];
+  std::vector<std::uint32_t> survivors_;
+  // The sphere pair each plain pair was last reported with (PairKey order: the smaller id's
+  // sphere first). A stop_at_first query tries it before searching: objects move little
+  // between frames, so a pair in contact is most often still in contact through it.
+  absl::flat_hash_map<std::pair<SceneObjectId, SceneObjectId>,
+                      std::pair<std::int32_t, std::int32_t>>
+      last_pair_;
 };
 
 }  // namespace inscribe

@@ -82,6 +82,16 @@ absl::StatusOr<std::vector<DistanceResult>> PairSeparationDistances(
     const std::vector<PosedPair>& pairs, const DistanceRequest& request = {},
     const std::atomic<bool>* cancel = nullptr);
 
+// The value of one sphere pair, a[i] against b[j], posed: the expression
+// BruteForceSeparationDistance evaluates for that pair, bit for bit, with its witnesses
+// (`closer` stays false). For callers that remember a pair between frames. INVALID_ARGUMENT
+// for an index out of range or a bad pose.
+absl::StatusOr<DistanceResult> SpherePairDistance(const std::vector<Sphere>& a,
+                                                  const RigidPose& pose_a,
+                                                  const std::vector<Sphere>& b,
+                                                  const RigidPose& pose_b, std::int32_t i,
+                                                  std::int32_t j);
+
 // The same answer by comparing every sphere pair: O(#a #b), the reference the hierarchies are
 // tested against, and the `--hierarchy none` of the CLI. Tolerances are ignored (exact);
 // closer_than and max_distance are honoured.

@@ -441,8 +441,8 @@ Timing RunFcl(const Motion& motion, const std::vector<Model>& models, const Opti
 }
 
 // The same scene over the service: one SceneSession (SceneStream) to an inscribed on loopback,
-// every frame sending every pose; each reply is checked against core's Scene on the same frame
-// (every K-th frame) and must be identical.
+// every frame sending every pose; each reply is checked against core's Scene fed the same
+// frames (every K-th frame) and must be identical.
 Timing RunService(const client::Client& client, const Motion& motion,
                   const std::vector<Model>& models, bool certified, double threshold,
                   bool stop_at_first, const Options& options, int frames, int* failures) {
@@ -484,10 +484,11 @@ Timing RunService(const client::Client& client, const Motion& motion,
     }
     candidates += static_cast<double>(reply->candidate_pairs);
     close += static_cast<double>(reply->close_pairs);
+    // Every frame, untimed: a stop_at_first answer may depend on the scene's earlier frames.
+    absl::StatusOr<SceneFrame> want = local.SetPoses(moves).ok()
+                                          ? local.ClosePairs(session_options.query)
+                                          : absl::InternalError("poses");
     if (f % options.check_every != 0) continue;
-    SceneQuery query = session_options.query;
-    absl::StatusOr<SceneFrame> want =
-        local.SetPoses(moves).ok() ? local.ClosePairs(query) : absl::InternalError("poses");
     bool same = want.ok() && want->pairs.size() == reply->pairs.size();
     for (std::size_t k = 0; same && k < want->pairs.size(); ++k) {
       const ScenePair& x = want->pairs[k];

@@ -4,6 +4,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <tuple>
@@ -57,6 +58,11 @@ constexpr std::size_t kSweepLanes = 4;
 // Pairs per parallel chunk of the narrow phase; fewer run on the calling thread (a frame of a
 // few close pairs costs microseconds, less than forking would).
 constexpr std::size_t kNarrowChunk = 16;
+
+// The narrow phase runs on TBB's threads (SceneQuery::parallel) when the last frame's took at
+// least this long on one thread. Measured with scene_bench on 2 cores: forking made 64- and
+// 256-object frames of 25-75 us slower, and frames of 150 us or more faster.
+constexpr double kForkNarrowSeconds = 100e-6;
 
 // A lower bound on the distance between two oriented boxes (centres c, axes the columns of
 // unit rotations R, half sides h): the largest gap along the separating axes of the boxes' 6
@@ -199,8 +205,8 @@ absl::Status Scene::SetPoses(const std::vector<std::pair<SceneObjectId, RigidPos
   for (const auto& [position, pose] : checked) {
     Entry& e = objects_[position];
     e.object.pose = pose;
-    e.world_center = pose * e.local_center;
     e.rotation = pose.rotation.toRotationMatrix();
+    e.world_center = e.rotation * e.local_center + pose.translation;
     e.box_center = e.rotation * e.local_box_center + pose.translation;
     e.half = e.rotation.cwiseAbs() * e.local_half;
     e.scale = pose.translation.norm() + std::max(e.local_center.norm() + e.radius,
@@ -225,8 +231,7 @@ absl::Status Scene::Ignore(SceneObjectId a, SceneObjectId b) {
   return absl::OkStatus();
 }
 
-void Scene::Sweep(double threshold, std::vector<std::pair<std::uint32_t, std::uint32_t>>* out) {
-  out->clear();
+void Scene::PrepareSweep(double threshold) {
   const std::size_t n = objects_.size();
   if (n < 2) return;
   // Sweep along the axis where the centres spread most, so that intervals overlap least.
@@ -285,13 +290,18 @@ void Scene::Sweep(double threshold, std::vector<std::pair<std::uint32_t, std::ui
       high[k] = internal::LooseRoundUp(e.box_center[d] + e.half[d] + reach);
     }
   }
-  const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+}
+
+void Scene::SweepRows(std::size_t begin, std::size_t end, double threshold,
+                      std::vector<std::pair<std::uint32_t, std::uint32_t>>* out) const {
+  const std::size_t n = objects_.size();
+  const int axis = sweep_axis_, u = (axis + 1) % 3, v = (axis + 2) % 3;
   const float *low_s = sorted_low_[axis].data(), *high_s = sorted_high_[axis].data();
   const float *low_u = sorted_low_[u].data(), *high_u = sorted_high_[u].data();
   const float *low_v = sorted_low_[v].data(), *high_v = sorted_high_[v].data();
-  survivors_.resize(n);
-  std::uint32_t* survivors = survivors_.data();
-  for (std::size_t k = 0; k + 1 < n; ++k) {
+  std::vector<std::uint32_t> kept_rows(n);
+  std::uint32_t* survivors = kept_rows.data();
+  for (std::size_t k = begin; k < end && k + 1 < n; ++k) {
     // Sorted by low end (rounding down keeps the order: it is monotone): once a later box starts
     // past this one's grown high end, all later ones do. Of the rest, those whose grown boxes
     // overlap this one's on the other two axes are kept (and on this axis's other side, which
@@ -349,7 +359,8 @@ absl::StatusOr<SceneFrame> Scene::ClosePairs(const SceneQuery& query,
                                              const std::atomic<bool>* cancel) {
   if (absl::Status s = CheckSceneQuery(query); !s.ok()) return s;
   std::vector<std::pair<std::uint32_t, std::uint32_t>> candidates;
-  Sweep(query.threshold, &candidates);
+  PrepareSweep(query.threshold);
+  SweepRows(0, objects_.size(), query.threshold, &candidates);
 
   SceneFrame frame;
   frame.candidate_pairs = static_cast<std::int64_t>(candidates.size());
@@ -438,11 +449,23 @@ absl::StatusOr<SceneFrame> Scene::ClosePairs(const SceneQuery& query,
     out.result = std::move(interval.cover);
   };
   const auto cancelled = [cancel] { return cancel != nullptr && cancel->load(); };
+  // Each chunk adds its thread time to `work`: the narrow phase's cost on one thread, however
+  // many ran it.
+  std::atomic<std::int64_t> work_ns{0};
   const auto run = [&](std::size_t begin, std::size_t end) {
     if (cancelled()) return;
+    const auto start = std::chrono::steady_clock::now();
     for (std::size_t c = begin; c < end; ++c) answer(c);
+    work_ns += std::chrono::duration_cast<std::chrono::nanoseconds>(
+                   std::chrono::steady_clock::now() - start)
+                   .count();
   };
-  if (candidates.size() <= kNarrowChunk || !query.parallel) {
+  // Forking pays when the work is large: the other thread wakes, and reads poses and boxes
+  // this thread has just written, from its own cache. The last frame's work decides (the
+  // first frame's, the candidates' count).
+  const bool fork = query.parallel && candidates.size() > kNarrowChunk &&
+                    (last_narrow_seconds_ < 0.0 || last_narrow_seconds_ >= kForkNarrowSeconds);
+  if (!fork) {
     for (std::size_t begin = 0; begin < candidates.size(); begin += kNarrowChunk) {
       run(begin, std::min(candidates.size(), begin + kNarrowChunk));
     }
@@ -451,6 +474,7 @@ absl::StatusOr<SceneFrame> Scene::ClosePairs(const SceneQuery& query,
                       [&](const tbb::blocked_range<std::size_t>& r) { run(r.begin(), r.end()); });
   }
   if (cancelled()) return absl::CancelledError("scene frame cancelled");
+  last_narrow_seconds_ = 1e-9 * static_cast<double>(work_ns.load());
   for (std::size_t c = 0; c < candidates.size(); ++c) {
     if (!errors[c].ok()) {
       return absl::Status(errors[c].code(), absl::StrCat("pair (", answers[c].a, ", ", answers[c].b,

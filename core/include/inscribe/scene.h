@@ -162,8 +162,13 @@ class Scene {
   static std::pair<SceneObjectId, SceneObjectId> PairKey(SceneObjectId a, SceneObjectId b) {
     return a < b ? std::make_pair(a, b) : std::make_pair(b, a);
   }
-  // The pairs the broad phase keeps, as positions in objects_.
-  void Sweep(double threshold, std::vector<std::pair<std::uint32_t, std::uint32_t>>* out);
+  // The broad phase, in two steps. PrepareSweep orders the objects along the sweep axis and
+  // lays out their boxes (scratch below); SweepRows then appends the pairs it keeps whose first
+  // object is at rows [begin, end) of that order, as positions in objects_. SweepRows only
+  // reads.
+  void PrepareSweep(double threshold);
+  void SweepRows(std::size_t begin, std::size_t end, double threshold,
+                 std::vector<std::pair<std::uint32_t, std::uint32_t>>* out) const;
 
   std::vector<Entry> objects_;                             // dense; Remove moves the last in
   absl::flat_hash_map<SceneObjectId, std::size_t> index_;  // id -> position in objects_
@@ -179,7 +184,9 @@ class Scene {
   // rounded outward to floats), one dense array per end and axis, padded by empty boxes.
   std::vector<double> lows_;
   std::vector<float> sorted_low_[3], sorted_high_[3];
-  std::vector<std::uint32_t> survivors_;
+  // The last frame's narrow phase on one thread (seconds; -1 before the first): whether the
+  // next is worth forking.
+  double last_narrow_seconds_ = -1.0;
   // The sphere pair each plain pair was last reported with (PairKey order: the smaller id's
   // sphere first). A stop_at_first query tries it before searching: objects move little
   // between frames, so a pair in contact is most often still in contact through it.

@@ -268,6 +268,24 @@ std::vector<Sphere> Plate(double side, double r) {
   return out;
 }
 
+// Objects 0..count-1 of the shapes in turn, at random poses in a cube of side `box`, added to
+// `scene`; returned by id.
+std::map<SceneObjectId, SceneObject> AddObjects(
+    const std::vector<std::shared_ptr<const SphereHierarchy>>& shapes, SceneObjectId count,
+    double box, std::mt19937_64& rng, Scene* scene) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::map<SceneObjectId, SceneObject> objects;
+  for (SceneObjectId id = 0; id < count; ++id) {
+    SceneObject o;
+    o.id = id;
+    o.spheres = shapes[id % shapes.size()];
+    o.pose = PoseNear(rng, Vector3(unit(rng), unit(rng), unit(rng)) * box, 0.0);
+    EXPECT_TRUE(scene->Add(o).ok());
+    objects[id] = o;
+  }
+  return objects;
+}
+
 // Rods and plates packed densely, turned at random and by quarter turns (parallel edges, the
 // degenerate axes of the oriented-box test), each frame nudged by tiny moves so that many
 // pairs graze: the broad phase never drops a pair the brute force finds.
@@ -283,15 +301,9 @@ TEST(Scene, ThinObjectsGrazingEqualBruteForce) {
     return Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 2 * static_cast<double>(rng() % 4), axis));
   };
   Scene scene;
-  std::map<SceneObjectId, SceneObject> objects;
-  for (SceneObjectId id = 0; id < 60; ++id) {
-    SceneObject o;
-    o.id = id;
-    o.spheres = shapes[id % shapes.size()];
-    o.pose = PoseNear(rng, Vector3(unit(rng), unit(rng), unit(rng)) * 1.6, 0.0);
+  std::map<SceneObjectId, SceneObject> objects = AddObjects(shapes, 60, 1.6, rng, &scene);
+  for (auto& [id, o] : objects) {
     if (id % 2 == 0) o.pose.rotation = quarter_turns();
-    ASSERT_TRUE(scene.Add(o).ok());
-    objects[id] = o;
   }
   std::int64_t candidates = 0, close = 0;
   for (int frame = 0; frame < 40; ++frame) {
@@ -328,17 +340,8 @@ TEST(Scene, StopAtFirstAcrossFramesEqualsBruteForce) {
       Hierarchy(RandomSpheres(12, 22), HierarchyVolume::kSphere),
       Hierarchy(Rod(1.2, 0.04), HierarchyVolume::kRss)};
   std::mt19937_64 rng(73);
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
   Scene scene;
-  std::map<SceneObjectId, SceneObject> objects;
-  for (SceneObjectId id = 0; id < 40; ++id) {
-    SceneObject o;
-    o.id = id;
-    o.spheres = shapes[id % shapes.size()];
-    o.pose = PoseNear(rng, Vector3(unit(rng), unit(rng), unit(rng)) * 2.5, 0.0);
-    ASSERT_TRUE(scene.Add(o).ok());
-    objects[id] = o;
-  }
+  std::map<SceneObjectId, SceneObject> objects = AddObjects(shapes, 40, 2.5, rng, &scene);
   for (int frame = 0; frame < 60; ++frame) {
     std::vector<std::pair<SceneObjectId, RigidPose>> moves;
     for (auto& [id, o] : objects) {

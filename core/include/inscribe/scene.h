@@ -77,8 +77,9 @@ struct SceneQuery {
   // reported with, so which sphere pair answers may depend on earlier frames. The same pairs
   // are reported; certified pairs are answered in full either way.
   bool stop_at_first = false;
-  // Answer the candidates on TBB's threads when there are more than a few (true), or all on
-  // the calling thread (false: a server answering a small frame on its own thread).
+  // Answer the candidates on TBB's threads when the frame is worth it (true: more than a few
+  // candidates, and the scene's last frame took 100 us or more of narrow phase), or all on the
+  // calling thread (false: a server answering a small frame on its own thread).
   bool parallel = true;
   // At most this many pairs are returned: the nearest ones (by distance, or by the covers'
   // distance for certified pairs), with SceneFrame::truncated set when more were close.
@@ -132,10 +133,9 @@ class Scene {
   bool contains(SceneObjectId id) const { return index_.count(id) != 0; }
 
   // Every considered pair closer than query.threshold. Pairs are answered in parallel (TBB)
-  // when there are many and query.parallel, polling `cancel` (may be null): CANCELLED once it
-  // is set. Errors:
-  // CheckSceneQuery's; INVALID_ARGUMENT for a certified pair whose coordinates are beyond
-  // kCertifiedDistanceMaxScale.
+  // when query.parallel and the frame is worth it (SceneQuery::parallel), polling `cancel` (may be
+  // null): CANCELLED once it is set. Errors: CheckSceneQuery's; INVALID_ARGUMENT for a certified
+  // pair whose coordinates are beyond kCertifiedDistanceMaxScale.
   absl::StatusOr<SceneFrame> ClosePairs(const SceneQuery& query,
                                         const std::atomic<bool>* cancel = nullptr);
 

@@ -64,36 +64,45 @@ constexpr std::size_t kNarrowChunk = 16;
 // 256-object frames of 25-75 us slower, and frames of 150 us or more faster.
 constexpr double kForkNarrowSeconds = 100e-6;
 
-// A lower bound on the distance between two oriented boxes (centres c, axes the columns of
-// unit rotations R, half sides h): the largest gap along the separating axes of the boxes' 6
-// faces and of the 9 pairs of their edges (0 or less when no axis separates them). An edge
-// pair's axis is used only when it is far from degenerate (|n| >= 1e-3 for near-parallel
-// edges; the face axes cover those): the gaps then err by a few ulps of the coordinates
-// over |n|, far below the broad phase's slack.
-double OrientedBoxGap(const Vector3& center_a, const Eigen::Matrix3d& axes_a, const Vector3& half_a,
-                      const Vector3& center_b, const Eigen::Matrix3d& axes_b,
-                      const Vector3& half_b) {
+// True when two oriented boxes (centres c, axes the columns of unit rotations R, half sides h)
+// are at least `reach` apart along one of their separating axes: the boxes' 6 face normals and
+// the 9 cross products of their edges, each gap a lower bound on the boxes' distance. The
+// face axes are tried first and the test stops at the first axis that separates. An edge
+// pair's axis is used only when far from degenerate (|n| >= 1e-3; near-parallel edges are
+// covered by the face axes): the gaps then err by a few ulps of the coordinates over |n|, far
+// below the broad phase's slack.
+bool OrientedBoxesApart(const Vector3& center_a, const Eigen::Matrix3d& axes_a,
+                        const Vector3& half_a, const Vector3& center_b,
+                        const Eigen::Matrix3d& axes_b, const Vector3& half_b, double reach) {
   // b's axes and centre in a's frame.
   const Eigen::Matrix3d r = axes_a.transpose() * axes_b;
   const Eigen::Matrix3d abs_r = r.cwiseAbs();
   const Vector3 t = axes_a.transpose() * (center_b - center_a);
-  double gap = ((t.cwiseAbs() - half_a) - abs_r * half_b).maxCoeff();
+  for (int i = 0; i < 3; ++i) {
+    if (std::abs(t[i]) - half_a[i] - abs_r.row(i).dot(half_b) >= reach) return true;
+  }
   const Vector3 t_b = r.transpose() * t;
-  gap = std::max(gap, ((t_b.cwiseAbs() - half_b) - abs_r.transpose() * half_a).maxCoeff());
+  for (int j = 0; j < 3; ++j) {
+    if (std::abs(t_b[j]) - half_b[j] - abs_r.col(j).dot(half_a) >= reach) return true;
+  }
   for (int i = 0; i < 3; ++i) {
     const int i1 = (i + 1) % 3, i2 = (i + 2) % 3;
     for (int j = 0; j < 3; ++j) {
       const int j1 = (j + 1) % 3, j2 = (j + 2) % 3;
-      // The axis a_i x b_j in a's frame has length sqrt(1 - r_ij^2).
+      // The axis a_i x b_j in a's frame has length sqrt(1 - r_ij^2); the gap along it is
+      // (distance - radii) / length, compared here as distance - radii >= reach * length.
       const double length_squared = 1.0 - r(i, j) * r(i, j);
       if (!(length_squared >= 1e-6)) continue;
-      const double distance = std::abs(t[i2] * r(i1, j) - t[i1] * r(i2, j));
-      const double reach = half_a[i1] * abs_r(i2, j) + half_a[i2] * abs_r(i1, j) +
-                           half_b[j1] * abs_r(i, j2) + half_b[j2] * abs_r(i, j1);
-      gap = std::max(gap, (distance - reach) / std::sqrt(length_squared));
+      const double apart = std::abs(t[i2] * r(i1, j) - t[i1] * r(i2, j)) -
+                           (half_a[i1] * abs_r(i2, j) + half_a[i2] * abs_r(i1, j) +
+                            half_b[j1] * abs_r(i, j2) + half_b[j2] * abs_r(i, j1));
+      if (reach > 0.0 ? apart > 0.0 && apart >= reach * std::sqrt(length_squared)
+                      : apart >= 0.0 || apart >= reach * std::sqrt(length_squared)) {
+        return true;
+      }
     }
   }
-  return gap;
+  return false;
 }
 
 absl::Status ObjectError(SceneObjectId id, const absl::Status& status) {
@@ -345,8 +354,8 @@ void Scene::SweepRows(std::size_t begin, std::size_t end, double threshold,
       if (!(box_gap < threshold + slack)) continue;
       const double gap = (a.world_center - b.world_center).norm() - a.radius - b.radius;
       if (!(gap < threshold + slack)) continue;
-      if (!(OrientedBoxGap(a.box_center, a.rotation, a.local_half, b.box_center, b.rotation,
-                           b.local_half) < threshold + slack)) {
+      if (OrientedBoxesApart(a.box_center, a.rotation, a.local_half, b.box_center, b.rotation,
+                             b.local_half, threshold + slack)) {
         continue;
       }
       if (!ignored_.empty() && ignored_.count(PairKey(a.object.id, b.object.id)) != 0) continue;

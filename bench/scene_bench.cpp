@@ -22,6 +22,8 @@
 // K-th) differs from the brute force over all pairs of objects and all pairs of spheres, a
 // certified frame misses a pair FCL finds closer, or a service reply differs from core's
 // Scene or fails; 2 a model could not be prepared or the server not started.
+#include "scene_bench.h"
+
 #include <fcl/fcl.h>
 #include <tbb/global_control.h>
 
@@ -52,10 +54,8 @@
 #include "inscribe/sphere_set_generation.h"
 #include "support/fcl_solid_distance.h"
 
-namespace {
+namespace inscribe::scene_bench {
 
-using namespace inscribe;
-using Clock = std::chrono::steady_clock;
 using testing::BuildFclMesh;
 using testing::FclMesh;
 using testing::ToFcl;
@@ -63,39 +63,6 @@ using testing::ToFcl;
 constexpr double kTargetFps = 1000.0;    // a 64-object scene
 constexpr double kTargetSpeedup = 30.0;  // against FCL's broad plus narrow phase
 constexpr double kAgreement = 1e-9;
-
-struct Options {
-  std::vector<std::string> models = {"eight", "cow", "elephant", "knot1", "fandisk", "pig"};
-  std::vector<int> objects = {16, 64, 256};
-  int frames = 2000;
-  int fcl_frames = 100;
-  std::int64_t spheres = 200;
-  double threshold = 0.05;  // object sizes
-  double spacing = 1.6;     // object sizes between neighbouring centres
-  double step = 0.01;       // object sizes per frame
-  double turn = 0.02;       // radians per frame
-  bool certified = false;
-  bool service = true;  // also over SceneStream
-  std::vector<std::string> queries = {"distance", "certified", "contact"};
-  int check_every = 100;
-  std::uint64_t seed = 1;
-  std::string data_dir;
-};
-
-// One model: its sphere sets' hierarchies and FCL's tree over the same (scaled) mesh.
-struct Model {
-  std::string name;
-  std::int64_t triangles = 0;
-  std::shared_ptr<const SphereHierarchy> spheres, internal, cover;
-  double cover_delta = 0.0;
-  std::shared_ptr<FclMesh> fcl;
-  // What the service rows upload: the dilated set, and with --certified the cores (the
-  // internal set of a certified object) and the cover with its certificate.
-  SphereSet dilated_set, cores_set, cover_set;
-  CoverCertificate certificate;
-  // The keys the server gave them.
-  std::string spheres_key, cores_key, cover_key;
-};
 
 Mesh ScaledToUnitBox(Mesh mesh) {
   const BoundingBox box = ComputeBoundingBox(mesh.vertices);
@@ -156,13 +123,6 @@ absl::StatusOr<Model> PrepareModel(const std::string& name, const Options& optio
   return model;
 }
 
-// Every object's pose at every frame: a random walk inside a box, the same for every run.
-struct Motion {
-  std::vector<std::size_t> model;            // per object
-  std::vector<std::vector<RigidPose>> pose;  // [frame][object]
-  double box = 0.0;
-};
-
 Motion MakeMotion(int objects, int frames, std::size_t models, const Options& options,
                   std::uint64_t seed) {
   std::mt19937_64 rng(seed);
@@ -204,11 +164,6 @@ Motion MakeMotion(int objects, int frames, std::size_t models, const Options& op
   }
   return m;
 }
-
-struct Timing {
-  double fps = 0.0, p50_us = 0.0, p99_us = 0.0;
-  double candidates = 0.0, close = 0.0;  // per frame, means
-};
 
 // Per frame, the pairs (smaller index first) FCL found closer than the threshold (its exact
 // mesh distance) or in contact.
@@ -440,91 +395,11 @@ Timing RunFcl(const Motion& motion, const std::vector<Model>& models, const Opti
                    static_cast<double>(data.close));
 }
 
-// The same scene over the service: one SceneSession (SceneStream) to an inscribed on loopback,
-// every frame sending every pose; each reply is checked against core's Scene fed the same
-// frames (every K-th frame) and must be identical.
-Timing RunService(const client::Client& client, const Motion& motion,
-                  const std::vector<Model>& models, bool certified, double threshold,
-                  bool stop_at_first, const Options& options, int frames, int* failures) {
-  std::vector<client::SceneSessionObject> objects;
-  for (std::size_t i = 0; i < motion.model.size(); ++i) {
-    const Model& m = models[motion.model[i]];
-    client::SceneSessionObject o;
-    o.object.id = i;
-    o.object.pose = motion.pose[0][i];
-    o.sphere_set_key = certified ? m.cores_key : m.spheres_key;
-    if (certified) o.cover_key = m.cover_key;
-    objects.push_back(std::move(o));
-  }
-  client::SceneSessionOptions session_options;
-  session_options.volume = HierarchyVolume::kSphere;
-  session_options.query.threshold = threshold;
-  session_options.query.stop_at_first = stop_at_first;
-  absl::StatusOr<client::SceneSession> session = client.OpenSceneSession(objects, session_options);
-  if (!session.ok()) {
-    std::fprintf(stderr, "SceneStream: %s\n", std::string(session.status().message()).c_str());
-    ++*failures;
-    return Timing{};
-  }
-  Scene local = MakeScene(motion, models, certified);
-  std::vector<std::pair<SceneObjectId, RigidPose>> moves(motion.model.size());
-  std::vector<double> seconds;
-  double candidates = 0.0, close = 0.0;
-  for (int f = 0; f < frames; ++f) {
-    const auto& poses = motion.pose[static_cast<std::size_t>(f)];
-    const Clock::time_point start = Clock::now();
-    for (std::size_t i = 0; i < poses.size(); ++i) moves[i] = {i, poses[i]};
-    absl::StatusOr<client::SceneFrameResult> reply = session->Frame(moves);
-    seconds.push_back(std::chrono::duration<double>(Clock::now() - start).count());
-    if (!reply.ok()) {
-      std::fprintf(stderr, "SceneStream frame %d: %s\n", f,
-                   std::string(reply.status().message()).c_str());
-      ++*failures;
-      return Summarise(std::move(seconds), candidates, close);
-    }
-    candidates += static_cast<double>(reply->candidate_pairs);
-    close += static_cast<double>(reply->close_pairs);
-    // Every frame, untimed: a stop_at_first answer may depend on the scene's earlier frames.
-    absl::StatusOr<SceneFrame> want = local.SetPoses(moves).ok()
-                                          ? local.ClosePairs(session_options.query)
-                                          : absl::InternalError("poses");
-    if (f % options.check_every != 0) continue;
-    bool same = want.ok() && want->pairs.size() == reply->pairs.size();
-    for (std::size_t k = 0; same && k < want->pairs.size(); ++k) {
-      const ScenePair& x = want->pairs[k];
-      const ScenePair& y = reply->pairs[k];
-      same = x.a == y.a && x.b == y.b && x.result.distance == y.result.distance &&
-             x.lower == y.lower && x.upper == y.upper && x.certified == y.certified;
-    }
-    if (!same) {
-      std::fprintf(stderr, "SceneStream frame %d differs from core's Scene: %zu pairs, core %zu", f,
-                   reply->pairs.size(), want.ok() ? want->pairs.size() : 0);
-      for (std::size_t k = 0; want.ok() && k < std::min(want->pairs.size(), reply->pairs.size());
-           ++k) {
-        const ScenePair& x = want->pairs[k];
-        const ScenePair& y = reply->pairs[k];
-        if (x.a != y.a || x.b != y.b || x.result.distance != y.result.distance ||
-            x.lower != y.lower || x.upper != y.upper) {
-          std::fprintf(stderr,
-                       "; first difference (%llu, %llu) %.17g [%.17g, %.17g] against "
-                       "(%llu, %llu) %.17g [%.17g, %.17g]",
-                       static_cast<unsigned long long>(y.a), static_cast<unsigned long long>(y.b),
-                       y.result.distance, y.lower, y.upper, static_cast<unsigned long long>(x.a),
-                       static_cast<unsigned long long>(x.b), x.result.distance, x.lower, x.upper);
-          break;
-        }
-      }
-      std::fprintf(stderr, "\n");
-      ++*failures;
-    }
-  }
-  if (absl::Status closed = session->Close(); !closed.ok()) ++*failures;
-  return Summarise(std::move(seconds), candidates, close);
-}
-
-}  // namespace
+}  // namespace inscribe::scene_bench
 
 int main(int argc, char** argv) {
+  using namespace inscribe;
+  using namespace inscribe::scene_bench;
   Options options;
   options.data_dir = INSCRIBE_SOURCE_DIR "/data";
   if (const char* env = std::getenv("INSCRIBE_DATA_DIR")) options.data_dir = env;

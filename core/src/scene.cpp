@@ -301,8 +301,8 @@ void Scene::PrepareSweep(double threshold) {
   }
 }
 
-void Scene::SweepRows(std::size_t begin, std::size_t end, double threshold,
-                      std::vector<std::pair<std::uint32_t, std::uint32_t>>* out) const {
+void Scene::SweepPairs(double threshold,
+                       std::vector<std::pair<std::uint32_t, std::uint32_t>>* out) const {
   const std::size_t n = objects_.size();
   const int axis = sweep_axis_, u = (axis + 1) % 3, v = (axis + 2) % 3;
   const float *low_s = sorted_low_[axis].data(), *high_s = sorted_high_[axis].data();
@@ -310,7 +310,7 @@ void Scene::SweepRows(std::size_t begin, std::size_t end, double threshold,
   const float *low_v = sorted_low_[v].data(), *high_v = sorted_high_[v].data();
   std::vector<std::uint32_t> kept_rows(n);
   std::uint32_t* survivors = kept_rows.data();
-  for (std::size_t k = begin; k < end && k + 1 < n; ++k) {
+  for (std::size_t k = 0; k + 1 < n; ++k) {
     // Sorted by low end (rounding down keeps the order: it is monotone): once a later box starts
     // past this one's grown high end, all later ones do. Of the rest, those whose grown boxes
     // overlap this one's on the other two axes are kept (and on this axis's other side, which
@@ -369,7 +369,7 @@ absl::StatusOr<SceneFrame> Scene::ClosePairs(const SceneQuery& query,
   if (absl::Status s = CheckSceneQuery(query); !s.ok()) return s;
   std::vector<std::pair<std::uint32_t, std::uint32_t>> candidates;
   PrepareSweep(query.threshold);
-  SweepRows(0, objects_.size(), query.threshold, &candidates);
+  SweepPairs(query.threshold, &candidates);
 
   SceneFrame frame;
   frame.candidate_pairs = static_cast<std::int64_t>(candidates.size());

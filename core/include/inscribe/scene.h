@@ -163,12 +163,11 @@ class Scene {
     return a < b ? std::make_pair(a, b) : std::make_pair(b, a);
   }
   // The broad phase, in two steps. PrepareSweep orders the objects along the sweep axis and
-  // lays out their boxes (scratch below); SweepRows then appends the pairs it keeps whose first
-  // object is at rows [begin, end) of that order, as positions in objects_. SweepRows only
-  // reads.
+  // lays out their boxes (scratch below); SweepPairs then appends the pairs it keeps, as
+  // positions in objects_.
   void PrepareSweep(double threshold);
-  void SweepRows(std::size_t begin, std::size_t end, double threshold,
-                 std::vector<std::pair<std::uint32_t, std::uint32_t>>* out) const;
+  void SweepPairs(double threshold,
+                  std::vector<std::pair<std::uint32_t, std::uint32_t>>* out) const;
 
   std::vector<Entry> objects_;                             // dense; Remove moves the last in
   absl::flat_hash_map<SceneObjectId, std::size_t> index_;  // id -> position in objects_

@@ -319,8 +319,8 @@ void StreamRow(const std::string& address, const std::vector<const Model*>& mode
 }
 
 // A TCP round trip on loopback: one byte each way between two threads, TCP_NODELAY, as gRPC
-// sets it. Median of `count`, seconds; 0 if a socket call failed.
-double LoopbackRoundTrip(int count) {
+// sets it, each after `pause`. Median of `count`, seconds; 0 if a socket call failed.
+double LoopbackRoundTrip(int count, Clock::duration pause) {
   const int listener = socket(AF_INET, SOCK_STREAM, 0);
   sockaddr_in address{};
   address.sin_family = AF_INET;
@@ -351,6 +351,7 @@ double LoopbackRoundTrip(int count) {
   std::vector<double> times;
   char byte = 1;
   for (int i = 0; i < count; ++i) {
+    std::this_thread::sleep_for(pause);
     const Clock::time_point sent = Clock::now();
     if (write(client, &byte, 1) != 1 || read(client, &byte, 1) != 1) break;
     times.push_back(Seconds(Clock::now() - sent));
@@ -364,13 +365,18 @@ double LoopbackRoundTrip(int count) {
 
 // What one client's frame round trip is made of (medians): the frame's queries in-process on
 // the same hierarchies, a bare TCP round trip on loopback, and the round trip of an empty frame
-// (gRPC's per-message cost both ways and the client library's).
+// (gRPC's per-message cost both ways and the client library's). The compute and the empty
+// frame are measured back to back and again after a pause of a paced client's period (10 ms),
+// which on a shared machine finds the caches cold.
 void FloorRows(const std::string& address, const std::vector<const Model*>& models,
                const Options& options) {
   const double diagonal = std::max(models[0]->diagonal, models.back()->diagonal);
   const std::vector<RigidPose> pool = PoseSet(2 * 4096, diagonal, 99);
+  constexpr int kPausedFrames = 200;
+  constexpr auto kPause = std::chrono::milliseconds(10);
   std::vector<double> compute;
-  for (int f = 0; f < 2000; ++f) {
+  std::vector<double> compute_paused;
+  for (int f = 0; f < 2000 + kPausedFrames; ++f) {
     const std::vector<client::PosePair> frame = Frame(models, pool, options.pairs, f);
     std::vector<PosedPair> pairs;
     for (const client::PosePair& p : frame) {
@@ -381,27 +387,38 @@ void FloorRows(const std::string& address, const std::vector<const Model*>& mode
       pairs.push_back({model(p.sphere_set_a)->hierarchy.get(),
                        model(p.sphere_set_b)->hierarchy.get(), p.pose_a, p.pose_b});
     }
+    const bool paused = f >= 2000;
+    if (paused) std::this_thread::sleep_for(kPause);
     const Clock::time_point start = Clock::now();
     absl::StatusOr<std::vector<DistanceResult>> results = PairSeparationDistances(pairs);
-    compute.push_back(Seconds(Clock::now() - start));
+    (paused ? compute_paused : compute).push_back(Seconds(Clock::now() - start));
     if (!results.ok()) return Error(std::string(results.status().message()));
   }
   std::cout << absl::StrFormat("| frame of %d pairs computed in-process | %.1f |\n", options.pairs,
                                1e6 * Percentile(compute, 0.5));
+  std::cout << absl::StrFormat("| the same, each after a 10 ms pause | %.1f |\n",
+                               1e6 * Percentile(compute_paused, 0.5));
   std::cout << absl::StrFormat("| TCP round trip on loopback (1 byte each way) | %.1f |\n",
-                               1e6 * LoopbackRoundTrip(5000));
+                               1e6 * LoopbackRoundTrip(5000, Clock::duration::zero()));
+  std::cout << absl::StrFormat("| the same, each after a 10 ms pause | %.1f |\n",
+                               1e6 * LoopbackRoundTrip(kPausedFrames, kPause));
   const client::Client client(client::MakeGrpcConnection(address));
   absl::StatusOr<client::DistanceSession> session = client.OpenDistanceSession();
   if (!session.ok()) return Error(std::string(session.status().message()));
   std::vector<double> empty;
-  for (int f = 0; f < 5050; ++f) {
+  std::vector<double> empty_paused;
+  for (int f = 0; f < 5050 + kPausedFrames; ++f) {
+    const bool paused = f >= 5050;
+    if (paused) std::this_thread::sleep_for(kPause);
     const Clock::time_point start = Clock::now();
     absl::StatusOr<std::vector<DistanceResult>> results = session->Query({});
-    if (f >= 50) empty.push_back(Seconds(Clock::now() - start));
+    if (f >= 50) (paused ? empty_paused : empty).push_back(Seconds(Clock::now() - start));
     if (!results.ok()) return Error(std::string(results.status().message()));
   }
   std::cout << absl::StrFormat("| DistanceStream round trip of an empty frame | %.1f |\n",
                                1e6 * Percentile(empty, 0.5));
+  std::cout << absl::StrFormat("| the same, each after a 10 ms pause | %.1f |\n",
+                               1e6 * Percentile(empty_paused, 0.5));
   if (absl::Status closed = session->Close(); !closed.ok()) Error(std::string(closed.message()));
 }
 

@@ -111,7 +111,7 @@ class Search {
 
  private:
   // b's point in a's frame.
-  Vector3 Move(const Vector3& p) const { return rel_.rotation * p + rel_.translation; }
+  Vector3 Move(const Vector3& p) const { return internal::MoveToA(rel_, p); }
 
   // A new best pair; pairs bounded at or above the new threshold cannot improve the answer
   // beyond the tolerance, or cannot answer a closer_than query yes.
@@ -139,7 +139,7 @@ class Search {
         const double squared = (s.center - moved[j]).squaredNorm();
         // d < threshold needs |c_a - c_b| < reach: impossible when reach <= 0.
         if (!(reach > 0.0) || squared >= reach * reach) continue;
-        const double d = (s.center - moved[j]).norm() - s.radius - spheres_b[j].radius;
+        const double d = internal::SphereGap(s.center, s.radius, moved[j], spheres_b[j].radius);
         if (d < threshold_) {
           Improve(d, a_.leaf_order()[static_cast<std::size_t>(sa.first + i)],
                   b_.leaf_order()[static_cast<std::size_t>(sb.first + j)]);
@@ -154,7 +154,7 @@ class Search {
   // already prune the pair.
   double Bound(HierarchyRef a, const Slot& sa, HierarchyRef b, const Slot& sb,
                const Vector3& moved_b, DistanceResult* out) const {
-    const double cheap = (sa.center - moved_b).norm() - sa.radius - sb.radius;
+    const double cheap = internal::SphereGap(sa.center, sa.radius, moved_b, sb.radius);
     const bool node_a = !IsLeaf(a), node_b = !IsLeaf(b);
     if (!node_a && !node_b) {
       ++out->sphere_tests;
@@ -205,7 +205,7 @@ void AddWitnesses(const std::vector<Sphere>& a, const std::vector<Sphere>& b,
   if (out->sphere_a < 0) return;
   const Sphere& sa = a[static_cast<std::size_t>(out->sphere_a)];
   const Sphere& sb = b[static_cast<std::size_t>(out->sphere_b)];
-  const Vector3 cb = relative.rotation * sb.center + relative.translation;
+  const Vector3 cb = internal::MoveToA(relative, sb.center);
   Vector3 u = cb - sa.center;
   const double length = u.norm();
   u = length > 0.0 ? Vector3(u / length) : Vector3::UnitX();
@@ -213,8 +213,13 @@ void AddWitnesses(const std::vector<Sphere>& a, const std::vector<Sphere>& b,
   out->point_b = pose_a * Vector3(cb - sb.radius * u);
 }
 
-DistanceResult Query(const SphereHierarchy& a, const RigidPose& pose_a, const SphereHierarchy& b,
-                     const RigidPose& pose_b, const DistanceRequest& request) {
+}  // namespace
+
+DistanceResult internal::CheckedSeparationDistance(const SphereHierarchy& a,
+                                                   const RigidPose& pose_a,
+                                                   const SphereHierarchy& b,
+                                                   const RigidPose& pose_b,
+                                                   const DistanceRequest& request) {
   const Relative relative = RelativePose(pose_a, pose_b);
   DistanceResult out;
   if (!internal::FloatFilteredSearch(a, b, relative, request, &out)) {
@@ -225,15 +230,13 @@ DistanceResult Query(const SphereHierarchy& a, const RigidPose& pose_a, const Sp
   return out;
 }
 
-}  // namespace
-
 absl::StatusOr<DistanceResult> SeparationDistance(const SphereHierarchy& a, const RigidPose& pose_a,
                                                   const SphereHierarchy& b, const RigidPose& pose_b,
                                                   const DistanceRequest& request) {
   if (absl::Status s = CheckRequest(request); !s.ok()) return s;
   if (absl::Status s = CheckPose(pose_a); !s.ok()) return s;
   if (absl::Status s = CheckPose(pose_b); !s.ok()) return s;
-  return Query(a, pose_a, b, pose_b, request);
+  return internal::CheckedSeparationDistance(a, pose_a, b, pose_b, request);
 }
 
 absl::StatusOr<std::vector<DistanceResult>> SeparationDistances(
@@ -247,8 +250,9 @@ absl::StatusOr<std::vector<DistanceResult>> SeparationDistances(
   }
   std::vector<DistanceResult> out(poses_b.size());
   const RigidPose identity;
-  tbb::parallel_for(std::size_t{0}, poses_b.size(),
-                    [&](std::size_t i) { out[i] = Query(a, identity, b, poses_b[i], request); });
+  tbb::parallel_for(std::size_t{0}, poses_b.size(), [&](std::size_t i) {
+    out[i] = internal::CheckedSeparationDistance(a, identity, b, poses_b[i], request);
+  });
   return out;
 }
 
@@ -274,7 +278,7 @@ absl::StatusOr<std::vector<DistanceResult>> PairSeparationDistances(
     if (cancelled()) return;
     for (std::size_t i = begin; i < end; ++i) {
       const PosedPair& p = pairs[i];
-      out[i] = Query(*p.a, p.pose_a, *p.b, p.pose_b, request);
+      out[i] = internal::CheckedSeparationDistance(*p.a, p.pose_a, *p.b, p.pose_b, request);
     }
   };
   if (pairs.size() <= kChunk) {
@@ -303,9 +307,9 @@ absl::StatusOr<DistanceResult> SpherePairDistance(const std::vector<Sphere>& a,
   const Relative relative = RelativePose(pose_a, pose_b);
   const Sphere& s = a[static_cast<std::size_t>(i)];
   const Sphere& t = b[static_cast<std::size_t>(j)];
-  const Vector3 moved = relative.rotation * t.center + relative.translation;
   DistanceResult out;
-  out.distance = (s.center - moved).norm() - s.radius - t.radius;
+  out.distance =
+      internal::SphereGap(s.center, s.radius, internal::MoveToA(relative, t.center), t.radius);
   out.sphere_a = i;
   out.sphere_b = j;
   out.sphere_tests = 1;
@@ -324,7 +328,7 @@ absl::StatusOr<DistanceResult> BruteForceSeparationDistance(const std::vector<Sp
   const Relative relative = RelativePose(pose_a, pose_b);
   std::vector<Vector3> moved(b.size());
   for (std::size_t j = 0; j < b.size(); ++j) {
-    moved[j] = relative.rotation * b[j].center + relative.translation;
+    moved[j] = internal::MoveToA(relative, b[j].center);
   }
   DistanceResult out;
   const bool yes_no = std::isfinite(request.closer_than);
@@ -334,7 +338,7 @@ absl::StatusOr<DistanceResult> BruteForceSeparationDistance(const std::vector<Sp
   for (std::size_t i = 0; i < a.size() && !(yes_no && best < request.closer_than); ++i) {
     for (std::size_t j = 0; j < b.size(); ++j) {
       ++out.sphere_tests;
-      const double d = (a[i].center - moved[j]).norm() - a[i].radius - b[j].radius;
+      const double d = internal::SphereGap(a[i].center, a[i].radius, moved[j], b[j].radius);
       if (d < best && d < wanted) {
         best = d;
         out.sphere_a = static_cast<std::int32_t>(i);

@@ -11,9 +11,8 @@
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#if defined(INSCRIBE_AVX2_FILTER)
 #include <immintrin.h>
-#define INSCRIBE_AVX2_FILTER 1
 #endif
 
 namespace inscribe::internal {
@@ -173,7 +172,7 @@ class FloatSearch {
   }
 
  private:
-  Vector3 Move(const Vector3& p) const { return rel_.rotation * p + rel_.translation; }
+  Vector3 Move(const Vector3& p) const { return MoveToA(rel_, p); }
 
   void Improve(double d, std::int32_t sphere_a, std::int32_t sphere_b) {
     best_ = d;
@@ -309,7 +308,7 @@ class FloatSearch {
   void ComparePair(std::int32_t i, std::int32_t j) {
     const Sphere& s = a_.ordered_spheres()[static_cast<std::size_t>(i)];
     const Sphere& t = b_.ordered_spheres()[static_cast<std::size_t>(j)];
-    const double d = (s.center - Move(t.center)).norm() - s.radius - t.radius;
+    const double d = SphereGap(s.center, s.radius, Move(t.center), t.radius);
     if (d < threshold_) {
       Improve(d, a_.leaf_order()[static_cast<std::size_t>(i)],
               b_.leaf_order()[static_cast<std::size_t>(j)]);

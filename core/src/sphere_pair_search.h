@@ -18,6 +18,24 @@ struct RelativeFrame {
   Vector3 translation;
 };
 
+// p, a point of b's frame, in a's frame: rotation * p + translation, each coordinate summed as
+// (r0 p0 + r1 p1) + r2 p2, then the translation. Scalar code, always inlined: the searches
+// move a centre per step.
+inline Vector3 MoveToA(const RelativeFrame& f, const Vector3& p) {
+  const Eigen::Matrix3d& r = f.rotation;
+  return Vector3(r(0, 0) * p.x() + r(0, 1) * p.y() + r(0, 2) * p.z() + f.translation.x(),
+                 r(1, 0) * p.x() + r(1, 1) * p.y() + r(1, 2) * p.z() + f.translation.y(),
+                 r(2, 0) * p.x() + r(2, 1) * p.y() + r(2, 2) * p.z() + f.translation.z());
+}
+
+// A sphere pair's value: centre distance less both radii, b's centre already in a's frame
+// (MoveToA). Every exact path evaluates a pair here (BruteForceSeparationDistance, both
+// searches, SpherePairDistance), so their answers agree to the bit.
+inline double SphereGap(const Vector3& center_a, double radius_a, const Vector3& moved_center_b,
+                        double radius_b) {
+  return (center_a - moved_center_b).norm() - radius_a - radius_b;
+}
+
 // The pruning threshold once a pair of value d is the best found: pairs bounded at or above it
 // cannot improve the answer beyond the request's tolerance, or cannot answer closer_than yes.
 inline double PruneThreshold(const DistanceRequest& request, double d) {
@@ -25,10 +43,22 @@ inline double PruneThreshold(const DistanceRequest& request, double d) {
   return std::min({d - tolerance, request.closer_than, request.max_distance});
 }
 
-// Whether the sphere-pair filter takes eight pairs per instruction sequence with AVX2 (the
-// same float operations per lane as the SSE2 filter's four, no fused multiply-add): true when
-// the CPU and the OS support it (x86-64 builds by GCC or Clang). Tests clear it to run the
-// SSE2 filter; never changed while queries run.
+// Float filters with an AVX2 variant (functions built with target("avx2"), chosen at run
+// time): x86-64 builds by GCC or Clang.
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#define INSCRIBE_AVX2_FILTER 1
+#endif
+
+// SeparationDistance without its checks, for a caller that checked the poses (CheckPose) and
+// the request once: Scene's narrow phase, the batch entry points.
+DistanceResult CheckedSeparationDistance(const SphereHierarchy& a, const RigidPose& pose_a,
+                                         const SphereHierarchy& b, const RigidPose& pose_b,
+                                         const DistanceRequest& request);
+
+// Whether the float filters (the search's sphere pairs, the scene's sweep) take eight lanes per
+// instruction sequence with AVX2 (the same float operations per lane as the SSE2 variants'
+// four, no fused multiply-add): true when the CPU and the OS support it. Tests clear it to run
+// the SSE2 variants; never changed while queries run.
 extern bool use_avx2_filter;
 
 // The exact answer of SeparationDistance (without witnesses) by a depth-first branch and

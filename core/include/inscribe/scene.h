@@ -179,10 +179,11 @@ class Scene {
   int sweep_axis_ = 0;
   bool order_valid_ = false;
   // Sweep's scratch, kept between frames: the low ends along the sweep axis by position, and
-  // the world boxes in sweep order (low ends, and high ends grown by the threshold and slack,
-  // rounded outward to floats), one dense array per end and axis, padded by empty boxes.
+  // in sweep order the world boxes (low ends, and high ends grown by the threshold and slack,
+  // rounded outward to floats) and the bounding spheres (float centres and reaches), one
+  // dense array per quantity and axis, padded by empty boxes.
   std::vector<double> lows_;
-  std::vector<float> sorted_low_[3], sorted_high_[3];
+  std::vector<float> sorted_low_[3], sorted_high_[3], sorted_center_[3], sorted_rho_;
   // The last frame's narrow phase on one thread (seconds; -1 before the first): whether the
   // next is worth forking.
   double last_narrow_seconds_ = -1.0;

@@ -13,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "sphere_pair_search.h"
 #include "support/sphere_sets.h"
 #include "support/test_meshes.h"
 
@@ -328,6 +329,61 @@ TEST(Scene, ThinObjectsGrazingEqualBruteForce) {
   }
   EXPECT_GT(close, 400);
   EXPECT_GE(candidates, close);
+}
+
+// One-sphere objects (the float sphere test in the sweep then decides alone) in pairs whose
+// gaps lie within 0.01 of the threshold, far from the origin (1e4: float rounding of the
+// centres is about 1e-3 there), on both sweep paths (AVX2 and SSE2): the float filters drop no
+// pair the brute force finds. Without the sphere test's margin, pairs within the rounding of
+// the threshold are lost.
+TEST(Scene, SweepFloatFiltersKeepGrazingPairsFarFromTheOrigin) {
+  std::mt19937_64 rng(91);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const bool avx2 = internal::use_avx2_filter;
+  for (const bool use_avx2 : {true, false}) {
+    internal::use_avx2_filter = use_avx2 && avx2;
+    for (const double threshold : {0.0, 0.02, -0.3}) {
+      Scene scene;
+      std::map<SceneObjectId, SceneObject> objects;
+      for (SceneObjectId pair = 0; pair < 150; ++pair) {
+        const Vector3 base =
+            Vector3(1e4, -1e4, 1e4) + Vector3(3.0 * (pair % 10), 3.0 * ((pair / 10) % 5),
+                                              3.0 * static_cast<double>(pair / 50));
+        const double r_a = 0.2 + 0.3 * unit(rng), r_b = 0.2 + 0.3 * unit(rng);
+        const Vector3 offset_a = RandomPose(rng, 0.2).translation;
+        const Vector3 offset_b = RandomPose(rng, 0.2).translation;
+        SceneObject a, b;
+        a.id = 2 * pair;
+        b.id = 2 * pair + 1;
+        a.spheres = Hierarchy({Sphere{offset_a, r_a}}, HierarchyVolume::kSphere);
+        b.spheres = Hierarchy({Sphere{offset_b, r_b}}, HierarchyVolume::kSphere);
+        a.pose = PoseNear(rng, base, 0.0);
+        b.pose = PoseNear(rng, Vector3::Zero(), 0.0);
+        // b's sphere centre at r_a + r_b + threshold + [-0.01, 0.01] from a's, in a random
+        // direction.
+        const Vector3 center_a = a.pose * offset_a;
+        const Vector3 direction = RandomPose(rng, 1.0).translation.normalized();
+        const double gap = std::max(0.05 - r_a - r_b, threshold) + 0.02 * (unit(rng) - 0.5);
+        const Vector3 center_b = center_a + direction * (r_a + r_b + gap);
+        b.pose.translation = center_b - b.pose.rotation * offset_b;
+        for (const SceneObject& o : {a, b}) {
+          ASSERT_TRUE(scene.Add(o).ok());
+          objects[o.id] = o;
+        }
+      }
+      SceneQuery query;
+      query.threshold = threshold;
+      absl::StatusOr<SceneFrame> got = scene.ClosePairs(query);
+      ASSERT_TRUE(got.ok()) << got.status();
+      const Reference expected = BruteForce(objects, {}, threshold);
+      ExpectEqual(
+          *got, expected,
+          std::string(use_avx2 ? "AVX2" : "SSE2") + " threshold " + std::to_string(threshold));
+      EXPECT_GT(expected.close.size(), 40u) << threshold;
+      EXPECT_LT(expected.close.size(), 110u) << threshold;
+    }
+  }
+  internal::use_avx2_filter = avx2;
 }
 
 // stop_at_first over frames of small moves, with objects removed and re-added under the same

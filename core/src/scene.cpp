@@ -302,6 +302,8 @@ absl::Status Scene::Add(SceneObject object) {
   }
   entry.local_box_center = 0.5 * (lo + hi);
   entry.local_half = 0.5 * (hi - lo);
+  entry.local_extent = std::max(entry.local_center.norm() + entry.radius,
+                                entry.local_box_center.norm() + entry.local_half.norm());
   entry.object = std::move(object);
   index_.emplace(entry.object.id, objects_.size());
   objects_.push_back(std::move(entry));
@@ -354,8 +356,7 @@ absl::Status Scene::SetPoses(const std::vector<std::pair<SceneObjectId, RigidPos
     e.world_center = e.rotation * e.local_center + pose.translation;
     e.box_center = e.rotation * e.local_box_center + pose.translation;
     e.half = e.rotation.cwiseAbs() * e.local_half;
-    e.scale = pose.translation.norm() + std::max(e.local_center.norm() + e.radius,
-                                                 e.local_box_center.norm() + e.local_half.norm());
+    e.scale = pose.translation.norm() + e.local_extent;
   }
   return absl::OkStatus();
 }
@@ -531,12 +532,16 @@ absl::StatusOr<SceneFrame> Scene::ClosePairs(const SceneQuery& query,
     if (!(a->object.certified() && b->object.certified())) {
       if (try_last_pair) {
         const auto hint = last_pair_.find(std::make_pair(out.a, out.b));
-        if (hint != last_pair_.end()) {
-          absl::StatusOr<DistanceResult> r =
-              SpherePairDistance(a->object.spheres->spheres(), pose_a, b->object.spheres->spheres(),
-                                 pose_b, hint->second.first, hint->second.second);
-          if (r.ok() && r->distance < plain.closer_than) {
-            out.result = *std::move(r);
+        const std::vector<Sphere>& spheres_a = a->object.spheres->spheres();
+        const std::vector<Sphere>& spheres_b = b->object.spheres->spheres();
+        // An id re-added with another set may name a pair out of range: searched instead.
+        if (hint != last_pair_.end() &&
+            static_cast<std::size_t>(hint->second.first) < spheres_a.size() &&
+            static_cast<std::size_t>(hint->second.second) < spheres_b.size()) {
+          DistanceResult r = internal::CheckedSpherePairDistance(
+              spheres_a, pose_a, spheres_b, pose_b, hint->second.first, hint->second.second);
+          if (r.distance < plain.closer_than) {
+            out.result = r;
             out.result.closer = true;
             rank[c] = out.result.distance;
             return;

@@ -304,6 +304,14 @@ absl::StatusOr<DistanceResult> SpherePairDistance(const std::vector<Sphere>& a,
   }
   if (absl::Status s = CheckPose(pose_a); !s.ok()) return s;
   if (absl::Status s = CheckPose(pose_b); !s.ok()) return s;
+  return internal::CheckedSpherePairDistance(a, pose_a, b, pose_b, i, j);
+}
+
+DistanceResult internal::CheckedSpherePairDistance(const std::vector<Sphere>& a,
+                                                   const RigidPose& pose_a,
+                                                   const std::vector<Sphere>& b,
+                                                   const RigidPose& pose_b, std::int32_t i,
+                                                   std::int32_t j) {
   const Relative relative = RelativePose(pose_a, pose_b);
   const Sphere& s = a[static_cast<std::size_t>(i)];
   const Sphere& t = b[static_cast<std::size_t>(j)];

@@ -55,6 +55,11 @@ DistanceResult CheckedSeparationDistance(const SphereHierarchy& a, const RigidPo
                                          const SphereHierarchy& b, const RigidPose& pose_b,
                                          const DistanceRequest& request);
 
+// SpherePairDistance without its checks: i and j within the sets, poses checked.
+DistanceResult CheckedSpherePairDistance(const std::vector<Sphere>& a, const RigidPose& pose_a,
+                                         const std::vector<Sphere>& b, const RigidPose& pose_b,
+                                         std::int32_t i, std::int32_t j);
+
 // Whether the float filters (the search's sphere pairs, the scene's sweep) take eight lanes per
 // instruction sequence with AVX2 (the same float operations per lane as the SSE2 variants'
 // four, no fused multiply-add): true when the CPU and the OS support it. Tests clear it to run

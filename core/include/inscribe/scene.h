@@ -154,9 +154,10 @@ class Scene {
     Vector3 local_box_center = Vector3::Zero(), local_half = Vector3::Zero();
     Vector3 box_center = Vector3::Zero(), half = Vector3::Zero();
     Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
-    // |translation| + |local_center| + radius: the coordinate scale of the broad phase's
-    // rounding slack.
+    // |translation| + local_extent: the coordinate scale of the broad phase's rounding slack;
+    // local_extent bounds |p| over the local sphere and box.
     double scale = 0.0;
+    double local_extent = 0.0;
   };
   // The ignore list's key: the two ids, smaller first.
   static std::pair<SceneObjectId, SceneObjectId> PairKey(SceneObjectId a, SceneObjectId b) {

@@ -457,7 +457,7 @@ void Scene::PrepareSweep(double threshold) {
 }
 
 void Scene::SweepPairs(double threshold,
-                       std::vector<std::pair<std::uint32_t, std::uint32_t>>* out) const {
+                       std::vector<std::pair<std::uint32_t, std::uint32_t>>* out) {
   const std::size_t n = objects_.size();
   SweepView view{};
   for (int d = 0; d < 3; ++d) {
@@ -472,7 +472,8 @@ void Scene::SweepPairs(double threshold,
 #else
   const auto scan = ScanRow;
 #endif
-  std::vector<std::uint32_t> kept_rows(n);
+  std::vector<std::uint32_t>& kept_rows = frame_scratch_.survivors;
+  kept_rows.resize(n);
   std::uint32_t* survivors = kept_rows.data();
   for (std::size_t k = 0; k + 1 < n; ++k) {
     const std::size_t kept = scan(view, k, survivors);
@@ -497,18 +498,22 @@ void Scene::SweepPairs(double threshold,
 absl::StatusOr<SceneFrame> Scene::ClosePairs(const SceneQuery& query,
                                              const std::atomic<bool>* cancel) {
   if (absl::Status s = CheckSceneQuery(query); !s.ok()) return s;
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> candidates;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>>& candidates = frame_scratch_.candidates;
+  candidates.clear();
   PrepareSweep(query.threshold);
   SweepPairs(query.threshold, &candidates);
 
   SceneFrame frame;
   frame.candidate_pairs = static_cast<std::int64_t>(candidates.size());
-  std::vector<ScenePair> answers(candidates.size());
-  std::vector<absl::Status> errors(candidates.size());
+  std::vector<ScenePair>& answers = frame_scratch_.answers;
+  answers.assign(candidates.size(), ScenePair{});
+  std::vector<absl::Status>& errors = frame_scratch_.errors;
+  errors.assign(candidates.size(), absl::OkStatus());
   // What a pair is close by and ranked by when max_pairs cuts: its distance, or for a certified
   // pair its covers' distance less the margin (lower before clamping at 0; +infinity when the
   // covers are no closer than threshold + margin).
-  std::vector<double> rank(candidates.size(), std::numeric_limits<double>::infinity());
+  std::vector<double>& rank = frame_scratch_.rank;
+  rank.assign(candidates.size(), std::numeric_limits<double>::infinity());
   DistanceRequest plain;
   plain.abs_err = query.abs_err;
   plain.rel_err = query.rel_err;

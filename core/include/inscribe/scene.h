@@ -167,8 +167,7 @@ class Scene {
   // lays out their boxes (scratch below); SweepPairs then appends the pairs it keeps, as
   // positions in objects_.
   void PrepareSweep(double threshold);
-  void SweepPairs(double threshold,
-                  std::vector<std::pair<std::uint32_t, std::uint32_t>>* out) const;
+  void SweepPairs(double threshold, std::vector<std::pair<std::uint32_t, std::uint32_t>>* out);
 
   std::vector<Entry> objects_;                             // dense; Remove moves the last in
   absl::flat_hash_map<SceneObjectId, std::size_t> index_;  // id -> position in objects_
@@ -185,6 +184,16 @@ class Scene {
   // dense array per quantity and axis, padded by empty boxes.
   std::vector<double> lows_;
   std::vector<float> sorted_low_[3], sorted_high_[3], sorted_center_[3], sorted_rho_;
+  // A frame's scratch, kept for its capacity: the sweep's survivors of a row, the candidate
+  // pairs (positions in objects_), their answers, errors and ranks.
+  struct FrameScratch {
+    std::vector<std::uint32_t> survivors;
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> candidates;
+    std::vector<ScenePair> answers;
+    std::vector<absl::Status> errors;
+    std::vector<double> rank;
+  };
+  FrameScratch frame_scratch_;
   // The last frame's narrow phase on one thread (seconds; -1 before the first): whether the
   // next is worth forking.
   double last_narrow_seconds_ = -1.0;

@@ -353,9 +353,9 @@ absl::Status Scene::SetPoses(const std::vector<std::pair<SceneObjectId, RigidPos
     Entry& e = objects_[position];
     e.object.pose = pose;
     e.rotation = pose.rotation.toRotationMatrix();
-    e.world_center = e.rotation * e.local_center + pose.translation;
-    e.box_center = e.rotation * e.local_box_center + pose.translation;
-    e.half = e.rotation.cwiseAbs() * e.local_half;
+    e.world_center = internal::RotateAndShift(e.rotation, e.local_center, pose.translation);
+    e.box_center = internal::RotateAndShift(e.rotation, e.local_box_center, pose.translation);
+    e.half = internal::RotateAndShift(e.rotation.cwiseAbs(), e.local_half, Vector3::Zero());
     e.scale = pose.translation.norm() + e.local_extent;
   }
   return absl::OkStatus();

@@ -18,14 +18,17 @@ struct RelativeFrame {
   Vector3 translation;
 };
 
-// p, a point of b's frame, in a's frame: rotation * p + translation, each coordinate summed as
-// (r0 p0 + r1 p1) + r2 p2, then the translation. Scalar code, always inlined: the searches
-// move a centre per step.
+// r p + t, each coordinate summed as (r0 p0 + r1 p1) + r2 p2, then t. Scalar code, always
+// inlined: Eigen's 3x3 product was a call where a search moves a centre per step.
+inline Vector3 RotateAndShift(const Eigen::Matrix3d& r, const Vector3& p, const Vector3& t) {
+  return Vector3(r(0, 0) * p.x() + r(0, 1) * p.y() + r(0, 2) * p.z() + t.x(),
+                 r(1, 0) * p.x() + r(1, 1) * p.y() + r(1, 2) * p.z() + t.y(),
+                 r(2, 0) * p.x() + r(2, 1) * p.y() + r(2, 2) * p.z() + t.z());
+}
+
+// p, a point of b's frame, in a's frame.
 inline Vector3 MoveToA(const RelativeFrame& f, const Vector3& p) {
-  const Eigen::Matrix3d& r = f.rotation;
-  return Vector3(r(0, 0) * p.x() + r(0, 1) * p.y() + r(0, 2) * p.z() + f.translation.x(),
-                 r(1, 0) * p.x() + r(1, 1) * p.y() + r(1, 2) * p.z() + f.translation.y(),
-                 r(2, 0) * p.x() + r(2, 1) * p.y() + r(2, 2) * p.z() + f.translation.z());
+  return RotateAndShift(f.rotation, p, f.translation);
 }
 
 // A sphere pair's value: centre distance less both radii, b's centre already in a's frame

@@ -32,6 +32,7 @@
 #include <iostream>
 #include <memory>
 #include <mutex>
+#include <numeric>
 #include <random>
 #include <string>
 #include <thread>
@@ -363,11 +364,33 @@ double LoopbackRoundTrip(int count, Clock::duration pause) {
   return Percentile(times, 0.5);
 }
 
+// Median time of 20,000 dependent loads chasing a random cycle through 256 KB (an L2 cache's
+// worth), back to back or each chase after `pause`: how much of its caches a thread keeps over
+// a paced client's period on this machine.
+double PointerChase(Clock::duration pause) {
+  constexpr std::size_t kEntries = 256 * 1024 / sizeof(std::uint32_t);
+  std::vector<std::uint32_t> order(kEntries), next(kEntries);
+  std::iota(order.begin(), order.end(), 0u);
+  std::shuffle(order.begin(), order.end(), std::mt19937(7));
+  for (std::size_t i = 0; i < kEntries; ++i) next[order[i]] = order[(i + 1) % kEntries];
+  std::vector<double> times;
+  std::uint32_t at = 0;
+  for (int round = 0; round < 200; ++round) {
+    std::this_thread::sleep_for(pause);
+    const Clock::time_point start = Clock::now();
+    for (int step = 0; step < 20000; ++step) at = next[at];
+    times.push_back(Seconds(Clock::now() - start));
+  }
+  static volatile std::uint32_t sink;
+  sink = at;
+  return Percentile(times, 0.5);
+}
+
 // What one client's frame round trip is made of (medians): the frame's queries in-process on
 // the same hierarchies, a bare TCP round trip on loopback, and the round trip of an empty frame
-// (gRPC's per-message cost both ways and the client library's). The compute and the empty
-// frame are measured back to back and again after a pause of a paced client's period (10 ms),
-// which on a shared machine finds the caches cold.
+// (gRPC's per-message cost both ways and the client library's). Each is measured back to back
+// and again after a pause of a paced client's period (10 ms), which on a shared machine finds
+// the caches cold; a pointer chase through 256 KB shows how cold.
 void FloorRows(const std::string& address, const std::vector<const Model*>& models,
                const Options& options) {
   const double diagonal = std::max(models[0]->diagonal, models.back()->diagonal);
@@ -398,6 +421,10 @@ void FloorRows(const std::string& address, const std::vector<const Model*>& mode
                                1e6 * Percentile(compute, 0.5));
   std::cout << absl::StrFormat("| the same, each after a 10 ms pause | %.1f |\n",
                                1e6 * Percentile(compute_paused, 0.5));
+  std::cout << absl::StrFormat("| 20,000 dependent loads within 256 KB | %.1f |\n",
+                               1e6 * PointerChase(Clock::duration::zero()));
+  std::cout << absl::StrFormat("| the same, each after a 10 ms pause | %.1f |\n",
+                               1e6 * PointerChase(kPause));
   std::cout << absl::StrFormat("| TCP round trip on loopback (1 byte each way) | %.1f |\n",
                                1e6 * LoopbackRoundTrip(5000, Clock::duration::zero()));
   std::cout << absl::StrFormat("| the same, each after a 10 ms pause | %.1f |\n",

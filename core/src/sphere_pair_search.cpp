@@ -520,8 +520,15 @@ bool FloatFilteredSearch(const SphereHierarchy& a, const SphereHierarchy& b,
   const double bound = std::max({a.max_abs_coordinate(), a.max_radius(), moved, b.max_radius()});
   // The rotation's departure from orthonormality: |R x| <= sqrt(1 + e) |x| <= (1 + e) |x|, e
   // the largest absolute row sum of R^T R - I.
-  const double departure =
-      (r.transpose() * r - Eigen::Matrix3d::Identity()).cwiseAbs().rowwise().sum().maxCoeff();
+  double departure = 0.0;
+  for (int i = 0; i < 3; ++i) {
+    double row_sum = 0.0;
+    for (int j = 0; j < 3; ++j) {
+      const double gram = r(0, i) * r(0, j) + r(1, i) * r(1, j) + r(2, i) * r(2, j);
+      row_sum += std::abs(gram - (i == j ? 1.0 : 0.0));
+    }
+    if (!(row_sum <= departure)) departure = row_sum;  // a NaN is kept, and refused below
+  }
   if (!std::isfinite(bound) || !(bound > 0.0) || !std::isfinite(departure) || departure > 1e-3) {
     return false;
   }

@@ -69,10 +69,10 @@ constexpr std::size_t kSweepLanes = 8;
 // double one, so the float distance (before its own rounding) within 7 u M; the float sum
 // rho_a + rho_b is at least R + 62.9 u M for R = r_a + r_b + reach in (0, M]; the squares and
 // their sum add relative errors of at most 4.02 u. Every pair whose double centre distance is
-// below R, which the exact sphere test needs, is thus kept with 55 u M to spare; for R <= 0
-// the exact test keeps none. The test is used when 2^-40 <= M <= 2^60 (no overflow, denormal
-// errors far below the margin) and the reach is finite; otherwise every centre is 0 and every
-// rho the largest float, and it keeps every pair.
+// below R (bounding spheres closer than the threshold plus the slack) is thus kept with 55 u M
+// to spare; for R <= 0 there is none (a centre distance is at least 0). The test is used when 2^-40
+// <= M <= 2^60 (no overflow, denormal errors far below the margin) and the reach is finite;
+// otherwise every centre is 0 and every rho the largest float, and it keeps every pair.
 constexpr int kSweepMarginExponent = 6 - 24;
 constexpr int kSweepMinExponent = -40, kSweepMaxExponent = 60;
 
@@ -423,9 +423,9 @@ void Scene::PrepareSweep(double threshold) {
   }
   // The boxes in sweep order, high ends grown by `reach`: the threshold plus the largest
   // rounding slack of any pair, rounded outward to floats. Boxes whose gap along some axis is
-  // at least `reach` cannot pass the exact test below (the largest gap along an axis against
-  // the threshold plus the pair's own slack), so this filter only skips pairs that test drops;
-  // the same holds for the float sphere test (kSweepMarginExponent).
+  // at least `reach` hold spheres no closer than the threshold plus any pair's slack, so the
+  // box test drops no pair that could be close; nor does the float sphere test
+  // (kSweepMarginExponent).
   const double reach = threshold + 2.0 * kBroadPhaseSlack * largest_scale + kCertifiedDistanceFloor;
   const double bound = std::max(largest_coordinate, 2.0 * largest_radius + std::abs(reach));
   const int exponent = bound > 0.0 && std::isfinite(bound) ? std::ilogb(bound) + 1 : 0;

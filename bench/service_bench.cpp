@@ -16,11 +16,7 @@
 //
 //   service_bench [--server HOST:PORT] [--frames N] [--frame-rates 100,1000]
 //                 [--sections batch,stream,floor,generate] [--quick] ...   (bench/run-service)
-#include <netinet/in.h>
-#include <netinet/tcp.h>
 #include <sys/resource.h>
-#include <sys/socket.h>
-#include <unistd.h>
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -32,7 +28,6 @@
 #include <iostream>
 #include <memory>
 #include <mutex>
-#include <numeric>
 #include <random>
 #include <string>
 #include <thread>
@@ -45,6 +40,7 @@
 #include "inscribe/mesh_validation.h"
 #include "inscribe/separation_distance.h"
 #include "inscribe/server/inscribe_server.h"
+#include "machine_probes.h"
 
 namespace inscribe {
 namespace {
@@ -319,73 +315,6 @@ void StreamRow(const std::string& address, const std::vector<const Model*>& mode
       p99 < 1e-3 ? " pass" : " MISS");
 }
 
-// A TCP round trip on loopback: one byte each way between two threads, TCP_NODELAY, as gRPC
-// sets it, each after `pause`. Median of `count`, seconds; 0 if a socket call failed.
-double LoopbackRoundTrip(int count, Clock::duration pause) {
-  const int listener = socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in address{};
-  address.sin_family = AF_INET;
-  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  socklen_t length = sizeof(address);
-  if (bind(listener, reinterpret_cast<sockaddr*>(&address), sizeof(address)) != 0 ||
-      listen(listener, 1) != 0 ||
-      getsockname(listener, reinterpret_cast<sockaddr*>(&address), &length) != 0) {
-    close(listener);
-    return 0.0;
-  }
-  const int client = socket(AF_INET, SOCK_STREAM, 0);
-  if (connect(client, reinterpret_cast<sockaddr*>(&address), sizeof(address)) != 0) {
-    close(client);
-    close(listener);
-    return 0.0;
-  }
-  const int server = accept(listener, nullptr, nullptr);
-  const int one = 1;
-  setsockopt(client, IPPROTO_TCP, TCP_NODELAY, &one, sizeof(one));
-  setsockopt(server, IPPROTO_TCP, TCP_NODELAY, &one, sizeof(one));
-  std::thread echo([server, count] {
-    char byte = 0;
-    for (int i = 0; i < count; ++i) {
-      if (read(server, &byte, 1) != 1 || write(server, &byte, 1) != 1) return;
-    }
-  });
-  std::vector<double> times;
-  char byte = 1;
-  for (int i = 0; i < count; ++i) {
-    std::this_thread::sleep_for(pause);
-    const Clock::time_point sent = Clock::now();
-    if (write(client, &byte, 1) != 1 || read(client, &byte, 1) != 1) break;
-    times.push_back(Seconds(Clock::now() - sent));
-  }
-  echo.join();
-  close(client);
-  close(server);
-  close(listener);
-  return Percentile(times, 0.5);
-}
-
-// Median time of 20,000 dependent loads chasing a random cycle through 256 KB (an L2 cache's
-// worth), back to back or each chase after `pause`: how much of its caches a thread keeps over
-// a paced client's period on this machine.
-double PointerChase(Clock::duration pause) {
-  constexpr std::size_t kEntries = 256 * 1024 / sizeof(std::uint32_t);
-  std::vector<std::uint32_t> order(kEntries), next(kEntries);
-  std::iota(order.begin(), order.end(), 0u);
-  std::shuffle(order.begin(), order.end(), std::mt19937(7));
-  for (std::size_t i = 0; i < kEntries; ++i) next[order[i]] = order[(i + 1) % kEntries];
-  std::vector<double> times;
-  std::uint32_t at = 0;
-  for (int round = 0; round < 200; ++round) {
-    std::this_thread::sleep_for(pause);
-    const Clock::time_point start = Clock::now();
-    for (int step = 0; step < 20000; ++step) at = next[at];
-    times.push_back(Seconds(Clock::now() - start));
-  }
-  static volatile std::uint32_t sink;
-  sink = at;
-  return Percentile(times, 0.5);
-}
-
 // What one client's frame round trip is made of (medians): the frame's queries in-process on
 // the same hierarchies, a bare TCP round trip on loopback, and the round trip of an empty frame
 // (gRPC's per-message cost both ways and the client library's). Each is measured back to back
@@ -421,14 +350,17 @@ void FloorRows(const std::string& address, const std::vector<const Model*>& mode
                                1e6 * Percentile(compute, 0.5));
   std::cout << absl::StrFormat("| the same, each after a 10 ms pause | %.1f |\n",
                                1e6 * Percentile(compute_paused, 0.5));
-  std::cout << absl::StrFormat("| 20,000 dependent loads within 256 KB | %.1f |\n",
-                               1e6 * PointerChase(Clock::duration::zero()));
+  std::cout << absl::StrFormat(
+      "| 20,000 dependent loads within 256 KB | %.1f |\n",
+      1e6 * Percentile(bench::PointerChases(200, Clock::duration::zero()), 0.5));
   std::cout << absl::StrFormat("| the same, each after a 10 ms pause | %.1f |\n",
-                               1e6 * PointerChase(kPause));
-  std::cout << absl::StrFormat("| TCP round trip on loopback (1 byte each way) | %.1f |\n",
-                               1e6 * LoopbackRoundTrip(5000, Clock::duration::zero()));
-  std::cout << absl::StrFormat("| the same, each after a 10 ms pause | %.1f |\n",
-                               1e6 * LoopbackRoundTrip(kPausedFrames, kPause));
+                               1e6 * Percentile(bench::PointerChases(200, kPause), 0.5));
+  std::cout << absl::StrFormat(
+      "| TCP round trip on loopback (1 byte each way) | %.1f |\n",
+      1e6 * Percentile(bench::LoopbackRoundTrips(5000, Clock::duration::zero()), 0.5));
+  std::cout << absl::StrFormat(
+      "| the same, each after a 10 ms pause | %.1f |\n",
+      1e6 * Percentile(bench::LoopbackRoundTrips(kPausedFrames, kPause), 0.5));
   const client::Client client(client::MakeGrpcConnection(address));
   absl::StatusOr<client::DistanceSession> session = client.OpenDistanceSession();
   if (!session.ok()) return Error(std::string(session.status().message()));

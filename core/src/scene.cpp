@@ -12,14 +12,8 @@
 
 #include "absl/strings/str_cat.h"
 #include "float_rounding.h"
+#include "scene_sweep.h"
 #include "sphere_pair_search.h"
-
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
-#if defined(INSCRIBE_AVX2_FILTER)
-#include <immintrin.h>
-#endif
 
 namespace inscribe {
 namespace {
@@ -56,131 +50,6 @@ static_assert(kBroadPhaseSlack > kCertifiedDistanceMargin);
 // that spreads them most.
 constexpr double kSweepAxisHysteresis = 0.7;
 
-// Boxes the sweep compares at a time: four with SSE, eight with AVX2; the arrays are padded
-// for the wider.
-constexpr std::size_t kSweepLanes = 8;
-
-// The sweep's float sphere test. Let M be a power of two at least every |coordinate| of the
-// objects' world centres and r_a + r_b + |reach| for every pair (reach: the threshold plus the
-// largest slack, as the boxes' grown ends), u = 2^-24. The centres are rounded to nearest and
-// each object's sphere reach rho = r + reach / 2 + margin / 2 rounded up, margin = 64 u M.
-// A pair passes when rho_a + rho_b > 0 and its float squared centre distance is below the
-// square of that sum. Rounding: each float coordinate difference is within 4 u M of the
-// double one, so the float distance (before its own rounding) within 7 u M; the float sum
-// rho_a + rho_b is at least R + 62.9 u M for R = r_a + r_b + reach in (0, M]; the squares and
-// their sum add relative errors of at most 4.02 u. Every pair whose double centre distance is
-// below R (bounding spheres closer than the threshold plus the slack) is thus kept with 55 u M
-// to spare; for R <= 0 there is none (a centre distance is at least 0). The test is used when 2^-40
-// <= M <= 2^60 (no overflow, denormal errors far below the margin) and the reach is finite;
-// otherwise every centre is 0 and every rho the largest float, and it keeps every pair.
-constexpr int kSweepMarginExponent = 6 - 24;
-constexpr int kSweepMinExponent = -40, kSweepMaxExponent = 60;
-
-// The sweep's arrays in sweep order, padded by kSweepLanes empty boxes (Scene::PrepareSweep).
-struct SweepView {
-  const float* low[3];     // box low ends, rounded down
-  const float* high[3];    // box high ends grown by the reach, rounded up
-  const float* center[3];  // sphere centres, rounded to nearest
-  const float* rho;        // sphere reaches, rounded up
-  int axis;                // the sweep axis: lows sorted along it
-};
-
-// Appends to `out` the positions after k whose grown boxes overlap k's on every axis and whose
-// float sphere test passes (see kSweepMarginExponent); returns how many. Sorted by low end
-// (rounding down keeps the order: it is monotone), once a later box starts past k's grown high
-// end, all later ones do. The other side of the sweep axis is tested too: it matters for a
-// negative threshold.
-std::size_t ScanRow(const SweepView& view, std::size_t k, std::uint32_t* out) {
-  const int s = view.axis, u = (s + 1) % 3, v = (s + 2) % 3;
-  std::size_t kept = 0;
-#if defined(__SSE2__)
-  const __m128 ks_high = _mm_set1_ps(view.high[s][k]), ks_low = _mm_set1_ps(view.low[s][k]);
-  const __m128 ku_high = _mm_set1_ps(view.high[u][k]), ku_low = _mm_set1_ps(view.low[u][k]);
-  const __m128 kv_high = _mm_set1_ps(view.high[v][k]), kv_low = _mm_set1_ps(view.low[v][k]);
-  const __m128 kx = _mm_set1_ps(view.center[0][k]), ky = _mm_set1_ps(view.center[1][k]),
-               kz = _mm_set1_ps(view.center[2][k]), k_rho = _mm_set1_ps(view.rho[k]);
-  const __m128 zero = _mm_setzero_ps();
-  for (std::size_t m = k + 1;; m += 4) {
-    const __m128 started = _mm_cmplt_ps(_mm_loadu_ps(view.low[s] + m), ks_high);
-    __m128 keep = _mm_and_ps(started, _mm_cmplt_ps(ks_low, _mm_loadu_ps(view.high[s] + m)));
-    keep = _mm_and_ps(keep, _mm_cmplt_ps(_mm_loadu_ps(view.low[u] + m), ku_high));
-    keep = _mm_and_ps(keep, _mm_cmplt_ps(ku_low, _mm_loadu_ps(view.high[u] + m)));
-    keep = _mm_and_ps(keep, _mm_cmplt_ps(_mm_loadu_ps(view.low[v] + m), kv_high));
-    keep = _mm_and_ps(keep, _mm_cmplt_ps(kv_low, _mm_loadu_ps(view.high[v] + m)));
-    const __m128 dx = _mm_sub_ps(_mm_loadu_ps(view.center[0] + m), kx);
-    const __m128 dy = _mm_sub_ps(_mm_loadu_ps(view.center[1] + m), ky);
-    const __m128 dz = _mm_sub_ps(_mm_loadu_ps(view.center[2] + m), kz);
-    const __m128 squared =
-        _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
-    const __m128 reach = _mm_add_ps(_mm_loadu_ps(view.rho + m), k_rho);
-    keep = _mm_and_ps(keep, _mm_and_ps(_mm_cmpgt_ps(reach, zero),
-                                       _mm_cmplt_ps(squared, _mm_mul_ps(reach, reach))));
-    for (int bits = _mm_movemask_ps(keep); bits != 0; bits &= bits - 1) {
-      out[kept++] = static_cast<std::uint32_t>(
-          m + static_cast<std::size_t>(__builtin_ctz(static_cast<unsigned>(bits))));
-    }
-    if (_mm_movemask_ps(started) != 0xf) break;
-  }
-#else
-  for (std::size_t m = k + 1; view.low[s][m] < view.high[s][k]; ++m) {
-    const float dx = view.center[0][m] - view.center[0][k];
-    const float dy = view.center[1][m] - view.center[1][k];
-    const float dz = view.center[2][m] - view.center[2][k];
-    const float reach = view.rho[m] + view.rho[k];
-    out[kept] = static_cast<std::uint32_t>(m);
-    kept += static_cast<std::size_t>(
-        (view.low[s][k] < view.high[s][m]) & (view.low[u][m] < view.high[u][k]) &
-        (view.low[u][k] < view.high[u][m]) & (view.low[v][m] < view.high[v][k]) &
-        (view.low[v][k] < view.high[v][m]) & (reach > 0.0f) &
-        (dx * dx + dy * dy + dz * dz < reach * reach));
-  }
-#endif
-  return kept;
-}
-
-#if defined(INSCRIBE_AVX2_FILTER)
-// ScanRow eight boxes at a time: the same float operations per lane.
-__attribute__((target("avx2"))) std::size_t ScanRowAvx2(const SweepView& view, std::size_t k,
-                                                        std::uint32_t* out) {
-  const int s = view.axis, u = (s + 1) % 3, v = (s + 2) % 3;
-  std::size_t kept = 0;
-  const __m256 ks_high = _mm256_set1_ps(view.high[s][k]), ks_low = _mm256_set1_ps(view.low[s][k]);
-  const __m256 ku_high = _mm256_set1_ps(view.high[u][k]), ku_low = _mm256_set1_ps(view.low[u][k]);
-  const __m256 kv_high = _mm256_set1_ps(view.high[v][k]), kv_low = _mm256_set1_ps(view.low[v][k]);
-  const __m256 kx = _mm256_set1_ps(view.center[0][k]), ky = _mm256_set1_ps(view.center[1][k]),
-               kz = _mm256_set1_ps(view.center[2][k]), k_rho = _mm256_set1_ps(view.rho[k]);
-  const __m256 zero = _mm256_setzero_ps();
-  for (std::size_t m = k + 1;; m += 8) {
-    const __m256 started = _mm256_cmp_ps(_mm256_loadu_ps(view.low[s] + m), ks_high, _CMP_LT_OQ);
-    __m256 keep = _mm256_and_ps(
-        started, _mm256_cmp_ps(ks_low, _mm256_loadu_ps(view.high[s] + m), _CMP_LT_OQ));
-    keep =
-        _mm256_and_ps(keep, _mm256_cmp_ps(_mm256_loadu_ps(view.low[u] + m), ku_high, _CMP_LT_OQ));
-    keep =
-        _mm256_and_ps(keep, _mm256_cmp_ps(ku_low, _mm256_loadu_ps(view.high[u] + m), _CMP_LT_OQ));
-    keep =
-        _mm256_and_ps(keep, _mm256_cmp_ps(_mm256_loadu_ps(view.low[v] + m), kv_high, _CMP_LT_OQ));
-    keep =
-        _mm256_and_ps(keep, _mm256_cmp_ps(kv_low, _mm256_loadu_ps(view.high[v] + m), _CMP_LT_OQ));
-    const __m256 dx = _mm256_sub_ps(_mm256_loadu_ps(view.center[0] + m), kx);
-    const __m256 dy = _mm256_sub_ps(_mm256_loadu_ps(view.center[1] + m), ky);
-    const __m256 dz = _mm256_sub_ps(_mm256_loadu_ps(view.center[2] + m), kz);
-    const __m256 squared = _mm256_add_ps(
-        _mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy)), _mm256_mul_ps(dz, dz));
-    const __m256 reach = _mm256_add_ps(_mm256_loadu_ps(view.rho + m), k_rho);
-    keep = _mm256_and_ps(
-        keep, _mm256_and_ps(_mm256_cmp_ps(reach, zero, _CMP_GT_OQ),
-                            _mm256_cmp_ps(squared, _mm256_mul_ps(reach, reach), _CMP_LT_OQ)));
-    for (int bits = _mm256_movemask_ps(keep); bits != 0; bits &= bits - 1) {
-      out[kept++] = static_cast<std::uint32_t>(
-          m + static_cast<std::size_t>(__builtin_ctz(static_cast<unsigned>(bits))));
-    }
-    if (_mm256_movemask_ps(started) != 0xff) break;
-  }
-  return kept;
-}
-#endif
-
 // Pairs per parallel chunk of the narrow phase; fewer run on the calling thread (a frame of a
 // few close pairs costs microseconds, less than forking would).
 constexpr std::size_t kNarrowChunk = 16;
@@ -189,57 +58,6 @@ constexpr std::size_t kNarrowChunk = 16;
 // least this long on one thread. Measured with scene_bench on 2 cores: forking made 64- and
 // 256-object frames of 25-75 us slower, and frames of 150 us or more faster.
 constexpr double kForkNarrowSeconds = 100e-6;
-
-// True when two oriented boxes (centres c, axes the columns of unit rotations R, half sides h)
-// are at least `reach` apart along one of their separating axes: the boxes' 6 face normals and
-// the 9 cross products of their edges, each gap a lower bound on the boxes' distance. The
-// face axes are tried first and the test stops at the first axis that separates. An edge
-// pair's axis is used only when far from degenerate (|n| >= 1e-3; near-parallel edges are
-// covered by the face axes): the gaps then err by a few ulps of the coordinates over |n|, far
-// below the broad phase's slack.
-bool OrientedBoxesApart(const Vector3& center_a, const Eigen::Matrix3d& axes_a,
-                        const Vector3& half_a, const Vector3& center_b,
-                        const Eigen::Matrix3d& axes_b, const Vector3& half_b, double reach) {
-  // b's axes and centre in a's frame, a row (one of a's axes) at a time: most separated
-  // pairs stop at a's first face axes.
-  const Vector3 d = center_b - center_a;
-  double r[3][3], abs_r[3][3], t[3];
-  for (int i = 0; i < 3; ++i) {
-    const auto axis = axes_a.col(i);
-    t[i] = axis.dot(d);
-    for (int j = 0; j < 3; ++j) {
-      r[i][j] = axis.dot(axes_b.col(j));
-      abs_r[i][j] = std::abs(r[i][j]);
-    }
-    const double extent_b =
-        abs_r[i][0] * half_b[0] + abs_r[i][1] * half_b[1] + abs_r[i][2] * half_b[2];
-    if (std::abs(t[i]) - half_a[i] - extent_b >= reach) return true;
-  }
-  for (int j = 0; j < 3; ++j) {
-    const double t_b = r[0][j] * t[0] + r[1][j] * t[1] + r[2][j] * t[2];
-    const double extent_a =
-        abs_r[0][j] * half_a[0] + abs_r[1][j] * half_a[1] + abs_r[2][j] * half_a[2];
-    if (std::abs(t_b) - half_b[j] - extent_a >= reach) return true;
-  }
-  for (int i = 0; i < 3; ++i) {
-    const int i1 = (i + 1) % 3, i2 = (i + 2) % 3;
-    for (int j = 0; j < 3; ++j) {
-      const int j1 = (j + 1) % 3, j2 = (j + 2) % 3;
-      // The axis a_i x b_j in a's frame has length sqrt(1 - r_ij^2); the gap along it is
-      // (distance - radii) / length, compared here as distance - radii >= reach * length.
-      const double length_squared = 1.0 - r[i][j] * r[i][j];
-      if (!(length_squared >= 1e-6)) continue;
-      const double apart = std::abs(t[i2] * r[i1][j] - t[i1] * r[i2][j]) -
-                           (half_a[i1] * abs_r[i2][j] + half_a[i2] * abs_r[i1][j] +
-                            half_b[j1] * abs_r[i][j2] + half_b[j2] * abs_r[i][j1]);
-      if (reach > 0.0 ? apart > 0.0 && apart >= reach * std::sqrt(length_squared)
-                      : apart >= 0.0 || apart >= reach * std::sqrt(length_squared)) {
-        return true;
-      }
-    }
-  }
-  return false;
-}
 
 absl::Status ObjectError(SceneObjectId id, const absl::Status& status) {
   return absl::Status(status.code(), absl::StrCat("object ", id, ": ", status.message()));
@@ -425,17 +243,13 @@ void Scene::PrepareSweep(double threshold) {
   // rounding slack of any pair, rounded outward to floats. Boxes whose gap along some axis is
   // at least `reach` hold spheres no closer than the threshold plus any pair's slack, so the
   // box test drops no pair that could be close; nor does the float sphere test
-  // (kSweepMarginExponent).
+  // (internal::SweepHalfMargin).
   const double reach = threshold + 2.0 * kBroadPhaseSlack * largest_scale + kCertifiedDistanceFloor;
-  const double bound = std::max(largest_coordinate, 2.0 * largest_radius + std::abs(reach));
-  const int exponent = bound > 0.0 && std::isfinite(bound) ? std::ilogb(bound) + 1 : 0;
-  const bool sphere_test = bound > 0.0 && std::isfinite(bound) && exponent >= kSweepMinExponent &&
-                           exponent <= kSweepMaxExponent;
-  const double half_margin =
-      sphere_test ? std::ldexp(1.0, exponent + kSweepMarginExponent - 1) : 0.0;
+  const double half_margin = internal::SweepHalfMargin(largest_coordinate, largest_radius, reach);
+  const bool sphere_test = half_margin >= 0.0;
   // kSweepLanes empty boxes after the last (low +infinity, high -infinity) end every row.
   const auto pad = [n](std::vector<float>& v, float empty) {
-    v.resize(n + kSweepLanes);
+    v.resize(n + internal::kSweepLanes);
     std::fill(v.begin() + static_cast<std::ptrdiff_t>(n), v.end(), empty);
   };
   for (int d = 0; d < 3; ++d) {
@@ -459,7 +273,7 @@ void Scene::PrepareSweep(double threshold) {
 void Scene::SweepPairs(double threshold,
                        std::vector<std::pair<std::uint32_t, std::uint32_t>>* out) {
   const std::size_t n = objects_.size();
-  SweepView view{};
+  internal::SweepView view{};
   for (int d = 0; d < 3; ++d) {
     view.low[d] = sorted_low_[d].data();
     view.high[d] = sorted_high_[d].data();
@@ -467,16 +281,11 @@ void Scene::SweepPairs(double threshold,
   }
   view.rho = sorted_rho_.data();
   view.axis = sweep_axis_;
-#if defined(INSCRIBE_AVX2_FILTER)
-  const auto scan = internal::use_avx2_filter ? ScanRowAvx2 : ScanRow;
-#else
-  const auto scan = ScanRow;
-#endif
   std::vector<std::uint32_t>& kept_rows = frame_scratch_.survivors;
   kept_rows.resize(n);
   std::uint32_t* survivors = kept_rows.data();
   for (std::size_t k = 0; k + 1 < n; ++k) {
-    const std::size_t kept = scan(view, k, survivors);
+    const std::size_t kept = internal::ScanSweepRow(view, k, survivors);
     const Entry& a = objects_[order_[k]];
     for (std::size_t q = 0; q < kept; ++q) {
       const std::uint32_t other = order_[survivors[q]];
@@ -485,8 +294,8 @@ void Scene::SweepPairs(double threshold,
       // The float box and sphere tests passed; the oriented boxes are tested in double, with
       // the pair's own slack.
       const double slack = kBroadPhaseSlack * (a.scale + b.scale) + kCertifiedDistanceFloor;
-      if (OrientedBoxesApart(a.box_center, a.rotation, a.local_half, b.box_center, b.rotation,
-                             b.local_half, threshold + slack)) {
+      if (internal::OrientedBoxesApart(a.box_center, a.rotation, a.local_half, b.box_center,
+                                       b.rotation, b.local_half, threshold + slack)) {
         continue;
       }
       if (!ignored_.empty() && ignored_.count(PairKey(a.object.id, b.object.id)) != 0) continue;

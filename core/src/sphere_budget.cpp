@@ -59,10 +59,7 @@ absl::StatusOr<SphereBudgetResult> GenerateWithSphereBudget(const BoundaryOracle
   }
   const double target = static_cast<double>(options.max_spheres);
   // The finest sigma the voxel limit allows: below it runs would be refused.
-  const Vector3 extent = box.extent().cwiseMax(Vector3::Constant(1e-12 * diagonal));
-  // From the volume's estimate up until the grid, whose sides round up to whole voxels, fits.
-  double finest = std::cbrt(extent.prod() / static_cast<double>(options.base.max_voxels));
-  while (!internal::MakeGrid(box, finest, options.base.max_voxels).ok()) finest *= 1.001;
+  const double finest = internal::FinestVoxelSize(box, options.base.max_voxels);
 
   SphereBudgetResult result;
   std::optional<MedialSphereResult> accepted;  // smallest sigma with n <= N
@@ -70,9 +67,7 @@ absl::StatusOr<SphereBudgetResult> GenerateWithSphereBudget(const BoundaryOracle
   std::optional<Run> previous;
   double slope = -2.0;
   double previous_gap = 0.0;  // relative bracket width before the last run, once bracketed
-  // First guess: the medial surface of a solid of this size, met by voxels of side sigma,
-  // gives about (diagonal / sigma)^2 / 4 spheres.
-  double sigma = std::max(finest, 0.5 * diagonal / std::sqrt(target));
+  double sigma = std::max(finest, internal::VoxelSizeForCount(diagonal, target));
   double reported = 0.0;
 
   for (int run = 0; run < options.max_runs; ++run) {

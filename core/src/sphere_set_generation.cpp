@@ -86,6 +86,10 @@ absl::Status CheckSphereSetParameters(const SphereSetParameters& p) {
     return absl::InvalidArgumentError(
         absl::StrCat("the sphere budget must be at least 1, got ", *p.max_spheres));
   }
+  if (p.selection != SphereSelection::kPaper && p.selection != SphereSelection::kOptimised) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("selection must be paper or optimised, got ", static_cast<int>(p.selection)));
+  }
   if (absl::Status s = CheckMedialSphereOptions(p.medial, /*need_voxel_size=*/false); !s.ok()) {
     return s;
   }
@@ -125,7 +129,23 @@ absl::StatusOr<GeneratedSphereSet> GenerateSphereSet(const Solid& solid,
     return Evaluated(solid, parameters, start, std::move(out));
   }
   MedialSphereResult medial;
-  if (const std::optional<std::int64_t> budget = EffectiveMaxSpheres(parameters)) {
+  const std::optional<std::int64_t> budget = EffectiveMaxSpheres(parameters);
+  if (budget && parameters.selection == SphereSelection::kOptimised) {
+    OptimisedSphereOptions optimised;
+    optimised.max_spheres = *budget;
+    optimised.base = parameters.medial;
+    absl::StatusOr<OptimisedSphereResult> chosen =
+        GenerateOptimisedSpheres(solid.oracle, optimised, control);
+    if (!chosen.ok()) return chosen.status();
+    out.runs = chosen->runs;
+    out.selection = SphereSelection::kOptimised;
+    out.pool_size = chosen->pool_size;
+    out.covered_fraction = chosen->selection.samples > 0
+                               ? static_cast<double>(chosen->selection.covered) /
+                                     static_cast<double>(chosen->selection.samples)
+                               : 0.0;
+    medial = std::move(chosen->best);
+  } else if (budget) {
     SphereBudgetOptions search;
     search.max_spheres = *budget;
     search.base = parameters.medial;

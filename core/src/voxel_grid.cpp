@@ -55,6 +55,14 @@ absl::StatusOr<Grid> MakeGrid(const BoundingBox& box, double size, std::int64_t 
   return grid;
 }
 
+double FinestVoxelSize(const BoundingBox& box, std::int64_t max_voxels) {
+  const Vector3 extent = box.extent().cwiseMax(Vector3::Constant(1e-12 * box.diagonal()));
+  // From the volume's estimate up until the grid, whose sides round up to whole voxels, fits.
+  double finest = std::cbrt(extent.prod() / static_cast<double>(max_voxels));
+  while (!MakeGrid(box, finest, max_voxels).ok()) finest *= 1.001;
+  return finest;
+}
+
 // Voxels inside the mesh or possibly crossed by its boundary, by octree-style culling over
 // blocks of voxels: a block whose centre lies outside by more than the block's circumradius is
 // dropped whole; one inside by more than that is kept whole without further queries.

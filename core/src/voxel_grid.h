@@ -1,9 +1,10 @@
 // Private: the voxel grid of medial-sphere generation, the culling of voxels wholly outside the
-// mesh, and the corner screen. Used by medial_spheres.cpp.
+// mesh, and the corner screen. Used by medial-sphere generation and the searches for a budget.
 #pragma once
 
 #include <array>
 #include <atomic>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -36,6 +37,17 @@ struct VisitedVoxel {
 // A grid of cubes of side `size` centred on `box`. INVALID_ARGUMENT naming both numbers when
 // it would have more than max_voxels cells (checked before anything is allocated).
 absl::StatusOr<Grid> MakeGrid(const BoundingBox& box, double size, std::int64_t max_voxels);
+
+// The smallest voxel size (to 0.1%) whose grid over `box` MakeGrid accepts. `box` must have a
+// positive finite diagonal.
+double FinestVoxelSize(const BoundingBox& box, std::int64_t max_voxels);
+
+// A first guess at the voxel size giving about `count` medial spheres: the medial surface of a
+// solid with this bounding-box diagonal, met by voxels of side sigma, gives about
+// (diagonal / sigma)^2 / 4 of them.
+inline double VoxelSizeForCount(double diagonal, double count) {
+  return 0.5 * diagonal / std::sqrt(count);
+}
 
 // Voxels inside the mesh or possibly crossed by its boundary, sorted by linear index. Adds the
 // closest-point queries it made to `queries`. When `*cancel` becomes true the work stops early

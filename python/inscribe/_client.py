@@ -125,6 +125,8 @@ class GenerateResult:
     seconds: float           # the original run's, when cached
     quality: dict            # QualityReport fields ({} when not evaluated)
     certificate: dict        # a cover's CoverCertificate fields ({} otherwise)
+    selection: str           # how the budget was spent: "paper" or "optimised"
+    pool_size: int           # optimised: the medial spheres chosen from; 0 otherwise
 
 
 @dataclasses.dataclass
@@ -314,7 +316,7 @@ class Client:
                  samples: Optional[int] = None, subdivide_boundary: bool = False,
                  max_protrusion: Optional[float] = None,
                  cover_resolution: Optional[float] = None, evaluate: bool = True,
-                 fill_holes: bool = False, progress: Optional[Callable[[float], None]] = None,
+                 fill_holes: bool = False, selection: Optional[str] = None, progress: Optional[Callable[[float], None]] = None,
                  progress_interval: float = 0.0,
                  timeout: Optional[float] = None) -> GenerateResult:
         """Spheres for `mesh` (an inscribe.Mesh, uploaded first, or the key of a stored one),
@@ -333,6 +335,8 @@ class Client:
             parameters.max_protrusion = max_protrusion
         if cover_resolution is not None:
             parameters.cover_resolution = cover_resolution
+        if selection is not None:
+            parameters.selection = selection  # the server names a bad one
         uploaded = isinstance(mesh, _inscribe.Mesh)
         key = self.put_mesh(mesh, fill_holes=fill_holes, timeout=timeout) if uploaded else mesh
         request = service_pb2.GenerateRequest(mesh_sha256=key, parameters=parameters,
@@ -368,7 +372,8 @@ class Client:
             quality=_fields(result.quality) if result.HasField("quality") else {},
             certificate=(_fields(result.cover.certificate)
                          if result.HasField("cover") and result.cover.HasField("certificate")
-                         else {}))
+                         else {}),
+            selection=result.selection, pool_size=result.pool_size)
 
     def get_sphere_set(self, sphere_set_key: str, *, timeout: Optional[float] = None):
         """The cached set `sphere_set_key` (SphereSet with contacts when it has them).

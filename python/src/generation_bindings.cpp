@@ -18,14 +18,6 @@
 namespace inscribe::python {
 namespace {
 
-SphereSetKind KindOf(const std::string& name) {
-  for (SphereSetKind kind :
-       {SphereSetKind::kInternal, SphereSetKind::kDilated, SphereSetKind::kCover}) {
-    if (name == SphereSetKindName(kind)) return kind;
-  }
-  throw py::value_error("kind must be 'internal', 'dilated' or 'cover', got '" + name + "'");
-}
-
 // Only what the caller gave overrides core's defaults (SphereSetParameters and the option
 // structs it holds); CheckSphereSetParameters judges the result.
 template <typename T>
@@ -40,9 +32,11 @@ std::shared_ptr<PySphereSet> Generate(
     std::optional<bool> subdivide_boundary, std::optional<std::int64_t> max_voxels,
     std::optional<double> dilation_growth, std::optional<double> max_protrusion,
     std::optional<double> cover_resolution, bool evaluate,
-    std::optional<std::int64_t> quality_samples, const py::object& progress) {
+    std::optional<std::int64_t> quality_samples, const std::optional<std::string>& selection,
+    const py::object& progress) {
   SphereSetParameters parameters;
-  parameters.kind = KindOf(kind);
+  parameters.kind = ValueOrRaise(ParseSphereSetKind(kind));
+  if (selection) parameters.selection = ValueOrRaise(ParseSphereSelection(*selection));
   parameters.max_spheres = max_spheres;
   parameters.voxel_size = voxel_size;
   Override(parameters.medial.object_angle, object_angle);
@@ -71,6 +65,10 @@ std::shared_ptr<PySphereSet> Generate(
   result->params = {{"kind", result->kind}};
   if (const std::optional<std::int64_t> budget = EffectiveMaxSpheres(parameters)) {
     result->params.emplace_back("max_spheres", *budget);
+    if (parameters.kind != SphereSetKind::kCover) {
+      result->params.emplace_back("selection",
+                                  std::string(SphereSelectionName(generated->selection)));
+    }
   }
   if (parameters.voxel_size) result->params.emplace_back("voxel_size", *parameters.voxel_size);
   if (parameters.max_protrusion) {
@@ -81,6 +79,10 @@ std::shared_ptr<PySphereSet> Generate(
                    {"runs", std::int64_t{generated->runs}},
                    {"generation_seconds", generated->generation_seconds},
                    {"seconds", generated->seconds}};
+  if (generated->selection == SphereSelection::kOptimised) {
+    result->stats.emplace_back("pool_size", generated->pool_size);
+    result->stats.emplace_back("covered_fraction", generated->covered_fraction);
+  }
   result->quality = generated->quality;
   if (generated->quality) result->stats.emplace_back("nerr", generated->quality->nerr);
   if (generated->cover) {
@@ -98,10 +100,14 @@ const std::string& GenerateDoc() {
 
 mesh: an inscribe.Mesh (validated and prepared on each call) or an inscribe.Solid
     (inscribe.prepare(mesh), reusable).
-max_spheres: at most N spheres: the finest voxel grid giving at most N (internal, dilated),
-    or the smallest protrusion reached with N (cover). voxel_size: sigma, the voxel side in
+max_spheres: at most N spheres, spent as `selection` says (internal, dilated), or the
+    smallest protrusion reached with N (cover). voxel_size: sigma, the voxel side in
     mesh units (internal, dilated only). At most one of the two; neither: a budget of )doc",
                         kDefaultMaxSpheres, R"doc(.
+selection: how a budget is spent (internal, dilated): 'paper' - the finest voxel grid
+    giving at most N, one sphere per voxel; 'optimised' - the N spheres of a finer grid's
+    pool that cover the most volume. None: ')doc",
+                        SphereSelectionName(kDefaultSphereSelection), R"doc('.
 kind: 'internal' - medial spheres inside the solid, tangent to it, with contacts (for
     Deformer); 'dilated' - grown to cover more of the boundary (they protrude);
     'cover' - a certified cover holding the whole solid (.certificate.delta bounds how far
@@ -208,7 +214,8 @@ void BindGeneration(py::module_& m) {
         py::arg("max_voxels") = py::none(), py::arg("dilation_growth") = py::none(),
         py::arg("max_protrusion") = py::none(), py::arg("cover_resolution") = py::none(),
         py::arg("evaluate") = true, py::arg("quality_samples") = py::none(),
-        py::arg("progress") = py::none(), GenerateDoc().c_str());
+        py::arg("selection") = py::none(), py::arg("progress") = py::none(),
+        GenerateDoc().c_str());
 
   m.def(
       "evaluate",

@@ -12,7 +12,7 @@
 #include <tuple>
 
 #include "inscribe/union_of_balls.h"
-#include "support/brute_force_closest_point.h"
+#include "support/medial_checks.h"
 #include "support/synthetic_meshes.h"
 #include "support/test_meshes.h"
 
@@ -20,7 +20,7 @@ namespace inscribe {
 namespace {
 
 using testing::Box;
-using testing::BruteForceDistance;
+using testing::ExpectInternalAndTangent;
 using testing::Icosphere;
 using testing::LoadTestMesh;
 
@@ -42,35 +42,6 @@ MedialSphereResult Generate(const BoundaryOracle& oracle, double voxel_size,
   return result.ok() ? *std::move(result) : MedialSphereResult{};
 }
 
-// Every sphere internal (centre inside; radius = brute-force distance to the boundary, so it
-// cannot stick out by more than rounding) and tangent (its contact lies on the boundary at
-// distance r from the centre).
-void ExpectInternalAndTangent(const BoundaryOracle& oracle, const MedialSphereResult& result) {
-  const Mesh& mesh = oracle.mesh();
-  const double diagonal = ComputeBoundingBox(mesh.vertices).diagonal();
-  ASSERT_EQ(result.set.contacts.size(), result.set.spheres.size());
-  for (std::size_t i = 0; i < result.set.size(); ++i) {
-    const Sphere& s = result.set.spheres[i];
-    const SurfaceContact& c = result.set.contacts[i];
-    ASSERT_GT(s.radius, 0.0) << "sphere " << i;
-    EXPECT_EQ(oracle.Classify(s.center), Side::kInside) << "sphere " << i;
-    const double exact = BruteForceDistance(mesh, s.center);
-    // Protrusion r - d(c), checked against the slow scan and against the oracle.
-    EXPECT_LE(s.radius - exact, 1e-9 * diagonal) << "sphere " << i << " sticks out";
-    EXPECT_LE(s.radius + oracle.SignedDistance(s.center), 1e-9 * diagonal) << "sphere " << i;
-    EXPECT_NEAR(s.radius, exact, 1e-12 * diagonal) << "sphere " << i << " is not tangent";
-    ASSERT_GE(c.triangle, 0);
-    ASSERT_LT(c.triangle, mesh.num_triangles());
-    EXPECT_NEAR(c.barycentric.sum(), 1.0, 1e-12);
-    EXPECT_GE(c.barycentric.minCoeff(), -1e-12);
-    const Vector3 contact = c.barycentric[0] * mesh.vertices.row(mesh.triangles(c.triangle, 0)) +
-                            c.barycentric[1] * mesh.vertices.row(mesh.triangles(c.triangle, 1)) +
-                            c.barycentric[2] * mesh.vertices.row(mesh.triangles(c.triangle, 2));
-    EXPECT_NEAR((contact.transpose() - s.center.transpose()).norm(), s.radius, 1e-9 * diagonal)
-        << "sphere " << i << ": contact not at distance r";
-  }
-}
-
 using VoxelKey = std::tuple<std::int64_t, std::int64_t, std::int64_t>;
 
 VoxelKey VoxelOf(const MedialSphereResult& result, const Vector3& x, double size) {
@@ -85,7 +56,7 @@ TEST(MedialSpheres, BoxSpheresAreInternalTangentAndMedial) {
   const BoundaryOracle oracle = MakeOracle(box);
   const MedialSphereResult result = Generate(oracle, 0.1);
   ASSERT_GT(result.set.size(), 20u);
-  ExpectInternalAndTangent(oracle, result);
+  ExpectInternalAndTangent(oracle, result.set);
   // A box's medial surface: points whose two smallest face distances are equal.
   for (const Sphere& s : result.set.spheres) {
     std::vector<double> d = {s.center.x(),       2.0 - s.center.x(), s.center.y(),
@@ -111,7 +82,7 @@ TEST(MedialSpheres, AtMostOneSphereInsideEachVoxel) {
     EXPECT_GE(std::get<0>(key), 0);
     EXPECT_LT(std::get<0>(key), result.grid_dims[0]);
   }
-  ExpectInternalAndTangent(oracle, result);
+  ExpectInternalAndTangent(oracle, result.set);
 }
 
 TEST(MedialSpheres, SubdividedBoundaryVoxelsHoldAtMostEight) {
@@ -129,7 +100,7 @@ TEST(MedialSpheres, SubdividedBoundaryVoxelsHoldAtMostEight) {
         << "two spheres in one half-size voxel";
   }
   for (const auto& [key, count] : per_voxel) EXPECT_LE(count, 8);
-  ExpectInternalAndTangent(oracle, split);
+  ExpectInternalAndTangent(oracle, split.set);
 }
 
 TEST(MedialSpheres, SameOutputBitForBitWhateverTheThreads) {
@@ -165,7 +136,7 @@ TEST(MedialSpheres, RealMeshesGiveInternalTangentSpheres) {
     const MedialSphereResult result =
         Generate(oracle, 0.05 * ComputeBoundingBox(mesh.vertices).diagonal());
     ASSERT_GT(result.set.size(), 10u);
-    ExpectInternalAndTangent(oracle, result);
+    ExpectInternalAndTangent(oracle, result.set);
   }
 }
 
@@ -223,7 +194,7 @@ TEST(MedialSpheres, SphereMeshGivesOneBigSphereNearItsCentre) {
   for (const Sphere& s : result.set.spheres) largest = std::max(largest, s.radius);
   // The level-3 icosphere's inradius is above 0.99.
   EXPECT_GT(largest, 0.98);
-  ExpectInternalAndTangent(oracle, result);
+  ExpectInternalAndTangent(oracle, result.set);
 }
 
 TEST(MedialSpheres, ObjectAngleFilters) {
@@ -336,7 +307,7 @@ TEST(SphereBudget, FinestGridWithinTheBudget) {
     EXPECT_GT(static_cast<std::int64_t>(Generate(oracle, found->rejected_voxel_size).set.size()),
               budget);
     EXPECT_LE(found->runs, options.max_runs);
-    ExpectInternalAndTangent(oracle, found->best);
+    ExpectInternalAndTangent(oracle, found->best.set);
   }
 }
 

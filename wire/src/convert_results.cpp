@@ -53,6 +53,7 @@ void GenerateRequestToProto(const std::string& mesh_sha256, const SphereSetParam
     wire->set_voxel_size(*p.voxel_size);
   } else if (const std::optional<std::int64_t> budget = EffectiveMaxSpheres(p)) {
     wire->set_max_spheres(*budget);
+    if (p.kind != SphereSetKind::kCover) wire->set_selection(SphereSelectionName(p.selection));
   }
   const MedialSphereOptions& m = p.medial;
   const MedialSphereOptions& d = defaults.medial;
@@ -97,6 +98,19 @@ absl::StatusOr<SphereSetParameters> SphereSetParametersFromProto(const v1::Gener
   if (by_size) p.voxel_size = wire.voxel_size();
   if (by_budget) p.max_spheres = wire.max_spheres();
   if (wire.has_max_protrusion()) p.max_protrusion = wire.max_protrusion();
+  if (wire.has_selection()) {
+    if (!by_budget || wire.cover()) {
+      return absl::InvalidArgumentError(
+          "parameters: selection spends a sphere budget (max_spheres) of internal or dilated "
+          "spheres; it means nothing with a voxel size or a cover");
+    }
+    absl::StatusOr<SphereSelection> selection = ParseSphereSelection(wire.selection());
+    if (!selection.ok()) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("parameters.selection: ", selection.status().message()));
+    }
+    p.selection = *selection;
+  }
   MedialSphereOptions& m = p.medial;
   // 0 means core's default for these three (proto3 scalars without presence).
   if (wire.object_angle() != 0.0) m.object_angle = wire.object_angle();
@@ -233,6 +247,9 @@ void GeneratedSphereSetToProto(const GeneratedSphereSet& g, v1::GenerateResult* 
   out->set_generation_seconds(g.generation_seconds);
   out->set_seconds(g.seconds);
   out->set_kind(KindToProto(g.kind));
+  out->set_selection(SphereSelectionName(g.selection));
+  out->set_pool_size(g.pool_size);
+  out->set_covered_fraction(g.covered_fraction);
   if (g.cover) {
     v1::CoverStats* cover = out->mutable_cover();
     CoverCertificateToProto(g.cover->certificate, cover->mutable_certificate());
@@ -257,6 +274,13 @@ absl::StatusOr<GeneratedSphereSet> GeneratedSphereSetFromProto(const v1::Generat
   g.generation_seconds = result.generation_seconds();
   g.seconds = result.seconds();
   g.kind = KindFromProto(result);
+  if (!result.selection().empty()) {
+    absl::StatusOr<SphereSelection> selection = ParseSphereSelection(result.selection());
+    if (!selection.ok()) return selection.status();
+    g.selection = *selection;
+  }
+  g.pool_size = result.pool_size();
+  g.covered_fraction = result.covered_fraction();
   if (result.has_cover()) {
     absl::StatusOr<CoverCertificate> certificate =
         CoverCertificateFromProto(result.cover().certificate());

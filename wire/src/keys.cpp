@@ -104,6 +104,11 @@ std::string GeneratedSphereSetKey(const std::string& mesh_key, const SphereSetPa
   if (p.evaluate && p.quality.surface_samples != quality_defaults.surface_samples) {
     absl::StrAppendFormat(&canonical, "quality_samples=%d\n", p.quality.surface_samples);
   }
+  // Sets made before the choice existed were the paper's.
+  if (p.kind != SphereSetKind::kCover && EffectiveMaxSpheres(p) &&
+      p.selection != SphereSelection::kPaper) {
+    absl::StrAppendFormat(&canonical, "selection=%s\n", SphereSelectionName(p.selection));
+  }
   if (p.kind == SphereSetKind::kCover) {
     absl::StrAppendFormat(&canonical, "cover=%s\nmax_protrusion=%.17g\ncover_resolution=%.17g\n",
                           kCoverAlgorithmVersion, p.max_protrusion.value_or(0.0),

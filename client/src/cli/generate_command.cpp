@@ -93,6 +93,7 @@ SphereFile MakeSphereFile(const GenerateCliOptions& options, const Generated& g)
   for (auto& param : medial) file.params.push_back(std::move(param));
   if (const std::optional<std::int64_t> budget = EffectiveMaxSpheres(p)) {
     file.params.emplace_back("max_spheres", *budget);
+    if (medial_run) file.params.emplace_back("selection", std::string(SphereSelectionName(r.selection)));
   }
   if (r.kind == SphereSetKind::kDilated) {
     file.params.emplace_back("dilation_growth", p.dilation.growth);
@@ -104,6 +105,10 @@ SphereFile MakeSphereFile(const GenerateCliOptions& options, const Generated& g)
   const QualityReport& quality = *r.quality;
   file.stats = {{"seconds", r.generation_seconds}};
   if (medial_run) file.stats.emplace_back("search_runs", static_cast<std::int64_t>(r.runs));
+  if (r.selection == SphereSelection::kOptimised) {
+    file.stats.emplace_back("pool_size", r.pool_size);
+    file.stats.emplace_back("covered_fraction", r.covered_fraction);
+  }
   NamedValues figures = {
       {"volume_mesh", quality.volume_mesh},
       {"volume_union", quality.volume_union},
@@ -189,6 +194,11 @@ void PrintSummary(const GenerateCliOptions& options, const Generated& g) {
   if (r.kind != SphereSetKind::kCover) {  // figures of the medial run (see MakeSphereFile)
     summary["epsilon"] = r.epsilon;
     summary["search_runs"] = r.runs;
+    summary["selection"] = SphereSelectionName(r.selection);
+    if (r.selection == SphereSelection::kOptimised) {
+      summary["pool_size"] = r.pool_size;
+      summary["covered_fraction"] = r.covered_fraction;
+    }
     summary["visited_voxels"] = r.stats.visited_voxels;
     summary["screened_voxels"] = r.stats.screened_voxels;
     summary["closest_point_queries"] = r.stats.closest_point_queries;
@@ -244,6 +254,19 @@ void AddGenerateCommand(CLI::App& app, CommandOutcome* outcome) {
       "count in the reported time. With --cover: at most N spheres, the smallest delta reached");
   voxel->excludes(budget);
   budget->excludes(voxel);
+  CLI::Option* selection =
+      cmd->add_option_function<std::string>(
+             "--selection",
+             [options](const std::string& name) {
+               absl::StatusOr<SphereSelection> parsed = ParseSphereSelection(name);
+               if (!parsed.ok()) throw CLI::ValidationError(std::string(parsed.status().message()));
+               options->parameters.selection = *parsed;
+             },
+             "How the sphere budget is spent: paper (the finest voxel grid within it, one sphere "
+             "per voxel) or optimised (the spheres of a finer grid's pool that cover the most "
+             "volume)")
+          ->default_str(SphereSelectionName(kDefaultSphereSelection));
+  selection->excludes(voxel);
   CLI::Option* cover = cmd->add_flag_callback(
       "--cover", [options] { options->parameters.kind = SphereSetKind::kCover; },
       "Make a certified cover instead: spheres proven to hold the whole solid, with delta, a "
@@ -257,6 +280,7 @@ void AddGenerateCommand(CLI::App& app, CommandOutcome* outcome) {
   voxel->excludes(protrusion);
   cover->excludes(voxel);
   voxel->excludes(cover);
+  selection->excludes(cover);
   cmd->add_option("--cover-resolution", options->parameters.cover_resolution,
                   "With --cover: the certificate's finest cell side, as a fraction of the "
                   "largest bounding-box side")

@@ -17,11 +17,14 @@
 #include "inscribe/sphere_cover.h"
 #include "inscribe/sphere_dilation.h"
 #include "inscribe/sphere_quality.h"
+#include "inscribe/sphere_selection.h"
 
 namespace inscribe {
 
 // The sphere budget used when neither a voxel size nor a budget is given.
 inline constexpr std::int64_t kDefaultMaxSpheres = 500;
+// How a budget is spent when the caller does not say.
+inline constexpr SphereSelection kDefaultSphereSelection = SphereSelection::kPaper;
 
 // What a generated set is, relative to its solid.
 enum class SphereSetKind {
@@ -47,6 +50,10 @@ struct SphereSetParameters {
   // max_protrusion too). A cover takes no voxel size.
   std::optional<double> voxel_size;
   std::optional<std::int64_t> max_spheres;
+  // How a budget is spent (internal and dilated sets): the paper's finest grid within it, or
+  // the optimised choice from a finer grid's pool (sphere_selection.h). A voxel size always
+  // means the paper's one sphere per voxel; covers choose their own balls.
+  SphereSelection selection = kDefaultSphereSelection;
   // Everything else about the medial spheres (object angle, epsilon, samples, screens,
   // boundary subdivision, the voxel limit); its voxel_size is ignored (see above). Covers
   // choose from balls of their own (sphere_cover.h) and ignore these.
@@ -80,7 +87,15 @@ CoverParameters CoverParametersOf(const SphereSetParameters& parameters);
 struct GeneratedSphereSet {
   SphereSetKind kind = SphereSetKind::kInternal;
   SphereSet set;            // S_D with contacts, else (dilated, cover) without
-  double voxel_size = 0.0;  // sigma used (the search's choice for a budget); 0 for a cover
+  // sigma used (the search's choice for a paper budget, the pool's for an optimised one); 0 for
+  // a cover.
+  double voxel_size = 0.0;
+  // The selection that spent the budget; kPaper for a fixed voxel size and for covers.
+  SphereSelection selection = SphereSelection::kPaper;
+  // Optimised selection: the pool's medial spheres and the sample points covered (of those in
+  // the pool's union); 0 otherwise.
+  std::int64_t pool_size = 0;
+  double covered_fraction = 0.0;
   // The medial-sphere run that made an internal or dilated set: epsilon used (mesh units, the
   // default resolved), runs (1 for a fixed sigma) and the run's figures. A cover's internal
   // set is GenerateCover's own: 0 runs and empty figures.

@@ -41,8 +41,33 @@ TEST(CliGenerate, JsonSummaryHasTheFiguresUsersNeed) {
   EXPECT_NEAR(j.at("nerr").get<double>(), (mesh - ball_union) / mesh, 1e-12);
   EXPECT_EQ(j.at("nerr_kind"), "exact");
   EXPECT_EQ(j.at("protruding_spheres").get<int>(), 0);
-  EXPECT_GT(j.at("search_runs").get<int>(), 1);
   EXPECT_EQ(j.at("surface_samples").get<int>(), 100000);
+  // The default spends the budget on the optimised selection: a pool, then a choice.
+  EXPECT_EQ(j.at("selection"), "optimised");
+  EXPECT_GT(j.at("pool_size").get<int>(), 120);
+  EXPECT_GT(j.at("covered_fraction").get<double>(), 0.5);
+  EXPECT_GE(j.at("search_runs").get<int>(), 1);
+}
+
+TEST(CliGenerate, SelectionPaperSearchesTheGridAndTheFileSaysWhich) {
+  INSCRIBE_REQUIRE_MESH("eight.off");
+  double nerr[2] = {0.0, 0.0};
+  int i = 0;
+  for (const char* selection : {"paper", "optimised"}) {
+    SCOPED_TRACE(selection);
+    const CliRun run = RunCli("generate " + Eight() + " --max-spheres 120 --selection " +
+                              selection + " --quality-samples 0");
+    ASSERT_EQ(run.exit_code, 0) << run.err;
+    const nlohmann::json j = nlohmann::json::parse(run.out);
+    EXPECT_EQ(j.at("params").at("selection"), selection);
+    EXPECT_LE(j.at("spheres").size(), 120u);
+    EXPECT_EQ(j.at("contacts").size(), j.at("spheres").size());
+    const bool optimised = std::string(selection) == "optimised";
+    EXPECT_EQ(j.at("stats").contains("pool_size"), optimised);
+    if (!optimised) EXPECT_GT(j.at("stats").at("search_runs").get<int>(), 1);
+    nerr[i++] = j.at("stats").at("nerr").get<double>();
+  }
+  EXPECT_LT(nerr[1], nerr[0]);
 }
 
 TEST(CliGenerate, DefaultOutputIsTheSphereSetJson) {
@@ -202,6 +227,9 @@ TEST(CliGenerate, BadOptionsAreClearErrorsNotHangs) {
       {"--cover --cover-resolution 0", 64, "resolution"},
       {"--cover --object-angle 0.5", 64, "excludes"},
       {"--cover --subdivide-boundary", 64, "excludes"},
+      {"--selection greedy", 64, "unknown sphere selection 'greedy'"},
+      {"--voxel-size 0.1 --selection paper", 64, "excludes"},
+      {"--cover --selection paper", 64, "excludes"},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.args);

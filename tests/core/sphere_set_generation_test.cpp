@@ -54,6 +54,15 @@ ByHand RunByHand(const Solid& solid, const SphereSetParameters& p) {
     EXPECT_TRUE(run.ok()) << run.status();
     medial = *std::move(run);
     out.runs = 1;
+  } else if (p.selection == SphereSelection::kOptimised) {
+    OptimisedSphereOptions optimised;
+    optimised.max_spheres = p.max_spheres.value_or(kDefaultMaxSpheres);
+    optimised.base = p.medial;
+    absl::StatusOr<OptimisedSphereResult> chosen =
+        GenerateOptimisedSpheres(solid.oracle, optimised);
+    EXPECT_TRUE(chosen.ok()) << chosen.status();
+    medial = std::move(chosen->best);
+    out.runs = chosen->runs;
   } else {
     SphereBudgetOptions budget;
     budget.max_spheres = p.max_spheres.value_or(kDefaultMaxSpheres);
@@ -123,7 +132,10 @@ TEST(GenerateSphereSet, EqualsItsStagesOnRealMeshes) {
     budget.max_spheres = 90;
     budget.medial.subdivide_boundary = true;
     budget.quality.surface_samples = 5000;
-    ExpectPipelineEqualsStages(solid, budget);
+    for (SphereSelection selection : {SphereSelection::kPaper, SphereSelection::kOptimised}) {
+      budget.selection = selection;
+      ExpectPipelineEqualsStages(solid, budget);
+    }
     SphereSetParameters dilated;
     dilated.voxel_size = 0.1;
     dilated.kind = SphereSetKind::kDilated;
@@ -143,7 +155,8 @@ TEST(GenerateSphereSet, NeitherSizeNorBudgetMeansTheDefaultBudget) {
   absl::StatusOr<GeneratedSphereSet> g = GenerateSphereSet(solid, defaults);
   ASSERT_TRUE(g.ok()) << g.status();
   EXPECT_LE(g->set.size(), static_cast<std::size_t>(kDefaultMaxSpheres));
-  EXPECT_GT(g->runs, 1);
+  EXPECT_EQ(g->selection, kDefaultSphereSelection);
+  EXPECT_GE(g->runs, 1);
   EXPECT_FALSE(g->quality.has_value());
 }
 

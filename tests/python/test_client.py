@@ -38,6 +38,14 @@ def test_generate_on_the_server_is_in_process_generation_bit_for_bit(server, eig
         assert again.cache == "memory" and again.sphere_set_key == result.sphere_set_key
         stored = client.get_sphere_set(result.sphere_set_key)
         assert np.array_equal(stored.spheres, local.spheres)
+        assert result.selection == "optimised" and result.pool_size > 60
+        paper = client.generate(eight, max_spheres=60, selection="paper")
+        local_paper = inscribe.generate(eight, max_spheres=60, selection="paper")
+        assert paper.selection == "paper" and paper.sphere_set_key != result.sphere_set_key
+        assert np.array_equal(paper.spheres.spheres, local_paper.spheres)
+        with pytest.raises(inscribe.Error) as raised:
+            client.generate(eight, max_spheres=60, selection="greedy")
+        assert raised.value.code == "INVALID_ARGUMENT" and "greedy" in str(raised.value)
 
 
 def test_distance_batch_and_session_match_in_process(server, eight):

@@ -22,6 +22,8 @@ def eight():
 @pytest.mark.parametrize("mesh, cli_args, kwargs", [
     ("bunny00.off", [], {}),
     ("eight.off", ["--max-spheres", "60"], {"max_spheres": 60}),
+    ("eight.off", ["--max-spheres", "60", "--selection", "paper"],
+     {"max_spheres": 60, "selection": "paper"}),
     ("fandisk.off", ["--voxel-size", "0.08"], {"voxel_size": 0.08}),
     ("eight.off", ["--max-spheres", "60", "--dilate"], {"max_spheres": 60, "kind": "dilated"}),
     ("eight.off", ["--cover", "--max-spheres", "80"], {"max_spheres": 80, "kind": "cover"}),
@@ -104,8 +106,18 @@ def test_ctrl_c_cancels_a_long_run():
     ({"object_angle": 4.0}, "object angle must lie in (0, pi) radians, got 4"),
     ({"kind": "hollow"}, "kind must be 'internal', 'dilated' or 'cover', got 'hollow'"),
     ({"kind": "cover", "voxel_size": 0.1}, "a cover takes a sphere budget or a max_protrusion"),
+    ({"selection": "greedy"}, "unknown sphere selection 'greedy': expected paper or optimised"),
 ])
 def test_bad_settings_are_value_errors_with_cores_message(eight, kwargs, message):
     with pytest.raises(ValueError) as raised:
         inscribe.generate(eight, **kwargs)
     assert message in str(raised.value)
+
+
+def test_the_optimised_selection_beats_the_papers_and_says_so(eight):
+    paper = inscribe.generate(eight, max_spheres=80, selection="paper")
+    optimised = inscribe.generate(eight, max_spheres=80)
+    assert optimised.stats["pool_size"] > 80 and "pool_size" not in paper.stats
+    assert optimised.params["selection"] == "optimised" and paper.params["selection"] == "paper"
+    assert len(optimised.spheres) <= 80
+    assert optimised.quality.nerr < paper.quality.nerr

@@ -177,7 +177,7 @@ bool SameParameters(const SphereSetParameters& a, const SphereSetParameters& b) 
          m.screen_samples == n.screen_samples && m.corner_screen == n.corner_screen &&
          m.pair_angle_margin == n.pair_angle_margin &&
          m.subdivide_boundary == n.subdivide_boundary && m.max_voxels == n.max_voxels &&
-         a.kind == b.kind &&
+         a.kind == b.kind && a.selection == b.selection &&
          (a.kind != SphereSetKind::kDilated || a.dilation.growth == b.dilation.growth) &&
          a.evaluate == b.evaluate &&
          (!a.evaluate || a.quality.surface_samples == b.quality.surface_samples) &&
@@ -203,6 +203,8 @@ TEST(GenerateParameters, EveryOptionSurvivesTheWire) {
   SphereSetParameters budget;
   budget.max_spheres = 42;
   budget.evaluate = false;
+  SphereSetParameters paper = budget;
+  paper.selection = SphereSelection::kPaper;
   SphereSetParameters defaults;  // the default budget goes as max_spheres
   SphereSetParameters cover;
   cover.kind = SphereSetKind::kCover;
@@ -211,7 +213,7 @@ TEST(GenerateParameters, EveryOptionSurvivesTheWire) {
   SphereSetParameters cover_budget;
   cover_budget.kind = SphereSetKind::kCover;
   cover_budget.max_spheres = 64;
-  for (const SphereSetParameters& p : {all, budget, defaults, cover, cover_budget}) {
+  for (const SphereSetParameters& p : {all, budget, paper, defaults, cover, cover_budget}) {
     v1::GenerateRequest request;
     GenerateRequestToProto("sha256:x", p, true, &request);
     EXPECT_EQ(request.mesh_sha256(), "sha256:x");
@@ -230,7 +232,7 @@ TEST(GenerateParameters, EveryOptionSurvivesTheWire) {
   EXPECT_FALSE(wire.has_screen_samples() || wire.has_corner_screen() ||
                wire.has_pair_angle_margin() || wire.has_dilation_growth() ||
                wire.has_quality_samples() || wire.has_max_protrusion() ||
-               wire.has_cover_resolution() || wire.cover());
+               wire.has_cover_resolution() || wire.has_selection() || wire.cover());
   EXPECT_EQ(wire.object_angle(), 0.0);
   EXPECT_EQ(wire.samples(), 0);
   // The caller's grid limit always travels: a server with a larger --max-voxels must not
@@ -321,6 +323,16 @@ TEST(GenerateParameters, BadRequestsNameTheProblem) {
   samples.mutable_parameters()->set_quality_samples(-1);
   EXPECT_THAT(SphereSetParametersFromProto(samples, 100).status().message(),
               HasSubstr("surface samples"));
+  v1::GenerateRequest selection;
+  selection.mutable_parameters()->set_max_spheres(10);
+  selection.mutable_parameters()->set_selection("greedy");
+  EXPECT_THAT(SphereSetParametersFromProto(selection, 100).status().message(),
+              HasSubstr("parameters.selection: unknown sphere selection 'greedy'"));
+  v1::GenerateRequest sized;
+  sized.mutable_parameters()->set_voxel_size(0.1);
+  sized.mutable_parameters()->set_selection("paper");
+  EXPECT_THAT(SphereSetParametersFromProto(sized, 100).status().message(),
+              HasSubstr("selection spends a sphere budget"));
 }
 
 TEST(GenerateParameters, BadCoverRequestsNameTheProblem) {

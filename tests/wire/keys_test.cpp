@@ -26,6 +26,7 @@ TEST(Keys, GeneratedKeysMatchVersionOneText) {
   dilated.kind = SphereSetKind::kDilated;
   dilated.dilation.growth = 0.5;
   dilated.evaluate = false;
+  dilated.selection = SphereSelection::kPaper;  // sets made before the choice existed
   EXPECT_EQ(GeneratedSphereSetKey(kMesh, dilated, true),
             "spheres/v1/0123456789abcdefe4f0ed8ca1ed48e91844bf8870a4bcde1685ca90d28e3de1");
 }
@@ -60,7 +61,8 @@ TEST(Keys, EveryParameterChangesTheKey) {
   p = base, p.kind = SphereSetKind::kDilated, p.dilation.growth = 0.0, add(p);
   p = base, p.evaluate = false, add(p);
   p = base, p.quality.surface_samples = 5000, add(p);
-  EXPECT_EQ(keys.size(), 15u);
+  p = base, p.selection = SphereSelection::kPaper, add(p);
+  EXPECT_EQ(keys.size(), 16u);
   // Growth means nothing without dilation, nor quality samples without evaluation.
   p = base, p.dilation.growth = 0.3;
   EXPECT_EQ(GeneratedSphereSetKey(kMesh, p, false), GeneratedSphereSetKey(kMesh, base, false));

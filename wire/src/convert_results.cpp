@@ -53,7 +53,9 @@ void GenerateRequestToProto(const std::string& mesh_sha256, const SphereSetParam
     wire->set_voxel_size(*p.voxel_size);
   } else if (const std::optional<std::int64_t> budget = EffectiveMaxSpheres(p)) {
     wire->set_max_spheres(*budget);
-    if (p.kind != SphereSetKind::kCover) wire->set_selection(SphereSelectionName(p.selection));
+    if (p.kind != SphereSetKind::kCover && p.selection != defaults.selection) {
+      wire->set_selection(SphereSelectionName(p.selection));
+    }
   }
   const MedialSphereOptions& m = p.medial;
   const MedialSphereOptions& d = defaults.medial;

@@ -24,7 +24,7 @@ namespace inscribe {
 // The sphere budget used when neither a voxel size nor a budget is given.
 inline constexpr std::int64_t kDefaultMaxSpheres = 500;
 // How a budget is spent when the caller does not say.
-inline constexpr SphereSelection kDefaultSphereSelection = SphereSelection::kPaper;
+inline constexpr SphereSelection kDefaultSphereSelection = SphereSelection::kOptimised;
 
 // What a generated set is, relative to its solid.
 enum class SphereSetKind {

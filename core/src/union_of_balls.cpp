@@ -38,21 +38,36 @@ namespace {
 
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using WeightedPoint = Kernel::Weighted_point_3;
-// Vertex info: the vertex's slot in the inserted point list (ball_of_vertex maps it to the
-// input). Cell info: the cell's number in ClassifyAtAlphaZero's flat arrays. The fixed alpha
-// shape bases serve FixedAlphaShapeDualComplex, the reference the tests compare against.
-using VertexBase = CGAL::Fixed_alpha_shape_vertex_base_3<
-    Kernel, CGAL::Triangulation_vertex_base_with_info_3<
-                std::int32_t, Kernel, CGAL::Regular_triangulation_vertex_base_3<Kernel>>>;
+// Regular_triangulation_cell_base_3's hidden point container when hidden points are
+// discarded: never filled, and 8 bytes per cell instead of an empty std::list's 24.
+struct NoHiddenPoints {
+  using iterator = WeightedPoint*;
+  using const_iterator = const WeightedPoint*;
+  iterator begin() { return nullptr; }
+  iterator end() { return nullptr; }
+  const_iterator begin() const { return nullptr; }
+  const_iterator end() const { return nullptr; }
+};
 // Hidden points are not needed (the redundant balls are found by elimination), so not kept.
-using CellBase = CGAL::Fixed_alpha_shape_cell_base_3<
-    Kernel, CGAL::Triangulation_cell_base_with_info_3<
-                std::int32_t, Kernel,
-                CGAL::Regular_triangulation_cell_base_3<
-                    Kernel, CGAL::Triangulation_cell_base_3<Kernel>, CGAL::Discard_hidden_points>>>;
-using Tds = CGAL::Triangulation_data_structure_3<VertexBase, CellBase>;
-using RegularTriangulation = CGAL::Regular_triangulation_3<Kernel, Tds>;
-using AlphaShape = CGAL::Fixed_alpha_shape_3<RegularTriangulation>;
+using RegularCellBase =
+    CGAL::Regular_triangulation_cell_base_3<Kernel, CGAL::Triangulation_cell_base_3<Kernel>,
+                                            CGAL::Discard_hidden_points, NoHiddenPoints>;
+// Vertex info: the vertex's slot in the inserted point list (ball_of_vertex maps it to the
+// input). Cell info: the cell's number in ClassifyAtAlphaZero. 72 bytes per cell.
+using VertexBase =
+    CGAL::Triangulation_vertex_base_with_info_3<std::int32_t, Kernel,
+                                                CGAL::Regular_triangulation_vertex_base_3<Kernel>>;
+using CellBase = CGAL::Triangulation_cell_base_with_info_3<std::int32_t, Kernel, RegularCellBase>;
+using RegularTriangulation =
+    CGAL::Regular_triangulation_3<Kernel,
+                                  CGAL::Triangulation_data_structure_3<VertexBase, CellBase>>;
+// FixedAlphaShapeDualComplex's triangulation: the same with the alpha shape's classification
+// fields (a second instantiation; only the tests use it).
+using AlphaShapeTriangulation = CGAL::Regular_triangulation_3<
+    Kernel, CGAL::Triangulation_data_structure_3<
+                CGAL::Fixed_alpha_shape_vertex_base_3<Kernel, VertexBase>,
+                CGAL::Fixed_alpha_shape_cell_base_3<Kernel, RegularCellBase>>>;
+using AlphaShape = CGAL::Fixed_alpha_shape_3<AlphaShapeTriangulation>;
 
 constexpr std::int32_t kPadding = -1;
 constexpr double kMaxMagnitude = 1e150;
@@ -147,9 +162,9 @@ void ForEachIndex(std::size_t n, const F& f) {
 
 // The regular triangulation of the distinct balls, padded to dimension 3 if the centres span
 // less. Vertex info is the index into `ball_of_vertex`, which gives the input ball or kPadding.
+template <typename Triangulation>
 absl::Status Triangulate(const std::vector<Sphere>& balls,
-                         const std::vector<std::int32_t>& distinct,
-                         RegularTriangulation* triangulation,
+                         const std::vector<std::int32_t>& distinct, Triangulation* triangulation,
                          std::vector<std::int32_t>* ball_of_vertex) {
   std::vector<std::pair<WeightedPoint, std::int32_t>> points;
   points.reserve(distinct.size() + 4);
@@ -437,15 +452,19 @@ absl::StatusOr<DualComplex> DualComplexBy(const std::vector<Sphere>& balls, Clas
 
   const std::vector<std::int32_t> distinct = DistinctBalls(balls, &complex.redundant);
   try {
-    RegularTriangulation triangulation;
     std::vector<std::int32_t> ball_of_vertex;
-    if (absl::Status s = Triangulate(balls, distinct, &triangulation, &ball_of_vertex); !s.ok()) {
-      return s;
-    }
     bool clean = false;
     if (classifier == Classifier::kDirect) {
+      RegularTriangulation triangulation;
+      if (absl::Status s = Triangulate(balls, distinct, &triangulation, &ball_of_vertex); !s.ok()) {
+        return s;
+      }
       clean = ClassifyAtAlphaZero(triangulation, ball_of_vertex, &complex);
     } else {
+      AlphaShapeTriangulation triangulation;
+      if (absl::Status s = Triangulate(balls, distinct, &triangulation, &ball_of_vertex); !s.ok()) {
+        return s;
+      }
       const AlphaShape shape(triangulation, 0.0);  // takes the triangulation's content
       clean = ExtractComplex(shape, ball_of_vertex, &complex);
     }

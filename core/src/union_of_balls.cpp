@@ -4,9 +4,6 @@
 #include "inscribe/union_of_balls.h"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Fixed_alpha_shape_3.h>
-#include <CGAL/Fixed_alpha_shape_cell_base_3.h>
-#include <CGAL/Fixed_alpha_shape_vertex_base_3.h>
 #include <CGAL/Regular_triangulation_3.h>
 #include <CGAL/Regular_triangulation_cell_base_3.h>
 #include <CGAL/Regular_triangulation_vertex_base_3.h>
@@ -31,7 +28,6 @@
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
 #include "ball_intersection_volumes.h"
-#include "fixed_alpha_shape_dual_complex.h"
 
 namespace inscribe {
 namespace {
@@ -61,13 +57,6 @@ using CellBase = CGAL::Triangulation_cell_base_with_info_3<std::int32_t, Kernel,
 using RegularTriangulation =
     CGAL::Regular_triangulation_3<Kernel,
                                   CGAL::Triangulation_data_structure_3<VertexBase, CellBase>>;
-// FixedAlphaShapeDualComplex's triangulation: the same with the alpha shape's classification
-// fields (a second instantiation; only the tests use it).
-using AlphaShapeTriangulation = CGAL::Regular_triangulation_3<
-    Kernel, CGAL::Triangulation_data_structure_3<
-                CGAL::Fixed_alpha_shape_vertex_base_3<Kernel, VertexBase>,
-                CGAL::Fixed_alpha_shape_cell_base_3<Kernel, RegularCellBase>>>;
-using AlphaShape = CGAL::Fixed_alpha_shape_3<AlphaShapeTriangulation>;
 
 constexpr std::int32_t kPadding = -1;
 constexpr double kMaxMagnitude = 1e150;
@@ -116,7 +105,7 @@ std::vector<std::int32_t> DistinctBalls(const std::vector<Sphere>& balls,
 
 // Four zero-weight points far outside every ball, at the corners of a regular tetrahedron
 // about the balls' bounding box. Added only when the centres span less than 3 dimensions (the
-// alpha shape needs a 3-dimensional triangulation). They change the regular triangulation but
+// classification needs a 3-dimensional triangulation). They change the regular triangulation but
 // not the dual complex: each is a point ball disjoint from the union, so inside the union
 // every power cell is unchanged (power to a padding point > 0 >= power to a covering ball), and
 // no simplex with a padding vertex has a common point of its balls.
@@ -162,9 +151,9 @@ void ForEachIndex(std::size_t n, const F& f) {
 
 // The regular triangulation of the distinct balls, padded to dimension 3 if the centres span
 // less. Vertex info is the index into `ball_of_vertex`, which gives the input ball or kPadding.
-template <typename Triangulation>
 absl::Status Triangulate(const std::vector<Sphere>& balls,
-                         const std::vector<std::int32_t>& distinct, Triangulation* triangulation,
+                         const std::vector<std::int32_t>& distinct,
+                         RegularTriangulation* triangulation,
                          std::vector<std::int32_t>* ball_of_vertex) {
   std::vector<std::pair<WeightedPoint, std::int32_t>> points;
   points.reserve(distinct.size() + 4);
@@ -185,48 +174,11 @@ absl::Status Triangulate(const std::vector<Sphere>& balls,
     }
     triangulation->insert(padding.begin(), padding.end());
   }
-  // Neither classification handles a triangulation below dimension 3.
+  // ClassifyAtAlphaZero needs dimension 3.
   if (triangulation->dimension() < 3) {
     return absl::InternalError("dual complex: the padded triangulation is not 3-dimensional");
   }
   return absl::OkStatus();
-}
-
-// Fills the simplices of `complex` from the alpha shape: every finite simplex not EXTERIOR,
-// i.e. INTERIOR, REGULAR or SINGULAR at alpha = 0. Returns false if one has a padding vertex
-// (impossible by construction; checked rather than assumed).
-bool ExtractComplex(const AlphaShape& shape, const std::vector<std::int32_t>& ball_of_vertex,
-                    DualComplex* complex) {
-  bool padding_in_complex = false;
-  const auto id = [&](const AlphaShape::Vertex_handle& v) {
-    const std::int32_t ball = ball_of_vertex[static_cast<std::size_t>(v->info())];
-    if (ball == kPadding) padding_in_complex = true;
-    return ball;
-  };
-  for (auto v = shape.finite_vertices_begin(); v != shape.finite_vertices_end(); ++v) {
-    const std::int32_t ball = ball_of_vertex[static_cast<std::size_t>(v->info())];
-    if (ball == kPadding) continue;  // isolated points by construction
-    if (shape.classify(v) != AlphaShape::EXTERIOR) complex->vertices.push_back(ball);
-  }
-  for (auto e = shape.finite_edges_begin(); e != shape.finite_edges_end(); ++e) {
-    if (shape.classify(*e) == AlphaShape::EXTERIOR) continue;
-    complex->edges.push_back(
-        SortedTuple<2>({id(e->first->vertex(e->second)), id(e->first->vertex(e->third))}));
-  }
-  for (auto f = shape.finite_facets_begin(); f != shape.finite_facets_end(); ++f) {
-    if (shape.classify(*f) == AlphaShape::EXTERIOR) continue;
-    std::array<std::int32_t, 3> t;
-    for (int k = 0, j = 0; k < 4; ++k) {
-      if (k != f->second) t[static_cast<std::size_t>(j++)] = id(f->first->vertex(k));
-    }
-    complex->triangles.push_back(SortedTuple(t));
-  }
-  for (auto c = shape.finite_cells_begin(); c != shape.finite_cells_end(); ++c) {
-    if (shape.classify(c) == AlphaShape::EXTERIOR) continue;
-    complex->tetrahedra.push_back(
-        SortedTuple<4>({id(c->vertex(0)), id(c->vertex(1)), id(c->vertex(2)), id(c->vertex(3))}));
-  }
-  return !padding_in_complex;
 }
 
 // The six edges of a cell as pairs of vertex positions.
@@ -443,32 +395,34 @@ absl::Status CheckIndices(const std::vector<std::array<std::int32_t, N>>& simpli
   return absl::OkStatus();
 }
 
-enum class Classifier { kDirect, kFixedAlphaShape };
+// Sum of term(s) over `simplices` in long double, in list order. The terms are evaluated in
+// parallel into their own slots, so the sum's bits do not depend on the thread count.
+template <typename Simplex, typename Term>
+long double OrderedSum(const std::vector<Simplex>& simplices, const Term& term) {
+  std::vector<double> terms(simplices.size());
+  ForEachIndex(simplices.size(), [&](std::size_t s) { terms[s] = term(simplices[s]); });
+  long double sum = 0;
+  for (double t : terms) sum += t;
+  return sum;
+}
 
-absl::StatusOr<DualComplex> DualComplexBy(const std::vector<Sphere>& balls, Classifier classifier) {
+}  // namespace
+
+absl::StatusOr<DualComplex> ComputeDualComplex(const std::vector<Sphere>& balls) {
   if (absl::Status s = ValidateBalls(balls); !s.ok()) return s;
   DualComplex complex;
   if (balls.empty()) return complex;
 
   const std::vector<std::int32_t> distinct = DistinctBalls(balls, &complex.redundant);
   try {
+    RegularTriangulation triangulation;
     std::vector<std::int32_t> ball_of_vertex;
-    bool clean = false;
-    if (classifier == Classifier::kDirect) {
-      RegularTriangulation triangulation;
-      if (absl::Status s = Triangulate(balls, distinct, &triangulation, &ball_of_vertex); !s.ok()) {
-        return s;
-      }
-      clean = ClassifyAtAlphaZero(triangulation, ball_of_vertex, &complex);
-    } else {
-      AlphaShapeTriangulation triangulation;
-      if (absl::Status s = Triangulate(balls, distinct, &triangulation, &ball_of_vertex); !s.ok()) {
-        return s;
-      }
-      const AlphaShape shape(triangulation, 0.0);  // takes the triangulation's content
-      clean = ExtractComplex(shape, ball_of_vertex, &complex);
+    if (absl::Status s = Triangulate(balls, distinct, &triangulation, &ball_of_vertex); !s.ok()) {
+      return s;
     }
-    if (!clean) return absl::InternalError("dual complex: a padding point entered the complex");
+    if (!ClassifyAtAlphaZero(triangulation, ball_of_vertex, &complex)) {
+      return absl::InternalError("dual complex: a padding point entered the complex");
+    }
   } catch (const std::exception& e) {
     return absl::InternalError(absl::StrCat("CGAL: ", e.what()));
   }
@@ -487,31 +441,6 @@ absl::StatusOr<DualComplex> DualComplexBy(const std::vector<Sphere>& balls, Clas
   std::sort(complex.redundant.begin(), complex.redundant.end());
   return complex;
 }
-
-// Sum of term(s) over `simplices` in long double, in list order. The terms are evaluated in
-// parallel into their own slots, so the sum's bits do not depend on the thread count.
-template <typename Simplex, typename Term>
-long double OrderedSum(const std::vector<Simplex>& simplices, const Term& term) {
-  std::vector<double> terms(simplices.size());
-  ForEachIndex(simplices.size(), [&](std::size_t s) { terms[s] = term(simplices[s]); });
-  long double sum = 0;
-  for (double t : terms) sum += t;
-  return sum;
-}
-
-}  // namespace
-
-absl::StatusOr<DualComplex> ComputeDualComplex(const std::vector<Sphere>& balls) {
-  return DualComplexBy(balls, Classifier::kDirect);
-}
-
-namespace internal {
-
-absl::StatusOr<DualComplex> FixedAlphaShapeDualComplex(const std::vector<Sphere>& balls) {
-  return DualComplexBy(balls, Classifier::kFixedAlphaShape);
-}
-
-}  // namespace internal
 
 absl::StatusOr<double> UnionVolume(const std::vector<Sphere>& balls, const DualComplex& complex) {
   if (absl::Status s = ValidateBalls(balls); !s.ok()) return s;

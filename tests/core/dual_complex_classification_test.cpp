@@ -1,6 +1,6 @@
 // ComputeDualComplex classifies the regular triangulation at alpha = 0 itself; these tests
 // compare it, simplex for simplex, with CGAL's Fixed_alpha_shape_3 on the same input
-// (internal::FixedAlphaShapeDualComplex), on random and on degenerate sets.
+// (testing::FixedAlphaShapeDualComplex), on random and on degenerate sets.
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
 
@@ -13,13 +13,14 @@
 #include <string>
 #include <vector>
 
-#include "fixed_alpha_shape_dual_complex.h"
 #include "inscribe/union_of_balls.h"
+#include "support/fixed_alpha_shape_dual_complex.h"
 #include "support/sphere_sets.h"
 
 namespace inscribe {
 namespace {
 
+using testing::FixedAlphaShapeDualComplex;
 using testing::RandomBalls;
 
 Sphere Ball(double x, double y, double z, double r) { return Sphere{Vector3(x, y, z), r}; }
@@ -27,15 +28,14 @@ Sphere Ball(double x, double y, double z, double r) { return Sphere{Vector3(x, y
 // The direct complex of `balls`, after checking it equals the reference.
 DualComplex ExpectSameComplex(const std::vector<Sphere>& balls, const std::string& what) {
   const absl::StatusOr<DualComplex> direct = ComputeDualComplex(balls);
-  const absl::StatusOr<DualComplex> reference = internal::FixedAlphaShapeDualComplex(balls);
+  const DualComplex reference = FixedAlphaShapeDualComplex(balls);
   EXPECT_TRUE(direct.ok()) << what << ": " << direct.status();
-  EXPECT_TRUE(reference.ok()) << what << ": " << reference.status();
-  if (!direct.ok() || !reference.ok()) return {};
-  EXPECT_EQ(direct->vertices, reference->vertices) << what;
-  EXPECT_EQ(direct->edges, reference->edges) << what;
-  EXPECT_EQ(direct->triangles, reference->triangles) << what;
-  EXPECT_EQ(direct->tetrahedra, reference->tetrahedra) << what;
-  EXPECT_EQ(direct->redundant, reference->redundant) << what;
+  if (!direct.ok()) return {};
+  EXPECT_EQ(direct->vertices, reference.vertices) << what;
+  EXPECT_EQ(direct->edges, reference.edges) << what;
+  EXPECT_EQ(direct->triangles, reference.triangles) << what;
+  EXPECT_EQ(direct->tetrahedra, reference.tetrahedra) << what;
+  EXPECT_EQ(direct->redundant, reference.redundant) << what;
   return *direct;
 }
 

@@ -181,8 +181,9 @@ absl::Status Triangulate(const std::vector<Sphere>& balls,
   return absl::OkStatus();
 }
 
-// The six edges of a cell as pairs of vertex positions.
+// The six edges of a cell as pairs of vertex positions, and for each the two other positions.
 constexpr int kEdgeEnds[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+constexpr int kEdgeOthers[6][2] = {{2, 3}, {1, 3}, {1, 2}, {0, 3}, {0, 2}, {0, 1}};
 
 int PopCount(std::uint8_t bits) {
   int n = 0;
@@ -282,15 +283,15 @@ bool ClassifyAtAlphaZero(RegularTriangulation& triangulation,
   std::vector<std::uint8_t> owned_edge_in(num_cells, 0);
   ForEachIndex(num_cells, [&](std::size_t c) {
     const CellHandle& h = cells[c];
+    const auto precedes = [c](std::int32_t n) { return n >= 0 && static_cast<std::size_t>(n) < c; };
+    std::int32_t neighbor_number[4];
+    for (int k = 0; k < 4; ++k) neighbor_number[k] = number(h->neighbor(k));
     for (int e = 0; e < 6; ++e) {
-      const auto first = triangulation.incident_cells(h, kEdgeEnds[e][0], kEdgeEnds[e][1]);
-      auto around = first;
-      bool owned = true;
-      do {
-        const std::int32_t n = number(around);
-        owned = n < 0 || static_cast<std::size_t>(n) >= c;
-      } while (owned && ++around != first);
-      if (!owned) continue;
+      // The cells across this cell's two facets around the edge: most edges end here.
+      if (precedes(neighbor_number[kEdgeOthers[e][0]]) ||
+          precedes(neighbor_number[kEdgeOthers[e][1]])) {
+        continue;
+      }
       const VertexHandle u = h->vertex(kEdgeEnds[e][0]);
       const VertexHandle w = h->vertex(kEdgeEnds[e][1]);
       // The two facets of a cell around the edge are those opposite its two other vertices.
@@ -303,13 +304,25 @@ bool ClassifyAtAlphaZero(RegularTriangulation& triangulation,
         }
         return std::make_pair(k[0], k[1]);
       };
+      // One walk around the edge: is this cell the lowest-numbered, and is a facet in.
+      const auto first = triangulation.incident_cells(h, kEdgeEnds[e][0], kEdgeEnds[e][1]);
+      auto around = first;
+      bool owned = true;
       bool in = false;
       do {
-        if (number(around) < 0) continue;
-        const auto [k, l] = others(around);
-        const std::uint8_t bits = facet_in[static_cast<std::size_t>(number(around))];
-        in = ((bits >> k) & 1u) || ((bits >> l) & 1u);
-      } while (!in && ++around != first);
+        const std::int32_t n = number(around);
+        if (n < 0) continue;
+        if (precedes(n)) {
+          owned = false;
+          break;
+        }
+        if (!in) {
+          const auto [k, l] = others(around);
+          const std::uint8_t bits = facet_in[static_cast<std::size_t>(n)];
+          in = ((bits >> k) & 1u) || ((bits >> l) & 1u);
+        }
+      } while (++around != first);
+      if (!owned) continue;
       if (!in && !radius_exceeds_zero(u->point(), w->point())) {
         in = true;
         do {

@@ -12,7 +12,6 @@
 #include <CGAL/Triangulation_vertex_base_with_info_3.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include <tbb/parallel_sort.h>
 
 #include <algorithm>
 #include <array>
@@ -387,6 +386,28 @@ bool ClassifyAtAlphaZero(RegularTriangulation& triangulation,
   return !padding_in_complex;
 }
 
+// Sorts simplices (ascending tuples of ball indices in [0, num_balls)) lexicographically: a
+// counting sort by the lowest index, then each bucket (the few simplices whose lowest ball is
+// that one) by std::sort, in parallel. Entries are distinct, so the order is unique whatever
+// the schedule. O(#simplices + num_balls), against O(#simplices log #simplices) comparisons of
+// tuples for one sort of the whole list.
+template <std::size_t N>
+void SortSimplices(std::vector<std::array<std::int32_t, N>>* simplices, std::size_t num_balls) {
+  std::vector<std::size_t> start(num_balls + 1, 0);
+  for (const auto& s : *simplices) ++start[static_cast<std::size_t>(s[0]) + 1];
+  std::partial_sum(start.begin(), start.end(), start.begin());
+  std::vector<std::array<std::int32_t, N>> sorted(simplices->size());
+  {
+    std::vector<std::size_t> next(start.begin(), start.end() - 1);
+    for (const auto& s : *simplices) sorted[next[static_cast<std::size_t>(s[0])]++] = s;
+  }
+  ForEachIndex(num_balls, [&](std::size_t b) {
+    std::sort(sorted.begin() + static_cast<std::ptrdiff_t>(start[b]),
+              sorted.begin() + static_cast<std::ptrdiff_t>(start[b + 1]));
+  });
+  simplices->swap(sorted);
+}
+
 // Every index in [0, num_balls), each tuple strictly increasing (the formulas need distinct
 // balls).
 template <std::size_t N>
@@ -440,11 +461,10 @@ absl::StatusOr<DualComplex> ComputeDualComplex(const std::vector<Sphere>& balls)
     return absl::InternalError(absl::StrCat("CGAL: ", e.what()));
   }
 
-  // Each list has distinct entries, so the sorted order is unique whatever the schedule.
-  tbb::parallel_sort(complex.vertices.begin(), complex.vertices.end());
-  tbb::parallel_sort(complex.edges.begin(), complex.edges.end());
-  tbb::parallel_sort(complex.triangles.begin(), complex.triangles.end());
-  tbb::parallel_sort(complex.tetrahedra.begin(), complex.tetrahedra.end());
+  std::sort(complex.vertices.begin(), complex.vertices.end());
+  SortSimplices(&complex.edges, balls.size());
+  SortSimplices(&complex.triangles, balls.size());
+  SortSimplices(&complex.tetrahedra, balls.size());
   // Redundant: duplicates (already listed) plus distinct balls that are not vertices.
   for (std::int32_t i : distinct) {
     if (!std::binary_search(complex.vertices.begin(), complex.vertices.end(), i)) {

@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <exception>
@@ -434,7 +435,7 @@ absl::Status CheckIndices(const std::vector<std::array<std::int32_t, N>>& simpli
 template <typename Simplex, typename Term>
 long double OrderedSum(const std::vector<Simplex>& simplices, const Term& term) {
   std::vector<double> terms(simplices.size());
-  ForEachIndex(simplices.size(), [&](std::size_t s) { terms[s] = term(simplices[s]); });
+  ForEachIndex(simplices.size(), [&](std::size_t s) { terms[s] = term(s, simplices[s]); });
   long double sum = 0;
   for (double t : terms) sum += t;
   return sum;
@@ -491,18 +492,38 @@ absl::StatusOr<double> UnionVolume(const std::vector<Sphere>& balls, const DualC
   const auto ball = [&balls](std::int32_t i) -> const Sphere& {
     return balls[static_cast<std::size_t>(i)];
   };
-  // One long double accumulator per dimension: the terms have like signs within a dimension,
-  // and the alternating sum of the four totals is formed once at the end.
+  // The tetrahedra on each triangle (0, 1 or 2): a tetrahedron's term leaves out its faces'
+  // angle terms, which its triangles weigh by 1 - cofaces / 2 instead, so that a triangle
+  // inside the complex (two tetrahedra) needs no angle at all.
+  std::vector<std::atomic<std::uint8_t>> cofaces(complex.triangles.size());
+  ForEachIndex(complex.tetrahedra.size(), [&](std::size_t s) {
+    const std::array<std::int32_t, 4>& t = complex.tetrahedra[s];
+    for (std::size_t skip = 0; skip < 4; ++skip) {
+      std::array<std::int32_t, 3> face;
+      for (std::size_t k = 0, j = 0; k < 4; ++k) {
+        if (k != skip) face[j++] = t[k];
+      }
+      const auto it = std::lower_bound(complex.triangles.begin(), complex.triangles.end(), face);
+      if (it != complex.triangles.end() && *it == face) {
+        cofaces[static_cast<std::size_t>(it - complex.triangles.begin())].fetch_add(
+            1, std::memory_order_relaxed);
+      }
+    }
+  });
+  // One long double accumulator per dimension, formed in list order; the alternating sum of
+  // the four totals is formed once at the end.
   long double sum[4] = {0, 0, 0, 0};
   for (std::int32_t i : complex.vertices) sum[0] += internal::BallVolume(ball(i));
-  sum[1] = OrderedSum(complex.edges, [&](const std::array<std::int32_t, 2>& e) {
+  sum[1] = OrderedSum(complex.edges, [&](std::size_t, const std::array<std::int32_t, 2>& e) {
     return internal::TwoBallIntersectionVolume(ball(e[0]), ball(e[1]));
   });
-  sum[2] = OrderedSum(complex.triangles, [&](const std::array<std::int32_t, 3>& t) {
-    return internal::ThreeBallIntersectionVolume(ball(t[0]), ball(t[1]), ball(t[2]));
+  sum[2] = OrderedSum(complex.triangles, [&](std::size_t s, const std::array<std::int32_t, 3>& t) {
+    const double angle_weight = 1.0 - 0.5 * cofaces[s].load(std::memory_order_relaxed);
+    return internal::ThreeBallIntersectionVolume(ball(t[0]), ball(t[1]), ball(t[2]), angle_weight);
   });
-  sum[3] = OrderedSum(complex.tetrahedra, [&](const std::array<std::int32_t, 4>& t) {
-    return internal::FourBallIntersectionVolume(ball(t[0]), ball(t[1]), ball(t[2]), ball(t[3]));
+  sum[3] = OrderedSum(complex.tetrahedra, [&](std::size_t, const std::array<std::int32_t, 4>& t) {
+    return internal::FourBallVolumeWithoutFaceAngles(ball(t[0]), ball(t[1]), ball(t[2]),
+                                                     ball(t[3]));
   });
   return static_cast<double>(sum[0] - sum[1] + sum[2] - sum[3]);
 }

@@ -430,8 +430,8 @@ absl::Status CheckIndices(const std::vector<std::array<std::int32_t, N>>& simpli
   return absl::OkStatus();
 }
 
-// Sum of term(s) over `simplices` in long double, in list order. The terms are evaluated in
-// parallel into their own slots, so the sum's bits do not depend on the thread count.
+// Sum of term(s, simplices[s]) over `simplices` in long double, in list order. The terms are
+// evaluated in parallel into their own slots, so the sum's bits do not depend on the thread count.
 template <typename Simplex, typename Term>
 long double OrderedSum(const std::vector<Simplex>& simplices, const Term& term) {
   std::vector<double> terms(simplices.size());

@@ -46,6 +46,16 @@
 // G_mn is the triangle (z, P_mnk, P_mnl) plus the circular segment beyond its chord, of area
 // rho^2 (psi - sin psi) / 2.
 //
+// In the inclusion-exclusion a tetrahedron's term is subtracted and its faces' terms added.
+// Its corner angles on face m are the eps of its four triples, and gamma_k, gamma_l in psi_mn
+// are the triples' half arcs: with W_mn = r_m^2 a_mn + r_n^2 a_nm, the tetrahedron holds
+// -(1/3) r_m^3 eps and -(1/3) gamma (W_mn + d rho^2 / 2) for each, its triangle
+// -(2/3) r_m^3 eps and -(1/3) gamma (2 W_mn + d rho^2). So a triangle with k tetrahedra of the
+// complex on it weighs its angles by 1 - k/2 and the tetrahedra leave them out: 0 for a
+// triangle inside the complex. The tetrahedron keeps 2 pi r_m^3 per sphere and, per pair,
+// alpha (W_mn + d rho^2 / 2), the planar triangle and -d rho^2 sin(psi) / 2, sin(psi) from
+// the three angles' cosines and sines.
+//
 // Everything is computed relative to the first ball's centre, so a large common offset costs
 // no precision; Monte Carlo and quadrature tests (tests/core/union_of_balls_test.cpp) check
 // every configuration.
@@ -53,6 +63,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace inscribe::internal {
 namespace {
@@ -132,13 +143,14 @@ struct HalfArc {
   double s;
 };
 
+// gamma is left 0 without `with_gamma` (its atan2 not needed).
 HalfArc HalfArcInside(const PairGeometry& p, const Vector3& cm, const Vector3& ck,
-                      const TripleGeometry& t) {
+                      const TripleGeometry& t, bool with_gamma = true) {
   Vector3 towards_k = ck - cm;
   towards_k -= towards_k.dot(p.u) * p.u;
   towards_k.normalize();
   const double s = (t.y - p.q).dot(towards_k);
-  return {std::atan2(t.h, s), s};
+  return {with_gamma ? std::atan2(t.h, s) : 0.0, s};
 }
 
 // Exterior angle eps of F_m at a common point of S_m, S_n, S_k: the angle between the
@@ -151,16 +163,34 @@ double CornerAngle(const Oriented& mn, const Oriented& mk, double rm, double h) 
   return std::atan2(rm * h * sin_theta, rm * rm * cos_theta - mn.a * mk.a);
 }
 
-// Dihedral angle at edge (c_m, c_n) between the half-planes towards c_k and c_l.
-double DihedralAngle(const Vector3& u, const Vector3& cm, const Vector3& ck, const Vector3& cl) {
+double Cube(double x) { return x * x * x; }
+
+// (cos, sin) of atan2(y, x), y >= 0, without the atan2; (1, 0) for (0, 0) like atan2. Scaled
+// first: x and y may be squared lengths up to 1e300.
+struct UnitDirection {
+  double c = 1.0;
+  double s = 0.0;
+  UnitDirection(double x, double y) {
+    const double scale = std::max(std::abs(x), y);
+    if (!(scale > 0)) return;
+    x /= scale;
+    y /= scale;
+    const double norm = std::sqrt(x * x + y * y);
+    c = x / norm;
+    s = y / norm;
+  }
+};
+
+// Dihedral angle alpha at edge (c_m, c_n) between the half-planes towards c_k and c_l, as
+// (|pk| |pl| cos alpha, |pk| |pl| sin alpha), the arguments of atan2.
+std::pair<double, double> DihedralDirection(const Vector3& u, const Vector3& cm, const Vector3& ck,
+                                            const Vector3& cl) {
   Vector3 pk = ck - cm;
   Vector3 pl = cl - cm;
   pk -= pk.dot(u) * u;
   pl -= pl.dot(u) * u;
-  return std::atan2(pk.cross(pl).norm(), pk.dot(pl));
+  return {pk.dot(pl), pk.cross(pl).norm()};
 }
-
-double Cube(double x) { return x * x * x; }
 
 }  // namespace
 
@@ -179,7 +209,8 @@ double TwoBallIntersectionVolume(const Sphere& a, const Sphere& b) {
   return kPi / 3.0 * (ha * ha * (3 * ra - ha) + hb * hb * (3 * rb - hb));
 }
 
-double ThreeBallIntersectionVolume(const Sphere& a, const Sphere& b, const Sphere& c) {
+double ThreeBallIntersectionVolume(const Sphere& a, const Sphere& b, const Sphere& c,
+                                   double angle_weight) {
   const Vector3 o = a.center;
   const Vector3 centre[3] = {Vector3::Zero(), b.center - o, c.center - o};
   const double r[3] = {a.radius, b.radius, c.radius};
@@ -192,11 +223,13 @@ double ThreeBallIntersectionVolume(const Sphere& a, const Sphere& b, const Spher
   const TripleGeometry t = MakeTriple(centre[0], r[0], centre[1], r[1], centre[2], r[2]);
 
   // (V) with (A): each face has two arcs of angle 2 gamma and two corners of angle eps.
+  const bool angles = angle_weight != 0.0;
   double faces = 0.0;
   for (int m = 0; m < 3; ++m) {
     const int n = (m + 1) % 3;
     const int k = (m + 2) % 3;
-    const double eps = CornerAngle(pairs.From(m, n), pairs.From(m, k), r[m], t.h);
+    const double eps =
+        angles ? angle_weight * CornerAngle(pairs.From(m, n), pairs.From(m, k), r[m], t.h) : 0.0;
     faces += Cube(r[m]) * (2 * kPi - 2 * eps);
   }
   double planar = 0.0;
@@ -204,16 +237,18 @@ double ThreeBallIntersectionVolume(const Sphere& a, const Sphere& b, const Spher
     for (int n = m + 1; n < 3; ++n) {
       const int k = 3 - m - n;
       const PairGeometry& p = pairs.p[m][n];
-      const HalfArc arc = HalfArcInside(p, centre[m], centre[k], t);
-      planar += 2 * arc.gamma * (r[m] * r[m] * p.a_m + r[n] * r[n] * p.a_n);
-      planar += p.d * (p.rho2 * arc.gamma - arc.s * t.h);
+      const HalfArc arc = HalfArcInside(p, centre[m], centre[k], t, angles);
+      const double gamma = angle_weight * arc.gamma;
+      planar += 2 * gamma * (r[m] * r[m] * p.a_m + r[n] * r[n] * p.a_n);
+      planar += p.d * (p.rho2 * gamma - arc.s * t.h);
     }
   }
-  return std::max(0.0, (faces - planar) / 3.0);
+  const double volume = (faces - planar) / 3.0;
+  return angle_weight == 1.0 ? std::max(0.0, volume) : volume;
 }
 
-double FourBallIntersectionVolume(const Sphere& a, const Sphere& b, const Sphere& c,
-                                  const Sphere& d) {
+double FourBallVolumeWithoutFaceAngles(const Sphere& a, const Sphere& b, const Sphere& c,
+                                       const Sphere& d) {
   const Vector3 o = a.center;
   const Vector3 centre[4] = {Vector3::Zero(), b.center - o, c.center - o, d.center - o};
   const double r[4] = {a.radius, b.radius, c.radius, d.radius};
@@ -245,21 +280,13 @@ double FourBallIntersectionVolume(const Sphere& a, const Sphere& b, const Sphere
                      rhs[3] * centre[1].cross(centre[2])) /
                     centre[1].dot(centre[2].cross(centre[3]));
 
-  // (V) with (A): face m is a spherical triangle with one arc on each C_mn and one corner on
-  // each triple containing m.
+  // (V) with (A), less the face angles: face m is a spherical triangle whose three corner
+  // angles are those of the triples containing m, and whose arc on C_mn turns by
+  // psi = gamma_k + gamma_l - alpha, the gammas being those of the triples (m, n, k) and
+  // (m, n, l). Left: 2 pi per sphere, and per pair -alpha in the arc and segment terms, the
+  // triangle, and the segment's -sin(psi).
   double faces = 0.0;
-  for (int m = 0; m < 4; ++m) {
-    double eps_sum = 0.0;
-    for (int l = 0; l < 4; ++l) {
-      if (l == m) continue;
-      int others[2];
-      for (int n = 0, k = 0; n < 4; ++n) {
-        if (n != m && n != l) others[k++] = n;
-      }
-      eps_sum += CornerAngle(pairs.From(m, others[0]), pairs.From(m, others[1]), r[m], triple[l].h);
-    }
-    faces += Cube(r[m]) * (2 * kPi - eps_sum);
-  }
+  for (int m = 0; m < 4; ++m) faces += Cube(r[m]) * 2 * kPi;
   double planar = 0.0;
   for (int m = 0; m < 4; ++m) {
     for (int n = m + 1; n < 4; ++n) {
@@ -271,17 +298,23 @@ double FourBallIntersectionVolume(const Sphere& a, const Sphere& b, const Sphere
       }
       const PairGeometry& p = pairs.p[m][n];
       // triple[l] holds (m, n, k), triple[k] holds (m, n, l).
-      const double gamma_k = HalfArcInside(p, centre[m], centre[k], triple[l]).gamma;
-      const double gamma_l = HalfArcInside(p, centre[m], centre[l], triple[k]).gamma;
-      const double alpha = DihedralAngle(p.u, centre[m], centre[k], centre[l]);
-      const double psi = std::clamp(gamma_k + gamma_l - alpha, 0.0, 2 * kPi);
+      const UnitDirection gamma_k(HalfArcInside(p, centre[m], centre[k], triple[l], false).s,
+                                  triple[l].h);
+      const UnitDirection gamma_l(HalfArcInside(p, centre[m], centre[l], triple[k], false).s,
+                                  triple[k].h);
+      const auto [alpha_x, alpha_y] = DihedralDirection(p.u, centre[m], centre[k], centre[l]);
+      const UnitDirection alpha_turn(alpha_x, alpha_y);
+      const double alpha = std::atan2(alpha_y, alpha_x);
+      // sin(gamma_k + gamma_l - alpha) from the three directions.
+      const double c2 = gamma_k.c * gamma_l.c - gamma_k.s * gamma_l.s;
+      const double s2 = gamma_k.c * gamma_l.s + gamma_k.s * gamma_l.c;
+      const double sin_psi = s2 * alpha_turn.c - c2 * alpha_turn.s;
       const double triangle = 0.5 * (corner[l] - z).cross(corner[k] - z).norm();
-      const double segment = 0.5 * p.rho2 * (psi - std::sin(psi));
-      planar += psi * (r[m] * r[m] * p.a_m + r[n] * r[n] * p.a_n);
-      planar += p.d * (triangle + segment);
+      planar -= alpha * (r[m] * r[m] * p.a_m + r[n] * r[n] * p.a_n + 0.5 * p.d * p.rho2);
+      planar += p.d * (triangle - 0.5 * p.rho2 * sin_psi);
     }
   }
-  return std::max(0.0, (faces - planar) / 3.0);
+  return (faces - planar) / 3.0;
 }
 
 }  // namespace inscribe::internal

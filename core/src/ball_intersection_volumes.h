@@ -17,14 +17,24 @@ double TwoBallIntersectionVolume(const Sphere& a, const Sphere& b);
 // y ± h n (h >= 0): the configuration of every triangle of a dual complex, where the power
 // edge meets the union. Right wherever those two points lie, also when the point y is outside
 // the triangle of centres. If the spheres share no point (h^2 < 0, only by rounding for a dual
-// complex triangle) h is taken as 0, which is the limit. Cost: 6 atan2 plus O(1) arithmetic.
-double ThreeBallIntersectionVolume(const Sphere& a, const Sphere& b, const Sphere& c);
+// complex triangle) h is taken as 0, which is the limit.
+//
+// `angle_weight` scales the terms that are angles of the three spheres' arrangement (the
+// corner angles eps and the half arcs gamma, see the .cpp): 1 gives the volume (clamped at
+// 0); the inclusion-exclusion passes 1 - k/2 for a triangle with k tetrahedra of the complex
+// on it, because each of those tetrahedra's FourBallVolumeWithoutFaceAngles leaves out the
+// same angles with half the weight and the opposite sign. Cost: 6 atan2 plus O(1) arithmetic,
+// no atan2 at weight 0.
+double ThreeBallIntersectionVolume(const Sphere& a, const Sphere& b, const Sphere& c,
+                                   double angle_weight = 1.0);
 
 // vol(a ∩ b ∩ c ∩ d) for balls with non-coplanar centres whose power point (equal power to all
-// four) lies in all four balls: the configuration of every tetrahedron of a dual complex. The
-// intersection is then a curved tetrahedron: four spherical triangles, six circular arcs, four
-// corners. Cost: 30 atan2 and 6 sin plus O(1) arithmetic.
-double FourBallIntersectionVolume(const Sphere& a, const Sphere& b, const Sphere& c,
-                                  const Sphere& d);
+// four) lies in all four balls (the configuration of every tetrahedron of a dual complex),
+// less the terms that are angles of its four faces' three-ball arrangements (their corner
+// angles and half arcs); ThreeBallIntersectionVolume's angle_weight accounts for them. What
+// is left: the balls' full spheres, the dihedral angles, the planar triangles and the sines
+// of the arcs. Cost: 6 atan2 plus O(1) arithmetic.
+double FourBallVolumeWithoutFaceAngles(const Sphere& a, const Sphere& b, const Sphere& c,
+                                       const Sphere& d);
 
 }  // namespace inscribe::internal

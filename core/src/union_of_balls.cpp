@@ -1,20 +1,21 @@
-// Dual complex of a union of balls (CGAL regular triangulation + fixed alpha shape at 0) and
-// the union's volume by inclusion-exclusion over it. The only CGAL translation unit of this
+// Dual complex of a union of balls (CGAL regular triangulation classified at alpha = 0) and the
+// union's volume by inclusion-exclusion over it. The only CGAL translation unit of this
 // feature: a regular triangulation instantiation costs ~12 s and 1 GB to compile.
 #include "inscribe/union_of_balls.h"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Fixed_alpha_shape_3.h>
-#include <CGAL/Fixed_alpha_shape_cell_base_3.h>
-#include <CGAL/Fixed_alpha_shape_vertex_base_3.h>
 #include <CGAL/Regular_triangulation_3.h>
 #include <CGAL/Regular_triangulation_cell_base_3.h>
 #include <CGAL/Regular_triangulation_vertex_base_3.h>
+#include <CGAL/Triangulation_cell_base_with_info_3.h>
 #include <CGAL/Triangulation_data_structure_3.h>
 #include <CGAL/Triangulation_vertex_base_with_info_3.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <exception>
@@ -33,17 +34,29 @@ namespace {
 
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using WeightedPoint = Kernel::Weighted_point_3;
-// Vertex info: index into the input, or kPadding for the far points added to reach dimension 3.
-using VertexBase = CGAL::Fixed_alpha_shape_vertex_base_3<
-    Kernel, CGAL::Triangulation_vertex_base_with_info_3<
-                std::int32_t, Kernel, CGAL::Regular_triangulation_vertex_base_3<Kernel>>>;
+// Regular_triangulation_cell_base_3's hidden point container when hidden points are
+// discarded: never filled, and 8 bytes per cell instead of an empty std::list's 24.
+struct NoHiddenPoints {
+  using iterator = WeightedPoint*;
+  using const_iterator = const WeightedPoint*;
+  iterator begin() { return nullptr; }
+  iterator end() { return nullptr; }
+  const_iterator begin() const { return nullptr; }
+  const_iterator end() const { return nullptr; }
+};
 // Hidden points are not needed (the redundant balls are found by elimination), so not kept.
-using CellBase = CGAL::Fixed_alpha_shape_cell_base_3<
-    Kernel, CGAL::Regular_triangulation_cell_base_3<Kernel, CGAL::Triangulation_cell_base_3<Kernel>,
-                                                    CGAL::Discard_hidden_points>>;
-using Tds = CGAL::Triangulation_data_structure_3<VertexBase, CellBase>;
-using RegularTriangulation = CGAL::Regular_triangulation_3<Kernel, Tds>;
-using AlphaShape = CGAL::Fixed_alpha_shape_3<RegularTriangulation>;
+using RegularCellBase =
+    CGAL::Regular_triangulation_cell_base_3<Kernel, CGAL::Triangulation_cell_base_3<Kernel>,
+                                            CGAL::Discard_hidden_points, NoHiddenPoints>;
+// Vertex info: the vertex's slot in the inserted point list (ball_of_vertex maps it to the
+// input). Cell info: the cell's number in ClassifyAtAlphaZero. 72 bytes per cell.
+using VertexBase =
+    CGAL::Triangulation_vertex_base_with_info_3<std::int32_t, Kernel,
+                                                CGAL::Regular_triangulation_vertex_base_3<Kernel>>;
+using CellBase = CGAL::Triangulation_cell_base_with_info_3<std::int32_t, Kernel, RegularCellBase>;
+using RegularTriangulation =
+    CGAL::Regular_triangulation_3<Kernel,
+                                  CGAL::Triangulation_data_structure_3<VertexBase, CellBase>>;
 
 constexpr std::int32_t kPadding = -1;
 constexpr double kMaxMagnitude = 1e150;
@@ -92,7 +105,7 @@ std::vector<std::int32_t> DistinctBalls(const std::vector<Sphere>& balls,
 
 // Four zero-weight points far outside every ball, at the corners of a regular tetrahedron
 // about the balls' bounding box. Added only when the centres span less than 3 dimensions (the
-// alpha shape needs a 3-dimensional triangulation). They change the regular triangulation but
+// classification needs a 3-dimensional triangulation). They change the regular triangulation but
 // not the dual complex: each is a point ball disjoint from the union, so inside the union
 // every power cell is unchanged (power to a padding point > 0 >= power to a covering ball), and
 // no simplex with a padding vertex has a common point of its balls.
@@ -126,38 +139,274 @@ std::array<std::int32_t, N> SortedTuple(std::array<std::int32_t, N> t) {
   return t;
 }
 
-// Fills the simplices of `complex` from the alpha shape: every finite simplex not EXTERIOR,
-// i.e. INTERIOR, REGULAR or SINGULAR at alpha = 0. Returns false if one has a padding vertex
-// (impossible by construction; checked rather than assumed).
-bool ExtractComplex(const AlphaShape& shape, DualComplex* complex) {
-  bool padding_in_complex = false;
-  const auto id = [&padding_in_complex](const AlphaShape::Vertex_handle& v) {
-    if (v->info() == kPadding) padding_in_complex = true;
-    return v->info();
-  };
-  for (auto v = shape.finite_vertices_begin(); v != shape.finite_vertices_end(); ++v) {
-    if (v->info() == kPadding) continue;  // isolated points by construction
-    if (shape.classify(v) != AlphaShape::EXTERIOR) complex->vertices.push_back(v->info());
+// f(i) for every i in [0, n) on the TBB pool. Every use writes only to slot i of its outputs,
+// so the result does not depend on the thread count or the schedule.
+template <typename F>
+void ForEachIndex(std::size_t n, const F& f) {
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024),
+                    [&f](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t i = range.begin(); i != range.end(); ++i) f(i);
+                    });
+}
+
+// The regular triangulation of the distinct balls, padded to dimension 3 if the centres span
+// less. Vertex info is the index into `ball_of_vertex`, which gives the input ball or kPadding.
+absl::Status Triangulate(const std::vector<Sphere>& balls,
+                         const std::vector<std::int32_t>& distinct,
+                         RegularTriangulation* triangulation,
+                         std::vector<std::int32_t>* ball_of_vertex) {
+  std::vector<std::pair<WeightedPoint, std::int32_t>> points;
+  points.reserve(distinct.size() + 4);
+  for (std::int32_t i : distinct) {
+    const Sphere& b = balls[static_cast<std::size_t>(i)];
+    points.emplace_back(WeightedPoint(Kernel::Point_3(b.center.x(), b.center.y(), b.center.z()),
+                                      b.radius * b.radius),
+                        static_cast<std::int32_t>(points.size()));
   }
-  for (auto e = shape.finite_edges_begin(); e != shape.finite_edges_end(); ++e) {
-    if (shape.classify(*e) == AlphaShape::EXTERIOR) continue;
-    complex->edges.push_back(
-        SortedTuple<2>({id(e->first->vertex(e->second)), id(e->first->vertex(e->third))}));
-  }
-  for (auto f = shape.finite_facets_begin(); f != shape.finite_facets_end(); ++f) {
-    if (shape.classify(*f) == AlphaShape::EXTERIOR) continue;
-    std::array<std::int32_t, 3> t;
-    for (int k = 0, j = 0; k < 4; ++k) {
-      if (k != f->second) t[static_cast<std::size_t>(j++)] = id(f->first->vertex(k));
+  *ball_of_vertex = distinct;
+  // Range insertion: spatial sort (Hilbert order) first, then insertion.
+  triangulation->insert(points.begin(), points.end());
+  if (triangulation->dimension() < 3) {
+    auto padding = PaddingPoints(balls);
+    for (auto& [point, slot] : padding) {
+      slot = static_cast<std::int32_t>(ball_of_vertex->size());
+      ball_of_vertex->push_back(kPadding);
     }
-    complex->triangles.push_back(SortedTuple(t));
+    triangulation->insert(padding.begin(), padding.end());
   }
-  for (auto c = shape.finite_cells_begin(); c != shape.finite_cells_end(); ++c) {
-    if (shape.classify(c) == AlphaShape::EXTERIOR) continue;
-    complex->tetrahedra.push_back(
-        SortedTuple<4>({id(c->vertex(0)), id(c->vertex(1)), id(c->vertex(2)), id(c->vertex(3))}));
+  // ClassifyAtAlphaZero needs dimension 3.
+  if (triangulation->dimension() < 3) {
+    return absl::InternalError("dual complex: the padded triangulation is not 3-dimensional");
+  }
+  return absl::OkStatus();
+}
+
+// The six edges of a cell as pairs of vertex positions, and for each the two other positions.
+constexpr int kEdgeEnds[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+constexpr int kEdgeOthers[6][2] = {{2, 3}, {1, 3}, {1, 2}, {0, 3}, {0, 2}, {0, 1}};
+
+int PopCount(std::uint8_t bits) {
+  int n = 0;
+  for (; bits != 0; bits &= static_cast<std::uint8_t>(bits - 1)) ++n;
+  return n;
+}
+
+// The alpha complex at alpha = 0 of `triangulation` (dimension 3), read straight off it with
+// the same exact predicates and the same rules as CGAL's Fixed_alpha_shape_3, so the same
+// complex (tests compare the two on random and degenerate input):
+//  - a finite cell is in when its orthogonal sphere's weighted squared radius is <= 0;
+//  - a finite facet is in when a cell on either side is in, or when its smallest orthogonal
+//    sphere has weighted squared radius <= 0 and neither opposite vertex lies strictly inside
+//    it (Gabriel);
+//  - an edge is in when one of its facets is in, or under the same two conditions with every
+//    vertex of its link;
+//  - a vertex is in when one of its edges is in, or when it is Gabriel (its ball is nearest to
+//    its centre in power).
+// Finite cells are numbered through their info (infinite ones get -1). Each facet belongs to
+// the lower-numbered of its finite cells and each edge to the lowest-numbered finite cell
+// around it; flags are bytes per cell, filled in parallel, each by its own cell, so the
+// result does not depend on the schedule. Memory beyond the triangulation: 12 bytes per cell
+// (first touches of fresh pages are a large part of the cost here). Returns false if a simplex
+// has a padding vertex (impossible by construction; checked). Cost O(#cells) predicates plus
+// O(sum of edge degrees) walking around edges.
+bool ClassifyAtAlphaZero(RegularTriangulation& triangulation,
+                         const std::vector<std::int32_t>& ball_of_vertex, DualComplex* complex) {
+  using CellHandle = RegularTriangulation::Cell_handle;
+  using VertexHandle = RegularTriangulation::Vertex_handle;
+  const Kernel& traits = triangulation.geom_traits();
+  const auto radius_exceeds_zero = [cmp = traits.compare_weighted_squared_radius_3_object()](
+                                       const auto&... p) { return cmp(p..., 0.0) == CGAL::LARGER; };
+  const auto strictly_inside =
+      [side = traits.power_side_of_bounded_power_sphere_3_object()](const auto&... p) {
+        return side(p...) == CGAL::ON_BOUNDED_SIDE;
+      };
+
+  std::vector<CellHandle> cells;
+  cells.reserve(triangulation.tds().number_of_cells());
+  for (auto c = triangulation.all_cells_begin(); c != triangulation.all_cells_end(); ++c) {
+    if (triangulation.is_infinite(c)) {
+      c->info() = -1;
+    } else {
+      c->info() = static_cast<std::int32_t>(cells.size());
+      cells.push_back(c);
+    }
+  }
+  const std::size_t num_cells = cells.size();
+  const auto number = [](const CellHandle& c) { return c->info(); };
+
+  std::vector<std::uint8_t> cell_in(num_cells, 0);
+  ForEachIndex(num_cells, [&](std::size_t c) {
+    const CellHandle& h = cells[c];
+    cell_in[c] = !radius_exceeds_zero(h->vertex(0)->point(), h->vertex(1)->point(),
+                                      h->vertex(2)->point(), h->vertex(3)->point());
+  });
+
+  // Bit f: facet f (opposite vertex f) is in. `owned_facet_in` has the bits of the facets this
+  // cell owns, `facet_in` all four.
+  const auto owns_facet = [&number](std::size_t c, const CellHandle& neighbor) {
+    const std::int32_t n = number(neighbor);
+    return n < 0 || static_cast<std::int32_t>(c) < n;
+  };
+  std::vector<std::uint8_t> owned_facet_in(num_cells, 0);
+  ForEachIndex(num_cells, [&](std::size_t c) {
+    const CellHandle& h = cells[c];
+    for (int f = 0; f < 4; ++f) {
+      const CellHandle n = h->neighbor(f);
+      if (!owns_facet(c, n)) continue;
+      bool in = cell_in[c] || (number(n) >= 0 && cell_in[static_cast<std::size_t>(number(n))]);
+      if (!in) {
+        const auto& a = h->vertex((f + 1) % 4)->point();
+        const auto& b = h->vertex((f + 2) % 4)->point();
+        const auto& d = h->vertex((f + 3) % 4)->point();
+        const VertexHandle far = n->vertex(n->index(h));
+        in = !radius_exceeds_zero(a, b, d) && !strictly_inside(a, b, d, h->vertex(f)->point()) &&
+             (triangulation.is_infinite(far) || !strictly_inside(a, b, d, far->point()));
+      }
+      if (in) owned_facet_in[c] |= static_cast<std::uint8_t>(1u << f);
+    }
+  });
+  std::vector<std::uint8_t> facet_in(num_cells, 0);
+  ForEachIndex(num_cells, [&](std::size_t c) {
+    const CellHandle& h = cells[c];
+    std::uint8_t bits = owned_facet_in[c];
+    for (int f = 0; f < 4; ++f) {
+      const CellHandle n = h->neighbor(f);
+      if (owns_facet(c, n)) continue;
+      if ((owned_facet_in[static_cast<std::size_t>(number(n))] >> n->index(h)) & 1u) {
+        bits |= static_cast<std::uint8_t>(1u << f);
+      }
+    }
+    facet_in[c] = bits;
+  });
+
+  // Bit e: edge kEdgeEnds[e] is in, set in the edge's lowest-numbered finite cell only.
+  std::vector<std::uint8_t> owned_edge_in(num_cells, 0);
+  ForEachIndex(num_cells, [&](std::size_t c) {
+    const CellHandle& h = cells[c];
+    const auto precedes = [c](std::int32_t n) { return n >= 0 && static_cast<std::size_t>(n) < c; };
+    std::int32_t neighbor_number[4];
+    for (int k = 0; k < 4; ++k) neighbor_number[k] = number(h->neighbor(k));
+    for (int e = 0; e < 6; ++e) {
+      // The cells across this cell's two facets around the edge: most edges end here.
+      if (precedes(neighbor_number[kEdgeOthers[e][0]]) ||
+          precedes(neighbor_number[kEdgeOthers[e][1]])) {
+        continue;
+      }
+      const VertexHandle u = h->vertex(kEdgeEnds[e][0]);
+      const VertexHandle w = h->vertex(kEdgeEnds[e][1]);
+      // The two facets of a cell around the edge are those opposite its two other vertices.
+      const auto others = [&u, &w](const CellHandle& cell) {
+        const int iu = cell->index(u);
+        const int iw = cell->index(w);
+        int k[2];
+        for (int i = 0, j = 0; i < 4; ++i) {
+          if (i != iu && i != iw) k[j++] = i;
+        }
+        return std::make_pair(k[0], k[1]);
+      };
+      // One walk around the edge: is this cell the lowest-numbered, and is a facet in.
+      const auto first = triangulation.incident_cells(h, kEdgeEnds[e][0], kEdgeEnds[e][1]);
+      auto around = first;
+      bool owned = true;
+      bool in = false;
+      do {
+        const std::int32_t n = number(around);
+        if (n < 0) continue;
+        if (precedes(n)) {
+          owned = false;
+          break;
+        }
+        if (!in) {
+          const auto [k, l] = others(around);
+          const std::uint8_t bits = facet_in[static_cast<std::size_t>(n)];
+          in = ((bits >> k) & 1u) || ((bits >> l) & 1u);
+        }
+      } while (++around != first);
+      if (!owned) continue;
+      if (!in && !radius_exceeds_zero(u->point(), w->point())) {
+        in = true;
+        do {
+          if (number(around) < 0) continue;
+          const auto [k, l] = others(around);
+          in = !strictly_inside(u->point(), w->point(), around->vertex(k)->point()) &&
+               !strictly_inside(u->point(), w->point(), around->vertex(l)->point());
+        } while (in && ++around != first);
+      }
+      if (in) owned_edge_in[c] |= static_cast<std::uint8_t>(1u << e);
+    }
+  });
+
+  bool padding_in_complex = false;
+  const auto ball = [&](const VertexHandle& v) {
+    const std::int32_t i = ball_of_vertex[static_cast<std::size_t>(v->info())];
+    if (i == kPadding) padding_in_complex = true;
+    return i;
+  };
+  std::size_t num_edges = 0;
+  std::size_t num_triangles = 0;
+  std::size_t num_tetrahedra = 0;
+  for (std::size_t c = 0; c < num_cells; ++c) {
+    num_edges += static_cast<std::size_t>(PopCount(owned_edge_in[c]));
+    num_triangles += static_cast<std::size_t>(PopCount(owned_facet_in[c]));
+    num_tetrahedra += cell_in[c];
+  }
+  complex->edges.reserve(num_edges);
+  complex->triangles.reserve(num_triangles);
+  complex->tetrahedra.reserve(num_tetrahedra);
+  std::vector<std::uint8_t> vertex_in(ball_of_vertex.size(), 0);
+  for (std::size_t c = 0; c < num_cells; ++c) {
+    const CellHandle& h = cells[c];
+    for (int e = 0; e < 6; ++e) {
+      if (!((owned_edge_in[c] >> e) & 1u)) continue;
+      const VertexHandle u = h->vertex(kEdgeEnds[e][0]);
+      const VertexHandle w = h->vertex(kEdgeEnds[e][1]);
+      complex->edges.push_back(SortedTuple<2>({ball(u), ball(w)}));
+      vertex_in[static_cast<std::size_t>(u->info())] = 1;
+      vertex_in[static_cast<std::size_t>(w->info())] = 1;
+    }
+    for (int f = 0; f < 4; ++f) {
+      if (!((owned_facet_in[c] >> f) & 1u)) continue;
+      complex->triangles.push_back(
+          SortedTuple<3>({ball(h->vertex((f + 1) % 4)), ball(h->vertex((f + 2) % 4)),
+                          ball(h->vertex((f + 3) % 4))}));
+    }
+    if (cell_in[c]) {
+      complex->tetrahedra.push_back(SortedTuple<4>(
+          {ball(h->vertex(0)), ball(h->vertex(1)), ball(h->vertex(2)), ball(h->vertex(3))}));
+    }
+  }
+  for (auto v = triangulation.finite_vertices_begin(); v != triangulation.finite_vertices_end();
+       ++v) {
+    const std::int32_t i = ball_of_vertex[static_cast<std::size_t>(v->info())];
+    if (i == kPadding) continue;  // isolated points by construction
+    if (vertex_in[static_cast<std::size_t>(v->info())] ||
+        (triangulation.is_Gabriel(v) && !radius_exceeds_zero(v->point()))) {
+      complex->vertices.push_back(i);
+    }
   }
   return !padding_in_complex;
+}
+
+// Sorts simplices (ascending tuples of ball indices in [0, num_balls)) lexicographically: a
+// counting sort by the lowest index, then each bucket (the few simplices whose lowest ball is
+// that one) by std::sort, in parallel. Entries are distinct, so the order is unique whatever
+// the schedule. O(#simplices + num_balls), against O(#simplices log #simplices) comparisons of
+// tuples for one sort of the whole list.
+template <std::size_t N>
+void SortSimplices(std::vector<std::array<std::int32_t, N>>* simplices, std::size_t num_balls) {
+  std::vector<std::size_t> start(num_balls + 1, 0);
+  for (const auto& s : *simplices) ++start[static_cast<std::size_t>(s[0]) + 1];
+  std::partial_sum(start.begin(), start.end(), start.begin());
+  std::vector<std::array<std::int32_t, N>> sorted(simplices->size());
+  {
+    std::vector<std::size_t> next(start.begin(), start.end() - 1);
+    for (const auto& s : *simplices) sorted[next[static_cast<std::size_t>(s[0])]++] = s;
+  }
+  ForEachIndex(num_balls, [&](std::size_t b) {
+    std::sort(sorted.begin() + static_cast<std::ptrdiff_t>(start[b]),
+              sorted.begin() + static_cast<std::ptrdiff_t>(start[b + 1]));
+  });
+  simplices->swap(sorted);
 }
 
 // Every index in [0, num_balls), each tuple strictly increasing (the formulas need distinct
@@ -181,6 +430,17 @@ absl::Status CheckIndices(const std::vector<std::array<std::int32_t, N>>& simpli
   return absl::OkStatus();
 }
 
+// Sum of term(s, simplices[s]) over `simplices` in long double, in list order. The terms are
+// evaluated in parallel into their own slots, so the sum's bits do not depend on the thread count.
+template <typename Simplex, typename Term>
+long double OrderedSum(const std::vector<Simplex>& simplices, const Term& term) {
+  std::vector<double> terms(simplices.size());
+  ForEachIndex(simplices.size(), [&](std::size_t s) { terms[s] = term(s, simplices[s]); });
+  long double sum = 0;
+  for (double t : terms) sum += t;
+  return sum;
+}
+
 }  // namespace
 
 absl::StatusOr<DualComplex> ComputeDualComplex(const std::vector<Sphere>& balls) {
@@ -189,28 +449,13 @@ absl::StatusOr<DualComplex> ComputeDualComplex(const std::vector<Sphere>& balls)
   if (balls.empty()) return complex;
 
   const std::vector<std::int32_t> distinct = DistinctBalls(balls, &complex.redundant);
-  std::vector<std::pair<WeightedPoint, std::int32_t>> points;
-  points.reserve(distinct.size() + 4);
-  for (std::int32_t i : distinct) {
-    const Sphere& b = balls[static_cast<std::size_t>(i)];
-    points.emplace_back(WeightedPoint(Kernel::Point_3(b.center.x(), b.center.y(), b.center.z()),
-                                      b.radius * b.radius),
-                        i);
-  }
   try {
     RegularTriangulation triangulation;
-    // Range insertion: spatial sort (Hilbert order) first, then insertion.
-    triangulation.insert(points.begin(), points.end());
-    if (triangulation.dimension() < 3) {
-      const auto padding = PaddingPoints(balls);
-      triangulation.insert(padding.begin(), padding.end());
+    std::vector<std::int32_t> ball_of_vertex;
+    if (absl::Status s = Triangulate(balls, distinct, &triangulation, &ball_of_vertex); !s.ok()) {
+      return s;
     }
-    // CGAL's alpha shape classifies nothing below dimension 3 (reading it then is undefined).
-    if (triangulation.dimension() < 3) {
-      return absl::InternalError("dual complex: the padded triangulation is not 3-dimensional");
-    }
-    const AlphaShape shape(triangulation, 0.0);  // takes the triangulation's content
-    if (!ExtractComplex(shape, &complex)) {
+    if (!ClassifyAtAlphaZero(triangulation, ball_of_vertex, &complex)) {
       return absl::InternalError("dual complex: a padding point entered the complex");
     }
   } catch (const std::exception& e) {
@@ -218,9 +463,9 @@ absl::StatusOr<DualComplex> ComputeDualComplex(const std::vector<Sphere>& balls)
   }
 
   std::sort(complex.vertices.begin(), complex.vertices.end());
-  std::sort(complex.edges.begin(), complex.edges.end());
-  std::sort(complex.triangles.begin(), complex.triangles.end());
-  std::sort(complex.tetrahedra.begin(), complex.tetrahedra.end());
+  SortSimplices(&complex.edges, balls.size());
+  SortSimplices(&complex.triangles, balls.size());
+  SortSimplices(&complex.tetrahedra, balls.size());
   // Redundant: duplicates (already listed) plus distinct balls that are not vertices.
   for (std::int32_t i : distinct) {
     if (!std::binary_search(complex.vertices.begin(), complex.vertices.end(), i)) {
@@ -247,19 +492,39 @@ absl::StatusOr<double> UnionVolume(const std::vector<Sphere>& balls, const DualC
   const auto ball = [&balls](std::int32_t i) -> const Sphere& {
     return balls[static_cast<std::size_t>(i)];
   };
-  // One long double accumulator per dimension: the terms have like signs within a dimension,
-  // and the alternating sum of the four totals is formed once at the end.
+  // The tetrahedra on each triangle (0, 1 or 2): a tetrahedron's term leaves out its faces'
+  // angle terms, which its triangles weigh by 1 - cofaces / 2 instead, so that a triangle
+  // inside the complex (two tetrahedra) needs no angle at all.
+  std::vector<std::atomic<std::uint8_t>> cofaces(complex.triangles.size());
+  ForEachIndex(complex.tetrahedra.size(), [&](std::size_t s) {
+    const std::array<std::int32_t, 4>& t = complex.tetrahedra[s];
+    for (std::size_t skip = 0; skip < 4; ++skip) {
+      std::array<std::int32_t, 3> face;
+      for (std::size_t k = 0, j = 0; k < 4; ++k) {
+        if (k != skip) face[j++] = t[k];
+      }
+      const auto it = std::lower_bound(complex.triangles.begin(), complex.triangles.end(), face);
+      if (it != complex.triangles.end() && *it == face) {
+        cofaces[static_cast<std::size_t>(it - complex.triangles.begin())].fetch_add(
+            1, std::memory_order_relaxed);
+      }
+    }
+  });
+  // One long double accumulator per dimension, formed in list order; the alternating sum of
+  // the four totals is formed once at the end.
   long double sum[4] = {0, 0, 0, 0};
   for (std::int32_t i : complex.vertices) sum[0] += internal::BallVolume(ball(i));
-  for (const auto& e : complex.edges) {
-    sum[1] += internal::TwoBallIntersectionVolume(ball(e[0]), ball(e[1]));
-  }
-  for (const auto& t : complex.triangles) {
-    sum[2] += internal::ThreeBallIntersectionVolume(ball(t[0]), ball(t[1]), ball(t[2]));
-  }
-  for (const auto& t : complex.tetrahedra) {
-    sum[3] += internal::FourBallIntersectionVolume(ball(t[0]), ball(t[1]), ball(t[2]), ball(t[3]));
-  }
+  sum[1] = OrderedSum(complex.edges, [&](std::size_t, const std::array<std::int32_t, 2>& e) {
+    return internal::TwoBallIntersectionVolume(ball(e[0]), ball(e[1]));
+  });
+  sum[2] = OrderedSum(complex.triangles, [&](std::size_t s, const std::array<std::int32_t, 3>& t) {
+    const double angle_weight = 1.0 - 0.5 * cofaces[s].load(std::memory_order_relaxed);
+    return internal::ThreeBallIntersectionVolume(ball(t[0]), ball(t[1]), ball(t[2]), angle_weight);
+  });
+  sum[3] = OrderedSum(complex.tetrahedra, [&](std::size_t, const std::array<std::int32_t, 4>& t) {
+    return internal::FourBallVolumeWithoutFaceAngles(ball(t[0]), ball(t[1]), ball(t[2]),
+                                                     ball(t[3]));
+  });
   return static_cast<double>(sum[0] - sum[1] + sum[2] - sum[3]);
 }
 

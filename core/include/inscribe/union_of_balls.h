@@ -42,8 +42,9 @@ struct DualComplex {
 
 // Dual complex of `balls` (centres in mesh frame, radii in mesh units). Built from CGAL's
 // Regular_triangulation_3 (exact predicates, symbolic perturbation for degenerate input such
-// as co-spherical or coplanar centres) classified by Fixed_alpha_shape_3 at alpha = 0. Empty
-// input gives an empty complex.
+// as co-spherical or coplanar centres), classified at alpha = 0 with Fixed_alpha_shape_3's
+// rules and exact predicates in one pass over its cells (in parallel on the TBB pool; the
+// result does not depend on the thread count). Empty input gives an empty complex.
 //
 // Errors: INVALID_ARGUMENT naming the first bad ball (non-finite centre or radius, radius <= 0,
 // a coordinate or radius above 1e150) or for more than 2^31 - 1 balls; INTERNAL with CGAL's
@@ -55,8 +56,12 @@ absl::StatusOr<DualComplex> ComputeDualComplex(const std::vector<Sphere>& balls)
 // formula over the dual complex (Edelsbrunner 1995):
 //   vol = sum_vertices vol(b_i) - sum_edges vol(b_i ∩ b_j) + sum_triangles vol(b_i ∩ b_j ∩ b_k)
 //         - sum_tetrahedra vol(b_i ∩ b_j ∩ b_k ∩ b_l),
-// every term in closed form (no sampling, no quadrature). Terms are computed relative to one
-// of their balls' centres (no loss from a large common offset) and summed in long double; the
+// every term in closed form (no sampling, no quadrature). The angle terms that a tetrahedron
+// shares with its faces cancel exactly against theirs and are left out of both, so a triangle
+// with two tetrahedra of the complex on it costs no trigonometry. Terms are computed relative
+// to one of their balls' centres (no loss from a large common offset), in parallel, and
+// summed in long double in the complex's order, so the bits do not depend on the thread
+// count; the
 // tests find agreement with an independent quadrature to about 1e-14 relative, including
 // degenerate (co-spherical, coplanar) input. Empty input gives 0.
 //

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <iterator>
+#include <limits>
 
 #include "mesh_topology.h"
 
@@ -24,6 +25,40 @@ Point VertexPoint(const Mesh& mesh, Eigen::Index v) {
 
 }  // namespace
 
+bool IsOrientedManifold(const Mesh& mesh) {
+  const std::vector<EdgeUse> uses = SortedEdgeUses(mesh);
+  // Corner k of triangle t is 3t + k; the corners of one vertex that share an edge are joined.
+  DisjointSets fans(static_cast<std::size_t>(mesh.num_triangles()) * 3);
+  auto corner = [&mesh](const EdgeUse& use, std::int32_t vertex) {
+    const int k = mesh.triangles(use.triangle, use.side) == vertex ? use.side : (use.side + 1) % 3;
+    return static_cast<std::size_t>(use.triangle) * 3 + static_cast<std::size_t>(k);
+  };
+  for (std::size_t i = 0; i < uses.size();) {
+    std::size_t j = i + 1;
+    while (j < uses.size() && uses[j].lo == uses[i].lo && uses[j].hi == uses[i].hi) ++j;
+    if (j - i > 2) return false;
+    if (j - i == 2) {
+      if (uses[i].forward == uses[i + 1].forward) return false;
+      for (std::int32_t vertex : {uses[i].lo, uses[i].hi}) {
+        fans.Union(corner(uses[i], vertex), corner(uses[i + 1], vertex));
+      }
+    }
+    i = j;
+  }
+  std::vector<std::size_t> fan_of(static_cast<std::size_t>(mesh.num_vertices()),
+                                  std::numeric_limits<std::size_t>::max());
+  for (Eigen::Index t = 0; t < mesh.triangles.rows(); ++t) {
+    if (!HasDistinctCorners(mesh, t)) continue;
+    for (int k = 0; k < 3; ++k) {
+      const std::size_t root = fans.Find(static_cast<std::size_t>(t) * 3 + k);
+      std::size_t& fan = fan_of[static_cast<std::size_t>(mesh.triangles(t, k))];
+      if (fan == std::numeric_limits<std::size_t>::max()) fan = root;
+      if (fan != root) return false;  // two fans meet at this vertex
+    }
+  }
+  return true;
+}
+
 std::optional<std::vector<std::pair<std::int32_t, std::int32_t>>> SelfIntersectingPairs(
     const Mesh& mesh) {
   std::vector<Point> points;
@@ -38,14 +73,17 @@ std::optional<std::vector<std::pair<std::int32_t, std::int32_t>>> SelfIntersecti
                         static_cast<std::size_t>(mesh.triangles(t, 2))});
     original.push_back(static_cast<std::int32_t>(t));
   }
+  if (!IsOrientedManifold(mesh)) return std::nullopt;
   namespace PMP = CGAL::Polygon_mesh_processing;
   try {
-    if (!PMP::is_polygon_soup_a_polygon_mesh(polygons)) return std::nullopt;
     SurfaceMesh surface;
     PMP::polygon_soup_to_polygon_mesh(points, polygons, surface);
     if (surface.number_of_faces() != polygons.size()) return std::nullopt;
     std::vector<std::pair<SurfaceMesh::Face_index, SurfaceMesh::Face_index>> faces;
-    PMP::self_intersections(surface, std::back_inserter(faces));
+    // Parallel over the box pairs (TBB); the pairs are sorted below, so the order they come
+    // in does not matter.
+    PMP::self_intersections<CGAL::Parallel_if_available_tag>(surface,
+                                                              std::back_inserter(faces));
     // polygon_soup_to_polygon_mesh adds faces in input order, so face i is polygon i.
     std::vector<std::pair<std::int32_t, std::int32_t>> pairs;
     pairs.reserve(faces.size());

@@ -17,6 +17,13 @@ namespace inscribe::internal {
 std::optional<std::vector<std::pair<std::int32_t, std::int32_t>>> SelfIntersectingPairs(
     const Mesh& mesh);
 
+// Whether the triangles with distinct corners form an oriented 2-manifold with boundary, the
+// soup CGAL's polygon_soup_to_polygon_mesh needs: every edge in at most two of them, walked in
+// opposite directions when in two, and the triangles around each vertex one fan (connected
+// through shared edges). CGAL's is_polygon_soup_a_polygon_mesh's verdict, from sorted edge
+// uses instead of a tree of edges (13 s against 0.4 s on 1.2 million triangles): O(#T log #T).
+bool IsOrientedManifold(const Mesh& mesh);
+
 // Number of triangles whose corners are distinct but collinear (zero area), exact predicate;
 // `first` receives the first such triangle or -1.
 std::int64_t CountCollinearTriangles(const Mesh& mesh, std::int64_t* first);

@@ -25,6 +25,7 @@
 #include "inscribe/mesh_validation.h"
 #include "inscribe/solid.h"
 #include "inscribe/sphere_io.h"
+#include "inscribe/sphere_set_generation.h"
 #include "support/synthetic_meshes.h"
 #include "support/test_meshes.h"
 
@@ -232,18 +233,18 @@ TEST_F(CliUrdf, SpheresMatchARecomputationInEachLinksOwnFrame) {
 
     // Recompute: the mesh placed here, validated and spherized with the same parameters.
     const auto start = std::chrono::steady_clock::now();
-    absl::StatusOr<ValidatedMesh> mesh = PrepareMesh(LinkMesh(spec));
-    ASSERT_TRUE(mesh.ok()) << mesh.status();
-    const double diagonal = mesh->report.bbox.diagonal();
-    absl::StatusOr<BoundaryOracle> oracle = BoundaryOracle::Build(mesh->mesh);
-    ASSERT_TRUE(oracle.ok());
-    SphereBudgetOptions budget;
-    budget.max_spheres = kMaxSpheres;
-    const absl::StatusOr<SphereBudgetResult> expected = GenerateWithSphereBudget(*oracle, budget);
+    absl::StatusOr<Solid> solid = PrepareSolid(LinkMesh(spec));
+    ASSERT_TRUE(solid.ok()) << solid.status();
+    const double diagonal = solid->report.bbox.diagonal();
+    const BoundaryOracle* oracle = &solid->oracle;
+    SphereSetParameters parameters;  // core's defaults, as the CLI's
+    parameters.max_spheres = kMaxSpheres;
+    parameters.evaluate = false;
+    const absl::StatusOr<GeneratedSphereSet> expected = GenerateSphereSet(*solid, parameters);
     ASSERT_TRUE(expected.ok()) << expected.status();
     const double recompute_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    const std::vector<Sphere>& reference = expected->best.set.spheres;
+    const std::vector<Sphere>& reference = expected->set.spheres;
     ASSERT_EQ(written.size(), reference.size());
     double centre_deviation = 0.0, radius_deviation = 0.0, tangency = 0.0;
     for (std::size_t i = 0; i < written.size(); ++i) {

@@ -13,6 +13,8 @@
 #include <utility>
 #include <vector>
 
+#include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
+
 #include "absl/strings/str_cat.h"
 #include "inscribe/mesh_io.h"
 #include "mesh_topology.h"       // private: core/src
@@ -268,6 +270,81 @@ TEST(ValidateMesh, CgalPigIsOpen) {
   const ValidatedMesh v = ValidateMesh(*pig);
   EXPECT_EQ(v.report.border_edges, 55);
   EXPECT_FALSE(v.report.usable());
+}
+
+}  // namespace
+}  // namespace inscribe
+
+namespace inscribe {
+namespace {
+
+// CGAL's own verdict on the same soup: the slow obvious reference of IsOrientedManifold.
+bool CgalSaysPolygonMesh(const Mesh& mesh) {
+  std::vector<std::array<std::size_t, 3>> polygons;
+  for (Eigen::Index t = 0; t < mesh.triangles.rows(); ++t) {
+    if (!internal::HasDistinctCorners(mesh, t)) continue;
+    polygons.push_back({static_cast<std::size_t>(mesh.triangles(t, 0)),
+                        static_cast<std::size_t>(mesh.triangles(t, 1)),
+                        static_cast<std::size_t>(mesh.triangles(t, 2))});
+  }
+  return CGAL::Polygon_mesh_processing::is_polygon_soup_a_polygon_mesh(polygons);
+}
+
+TEST(IsOrientedManifold, AgreesWithCgalOnRealAndBrokenMeshes) {
+  std::vector<std::pair<std::string, Mesh>> cases;
+  for (const char* name : {"eight.off", "knot1.off", "fandisk.off"}) {
+    cases.emplace_back(name, testing::LoadTestMesh(name));
+  }
+  const Mesh cube = testing::Box(Vector3::Zero(), Vector3::Ones());
+  cases.emplace_back("cube", cube);
+  Mesh flipped = cube;
+  std::swap(flipped.triangles(3, 1), flipped.triangles(3, 2));
+  cases.emplace_back("one triangle flipped", flipped);
+  Mesh open = cube;
+  open.triangles.conservativeResize(open.triangles.rows() - 1, 3);
+  cases.emplace_back("open (a border)", open);
+  Mesh three = cube;  // an edge in three triangles
+  three.triangles.conservativeResize(three.triangles.rows() + 1, 3);
+  three.triangles.row(three.triangles.rows() - 1) = cube.triangles.row(0);
+  std::swap(three.triangles(three.triangles.rows() - 1, 1),
+            three.triangles(three.triangles.rows() - 1, 2));
+  cases.emplace_back("edge in three triangles", three);
+  // Two cubes sharing one corner vertex: two fans at that vertex.
+  Mesh bowtie;
+  bowtie.vertices.resize(2 * cube.vertices.rows() - 1, 3);
+  bowtie.vertices.topRows(cube.vertices.rows()) = cube.vertices;
+  Eigen::Index shared = 0;
+  for (Eigen::Index v = 0; v < cube.vertices.rows(); ++v) {
+    if (cube.vertices.row(v).isZero()) shared = v;
+  }
+  std::vector<Eigen::Index> second(static_cast<std::size_t>(cube.vertices.rows()));
+  Eigen::Index next = cube.vertices.rows();
+  for (Eigen::Index v = 0; v < cube.vertices.rows(); ++v) {
+    if (v == shared) {
+      second[static_cast<std::size_t>(v)] = shared;
+      continue;
+    }
+    second[static_cast<std::size_t>(v)] = next;
+    bowtie.vertices.row(next++) = -cube.vertices.row(v);  // the mirror cube
+  }
+  bowtie.triangles.resize(2 * cube.triangles.rows(), 3);
+  for (Eigen::Index t = 0; t < cube.triangles.rows(); ++t) {
+    bowtie.triangles.row(t) = cube.triangles.row(t);
+    for (int k = 0; k < 3; ++k) {
+      // Mirroring flips orientation: walk the corners backwards.
+      bowtie.triangles(cube.triangles.rows() + t, k) = static_cast<std::int32_t>(
+          second[static_cast<std::size_t>(cube.triangles(t, 2 - k))]);
+    }
+  }
+  cases.emplace_back("two cubes at one vertex", bowtie);
+  int manifold = 0;
+  for (const auto& [name, mesh] : cases) {
+    SCOPED_TRACE(name);
+    const bool ours = internal::IsOrientedManifold(mesh);
+    EXPECT_EQ(ours, CgalSaysPolygonMesh(mesh));
+    manifold += ours;
+  }
+  EXPECT_EQ(manifold, 5);  // the three meshes, the cube and the open cube
 }
 
 }  // namespace

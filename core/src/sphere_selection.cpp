@@ -343,8 +343,8 @@ absl::StatusOr<CoverageSelection> SelectByCoverage(const std::vector<Sphere>& ba
     for (int pass = 0; pass < options.swap_passes; ++pass) {
       std::vector<Pending> order;  // sole cover, then index; least first
       for (std::int32_t index : out.chosen) {
-        order.push_back({CountIn(grid, cover.once(), balls[static_cast<std::size_t>(index)]),
-                         index});
+        order.push_back(
+            {CountIn(grid, cover.once(), balls[static_cast<std::size_t>(index)]), index});
       }
       std::sort(order.begin(), order.end(), [](const Pending& a, const Pending& b) {
         return a.gain != b.gain ? a.gain < b.gain : a.index < b.index;
@@ -408,9 +408,9 @@ absl::Status CheckOptimisedSphereOptions(const OptimisedSphereOptions& options) 
   }
   if (options.grid_points != 0 &&
       (options.grid_points < kMinGridPoints || options.grid_points > kMaxGridPoints)) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "grid_points must be 0 (the default) or lie in [", kMinGridPoints, ", 2^31], got ",
-        options.grid_points));
+    return absl::InvalidArgumentError(
+        absl::StrCat("grid_points must be 0 (the default) or lie in [", kMinGridPoints,
+                     ", 2^31], got ", options.grid_points));
   }
   if (options.max_pool_runs < 1) {
     return absl::InvalidArgumentError(

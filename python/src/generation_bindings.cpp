@@ -214,8 +214,7 @@ void BindGeneration(py::module_& m) {
         py::arg("max_voxels") = py::none(), py::arg("dilation_growth") = py::none(),
         py::arg("max_protrusion") = py::none(), py::arg("cover_resolution") = py::none(),
         py::arg("evaluate") = true, py::arg("quality_samples") = py::none(),
-        py::arg("selection") = py::none(), py::arg("progress") = py::none(),
-        GenerateDoc().c_str());
+        py::arg("selection") = py::none(), py::arg("progress") = py::none(), GenerateDoc().c_str());
 
   m.def(
       "evaluate",

@@ -1,5 +1,6 @@
 #include "inscribe/mesh_validation.h"
 
+#include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -12,8 +13,6 @@
 #include <set>
 #include <utility>
 #include <vector>
-
-#include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
 
 #include "absl/strings/str_cat.h"
 #include "inscribe/mesh_io.h"
@@ -332,8 +331,8 @@ TEST(IsOrientedManifold, AgreesWithCgalOnRealAndBrokenMeshes) {
     bowtie.triangles.row(t) = cube.triangles.row(t);
     for (int k = 0; k < 3; ++k) {
       // Mirroring flips orientation: walk the corners backwards.
-      bowtie.triangles(cube.triangles.rows() + t, k) = static_cast<std::int32_t>(
-          second[static_cast<std::size_t>(cube.triangles(t, 2 - k))]);
+      bowtie.triangles(cube.triangles.rows() + t, k) =
+          static_cast<std::int32_t>(second[static_cast<std::size_t>(cube.triangles(t, 2 - k))]);
     }
   }
   cases.emplace_back("two cubes at one vertex", bowtie);

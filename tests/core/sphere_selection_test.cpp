@@ -143,8 +143,7 @@ TEST(SelectByCoverage, BadInputIsAClearError) {
   const std::vector<Sphere> balls = RandomBalls(10, 1.0, 0.1, 0.2, 1);
   CoverageSelectionOptions options;
   options.max_spheres = 0;
-  EXPECT_EQ(SelectByCoverage(balls, options).status().code(),
-            absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(SelectByCoverage(balls, options).status().code(), absl::StatusCode::kInvalidArgument);
   options.max_spheres = 3;
   options.grid_points = 10;
   EXPECT_NE(SelectByCoverage(balls, options).status().message().find("grid_points"),
@@ -152,8 +151,7 @@ TEST(SelectByCoverage, BadInputIsAClearError) {
   options.grid_points = 1 << 16;
   std::vector<Sphere> bad = balls;
   bad[4].radius = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_NE(SelectByCoverage(bad, options).status().message().find("sphere 4"),
-            std::string::npos);
+  EXPECT_NE(SelectByCoverage(bad, options).status().message().find("sphere 4"), std::string::npos);
   EXPECT_TRUE(SelectByCoverage({}, options)->chosen.empty());
 }
 
@@ -240,9 +238,8 @@ TEST(OptimisedSpheres, BadOptionsNameTheField) {
             std::string::npos);
   options.pool_factor = 3.0;
   options.base.object_angle = 4.0;
-  EXPECT_NE(
-      GenerateOptimisedSpheres(solid.oracle, options).status().message().find("object angle"),
-      std::string::npos);
+  EXPECT_NE(GenerateOptimisedSpheres(solid.oracle, options).status().message().find("object angle"),
+            std::string::npos);
   EXPECT_EQ(ParseSphereSelection("greedy").status().code(), absl::StatusCode::kInvalidArgument);
   EXPECT_EQ(*ParseSphereSelection(SphereSelectionName(SphereSelection::kOptimised)),
             SphereSelection::kOptimised);

@@ -32,5 +32,4 @@ void ExpectInternalAndTangent(const BoundaryOracle& oracle, const SphereSet& set
   }
 }
 
-
 }  // namespace inscribe::testing

@@ -93,7 +93,8 @@ SphereFile MakeSphereFile(const GenerateCliOptions& options, const Generated& g)
   for (auto& param : medial) file.params.push_back(std::move(param));
   if (const std::optional<std::int64_t> budget = EffectiveMaxSpheres(p)) {
     file.params.emplace_back("max_spheres", *budget);
-    if (medial_run) file.params.emplace_back("selection", std::string(SphereSelectionName(r.selection)));
+    if (medial_run)
+      file.params.emplace_back("selection", std::string(SphereSelectionName(r.selection)));
   }
   if (r.kind == SphereSetKind::kDilated) {
     file.params.emplace_back("dilation_growth", p.dilation.growth);

@@ -57,8 +57,8 @@ struct CoverageSelection {
 // coverage with lazy gain evaluation. Coverage is submodular, so a ball's gain only falls as
 // others are chosen and its last count bounds it from above; each step takes a ball whose
 // fresh gain is within 1/16 of the best bound left, so the set covers at least
-// 1 - e^(-15/16) (61%) of what the best N balls cover, and in practice far more. Stops early when no ball adds a sample. Deterministic
-// (ties go to the lower index) whatever the thread count.
+// 1 - e^(-15/16) (61%) of what the best N balls cover, and in practice far more. Stops early when
+// no ball adds a sample. Deterministic (ties go to the lower index) whatever the thread count.
 // Errors: INVALID_ARGUMENT for N <= 0, grid_points out of range, a bad ball (CheckSphere) or
 // more than 2^31 - 1 balls; CANCELLED.
 // Cost: O(sum over balls of (r / h)^2 (1 + r / 64h)) word operations up front (h the grid

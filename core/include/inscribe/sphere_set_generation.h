@@ -86,7 +86,7 @@ CoverParameters CoverParametersOf(const SphereSetParameters& parameters);
 
 struct GeneratedSphereSet {
   SphereSetKind kind = SphereSetKind::kInternal;
-  SphereSet set;            // S_D with contacts, else (dilated, cover) without
+  SphereSet set;  // S_D with contacts, else (dilated, cover) without
   // sigma used (the search's choice for a paper budget, the pool's for an optimised one); 0 for
   // a cover.
   double voxel_size = 0.0;

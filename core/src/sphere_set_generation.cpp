@@ -140,10 +140,7 @@ absl::StatusOr<GeneratedSphereSet> GenerateSphereSet(const Solid& solid,
     out.runs = chosen->runs;
     out.selection = SphereSelection::kOptimised;
     out.pool_size = chosen->pool_size;
-    out.covered_fraction = chosen->selection.samples > 0
-                               ? static_cast<double>(chosen->selection.covered) /
-                                     static_cast<double>(chosen->selection.samples)
-                               : 0.0;
+    out.covered_fraction = chosen->selection.covered_fraction();
     medial = std::move(chosen->best);
   } else if (budget) {
     SphereBudgetOptions search;

@@ -262,10 +262,12 @@ absl::StatusOr<std::int64_t> InscribeService::GenerateWorkBytes(
           limits_.max_voxels));
     }
   } else if (size) {
-    // A sphere budget N: the search starts at voxels of side ~diagonal / (2 sqrt N) (sphere
-    // counts grow as (diagonal / sigma)^2 / 4) and refines from there; half that side, 8x the
-    // voxels, bounds where it ends on the meshes measured (at most the --max-voxels grid). A
-    // cover bounded by max_protrusion instead is estimated as one of the default budget.
+    // A sphere budget N: the paper's search starts at voxels of side ~diagonal / (2 sqrt N)
+    // (sphere counts grow as (diagonal / sigma)^2 / 4) and refines from there, and the
+    // optimised selection's pool of ~3N spheres sits about sqrt(3) finer; half that side, 8x
+    // the voxels, bounds where either ends on the meshes measured (at most the --max-voxels
+    // grid). A cover bounded by max_protrusion instead is estimated as one of the default
+    // budget.
     const std::int64_t budget = EffectiveMaxSpheres(parameters).value_or(kDefaultMaxSpheres);
     const double sigma =
         0.5 * size->extent.norm() / std::sqrt(std::max(static_cast<double>(budget), 1.0));

@@ -51,6 +51,11 @@ struct CoverageSelection {
   std::int64_t evaluations = 0;      // gains counted (up front, lazily and in the swap passes)
   std::int64_t swaps = 0;            // chosen balls replaced in the swap passes
   double grid_spacing = 0.0;         // distance between neighbouring sample points
+
+  // covered / samples: the share of the balls' union the chosen ones hold (0 without samples).
+  double covered_fraction() const {
+    return samples > 0 ? static_cast<double>(covered) / static_cast<double>(samples) : 0.0;
+  }
 };
 
 // Chooses at most N of `balls` whose union holds the most sample points: greedy maximum

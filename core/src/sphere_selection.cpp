@@ -18,6 +18,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "coverage_grid.h"
 #include "voxel_grid.h"
 
 namespace inscribe {
@@ -32,191 +33,9 @@ double SecondsSince(Clock::time_point start) {
 constexpr std::int64_t kMinGridPoints = 4096;
 constexpr std::int64_t kMaxGridPoints = std::int64_t{1} << 31;
 
-// Sample points origin + spacing * (i, j, k), 0 <= i < dims[0] etc. Row (j, k) holds its
-// dims[0] points; bit fields give each row `words_per_row` 64-bit words.
-class SampleGrid {
- public:
-  SampleGrid(const std::vector<Sphere>& balls, std::int64_t max_points) {
-    Vector3 low = Vector3::Constant(std::numeric_limits<double>::infinity());
-    Vector3 high = -low;
-    for (const Sphere& ball : balls) {
-      low = low.cwiseMin(ball.center - Vector3::Constant(ball.radius));
-      high = high.cwiseMax(ball.center + Vector3::Constant(ball.radius));
-    }
-    const Vector3 extent = high - low;
-    spacing_ = std::cbrt(extent.prod() / static_cast<double>(max_points));
-    // Sides round up to whole spacings: grow the spacing until the points fit.
-    while (PointsAt(extent, spacing_) > static_cast<double>(max_points)) spacing_ *= 1.001;
-    for (int axis = 0; axis < 3; ++axis) {
-      dims_[axis] = static_cast<std::int64_t>(std::floor(extent[axis] / spacing_)) + 1;
-    }
-    // Centre the points in the box.
-    origin_ = low + 0.5 * (extent - spacing_ * Vector3(static_cast<double>(dims_[0] - 1),
-                                                       static_cast<double>(dims_[1] - 1),
-                                                       static_cast<double>(dims_[2] - 1)));
-    words_per_row_ = (dims_[0] + 63) / 64;
-  }
-
-  double spacing() const { return spacing_; }
-  std::int64_t row_length() const { return dims_[0]; }
-  std::int64_t rows() const { return dims_[1] * dims_[2]; }
-  std::int64_t words_per_row() const { return words_per_row_; }
-
-  // Calls f(row, first, last) for each row the ball meets, with its points first..last
-  // (inclusive) inside the ball.
-  template <typename F>
-  void ForEachRun(const Sphere& ball, F&& f) const {
-    const Vector3 c = (ball.center - origin_) / spacing_;
-    const double rs = ball.radius / spacing_;
-    const std::int64_t k0 = std::max<std::int64_t>(0, Ceil(c.z() - rs));
-    const std::int64_t k1 = std::min<std::int64_t>(dims_[2] - 1, Floor(c.z() + rs));
-    for (std::int64_t k = k0; k <= k1; ++k) {
-      const double dz = static_cast<double>(k) - c.z();
-      const double slice = rs * rs - dz * dz;
-      if (slice < 0.0) continue;
-      const double ry = std::sqrt(slice);
-      const std::int64_t j0 = std::max<std::int64_t>(0, Ceil(c.y() - ry));
-      const std::int64_t j1 = std::min<std::int64_t>(dims_[1] - 1, Floor(c.y() + ry));
-      for (std::int64_t j = j0; j <= j1; ++j) {
-        const double dy = static_cast<double>(j) - c.y();
-        const double chord = slice - dy * dy;
-        if (chord < 0.0) continue;
-        const double rx = std::sqrt(chord);
-        const std::int64_t i0 = std::max<std::int64_t>(0, Ceil(c.x() - rx));
-        const std::int64_t i1 = std::min<std::int64_t>(dims_[0] - 1, Floor(c.x() + rx));
-        if (i0 <= i1) f(j + dims_[1] * k, i0, i1);
-      }
-    }
-  }
-
- private:
-  static double PointsAt(const Vector3& extent, double spacing) {
-    return (std::floor(extent.x() / spacing) + 1.0) * (std::floor(extent.y() / spacing) + 1.0) *
-           (std::floor(extent.z() / spacing) + 1.0);
-  }
-  static std::int64_t Ceil(double x) { return static_cast<std::int64_t>(std::ceil(x)); }
-  static std::int64_t Floor(double x) { return static_cast<std::int64_t>(std::floor(x)); }
-
-  Vector3 origin_ = Vector3::Zero();
-  double spacing_ = 0.0;
-  std::array<std::int64_t, 3> dims_ = {0, 0, 0};
-  std::int64_t words_per_row_ = 0;
-};
-
-// One bit per sample point of a SampleGrid.
-class BitField {
- public:
-  explicit BitField(const SampleGrid& grid)
-      : words_per_row_(grid.words_per_row()),
-        words_(static_cast<std::size_t>(grid.words_per_row() * grid.rows()), 0) {}
-
-  void Set(std::int64_t row, std::int64_t first, std::int64_t last) {
-    ForEachWord(row, first, last, [](std::uint64_t& word, std::uint64_t mask) { word |= mask; });
-  }
-  void Clear(std::int64_t row, std::int64_t first, std::int64_t last) {
-    ForEachWord(row, first, last, [](std::uint64_t& word, std::uint64_t mask) { word &= ~mask; });
-  }
-  void Set(std::int64_t row, std::int64_t i) {
-    words_[Word(row, i)] |= std::uint64_t{1} << (i & 63);
-  }
-  void Clear(std::int64_t row, std::int64_t i) {
-    words_[Word(row, i)] &= ~(std::uint64_t{1} << (i & 63));
-  }
-  // Set points among first..last.
-  std::int64_t Count(std::int64_t row, std::int64_t first, std::int64_t last) const {
-    const std::uint64_t* words = &words_[Word(row, 0)];
-    const std::int64_t w0 = first >> 6;
-    const std::int64_t w1 = last >> 6;
-    const std::uint64_t head = ~std::uint64_t{0} << (first & 63);
-    const std::uint64_t tail = ~std::uint64_t{0} >> (63 - (last & 63));
-    if (w0 == w1) return __builtin_popcountll(words[w0] & head & tail);
-    std::int64_t count = __builtin_popcountll(words[w0] & head);
-    for (std::int64_t w = w0 + 1; w < w1; ++w) count += __builtin_popcountll(words[w]);
-    return count + __builtin_popcountll(words[w1] & tail);
-  }
-  std::int64_t CountAll() const {
-    std::int64_t count = 0;
-    for (std::uint64_t word : words_) count += __builtin_popcountll(word);
-    return count;
-  }
-
- private:
-  std::size_t Word(std::int64_t row, std::int64_t i) const {
-    return static_cast<std::size_t>(row * words_per_row_ + (i >> 6));
-  }
-  template <typename Op>
-  void ForEachWord(std::int64_t row, std::int64_t first, std::int64_t last, Op&& op) {
-    std::uint64_t* words = &words_[Word(row, 0)];
-    const std::int64_t w0 = first >> 6;
-    const std::int64_t w1 = last >> 6;
-    const std::uint64_t head = ~std::uint64_t{0} << (first & 63);
-    const std::uint64_t tail = ~std::uint64_t{0} >> (63 - (last & 63));
-    if (w0 == w1) {
-      op(words[w0], head & tail);
-      return;
-    }
-    op(words[w0], head);
-    for (std::int64_t w = w0 + 1; w < w1; ++w) op(words[w], ~std::uint64_t{0});
-    op(words[w1], tail);
-  }
-
-  std::int64_t words_per_row_ = 0;
-  std::vector<std::uint64_t> words_;
-};
-
-// Points of `ball` set in `field`.
-std::int64_t CountIn(const SampleGrid& grid, const BitField& field, const Sphere& ball) {
-  std::int64_t count = 0;
-  grid.ForEachRun(ball, [&](std::int64_t row, std::int64_t first, std::int64_t last) {
-    count += field.Count(row, first, last);
-  });
-  return count;
-}
-
-// The chosen balls' cover of the samples, point by point, for the swap search: how many chosen
-// balls hold each point, the points held by none (`uncovered`) and by exactly one (`once`).
-// Every point of a pool ball is a sample, so adding and removing pool balls keeps the fields
-// exact.
-class CoverCounts {
- public:
-  CoverCounts(const SampleGrid& grid, BitField uncovered)
-      : grid_(grid),
-        uncovered_(std::move(uncovered)),
-        once_(grid),
-        counts_(static_cast<std::size_t>(grid.row_length() * grid.rows()), 0) {}
-
-  const BitField& uncovered() const { return uncovered_; }
-  const BitField& once() const { return once_; }
-
-  // A chosen ball (the greedy's are counted in this way once it has cleared their points).
-  void Add(const Sphere& ball) { Change(ball, +1); }
-  void Remove(const Sphere& ball) { Change(ball, -1); }
-
- private:
-  void Change(const Sphere& ball, int step) {
-    grid_.ForEachRun(ball, [&](std::int64_t row, std::int64_t first, std::int64_t last) {
-      std::uint16_t* count = &counts_[static_cast<std::size_t>(row * grid_.row_length())];
-      for (std::int64_t i = first; i <= last; ++i) {
-        const int now = count[i] + step;
-        count[i] = static_cast<std::uint16_t>(now);
-        if (now == 0) {
-          uncovered_.Set(row, i);
-          once_.Clear(row, i);
-        } else if (now == 1) {
-          uncovered_.Clear(row, i);
-          once_.Set(row, i);
-        } else if (now == 2) {
-          once_.Clear(row, i);
-        }
-      }
-    });
-  }
-
-  const SampleGrid& grid_;
-  BitField uncovered_;
-  BitField once_;
-  std::vector<std::uint16_t> counts_;
-};
+using internal::BitField;
+using internal::CoverCounts;
+using internal::SampleGrid;
 
 // The lazy greedy chooses a ball whose fresh gain is within 2^-kSlackShift of the best upper
 // bound left, rather than recounting the others: each choice then covers at least (1 - 2^-4)
@@ -255,9 +74,11 @@ absl::StatusOr<SphereSelection> ParseSphereSelection(absl::string_view name) {
       absl::StrCat("unknown sphere selection '", name, "': expected paper or optimised"));
 }
 
-absl::StatusOr<CoverageSelection> SelectByCoverage(const std::vector<Sphere>& balls,
-                                                   const CoverageSelectionOptions& options,
-                                                   const GenerationControl& control) {
+// Cloned for x86-64-v2 as BitField::CountIn is (coverage_grid.cpp): the clears and the row
+// walks inlined here popcount and round too.
+__attribute__((target_clones("arch=x86-64-v2", "default"))) absl::StatusOr<CoverageSelection>
+SelectByCoverage(const std::vector<Sphere>& balls, const CoverageSelectionOptions& options,
+                 const GenerationControl& control) {
   if (options.max_spheres <= 0) {
     return absl::InvalidArgumentError(
         absl::StrCat("the sphere budget must be at least 1, got ", options.max_spheres));
@@ -291,7 +112,7 @@ absl::StatusOr<CoverageSelection> SelectByCoverage(const std::vector<Sphere>& ba
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       if (control.cancelled()) return;
                       for (std::size_t i = range.begin(); i != range.end(); ++i) {
-                        gains[i] = CountIn(grid, uncovered, balls[i]);
+                        gains[i] = uncovered.CountIn(balls[i]);
                       }
                     });
   if (control.cancelled()) return Cancelled();
@@ -312,7 +133,7 @@ absl::StatusOr<CoverageSelection> SelectByCoverage(const std::vector<Sphere>& ba
     Pending top = queue.top();
     queue.pop();
     const Sphere& ball = balls[static_cast<std::size_t>(top.index)];
-    top.gain = CountIn(grid, uncovered, ball);
+    top.gain = uncovered.CountIn(ball);
     ++out.evaluations;
     if (top.gain == 0) continue;
     // Every other ball's last count bounds its gain from above: when one of them may still
@@ -343,8 +164,7 @@ absl::StatusOr<CoverageSelection> SelectByCoverage(const std::vector<Sphere>& ba
     for (int pass = 0; pass < options.swap_passes; ++pass) {
       std::vector<Pending> order;  // sole cover, then index; least first
       for (std::int32_t index : out.chosen) {
-        order.push_back(
-            {CountIn(grid, cover.once(), balls[static_cast<std::size_t>(index)]), index});
+        order.push_back({cover.once().CountIn(balls[static_cast<std::size_t>(index)]), index});
       }
       std::sort(order.begin(), order.end(), [](const Pending& a, const Pending& b) {
         return a.gain != b.gain ? a.gain < b.gain : a.index < b.index;
@@ -356,13 +176,13 @@ absl::StatusOr<CoverageSelection> SelectByCoverage(const std::vector<Sphere>& ba
         const Sphere& s = balls[static_cast<std::size_t>(leaving)];
         cover.Remove(s);
         std::int32_t best = leaving;
-        std::int64_t best_gain = CountIn(grid, cover.uncovered(), s);
+        std::int64_t best_gain = cover.uncovered().CountIn(s);
         for (std::size_t c = 0; c < n; ++c) {
           if (chosen[c]) continue;
           const Sphere& candidate = balls[c];
           const double reach = s.radius + candidate.radius;
           if ((candidate.center - s.center).squaredNorm() >= reach * reach) continue;
-          const std::int64_t gain = CountIn(grid, cover.uncovered(), candidate);
+          const std::int64_t gain = cover.uncovered().CountIn(candidate);
           ++out.evaluations;
           if (gain > best_gain) {
             best_gain = gain;

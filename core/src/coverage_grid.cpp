@@ -1,0 +1,140 @@
+// The selection's sample grid and bit fields. See coverage_grid.h.
+#include "coverage_grid.h"
+
+namespace inscribe::internal {
+namespace {
+
+double PointsAt(const Vector3& extent, double spacing) {
+  return (std::floor(extent.x() / spacing) + 1.0) * (std::floor(extent.y() / spacing) + 1.0) *
+         (std::floor(extent.z() / spacing) + 1.0);
+}
+
+// A block counts as wholly inside a ball when its farthest point is inside by this relative
+// margin of r^2, and as outside when its nearest point is outside by it: far above the
+// rounding of RowRun's arithmetic, so such blocks hold exactly the points RowRun would give.
+constexpr double kBlockMargin = 1e-6;
+
+}  // namespace
+
+SampleGrid::SampleGrid(const std::vector<Sphere>& balls, std::int64_t max_points) {
+  Vector3 low = Vector3::Constant(std::numeric_limits<double>::infinity());
+  Vector3 high = -low;
+  for (const Sphere& ball : balls) {
+    low = low.cwiseMin(ball.center - Vector3::Constant(ball.radius));
+    high = high.cwiseMax(ball.center + Vector3::Constant(ball.radius));
+  }
+  const Vector3 extent = high - low;
+  spacing_ = std::cbrt(extent.prod() / static_cast<double>(max_points));
+  // Sides round up to whole spacings: grow the spacing until the points fit.
+  while (PointsAt(extent, spacing_) > static_cast<double>(max_points)) spacing_ *= 1.001;
+  for (int axis = 0; axis < 3; ++axis) {
+    dims_[axis] = static_cast<std::int64_t>(std::floor(extent[axis] / spacing_)) + 1;
+  }
+  // Centre the points in the box.
+  origin_ = low + 0.5 * (extent - spacing_ * Vector3(static_cast<double>(dims_[0] - 1),
+                                                     static_cast<double>(dims_[1] - 1),
+                                                     static_cast<double>(dims_[2] - 1)));
+  words_per_row_ = (dims_[0] + 63) / 64;
+}
+
+BitField::BitField(const SampleGrid& grid)
+    : grid_(grid),
+      words_per_row_(grid.words_per_row()),
+      blocks_y_((grid.dim(1) + kBlockRows - 1) / kBlockRows),
+      words_(static_cast<std::size_t>(grid.words_per_row() * grid.rows()), 0),
+      block_counts_(static_cast<std::size_t>(grid.words_per_row() * blocks_y_ *
+                                             ((grid.dim(2) + kBlockRows - 1) / kBlockRows)),
+                    0) {}
+
+std::int64_t BitField::CountAll() const {
+  std::int64_t count = 0;
+  for (std::int32_t block : block_counts_) count += block;
+  return count;
+}
+
+// Cloned for x86-64-v2 (popcnt, SSE4.1 rounding), chosen at load time: with the baseline's
+// library popcount and floor the count runs at half speed.
+__attribute__((target_clones("arch=x86-64-v2", "default"))) std::int64_t BitField::CountIn(
+    const Sphere& sphere) const {
+  const SampleGrid::Ball ball = grid_.ToGrid(sphere);
+  // ForEachRun's slices along z; along x and y its runs end where square roots of rounded
+  // differences put them, so the blocks looked at reach one point further.
+  std::int64_t low[3], high[3];
+  for (int axis = 0; axis < 3; ++axis) {
+    const std::int64_t pad = axis == 2 ? 0 : 1;
+    low[axis] = std::max<std::int64_t>(0, SampleGrid::Ceil(ball.c[axis] - ball.r) - pad);
+    high[axis] =
+        std::min<std::int64_t>(grid_.dim(axis) - 1, SampleGrid::Floor(ball.c[axis] + ball.r) + pad);
+    if (low[axis] > high[axis]) return 0;
+  }
+  const double r2 = ball.r * ball.r;
+  const double inner = r2 * (1.0 - kBlockMargin);
+  const double outer = r2 * (1.0 + kBlockMargin);
+  // Squared distances from the centre to the nearest and farthest points of [lo, hi] on `axis`.
+  auto near_far = [&ball](int axis, std::int64_t lo, std::int64_t hi, double& near2, double& far2) {
+    const double a = static_cast<double>(lo) - ball.c[axis];
+    const double b = static_cast<double>(hi) - ball.c[axis];
+    const double nearest = a > 0.0 ? a : (b < 0.0 ? b : 0.0);
+    near2 += nearest * nearest;
+    far2 += std::max(a * a, b * b);
+  };
+  std::int64_t count = 0;
+  for (std::int64_t kb = low[2] / kBlockRows; kb <= high[2] / kBlockRows; ++kb) {
+    const std::int64_t z0 = kb * kBlockRows;
+    const std::int64_t z1 = std::min(grid_.dim(2) - 1, z0 + kBlockRows - 1);
+    for (std::int64_t jb = low[1] / kBlockRows; jb <= high[1] / kBlockRows; ++jb) {
+      const std::int64_t y0 = jb * kBlockRows;
+      const std::int64_t y1 = std::min(grid_.dim(1) - 1, y0 + kBlockRows - 1);
+      for (std::int64_t w = low[0] >> 6; w <= high[0] >> 6; ++w) {
+        const std::int32_t in_block = block_counts_[Block3(w, jb, kb)];
+        if (in_block == 0) continue;
+        const std::int64_t x0 = w * 64;
+        const std::int64_t x1 = std::min(grid_.dim(0) - 1, x0 + 63);
+        double near2 = 0.0, far2 = 0.0;
+        near_far(0, x0, x1, near2, far2);
+        near_far(1, y0, y1, near2, far2);
+        near_far(2, z0, z1, near2, far2);
+        if (far2 <= inner) {
+          count += in_block;
+          continue;
+        }
+        if (near2 > outer) continue;
+        // Straddles the sphere: row by row, by ForEachRun's rule.
+        for (std::int64_t k = std::max(z0, low[2]); k <= std::min(z1, high[2]); ++k) {
+          for (std::int64_t j = y0; j <= y1; ++j) {
+            std::int64_t first, last;
+            if (!grid_.RowRun(ball, j, k, first, last)) continue;
+            first = std::max(first, x0);
+            last = std::min(last, x1);
+            if (first > last) continue;
+            const std::uint64_t mask =
+                (~std::uint64_t{0} << (first & 63)) & (~std::uint64_t{0} >> (63 - (last & 63)));
+            count += __builtin_popcountll(words_[Word(grid_.row(j, k), w)] & mask);
+          }
+        }
+      }
+    }
+  }
+  return count;
+}
+
+void CoverCounts::Change(const Sphere& ball, int step) {
+  grid_.ForEachRun(ball, [&](std::int64_t row, std::int64_t first, std::int64_t last) {
+    std::uint16_t* count = &counts_[static_cast<std::size_t>(row * grid_.row_length())];
+    for (std::int64_t i = first; i <= last; ++i) {
+      const int now = count[i] + step;
+      count[i] = static_cast<std::uint16_t>(now);
+      if (now == 0) {
+        uncovered_.Set(row, i);
+        once_.Clear(row, i);
+      } else if (now == 1) {
+        uncovered_.Clear(row, i);
+        once_.Set(row, i);
+      } else if (now == 2) {
+        once_.Clear(row, i);
+      }
+    }
+  });
+}
+
+}  // namespace inscribe::internal

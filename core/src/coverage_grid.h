@@ -1,0 +1,208 @@
+// Private: the sample grid of the optimised selection (sphere_selection.cpp) and its bit
+// fields. Sample points lie on a regular grid; a bit field keeps one bit per point in rows
+// along x, and a ball meets each row in one run of points, so counting the points of a ball
+// still set is a popcount over its runs. Each bit field also keeps the number of set bits of
+// every block of 64 x 4 x 4 points (one word of 4 x 4 rows), so a count can take a block
+// wholly inside the ball at once and skip an empty one: late in a greedy choice, a large
+// ball's recount touches its surface's blocks instead of all its rows.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "inscribe/sphere.h"
+
+namespace inscribe::internal {
+
+// Sample points origin + spacing * (i, j, k), 0 <= i < dims[0] etc. Row (j, k) holds its
+// dims[0] points; bit fields give each row `words_per_row` 64-bit words.
+class SampleGrid {
+ public:
+  // The finest grid of at most max_points points over the balls' bounding box, centred in it.
+  SampleGrid(const std::vector<Sphere>& balls, std::int64_t max_points);
+
+  double spacing() const { return spacing_; }
+  std::int64_t dim(int axis) const { return dims_[axis]; }
+  std::int64_t row_length() const { return dims_[0]; }
+  std::int64_t rows() const { return dims_[1] * dims_[2]; }
+  std::int64_t words_per_row() const { return words_per_row_; }
+  std::int64_t row(std::int64_t j, std::int64_t k) const { return j + dims_[1] * k; }
+
+  // A ball in grid units: centre (origin at point (0, 0, 0), one unit per spacing) and radius.
+  struct Ball {
+    Vector3 c;
+    double r;
+  };
+  Vector3 PointAt(std::int64_t i, std::int64_t j, std::int64_t k) const {
+    return origin_ + spacing_ * Vector3(static_cast<double>(i), static_cast<double>(j),
+                                        static_cast<double>(k));
+  }
+  Ball ToGrid(const Sphere& ball) const {
+    return Ball{(ball.center - origin_) / spacing_, ball.radius / spacing_};
+  }
+
+  // The points of row (j, k) inside `ball`: false if none, else first..last (inclusive). The
+  // one rule of which points a ball holds; ForEachRun gives the same runs.
+  bool RowRun(const Ball& ball, std::int64_t j, std::int64_t k, std::int64_t& first,
+              std::int64_t& last) const {
+    const double dz = static_cast<double>(k) - ball.c.z();
+    const double slice = ball.r * ball.r - dz * dz;
+    if (slice < 0.0) return false;
+    const double ry = std::sqrt(slice);
+    if (j < Ceil(ball.c.y() - ry) || j > Floor(ball.c.y() + ry)) return false;
+    return Chord(ball, slice, j, first, last);
+  }
+
+  // Calls f(row, first, last) for each row the ball meets, with its points first..last
+  // (inclusive) inside the ball.
+  template <typename F>
+  void ForEachRun(const Sphere& sphere, F&& f) const {
+    const Ball ball = ToGrid(sphere);
+    const std::int64_t k0 = std::max<std::int64_t>(0, Ceil(ball.c.z() - ball.r));
+    const std::int64_t k1 = std::min<std::int64_t>(dims_[2] - 1, Floor(ball.c.z() + ball.r));
+    for (std::int64_t k = k0; k <= k1; ++k) {
+      const double dz = static_cast<double>(k) - ball.c.z();
+      const double slice = ball.r * ball.r - dz * dz;
+      if (slice < 0.0) continue;
+      const double ry = std::sqrt(slice);
+      const std::int64_t j0 = std::max<std::int64_t>(0, Ceil(ball.c.y() - ry));
+      const std::int64_t j1 = std::min<std::int64_t>(dims_[1] - 1, Floor(ball.c.y() + ry));
+      for (std::int64_t j = j0; j <= j1; ++j) {
+        std::int64_t first, last;
+        if (Chord(ball, slice, j, first, last)) f(row(j, k), first, last);
+      }
+    }
+  }
+
+  static std::int64_t Ceil(double x) { return static_cast<std::int64_t>(std::ceil(x)); }
+  static std::int64_t Floor(double x) { return static_cast<std::int64_t>(std::floor(x)); }
+
+ private:
+  bool Chord(const Ball& ball, double slice, std::int64_t j, std::int64_t& first,
+             std::int64_t& last) const {
+    const double dy = static_cast<double>(j) - ball.c.y();
+    const double chord = slice - dy * dy;
+    if (chord < 0.0) return false;
+    const double rx = std::sqrt(chord);
+    first = std::max<std::int64_t>(0, Ceil(ball.c.x() - rx));
+    last = std::min<std::int64_t>(dims_[0] - 1, Floor(ball.c.x() + rx));
+    return first <= last;
+  }
+
+  Vector3 origin_ = Vector3::Zero();
+  double spacing_ = 0.0;
+  std::array<std::int64_t, 3> dims_ = {0, 0, 0};
+  std::int64_t words_per_row_ = 0;
+};
+
+// One bit per sample point of a SampleGrid, with the set bits of each block of 64 x 4 x 4
+// points counted.
+class BitField {
+ public:
+  static constexpr std::int64_t kBlockRows = 4;  // block side along y and along z, in points
+
+  explicit BitField(const SampleGrid& grid);
+
+  void Set(std::int64_t row, std::int64_t first, std::int64_t last) {
+    ForEachWord(row, first, last, [](std::uint64_t& word, std::uint64_t mask) {
+      const std::int32_t added = __builtin_popcountll(~word & mask);
+      word |= mask;
+      return added;
+    });
+  }
+  void Clear(std::int64_t row, std::int64_t first, std::int64_t last) {
+    ForEachWord(row, first, last, [](std::uint64_t& word, std::uint64_t mask) {
+      const std::int32_t removed = __builtin_popcountll(word & mask);
+      word &= ~mask;
+      return -removed;
+    });
+  }
+  void Set(std::int64_t row, std::int64_t i) { Set(row, i, i); }
+  void Clear(std::int64_t row, std::int64_t i) { Clear(row, i, i); }
+
+  // Set points among first..last of `row`.
+  std::int64_t Count(std::int64_t row, std::int64_t first, std::int64_t last) const {
+    const std::uint64_t* words = &words_[Word(row, 0)];
+    const std::int64_t w0 = first >> 6;
+    const std::int64_t w1 = last >> 6;
+    const std::uint64_t head = ~std::uint64_t{0} << (first & 63);
+    const std::uint64_t tail = ~std::uint64_t{0} >> (63 - (last & 63));
+    if (w0 == w1) return __builtin_popcountll(words[w0] & head & tail);
+    std::int64_t count = __builtin_popcountll(words[w0] & head);
+    for (std::int64_t w = w0 + 1; w < w1; ++w) count += __builtin_popcountll(words[w]);
+    return count + __builtin_popcountll(words[w1] & tail);
+  }
+  std::int64_t CountAll() const;
+
+  // Set points inside `ball`; the same as summing Count over grid.ForEachRun(ball), faster.
+  std::int64_t CountIn(const Sphere& ball) const;
+
+ private:
+  std::size_t Word(std::int64_t row, std::int64_t w) const {
+    return static_cast<std::size_t>(row * words_per_row_ + w);
+  }
+  std::size_t Block(std::int64_t row, std::int64_t w) const {
+    const std::int64_t j = row % grid_.dim(1);
+    const std::int64_t k = row / grid_.dim(1);
+    return Block3(w, j / kBlockRows, k / kBlockRows);
+  }
+  std::size_t Block3(std::int64_t w, std::int64_t jb, std::int64_t kb) const {
+    return static_cast<std::size_t>(w + words_per_row_ * (jb + blocks_y_ * kb));
+  }
+  // op(word, mask) changes the word and returns the change in its set bits.
+  template <typename Op>
+  void ForEachWord(std::int64_t row, std::int64_t first, std::int64_t last, Op&& op) {
+    std::uint64_t* words = &words_[Word(row, 0)];
+    const std::int64_t w0 = first >> 6;
+    const std::int64_t w1 = last >> 6;
+    const std::uint64_t head = ~std::uint64_t{0} << (first & 63);
+    const std::uint64_t tail = ~std::uint64_t{0} >> (63 - (last & 63));
+    const std::size_t block = Block(row, 0);
+    for (std::int64_t w = w0; w <= w1; ++w) {
+      std::uint64_t mask = ~std::uint64_t{0};
+      if (w == w0) mask &= head;
+      if (w == w1) mask &= tail;
+      block_counts_[block + static_cast<std::size_t>(w)] += op(words[w], mask);
+    }
+  }
+
+  const SampleGrid& grid_;
+  std::int64_t words_per_row_ = 0;
+  std::int64_t blocks_y_ = 0;
+  std::vector<std::uint64_t> words_;
+  std::vector<std::int32_t> block_counts_;
+};
+
+// The chosen balls' cover of the samples, point by point, for the swap search: how many chosen
+// balls hold each point, the points held by none (`uncovered`) and by exactly one (`once`).
+// Every point of a pool ball is a sample, so adding and removing pool balls keeps the fields
+// exact.
+class CoverCounts {
+ public:
+  CoverCounts(const SampleGrid& grid, BitField uncovered)
+      : grid_(grid),
+        uncovered_(std::move(uncovered)),
+        once_(grid),
+        counts_(static_cast<std::size_t>(grid.row_length() * grid.rows()), 0) {}
+
+  const BitField& uncovered() const { return uncovered_; }
+  const BitField& once() const { return once_; }
+
+  // A chosen ball (the greedy's are counted in this way once it has cleared their points).
+  void Add(const Sphere& ball) { Change(ball, +1); }
+  void Remove(const Sphere& ball) { Change(ball, -1); }
+
+ private:
+  void Change(const Sphere& ball, int step);
+
+  const SampleGrid& grid_;
+  BitField uncovered_;
+  BitField once_;
+  std::vector<std::uint16_t> counts_;
+};
+
+}  // namespace inscribe::internal

@@ -11,7 +11,7 @@ double PointsAt(const Vector3& extent, double spacing) {
 
 // A block counts as wholly inside a ball when its farthest point is inside by this relative
 // margin of r^2, and as outside when its nearest point is outside by it: far above the
-// rounding of RowRun's arithmetic, so such blocks hold exactly the points RowRun would give.
+// rounding of SampleGrid's row rule, so such blocks hold exactly the points it gives.
 constexpr double kBlockMargin = 1e-6;
 
 }  // namespace
@@ -57,14 +57,16 @@ std::int64_t BitField::CountAll() const {
 __attribute__((target_clones("arch=x86-64-v2", "default"))) std::int64_t BitField::CountIn(
     const Sphere& sphere) const {
   const SampleGrid::Ball ball = grid_.ToGrid(sphere);
-  // ForEachRun's slices along z; along x and y its runs end where square roots of rounded
-  // differences put them, so the blocks looked at reach one point further.
-  std::int64_t low[3], high[3];
-  for (int axis = 0; axis < 3; ++axis) {
-    const std::int64_t pad = axis == 2 ? 0 : 1;
-    low[axis] = std::max<std::int64_t>(0, SampleGrid::Ceil(ball.c[axis] - ball.r) - pad);
+  // The blocks looked at: ForEachRun's slices along z; along x and y its runs end where square
+  // roots of rounded differences put them, so one point further.
+  std::int64_t k0, k1;
+  grid_.SliceRange(ball, k0, k1);
+  if (k0 > k1) return 0;
+  std::int64_t low[2], high[2];
+  for (int axis = 0; axis < 2; ++axis) {
+    low[axis] = std::max<std::int64_t>(0, SampleGrid::Ceil(ball.c[axis] - ball.r) - 1);
     high[axis] =
-        std::min<std::int64_t>(grid_.dim(axis) - 1, SampleGrid::Floor(ball.c[axis] + ball.r) + pad);
+        std::min<std::int64_t>(grid_.dim(axis) - 1, SampleGrid::Floor(ball.c[axis] + ball.r) + 1);
     if (low[axis] > high[axis]) return 0;
   }
   const double r2 = ball.r * ball.r;
@@ -78,38 +80,52 @@ __attribute__((target_clones("arch=x86-64-v2", "default"))) std::int64_t BitFiel
     near2 += nearest * nearest;
     far2 += std::max(a * a, b * b);
   };
+  const std::int64_t w_first = low[0] >> 6;
+  const std::int64_t w_last = high[0] >> 6;
   std::int64_t count = 0;
-  for (std::int64_t kb = low[2] / kBlockRows; kb <= high[2] / kBlockRows; ++kb) {
+  for (std::int64_t kb = k0 / kBlockRows; kb <= k1 / kBlockRows; ++kb) {
     const std::int64_t z0 = kb * kBlockRows;
     const std::int64_t z1 = std::min(grid_.dim(2) - 1, z0 + kBlockRows - 1);
     for (std::int64_t jb = low[1] / kBlockRows; jb <= high[1] / kBlockRows; ++jb) {
       const std::int64_t y0 = jb * kBlockRows;
       const std::int64_t y1 = std::min(grid_.dim(1) - 1, y0 + kBlockRows - 1);
-      for (std::int64_t w = low[0] >> 6; w <= high[0] >> 6; ++w) {
-        const std::int32_t in_block = block_counts_[Block3(w, jb, kb)];
-        if (in_block == 0) continue;
-        const std::int64_t x0 = w * 64;
-        const std::int64_t x1 = std::min(grid_.dim(0) - 1, x0 + 63);
-        double near2 = 0.0, far2 = 0.0;
-        near_far(0, x0, x1, near2, far2);
-        near_far(1, y0, y1, near2, far2);
-        near_far(2, z0, z1, near2, far2);
-        if (far2 <= inner) {
-          count += in_block;
-          continue;
+      // The blocks of this group of 4 x 4 rows, up to 64 at a time: empty or outside ones are
+      // skipped, wholly inside ones counted at once, and the words of the rest (bit w - chunk
+      // of `straddling`) popcounted row by row.
+      for (std::int64_t chunk = w_first; chunk <= w_last; chunk += 64) {
+        const std::int64_t chunk_last = std::min(w_last, chunk + 63);
+        std::uint64_t straddling = 0;
+        for (std::int64_t w = chunk; w <= chunk_last; ++w) {
+          const std::int32_t in_block = block_counts_[Block3(w, jb, kb)];
+          if (in_block == 0) continue;
+          double near2 = 0.0, far2 = 0.0;
+          near_far(0, w * 64, std::min(grid_.dim(0) - 1, w * 64 + 63), near2, far2);
+          near_far(1, y0, y1, near2, far2);
+          near_far(2, z0, z1, near2, far2);
+          if (far2 <= inner) {
+            count += in_block;
+          } else if (near2 <= outer) {
+            straddling |= std::uint64_t{1} << (w - chunk);
+          }
         }
-        if (near2 > outer) continue;
-        // Straddles the sphere: row by row, by ForEachRun's rule.
-        for (std::int64_t k = std::max(z0, low[2]); k <= std::min(z1, high[2]); ++k) {
-          for (std::int64_t j = y0; j <= y1; ++j) {
+        if (straddling == 0) continue;
+        for (std::int64_t k = std::max(z0, k0); k <= std::min(z1, k1); ++k) {
+          double slice;
+          std::int64_t j0, j1;
+          if (!grid_.Slice(ball, k, slice, j0, j1)) continue;
+          for (std::int64_t j = std::max(y0, j0); j <= std::min(y1, j1); ++j) {
             std::int64_t first, last;
-            if (!grid_.RowRun(ball, j, k, first, last)) continue;
-            first = std::max(first, x0);
-            last = std::min(last, x1);
-            if (first > last) continue;
-            const std::uint64_t mask =
-                (~std::uint64_t{0} << (first & 63)) & (~std::uint64_t{0} >> (63 - (last & 63)));
-            count += __builtin_popcountll(words_[Word(grid_.row(j, k), w)] & mask);
+            if (!grid_.Chord(ball, slice, j, first, last)) continue;
+            const std::uint64_t* words = &words_[Word(grid_.row(j, k), 0)];
+            const std::int64_t from = std::max(first >> 6, chunk);
+            const std::int64_t to = std::min(last >> 6, chunk_last);
+            for (std::int64_t w = from; w <= to; ++w) {
+              if (!((straddling >> (w - chunk)) & 1)) continue;
+              std::uint64_t mask = ~std::uint64_t{0};
+              if (w == first >> 6) mask &= ~std::uint64_t{0} << (first & 63);
+              if (w == last >> 6) mask &= ~std::uint64_t{0} >> (63 - (last & 63));
+              count += __builtin_popcountll(words[w] & mask);
+            }
           }
         }
       }

@@ -45,43 +45,26 @@ class SampleGrid {
     return Ball{(ball.center - origin_) / spacing_, ball.radius / spacing_};
   }
 
-  // The points of row (j, k) inside `ball`: false if none, else first..last (inclusive). The
-  // one rule of which points a ball holds; ForEachRun gives the same runs.
-  bool RowRun(const Ball& ball, std::int64_t j, std::int64_t k, std::int64_t& first,
-              std::int64_t& last) const {
+  // The ball's slices along z: the first and last k of the points it holds.
+  void SliceRange(const Ball& ball, std::int64_t& k0, std::int64_t& k1) const {
+    k0 = std::max<std::int64_t>(0, Ceil(ball.c.z() - ball.r));
+    k1 = std::min<std::int64_t>(dims_[2] - 1, Floor(ball.c.z() + ball.r));
+  }
+  // Slice k of the ball (k from SliceRange): false if empty, else the squared radius of its
+  // disc in `slice` and the rows j0..j1 it meets.
+  bool Slice(const Ball& ball, std::int64_t k, double& slice, std::int64_t& j0,
+             std::int64_t& j1) const {
     const double dz = static_cast<double>(k) - ball.c.z();
-    const double slice = ball.r * ball.r - dz * dz;
+    slice = ball.r * ball.r - dz * dz;
     if (slice < 0.0) return false;
     const double ry = std::sqrt(slice);
-    if (j < Ceil(ball.c.y() - ry) || j > Floor(ball.c.y() + ry)) return false;
-    return Chord(ball, slice, j, first, last);
+    j0 = std::max<std::int64_t>(0, Ceil(ball.c.y() - ry));
+    j1 = std::min<std::int64_t>(dims_[1] - 1, Floor(ball.c.y() + ry));
+    return j0 <= j1;
   }
-
-  // Calls f(row, first, last) for each row the ball meets, with its points first..last
-  // (inclusive) inside the ball.
-  template <typename F>
-  void ForEachRun(const Sphere& sphere, F&& f) const {
-    const Ball ball = ToGrid(sphere);
-    const std::int64_t k0 = std::max<std::int64_t>(0, Ceil(ball.c.z() - ball.r));
-    const std::int64_t k1 = std::min<std::int64_t>(dims_[2] - 1, Floor(ball.c.z() + ball.r));
-    for (std::int64_t k = k0; k <= k1; ++k) {
-      const double dz = static_cast<double>(k) - ball.c.z();
-      const double slice = ball.r * ball.r - dz * dz;
-      if (slice < 0.0) continue;
-      const double ry = std::sqrt(slice);
-      const std::int64_t j0 = std::max<std::int64_t>(0, Ceil(ball.c.y() - ry));
-      const std::int64_t j1 = std::min<std::int64_t>(dims_[1] - 1, Floor(ball.c.y() + ry));
-      for (std::int64_t j = j0; j <= j1; ++j) {
-        std::int64_t first, last;
-        if (Chord(ball, slice, j, first, last)) f(row(j, k), first, last);
-      }
-    }
-  }
-
-  static std::int64_t Ceil(double x) { return static_cast<std::int64_t>(std::ceil(x)); }
-  static std::int64_t Floor(double x) { return static_cast<std::int64_t>(std::floor(x)); }
-
- private:
+  // Row j of a slice (j from Slice): false if the ball holds none of its points, else they are
+  // first..last (inclusive). With SliceRange and Slice, the one rule of which points a ball
+  // holds.
   bool Chord(const Ball& ball, double slice, std::int64_t j, std::int64_t& first,
              std::int64_t& last) const {
     const double dy = static_cast<double>(j) - ball.c.y();
@@ -93,6 +76,28 @@ class SampleGrid {
     return first <= last;
   }
 
+  // Calls f(row, first, last) for each row the ball meets, with its points first..last
+  // (inclusive) inside the ball.
+  template <typename F>
+  __attribute__((always_inline)) void ForEachRun(const Sphere& sphere, F&& f) const {
+    const Ball ball = ToGrid(sphere);
+    std::int64_t k0, k1;
+    SliceRange(ball, k0, k1);
+    for (std::int64_t k = k0; k <= k1; ++k) {
+      double slice;
+      std::int64_t j0, j1;
+      if (!Slice(ball, k, slice, j0, j1)) continue;
+      for (std::int64_t j = j0; j <= j1; ++j) {
+        std::int64_t first, last;
+        if (Chord(ball, slice, j, first, last)) f(row(j, k), first, last);
+      }
+    }
+  }
+
+  static std::int64_t Ceil(double x) { return static_cast<std::int64_t>(std::ceil(x)); }
+  static std::int64_t Floor(double x) { return static_cast<std::int64_t>(std::floor(x)); }
+
+ private:
   Vector3 origin_ = Vector3::Zero();
   double spacing_ = 0.0;
   std::array<std::int64_t, 3> dims_ = {0, 0, 0};

@@ -11,6 +11,13 @@
 
 namespace inscribe::cli {
 
+absl::string_view WithoutComment(absl::string_view line) {
+  if (const auto hash = line.find('#'); hash != absl::string_view::npos) {
+    line = line.substr(0, hash);
+  }
+  return absl::StripAsciiWhitespace(line);
+}
+
 absl::StatusOr<std::vector<RigidPose>> ParsePoses(absl::string_view bytes,
                                                   const std::string& name) {
   std::vector<RigidPose> poses;
@@ -20,10 +27,7 @@ absl::StatusOr<std::vector<RigidPose>> ParsePoses(absl::string_view bytes,
     auto fail = [&](const std::string& why) {
       return absl::InvalidArgumentError(absl::StrCat(name, ": line ", number, ": ", why));
     };
-    absl::string_view text = line;
-    if (const auto hash = text.find('#'); hash != absl::string_view::npos) {
-      text = text.substr(0, hash);
-    }
+    const absl::string_view text = WithoutComment(line);
     const std::vector<absl::string_view> tokens =
         absl::StrSplit(text, absl::ByAnyChar(" \t\r,"), absl::SkipEmpty());
     if (tokens.empty()) continue;

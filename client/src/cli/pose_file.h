@@ -15,6 +15,9 @@ namespace inscribe::cli {
 // More poses than this in one file are refused (the results of one call stay in memory).
 inline constexpr std::int64_t kMaxPoses = 2'000'000;
 
+// A line of a pose file or pose log without its `#` comment and surrounding whitespace.
+absl::string_view WithoutComment(absl::string_view line);
+
 // Parses the bytes of a whole pose file; `name` (the path) starts every error message.
 // Quaternions within 1e-3 of unit length (rounded values such as 0.7071) are returned as
 // written, for the service to normalise (NormalizedPose accepts each); others are refused.

@@ -15,6 +15,7 @@
 #include "absl/strings/str_split.h"
 #include "absl/strings/strip.h"
 #include "nlohmann/json.hpp"
+#include "pose_file.h"
 
 namespace inscribe::cli {
 namespace {
@@ -301,11 +302,7 @@ absl::StatusOr<std::vector<PoseLogFrame>> ParsePoseLog(
     auto fail = [&](const std::string& why) {
       return absl::InvalidArgumentError(absl::StrCat(name, ": line ", number, ": ", why));
     };
-    absl::string_view text = line;
-    if (const auto hash = text.find('#'); hash != absl::string_view::npos) {
-      text = text.substr(0, hash);
-    }
-    text = absl::StripAsciiWhitespace(text);
+    const absl::string_view text = WithoutComment(line);
     if (text.empty()) continue;
     if (!content && absl::StartsWith(text, "frame")) {  // the header
       content = true;

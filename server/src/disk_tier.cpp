@@ -201,16 +201,14 @@ void DiskTier::TouchLocked(const std::string& name, std::int64_t bytes) {
   recency_.splice(recency_.begin(), recency_, it->second);
 }
 
-std::int64_t DiskTier::ForgetLocked(absl::string_view name) {
+void DiskTier::ForgetLocked(absl::string_view name) {
   const auto it = index_.find(name);
-  if (it == index_.end()) return 0;
+  if (it == index_.end()) return;
   const std::list<Indexed>::iterator entry = it->second;
-  const std::int64_t bytes = entry->bytes;
-  index_.erase(it);
-  recency_.erase(entry);
   --counts_.entries;
-  counts_.bytes -= bytes;
-  return bytes;
+  counts_.bytes -= entry->bytes;
+  index_.erase(it);  // before the entry: the key views its name
+  recency_.erase(entry);
 }
 
 void DiskTier::NoteFileLocked(const fs::path& path, const std::string& name) {
@@ -358,8 +356,8 @@ int DiskTier::WriteEntry(const fs::path& path, absl::string_view key, absl::stri
     NoteFileLocked(path, name);
     return 0;
   }
-  // Room first: the entries never exceed the bound, not even between this rename and the
-  // evictions.
+  // Room first, so that the entries exceed the bound at no moment, unless the ones that would
+  // go are pinned.
   const auto bytes = static_cast<std::int64_t>(header.size() + payload.size());
   EvictLocked(bytes);
   fs::rename(temp, path, error);

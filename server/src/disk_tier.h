@@ -122,9 +122,8 @@ class DiskTier {
   // Makes `name` the most recently used entry, holding `bytes`: added when missing, recounted
   // when its size changed.
   void TouchLocked(const std::string& name, std::int64_t bytes);
-  // Drops `name` from the index (its file is gone or going); returns its indexed bytes, 0 when
-  // it was not indexed.
-  std::int64_t ForgetLocked(absl::string_view name);
+  // Drops `name` from the index, if there (its file is gone or going).
+  void ForgetLocked(absl::string_view name);
   // While the entries and `incoming` bytes (a file about to be added) exceed the bound:
   // deletes the least recently used unpinned entry. Files already gone are only forgotten, not
   // counted as evictions.

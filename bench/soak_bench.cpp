@@ -1,12 +1,16 @@
 // Soak (issue 8): one inscribed process on loopback, N concurrent clients mixing Generate,
 // UpdateDeformation, Distance and DistanceStream for a fixed time, every loop bounded by a
 // deadline and an iteration cap so the run always ends by itself. Reports calls, errors (any
-// failed call, or an answer of the wrong size), p50/p99/max latency per RPC and the server's
-// resident memory at start (after warm-up), at the end and at its peak. Exit status 1 when any
-// call failed or the resident memory grew by more than the cache's memory budget (what the
-// server may legitimately keep) plus a fixed allowance for allocator slack.
+// failed call, or an answer of the wrong size), p50/p99/max latency per RPC, the server's
+// resident memory at start (after warm-up), at the end and at its peak, and its disk cache:
+// bytes at the end and the most seen (the server's count, sampled each second, and the entry
+// files in the directory), evictions and disk errors. Exit status 1 when any call failed, the
+// disk tier counted an error, the resident memory grew by more than the cache's memory budget
+// (what the server may legitimately keep) plus a fixed allowance for allocator slack, or, with
+// --cache-disk-bytes, the disk cache was ever seen above it.
 //
-//   soak_bench [--seconds S] [--clients N] [--cache-memory-bytes B] ...   (bench/run-soak)
+//   soak_bench [--seconds S] [--clients N] [--cache-memory-bytes B] [--cache-disk-bytes D] ...
+//   (bench/run-soak)
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -45,6 +49,7 @@ struct Options {
   int clients = 16;
   int jobs = 2;                                   // the server's --jobs
   std::int64_t cache_memory_bytes = 64ll << 20;   // the server's --cache-memory-bytes
+  std::int64_t cache_disk_bytes = 0;              // the server's --cache-disk-bytes (0: none)
   std::int64_t rss_allowance_bytes = 64ll << 20;  // allocator slack on top of the budget
   int variants = 8;                               // voxel sizes per model (cache misses)
   int batch = 200;                                // pose pairs per Distance call
@@ -191,6 +196,47 @@ double Quantile(std::vector<double>& values, double q) {
 
 double MiB(std::int64_t bytes) { return static_cast<double>(bytes) / (1 << 20); }
 
+// Bytes of the cache's entry files (dir/<2 hex>/<64 hex>) and of its temporary files (writes in
+// progress), walked while the server writes and deletes: files vanishing meanwhile are skipped.
+struct DirectoryBytes {
+  std::int64_t entries = 0;
+  std::int64_t temporary = 0;
+};
+DirectoryBytes MeasureDirectory(const std::filesystem::path& dir) {
+  DirectoryBytes bytes;
+  std::error_code error;
+  for (auto it = std::filesystem::recursive_directory_iterator(dir, error);
+       !error && it != std::filesystem::recursive_directory_iterator(); it.increment(error)) {
+    std::error_code ignored;
+    if (!it->is_regular_file(ignored)) continue;
+    const std::uintmax_t size = it->file_size(ignored);
+    if (ignored) continue;
+    const bool temporary = it->path().filename().string().find(".tmp-") != std::string::npos;
+    (temporary ? bytes.temporary : bytes.entries) += static_cast<std::int64_t>(size);
+  }
+  return bytes;
+}
+
+// The disk cache over the run: the server's count (CacheStats) and the directory, each second.
+struct DiskWatch {
+  std::int64_t max_counted = 0;
+  std::int64_t max_entries = 0;  // entry files in the directory
+  std::int64_t max_total = 0;    // entry and temporary files
+  int stats_errors = 0;
+
+  void Sample(const client::Client& client, const std::filesystem::path& dir) {
+    absl::StatusOr<client::ServerCacheStats> stats = client.CacheStats();
+    if (stats.ok()) {
+      max_counted = std::max(max_counted, stats->disk_bytes);
+    } else {
+      ++stats_errors;
+    }
+    const DirectoryBytes bytes = MeasureDirectory(dir);
+    max_entries = std::max(max_entries, bytes.entries);
+    max_total = std::max(max_total, bytes.entries + bytes.temporary);
+  }
+};
+
 int Run(const Options& options) {
   const std::filesystem::path cache_dir =
       std::filesystem::temp_directory_path() / ("inscribe-soak-" + std::to_string(getpid()));
@@ -198,7 +244,8 @@ int Run(const Options& options) {
   testing::InscribedProcess server(
       options.inscribed, {"--listen", "127.0.0.1:0", "--jobs", std::to_string(options.jobs),
                           "--log-level", "warn", "--cache-dir", cache_dir.string(),
-                          "--cache-memory-bytes", std::to_string(options.cache_memory_bytes)});
+                          "--cache-memory-bytes", std::to_string(options.cache_memory_bytes),
+                          "--cache-disk-bytes", std::to_string(options.cache_disk_bytes)});
   const std::string address = server.WaitUntilListening();
   if (address.empty()) {
     std::cerr << "soak: inscribed did not start:\n" << server.log() << "\n";
@@ -237,9 +284,11 @@ int Run(const Options& options) {
   const testing::ProcessMemory start_memory = testing::ReadProcessMemory(server.pid());
 
   std::cout << absl::StrFormat(
-      "# soak: %d clients, %.0f s, %d models, server --jobs %d --cache-memory-bytes %.0f MiB\n",
+      "# soak: %d clients, %.0f s, %d models, server --jobs %d --cache-memory-bytes %.0f MiB "
+      "--cache-disk-bytes %.1f MiB%s\n",
       options.clients, options.seconds, models.size(), options.jobs,
-      MiB(options.cache_memory_bytes));
+      MiB(options.cache_memory_bytes), MiB(options.cache_disk_bytes),
+      options.cache_disk_bytes == 0 ? " (unbounded)" : "");
   const Clock::time_point began = Clock::now();
   const Clock::time_point deadline = began + std::chrono::duration_cast<Clock::duration>(
                                                  std::chrono::duration<double>(options.seconds));
@@ -249,18 +298,29 @@ int Run(const Options& options) {
     threads.emplace_back(
         [&, c] { RunClient(options, clients[c], models, deadline, 0x5eed + c, records[c]); });
   }
-  // The server's memory once a minute (and the peak), while the clients run.
+  // The disk cache each second, and the server's memory once a minute (and the peak), while
+  // the clients run; on a channel of its own.
+  const client::Client watcher(client::MakeGrpcConnection(address), client_options);
+  DiskWatch disk;
   std::atomic<bool> done{false};
   std::thread monitor([&] {
     Clock::time_point next = began + std::chrono::minutes(1);
+    Clock::time_point next_disk = began;
     while (!done.load()) {
       std::this_thread::sleep_for(std::chrono::milliseconds(200));
+      if (Clock::now() >= next_disk) {
+        next_disk += std::chrono::seconds(1);
+        disk.Sample(watcher, cache_dir);
+      }
       if (Clock::now() >= next) {
         next += std::chrono::minutes(1);
         const testing::ProcessMemory m = testing::ReadProcessMemory(server.pid());
-        std::cout << absl::StrFormat("  %4.0f s: server RSS %.1f MiB (peak %.1f MiB)\n",
-                                     std::chrono::duration<double>(Clock::now() - began).count(),
-                                     MiB(m.resident), MiB(m.peak_resident))
+        std::cout << absl::StrFormat(
+                         "  %4.0f s: server RSS %.1f MiB (peak %.1f MiB), disk cache %.2f MiB "
+                         "(most seen %.2f MiB)\n",
+                         std::chrono::duration<double>(Clock::now() - began).count(),
+                         MiB(m.resident), MiB(m.peak_resident),
+                         MiB(MeasureDirectory(cache_dir).entries), MiB(disk.max_entries))
                   << std::flush;
       }
     }
@@ -268,6 +328,7 @@ int Run(const Options& options) {
   for (std::thread& thread : threads) thread.join();
   done = true;
   monitor.join();
+  disk.Sample(watcher, cache_dir);
   const double elapsed = std::chrono::duration<double>(Clock::now() - began).count();
   const testing::ProcessMemory end_memory = testing::ReadProcessMemory(server.pid());
 
@@ -289,12 +350,33 @@ int Run(const Options& options) {
     errors += rpc_errors;
   }
   absl::StatusOr<client::ServerCacheStats> stats = clients[0].CacheStats();
+  bool disk_ok = disk.stats_errors == 0;
   if (stats.ok()) {
     std::cout << absl::StrFormat(
         "\ncache: %d entries, %.1f MiB in memory; %d computations, %d evictions, %d memory hits, "
         "%d disk hits, %d disk entries\n",
         stats->entries, MiB(stats->bytes), stats->computations, stats->evictions,
         stats->memory_hits, stats->disk_hits, stats->disk_entries);
+    const DirectoryBytes end_bytes = MeasureDirectory(cache_dir);
+    std::cout << absl::StrFormat(
+        "disk cache: bound %s; end %d bytes (%.2f MiB, %d entries; directory %d bytes), most "
+        "seen %d bytes counted, %d in entry files, %d with temporary files; %d evictions "
+        "(%.2f MiB), %d too large; disk errors %d corrupt, %d write, %d skipped; %d failed "
+        "samples\n",
+        options.cache_disk_bytes == 0 ? std::string("none")
+                                      : absl::StrFormat("%d bytes", options.cache_disk_bytes),
+        stats->disk_bytes, MiB(stats->disk_bytes), stats->disk_entries, end_bytes.entries,
+        disk.max_counted, disk.max_entries, disk.max_total, stats->disk_evictions,
+        MiB(stats->disk_evicted_bytes), stats->disk_writes_too_large, stats->disk_errors,
+        stats->disk_write_errors, stats->disk_writes_skipped, disk.stats_errors);
+    disk_ok = disk_ok && stats->disk_errors + stats->disk_write_errors == 0 &&
+              stats->disk_bytes == end_bytes.entries;
+    // The server's count is exact (kept under its lock); a walk of the directory is not a
+    // snapshot (it may see a new file and the old one its write evicted), so it is reported,
+    // not checked, while the server runs.
+    if (options.cache_disk_bytes > 0) {
+      disk_ok = disk_ok && disk.max_counted <= options.cache_disk_bytes;
+    }
   } else {
     ++errors;
     std::cerr << "soak: CacheStats: " << stats.status() << "\n";
@@ -317,6 +399,10 @@ int Run(const Options& options) {
     return 1;
   }
   if (errors > 0) return 1;
+  if (!disk_ok) {
+    std::cerr << "soak: the disk cache went over its bound, miscounted or had errors\n";
+    return 1;
+  }
   if (growth > allowed) {
     std::cerr << "soak: server memory grew by more than the cache budget\n";
     return 1;
@@ -337,6 +423,10 @@ int main(int argc, char** argv) {
   app.add_option("--jobs", options.jobs, "the server's --jobs")->capture_default_str();
   app.add_option("--cache-memory-bytes", options.cache_memory_bytes,
                  "the server's --cache-memory-bytes")
+      ->capture_default_str();
+  app.add_option("--cache-disk-bytes", options.cache_disk_bytes,
+                 "the server's --cache-disk-bytes (0 = unbounded); the disk cache must stay "
+                 "within it")
       ->capture_default_str();
   app.add_option("--rss-allowance-bytes", options.rss_allowance_bytes,
                  "resident-memory growth allowed on top of the cache budget")

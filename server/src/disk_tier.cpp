@@ -5,10 +5,13 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cassert>
 #include <cerrno>
 #include <optional>
 #include <system_error>
+#include <tuple>
 #include <utility>
+#include <vector>
 
 #include "absl/strings/ascii.h"
 #include "absl/strings/escaping.h"
@@ -94,10 +97,26 @@ bool ReadAll(int fd, char* out, std::size_t size) {
 }  // namespace
 
 absl::StatusOr<std::unique_ptr<DiskTier>> DiskTier::Open(
-    const std::string& dir, std::function<void(const DiskTierEvent&)> on_event) {
-  std::unique_ptr<DiskTier> tier(new DiskTier(dir, std::move(on_event)));
+    const std::string& dir, std::int64_t max_bytes,
+    std::function<void(const DiskTierEvent&)> on_event) {
+  assert(max_bytes >= 0);
+  std::unique_ptr<DiskTier> tier(new DiskTier(dir, max_bytes, std::move(on_event)));
   if (absl::Status status = tier->Scan(); !status.ok()) return status;
   return tier;
+}
+
+DiskTier::PinnedName::PinnedName(DiskTier& tier, std::string name)
+    : tier_(tier), name_(std::move(name)) {
+  std::lock_guard<std::mutex> lock(tier_.mutex_);
+  ++tier_.pins_[name_];
+}
+
+DiskTier::PinnedName::~PinnedName() {
+  std::lock_guard<std::mutex> lock(tier_.mutex_);
+  const auto it = tier_.pins_.find(name_);
+  assert(it != tier_.pins_.end());
+  if (--it->second == 0) tier_.pins_.erase(it);
+  tier_.EvictLocked();  // what this pin held back, if anything
 }
 
 absl::Status DiskTier::Scan() {
@@ -118,7 +137,14 @@ absl::Status DiskTier::Scan() {
   ::close(fd);
   fs::remove(probe, error);
 
-  // Count the entries (dir/<2 hex>/<64 hex>); remove temporary files left by a crash.
+  // Index the entries (dir/<2 hex>/<64 hex>) by modification time; remove temporary files
+  // left by a crash.
+  struct Found {
+    timespec modified;
+    std::string name;
+    std::int64_t bytes;
+  };
+  std::vector<Found> found;
   const fs::directory_iterator end;
   fs::directory_iterator shards(dir_, error);
   for (; !error && shards != end; shards.increment(error)) {
@@ -137,21 +163,88 @@ absl::Status DiskTier::Scan() {
         fs::remove(files->path(), ignored);
         continue;
       }
+      struct stat info {};
       if (!IsLowerHex(name, 64) || !absl::StartsWith(name, shard_name) ||
-          !files->is_regular_file(ignored)) {
+          ::stat(files->path().c_str(), &info) != 0 || !S_ISREG(info.st_mode)) {
         continue;
       }
-      const std::uintmax_t size = files->file_size(ignored);
-      if (ignored) continue;
-      ++counts_.entries;
-      counts_.bytes += static_cast<std::int64_t>(size);
+      found.push_back(Found{info.st_mtim, name, static_cast<std::int64_t>(info.st_size)});
     }
   }
   if (error) {
     return absl::FailedPreconditionError(
         absl::StrCat("cannot list cache directory ", dir_.string(), ": ", error.message()));
   }
+  // Oldest first, so that each push to the front leaves the newest there. Equal times (coarse
+  // clocks) fall back to the name, so that the order does not depend on the listing's.
+  std::sort(found.begin(), found.end(), [](const Found& a, const Found& b) {
+    return std::tie(a.modified.tv_sec, a.modified.tv_nsec, a.name) <
+           std::tie(b.modified.tv_sec, b.modified.tv_nsec, b.name);
+  });
+  std::lock_guard<std::mutex> lock(mutex_);
+  for (const Found& entry : found) TouchLocked(entry.name, entry.bytes);
+  EvictLocked();
   return absl::OkStatus();
+}
+
+void DiskTier::TouchLocked(const std::string& name, std::int64_t bytes) {
+  const auto it = index_.find(name);
+  if (it == index_.end()) {
+    recency_.push_front(Indexed{name, bytes});
+    index_.emplace(recency_.front().name, recency_.begin());
+    ++counts_.entries;
+    counts_.bytes += bytes;
+    return;
+  }
+  counts_.bytes += bytes - it->second->bytes;
+  it->second->bytes = bytes;
+  recency_.splice(recency_.begin(), recency_, it->second);
+}
+
+void DiskTier::ForgetLocked(absl::string_view name) {
+  const auto it = index_.find(name);
+  if (it == index_.end()) return;
+  const std::list<Indexed>::iterator entry = it->second;
+  --counts_.entries;
+  counts_.bytes -= entry->bytes;
+  index_.erase(it);  // before the entry: the key views its name
+  recency_.erase(entry);
+}
+
+void DiskTier::NoteFileLocked(const fs::path& path, const std::string& name) {
+  struct stat info {};
+  if (::stat(path.c_str(), &info) != 0 || !S_ISREG(info.st_mode)) {
+    ForgetLocked(name);
+    return;
+  }
+  TouchLocked(name, static_cast<std::int64_t>(info.st_size));
+  EvictLocked();
+}
+
+void DiskTier::EvictLocked(std::int64_t incoming) {
+  if (max_bytes_ == 0) return;
+  // Walks from the least recently used end towards the front; `next` is the entry after the
+  // candidate, so erasing the candidate leaves it valid.
+  std::list<Indexed>::iterator next = recency_.end();
+  while (counts_.bytes + incoming > max_bytes_ && next != recency_.begin()) {
+    const std::list<Indexed>::iterator candidate = std::prev(next);
+    if (pins_.contains(candidate->name)) {  // being read or written: the next one goes
+      next = candidate;
+      continue;
+    }
+    const fs::path path = dir_ / candidate->name.substr(0, 2) / candidate->name;
+    std::error_code error;
+    const bool removed = fs::remove(path, error);
+    if (error) {  // cannot be deleted (e.g. a read-only directory): kept and counted as held
+      next = candidate;
+      continue;
+    }
+    if (removed) {  // else it had vanished: forgotten, not an eviction
+      ++counts_.evictions;
+      counts_.evicted_bytes += candidate->bytes;
+    }
+    ForgetLocked(candidate->name);
+  }
 }
 
 fs::path DiskTier::EntryPath(absl::string_view key) const {
@@ -163,9 +256,17 @@ fs::path DiskTier::EntryPath(absl::string_view key) const {
 
 std::optional<std::string> DiskTier::Read(absl::string_view key) {
   const fs::path path = EntryPath(key);
+  const std::string name = path.filename().string();
+  const PinnedName pin(*this, name);
   const FileDescriptor file(::open(path.c_str(), O_RDONLY | O_CLOEXEC));
   if (file.fd < 0) {
-    if (errno == ENOENT || errno == ENOTDIR) return std::nullopt;
+    if (errno == ENOENT || errno == ENOTDIR) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      // Indexed but missing: deleted behind this process's back, unless a write has just
+      // renamed it into place (NoteFileLocked looks again under the lock).
+      if (index_.contains(name)) NoteFileLocked(path, name);
+      return std::nullopt;
+    }
     DropFile(path);  // unreadable: as useless as a corrupt one
     return std::nullopt;
   }
@@ -185,6 +286,11 @@ std::optional<std::string> DiskTier::Read(absl::string_view key) {
     DropFile(path);
     return std::nullopt;
   }
+  // The modification time records the use for the order rebuilt at the next Open; should
+  // this fail, only that is lost.
+  ::futimens(file.fd, nullptr);
+  std::lock_guard<std::mutex> lock(mutex_);
+  NoteFileLocked(path, name);
   return payload;
 }
 
@@ -194,17 +300,21 @@ void DiskTier::DropFile(const fs::path& path) {
   std::error_code error;
   std::lock_guard<std::mutex> lock(mutex_);
   ++counts_.errors;
-  const std::uintmax_t size = fs::file_size(path, error);
-  if (fs::remove(path, error)) {
-    --counts_.entries;
-    counts_.bytes -= static_cast<std::int64_t>(size);
-  }
+  fs::remove(path, error);
+  if (!error) ForgetLocked(path.filename().string());  // removed, or gone already
 }
 
 void DiskTier::Write(absl::string_view key, absl::string_view payload) {
   const fs::path path = EntryPath(key);
+  const std::uint64_t size = EntryHeaderSize(key.size()) + payload.size();
+  if (max_bytes_ > 0 && size > static_cast<std::uint64_t>(max_bytes_)) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++counts_.writes_too_large;
+    return;
+  }
   std::error_code error;
   if (fs::exists(path, error)) return;  // kept: equal keys mean equal content
+  const PinnedName pin(*this, path.filename().string());
   const Attempt attempt = BeginWrite();
   if (!attempt.allowed) return;
   std::string failed_step;
@@ -239,11 +349,17 @@ int DiskTier::WriteEntry(const fs::path& path, absl::string_view key, absl::stri
     return failure;
   }
 
+  const std::string name = path.filename().string();
   std::lock_guard<std::mutex> lock(mutex_);
   if (fs::exists(path, error)) {  // written meanwhile (by a Put): keep that one
     fs::remove(temp, error);
+    NoteFileLocked(path, name);
     return 0;
   }
+  // Room first, so that the entries exceed the bound at no moment, unless the ones that would
+  // go are pinned.
+  const auto bytes = static_cast<std::int64_t>(header.size() + payload.size());
+  EvictLocked(bytes);
   fs::rename(temp, path, error);
   if (error) {
     *failed_step = absl::StrCat("rename ", temp.string());
@@ -251,8 +367,7 @@ int DiskTier::WriteEntry(const fs::path& path, absl::string_view key, absl::stri
     fs::remove(temp, error);
     return failure;
   }
-  ++counts_.entries;
-  counts_.bytes += static_cast<std::int64_t>(header.size() + payload.size());
+  TouchLocked(name, bytes);
   return 0;
 }
 
@@ -300,7 +415,9 @@ void DiskTier::EndWrite(const Attempt& attempt, int failure, const std::string& 
 
 DiskTier::Counts DiskTier::counts() const {
   std::lock_guard<std::mutex> lock(mutex_);
-  return counts_;
+  Counts counts = counts_;
+  counts.max_bytes = max_bytes_;
+  return counts;
 }
 
 }  // namespace inscribe::server

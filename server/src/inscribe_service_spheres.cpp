@@ -486,6 +486,10 @@ grpc::ServerUnaryReactor* InscribeService::CacheStats(grpc::CallbackServerContex
   response->set_disk_write_errors(s.disk_write_errors);
   response->set_disk_writes_skipped(s.disk_writes_skipped);
   response->set_disk_available(s.disk_available);
+  response->set_disk_bytes_limit(s.disk_bytes_limit);
+  response->set_disk_evictions(s.disk_evictions);
+  response->set_disk_evicted_bytes(s.disk_evicted_bytes);
+  response->set_disk_writes_too_large(s.disk_writes_too_large);
   reactor->Finish(grpc::Status::OK);
   return reactor;
 }

@@ -139,6 +139,11 @@ int main(int argc, char** argv) {
   app.add_option("--cache-dir", options.cache.disk_dir,
                  "directory of the on-disk result cache (created if missing); empty = memory only")
       ->capture_default_str();
+  // Validated by ResultCache::Open (a negative bound fails the start, naming the flag).
+  app.add_option("--cache-disk-bytes", options.cache.disk_bytes,
+                 "bytes of results kept on disk in --cache-dir (least recently used deleted "
+                 "first); 0 = unbounded")
+      ->capture_default_str();
   app.add_option("--cache-memory-bytes", options.cache.memory_bytes,
                  "bytes of results kept in memory (least recently used dropped first)")
       ->check(CLI::Range(std::int64_t{0}, std::int64_t{1} << 50))
@@ -197,14 +202,15 @@ int main(int argc, char** argv) {
       "event=serving address={} jobs={} max_queue={} max_message_bytes={} max_triangles={} "
       "max_voxels={} max_spheres={} max_poses={} max_scene_objects={} max_scene_pairs={} "
       "max_scene_ignored={} memory_budget={} cache_dir=\"{}\" "
-      "cache_memory_bytes={} "
+      "cache_disk_bytes={} cache_memory_bytes={} "
       "redis=\"{}\" tls={} auth={} metrics_port={}",
       (*server)->address(), (*server)->jobs(), options.max_queue, options.max_message_bytes,
       options.limits.max_triangles, options.limits.max_voxels, options.limits.max_spheres,
       options.limits.max_poses, options.limits.max_scene_objects, options.limits.max_scene_pairs,
       options.limits.max_scene_ignored, options.limits.memory_budget_bytes, options.cache.disk_dir,
-      options.cache.memory_bytes, inscribe::server::RedactRedisUrl(options.cache.redis_url),
-      options.tls.enabled(), !options.auth_tokens_file.empty(), (*server)->metrics_port());
+      options.cache.disk_bytes, options.cache.memory_bytes,
+      inscribe::server::RedactRedisUrl(options.cache.redis_url), options.tls.enabled(),
+      !options.auth_tokens_file.empty(), (*server)->metrics_port());
   if (!options.auth_tokens_file.empty() && !options.tls.enabled() &&
       !IsLoopbackListen(options.listen)) {
     spdlog::warn(

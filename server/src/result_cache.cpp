@@ -335,10 +335,14 @@ absl::StatusOr<std::unique_ptr<ResultCache>> ResultCache::Open(const ResultCache
     return absl::InvalidArgumentError(
         absl::StrCat("--cache-memory-bytes must be >= 0, got ", options.memory_bytes));
   }
+  if (options.disk_bytes < 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--cache-disk-bytes must be >= 0 (0 = unbounded), got ", options.disk_bytes));
+  }
   auto impl = std::make_unique<Impl>(options.memory_bytes);
   if (!options.disk_dir.empty()) {
     absl::StatusOr<std::unique_ptr<DiskTier>> disk =
-        DiskTier::Open(options.disk_dir, options.on_disk_tier_event);
+        DiskTier::Open(options.disk_dir, options.disk_bytes, options.on_disk_tier_event);
     if (disk.ok()) {
       impl->disk = *std::move(disk);
     } else if (options.on_disk_tier_event) {
@@ -395,6 +399,10 @@ ResultCacheStats ResultCache::stats() const {
     stats.disk_write_errors = disk.write_errors;
     stats.disk_writes_skipped = disk.writes_skipped;
     stats.disk_available = disk.available ? 1 : 0;
+    stats.disk_bytes_limit = disk.max_bytes;
+    stats.disk_evictions = disk.evictions;
+    stats.disk_evicted_bytes = disk.evicted_bytes;
+    stats.disk_writes_too_large = disk.writes_too_large;
   }
   if (impl_->shared != nullptr) {
     const RedisTier::Counts shared = impl_->shared->counts();

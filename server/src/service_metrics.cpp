@@ -115,6 +115,17 @@ class StateCollector {
         "1 while the disk cache tier (--cache-dir) is configured and writing, else 0 (none, "
         "unwritable at start, or writes stopped after a failure)",
         MetricType::Gauge, {Sample(s.disk_available, {}, MetricType::Gauge)});
+    add("inscribe_disk_cache_limit_bytes",
+        "Bound of the disk cache tier (--cache-disk-bytes); 0 = unbounded or no disk tier",
+        MetricType::Gauge, {Sample(s.disk_bytes_limit, {}, MetricType::Gauge)});
+    add("inscribe_disk_cache_evictions_total",
+        "Entries deleted from the disk cache tier for its bound, least recently used first",
+        MetricType::Counter, {Sample(s.disk_evictions, {}, MetricType::Counter)});
+    add("inscribe_disk_cache_evicted_bytes_total", "Bytes of those entries", MetricType::Counter,
+        {Sample(s.disk_evicted_bytes, {}, MetricType::Counter)});
+    add("inscribe_disk_cache_writes_too_large_total",
+        "Results not written to disk because their file alone exceeds the bound",
+        MetricType::Counter, {Sample(s.disk_writes_too_large, {}, MetricType::Counter)});
 
     const std::int64_t in_flight = pool_->jobs_in_flight();
     const JobPoolOptions& pool = pool_->options();

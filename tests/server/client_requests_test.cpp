@@ -294,15 +294,20 @@ TEST(Client, CacheStatsCopiesEveryCounter) {
   response.set_disk_entries(10);
   response.set_disk_bytes(11);
   response.set_disk_errors(12);
+  response.set_disk_bytes_limit(24);
+  response.set_disk_evictions(25);
+  response.set_disk_evicted_bytes(26);
+  response.set_disk_writes_too_large(27);
   auto connection = std::make_shared<MockConnection>();
   EXPECT_CALL(*connection, CacheStats(_, _)).WillOnce(Return(response));
   absl::StatusOr<ServerCacheStats> s = Client(connection).CacheStats();
   ASSERT_TRUE(s.ok());
   EXPECT_THAT(
-      (std::vector<std::int64_t>{s->entries, s->bytes, s->memory_hits, s->disk_hits, s->hits,
-                                 s->misses, s->computations, s->joined, s->evictions,
-                                 s->disk_entries, s->disk_bytes, s->disk_errors}),
-      ElementsAre(1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12));
+      (std::vector<std::int64_t>{
+          s->entries, s->bytes, s->memory_hits, s->disk_hits, s->hits, s->misses, s->computations,
+          s->joined, s->evictions, s->disk_entries, s->disk_bytes, s->disk_errors,
+          s->disk_bytes_limit, s->disk_evictions, s->disk_evicted_bytes, s->disk_writes_too_large}),
+      ElementsAre(1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 24, 25, 26, 27));
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 #include "fault_injection_support.h"
 
 #include <arpa/inet.h>
+#include <gtest/gtest.h>
 #include <netinet/in.h>
 #include <signal.h>
 #include <spawn.h>
@@ -61,6 +62,20 @@ ScratchDir::~ScratchDir() {
   std::error_code ignored;
   ChmodTree(path_.string(), fs::perms::owner_all);
   fs::remove_all(path_, ignored);
+}
+
+SphereSet RandomSet(int n, std::uint64_t seed) {
+  SphereSet set;
+  set.spheres = testing::RandomBalls(n, 1.0, 0.01, 0.1, seed);
+  return set;
+}
+
+void ExpectSameSpheres(const SphereSet& actual, const SphereSet& expected) {
+  ASSERT_EQ(actual.size(), expected.size());
+  for (std::size_t i = 0; i < actual.size(); ++i) {
+    ASSERT_EQ(actual.spheres[i].center, expected.spheres[i].center) << "sphere " << i;
+    ASSERT_EQ(actual.spheres[i].radius, expected.spheres[i].radius) << "sphere " << i;
+  }
 }
 
 std::string ScratchDir::Sub(const std::string& name) const {

@@ -1,5 +1,6 @@
-// Helpers of fault_injection_test.cpp: an inscribed child with a client and a metrics scrape,
-// scratch cache directories, and a DistanceStream client child process to kill.
+// Helpers of the fault injection tests: an inscribed child with a client and a metrics scrape,
+// scratch cache directories, random sphere sets, and a DistanceStream client child process to
+// kill.
 #pragma once
 
 #include <sys/types.h>
@@ -82,6 +83,12 @@ int TempFiles(const std::string& dir);
 
 std::string ReadBytes(const std::filesystem::path& path);
 void WriteBytes(const std::filesystem::path& path, const std::string& bytes);
+
+// Distinct small sets, cheap to store: n random balls from `seed`.
+SphereSet RandomSet(int n, std::uint64_t seed);
+
+// Equal sphere by sphere (a gtest failure otherwise).
+void ExpectSameSpheres(const SphereSet& actual, const SphereSet& expected);
 
 // Polls `condition` every 50 ms until it holds (true) or `timeout` passes (false).
 bool WaitFor(std::chrono::milliseconds timeout, const std::function<bool()>& condition);

@@ -47,6 +47,8 @@ namespace {
 
 namespace fs = std::filesystem;
 using faults::EntryFiles;
+using faults::ExpectSameSpheres;
+using faults::RandomSet;
 using faults::ReadBytes;
 using faults::ScratchDir;
 using faults::Server;
@@ -62,21 +64,6 @@ GenerateSettings CoarseFor(const Mesh& mesh) {
   settings.parameters.voxel_size = 0.05 * ComputeBoundingBox(mesh.vertices).diagonal();
   settings.parameters.evaluate = false;
   return settings;
-}
-
-void ExpectSameSpheres(const SphereSet& actual, const SphereSet& expected) {
-  ASSERT_EQ(actual.size(), expected.size());
-  for (std::size_t i = 0; i < actual.size(); ++i) {
-    ASSERT_EQ(actual.spheres[i].center, expected.spheres[i].center) << "sphere " << i;
-    ASSERT_EQ(actual.spheres[i].radius, expected.spheres[i].radius) << "sphere " << i;
-  }
-}
-
-// Distinct small sets, cheap to store: n random balls from `seed`.
-SphereSet RandomSet(int n, std::uint64_t seed) {
-  SphereSet set;
-  set.spheres = testing::RandomBalls(n, 1.0, 0.01, 0.1, seed);
-  return set;
 }
 
 // --- a. Corrupt entries ----------------------------------------------------------------------

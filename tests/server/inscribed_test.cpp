@@ -64,5 +64,23 @@ TEST(Inscribed, BadFlagValueIsAUsageError) {
   EXPECT_THAT(inscribed.log(), HasSubstr("--max-queue"));
 }
 
+TEST(Inscribed, BadCacheDiskBytesIsAnErrorNamingTheFlag) {
+  for (const std::vector<std::string>& args :
+       {std::vector<std::string>{"--cache-disk-bytes", "lots"},
+        std::vector<std::string>{"--cache-disk-bytes", "12x"},
+        std::vector<std::string>{"--cache-disk-bytes=-5"}}) {
+    SCOPED_TRACE(args.back());
+    std::vector<std::string> all = {"--listen", "127.0.0.1:0"};
+    all.insert(all.end(), args.begin(), args.end());
+    testing::InscribedProcess inscribed(INSCRIBED, all);
+    ASSERT_TRUE(inscribed.started());
+    EXPECT_EQ(inscribed.WaitUntilListening(), "");
+    const int status = inscribed.StopWith(0, std::chrono::seconds(30));
+    ASSERT_TRUE(status != -1 && WIFEXITED(status));
+    EXPECT_NE(WEXITSTATUS(status), 0);
+    EXPECT_THAT(inscribed.log(), HasSubstr("--cache-disk-bytes"));
+  }
+}
+
 }  // namespace
 }  // namespace inscribe::server

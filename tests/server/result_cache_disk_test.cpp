@@ -3,12 +3,10 @@
 // failures, and a full disk stopping writes until a retry after the backoff succeeds.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <openssl/evp.h>
 #include <signal.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
-#include <array>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -19,7 +17,6 @@
 #include <utility>
 #include <vector>
 
-#include "absl/strings/escaping.h"
 #include "absl/strings/str_cat.h"
 #include "inscribe/server/result_cache.h"
 #include "result_cache_test_support.h"
@@ -27,10 +24,12 @@
 namespace inscribe::server {
 namespace {
 
+using cache_test::EntryFile;
 using cache_test::MustNotCompute;
 using cache_test::MustNotDecode;
 using cache_test::OpenCache;
 using cache_test::Returning;
+using cache_test::Sha256;
 using cache_test::TempDir;
 using cache_test::Value;
 using ::testing::HasSubstr;
@@ -51,19 +50,6 @@ ResultCache::Decode CountingDecode(int* calls) {
     value.bytes = std::move(bytes);
     return value;
   };
-}
-
-std::string Sha256(absl::string_view data) {
-  std::array<unsigned char, 32> digest{};
-  unsigned int length = 0;
-  EXPECT_EQ(EVP_Digest(data.data(), data.size(), digest.data(), &length, EVP_sha256(), nullptr), 1);
-  return std::string(digest.begin(), digest.end());
-}
-
-// The documented layout: dir/<2 hex>/<64 hex of SHA-256(key)>.
-fs::path EntryFile(const std::string& dir, absl::string_view key) {
-  const std::string hex = absl::BytesToHexString(Sha256(key));
-  return fs::path(dir) / hex.substr(0, 2) / hex;
 }
 
 std::string LittleEndian(std::uint64_t value, int bytes) {

@@ -1,10 +1,13 @@
-// What the result cache tests share: a temporary directory per test, and values, compute and
-// decode functions that count their calls or fail the test when called.
+// What the result cache tests share: a temporary directory per test, the documented path of an
+// entry's file, and values, compute and decode functions that count their calls or fail the
+// test when called.
 #pragma once
 
 #include <gtest/gtest.h>
+#include <openssl/evp.h>
 #include <unistd.h>
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <filesystem>
@@ -14,6 +17,7 @@
 #include <system_error>
 #include <utility>
 
+#include "absl/strings/escaping.h"
 #include "absl/strings/str_cat.h"
 #include "inscribe/server/result_cache.h"
 
@@ -43,6 +47,20 @@ class TempDir {
  private:
   fs::path path_;
 };
+
+// SHA-256 by OpenSSL, independent of the server's own hashing.
+inline std::string Sha256(absl::string_view data) {
+  std::array<unsigned char, 32> digest{};
+  unsigned int length = 0;
+  EXPECT_EQ(EVP_Digest(data.data(), data.size(), digest.data(), &length, EVP_sha256(), nullptr), 1);
+  return std::string(digest.begin(), digest.end());
+}
+
+// The documented layout: dir/<2 hex>/<64 hex of SHA-256(key)>.
+inline fs::path EntryFile(const std::string& dir, absl::string_view key) {
+  const std::string hex = absl::BytesToHexString(Sha256(key));
+  return fs::path(dir) / hex.substr(0, 2) / hex;
+}
 
 inline ResultCacheOptions Options(std::int64_t memory_bytes, std::string dir) {
   ResultCacheOptions options;

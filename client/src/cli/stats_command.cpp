@@ -44,7 +44,11 @@ std::vector<std::pair<const char*, std::int64_t>> Counters(const client::ServerC
           {"shared_available", s.shared_available},
           {"disk_write_errors", s.disk_write_errors},
           {"disk_writes_skipped", s.disk_writes_skipped},
-          {"disk_available", s.disk_available}};
+          {"disk_available", s.disk_available},
+          {"disk_bytes_limit", s.disk_bytes_limit},
+          {"disk_evictions", s.disk_evictions},
+          {"disk_evicted_bytes", s.disk_evicted_bytes},
+          {"disk_writes_too_large", s.disk_writes_too_large}};
 }
 
 absl::Status RunStats(const StatsCliOptions& options) {
@@ -74,8 +78,9 @@ void AddStatsCommand(CLI::App& app, CommandOutcome* outcome) {
       "stats",
       "The server's result-cache counters: entries and bytes in memory and on disk, hits "
       "(memory, disk), misses, computations, joined (waited for an identical request), "
-      "evictions, disk errors, and the shared Redis tier's hits, misses, errors, writes, "
-      "skips (while it is down), corrupt values and availability");
+      "evictions, disk errors, the disk bound and its evictions, and the shared Redis tier's "
+      "hits, misses, errors, writes, skips (while it is down), corrupt values and "
+      "availability");
   cmd->add_flag("--json", options->json, "Print one JSON object on stdout");
   AddRemoteOptions(cmd, &options->remote, 60.0, /*server_required=*/true);
   cmd->callback([options, outcome] {

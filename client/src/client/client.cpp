@@ -420,6 +420,10 @@ absl::StatusOr<ServerCacheStats> Client::CacheStats(const CallOptions& options) 
   stats.disk_write_errors = response->disk_write_errors();
   stats.disk_writes_skipped = response->disk_writes_skipped();
   stats.disk_available = response->disk_available();
+  stats.disk_bytes_limit = response->disk_bytes_limit();
+  stats.disk_evictions = response->disk_evictions();
+  stats.disk_evicted_bytes = response->disk_evicted_bytes();
+  stats.disk_writes_too_large = response->disk_writes_too_large();
   return stats;
 }
 

@@ -195,6 +195,10 @@ struct ServerCacheStats {
   std::int64_t disk_write_errors = 0;
   std::int64_t disk_writes_skipped = 0;  // while the server's disk writes were stopped
   std::int64_t disk_available = 0;       // 1 while the server's disk tier is writing
+  std::int64_t disk_bytes_limit = 0;     // the server's --cache-disk-bytes; 0 = unbounded
+  std::int64_t disk_evictions = 0;       // entries deleted from disk for that bound
+  std::int64_t disk_evicted_bytes = 0;
+  std::int64_t disk_writes_too_large = 0;  // results larger than the whole bound, not written
 };
 
 // One object pair of a simulator frame: two cached sets and their world poses.

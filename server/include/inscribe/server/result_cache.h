@@ -82,6 +82,13 @@ struct ResultCacheOptions {
   // other writer. A directory that cannot be written, at Open or later, costs only the disk
   // tier (see DiskTierEvent); no lookup fails because of it.
   std::string disk_dir;
+  // --cache-disk-bytes: the disk tier holds entries up to this many bytes in all (each entry
+  // counts its file's size); 0 = unbounded. When a write takes them past it, the least
+  // recently used entries (by last read or write; the order survives restarts as the files'
+  // modification times) are deleted until they fit, skipping any being read or written at that
+  // moment. Open deletes down to it too, so a restart with a smaller bound shrinks the
+  // directory. An entry larger than the whole bound is not written (disk_writes_too_large).
+  std::int64_t disk_bytes = 0;
   // --redis: URL of the Redis server replicas share as a third tier,
   // "redis://[:PASSWORD@]HOST[:PORT][/DB]"; empty = none. Results are written through to it;
   // a lookup missing memory and disk reads it before computing. Redis down or slow never fails
@@ -168,6 +175,13 @@ struct ResultCacheStats {
   // or while its writes are stopped after a failure (see DiskTierEvent).
   std::int64_t disk_available = 0;
   std::int64_t disk_writes_skipped = 0;  // results not written while disk writes were stopped
+  // The disk tier's bound (ResultCacheOptions::disk_bytes; 0 = unbounded or no disk tier), the
+  // entries deleted for it since Open (at Open included) and their bytes, and the results not
+  // written because they alone exceed it.
+  std::int64_t disk_bytes_limit = 0;
+  std::int64_t disk_evictions = 0;
+  std::int64_t disk_evicted_bytes = 0;
+  std::int64_t disk_writes_too_large = 0;
 };
 
 // Thread-safe. Keys are printable: 1-200 characters from [A-Za-z0-9._:/-], e.g.
@@ -186,8 +200,8 @@ class ResultCache {
   // is not an error: the tier starts marked down, reported through on_shared_tier_event).
   // A disk_dir that cannot be created, listed or written is not an error either: the cache
   // runs without a disk tier (reported through on_disk_tier_event, kOff). INVALID_ARGUMENT for
-  // a negative memory budget or a malformed redis_url (naming the wrong part, never showing
-  // the password).
+  // a negative memory budget or disk bound (naming the flag) or a malformed redis_url (naming the
+  // wrong part, never showing the password).
   static absl::StatusOr<std::unique_ptr<ResultCache>> Open(const ResultCacheOptions& options);
 
   // No call may be in progress.

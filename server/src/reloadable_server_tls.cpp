@@ -92,18 +92,49 @@ bool KeyMatchesCertificate(const std::string& chain, const std::string& key_pem)
   return matches;
 }
 
-absl::Status WriteFile(const fs::path& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out << text;
-  out.close();
-  if (!out) {
-    return absl::FailedPreconditionError(absl::StrCat("cannot write ", path.string()));
+fs::path GenerationDir(const fs::path& dir, int generation) {
+  return dir / absl::StrCat("g", generation);
+}
+
+// Makes directory `generation` holding `files` (name, text), each stamped `mtime`.
+absl::Status WriteGeneration(const fs::path& generation,
+                             const std::vector<std::pair<const char*, const std::string*>>& files,
+                             fs::file_time_type mtime) {
+  std::error_code error;
+  fs::create_directory(generation, error);
+  if (error) {
+    return absl::FailedPreconditionError(
+        absl::StrCat("cannot make ", generation.string(), ": ", error.message()));
+  }
+  for (const auto& [name, text] : files) {
+    const fs::path path = generation / name;
+    std::ofstream out(path, std::ios::binary | std::ios::trunc);
+    out << *text;
+    out.close();
+    if (!out) return absl::FailedPreconditionError(absl::StrCat("cannot write ", path.string()));
+    fs::last_write_time(path, mtime, error);
+    if (error) {
+      return absl::FailedPreconditionError(
+          absl::StrCat("cannot set the mtime of ", path.string(), ": ", error.message()));
+    }
   }
   return absl::OkStatus();
 }
 
-fs::path GenerationDir(const fs::path& dir, int generation) {
-  return dir / absl::StrCat("g", generation);
+// Points the symlink <dir>/current at <dir>/<generation>. rename() replaces it in one step: a
+// path through it resolves to the old generation or to the new one, never to a missing file.
+absl::Status PointCurrentAt(const fs::path& dir, const fs::path& generation) {
+  const fs::path link = dir / "next";
+  std::error_code error;
+  fs::remove(link, error);
+  fs::create_directory_symlink(generation, link, error);
+  if (!error) fs::rename(link, dir / "current", error);
+  if (error) {
+    return absl::FailedPreconditionError(absl::StrCat("cannot point ", (dir / "current").string(),
+                                                      " at ", generation.string(), ": ",
+                                                      error.message()));
+  }
+  return absl::OkStatus();
 }
 
 }  // namespace
@@ -184,49 +215,25 @@ absl::Status ReloadableServerTls::Reload() {
 absl::Status ReloadableServerTls::Publish(const Pem& pem) {
   const int next = generation_ + 1;
   const fs::path next_dir = GenerationDir(dir_, next);
-  std::error_code error;
-  fs::create_directory(next_dir, error);
-  // gRPC re-reads the key and the chain when either's mtime (in whole seconds) changed while it
-  // read them; each generation is stamped at least a second after the last one, so a read that
-  // straddles the swap below always shows up as a change.
+  // gRPC reads the key and the chain again when either's mtime (in whole seconds) changed while
+  // it read them; each generation is stamped at least a second after the last one, so a read
+  // that straddles the swap always shows up as a change.
   const auto now = fs::file_time_type::clock::now();
   const auto stamp =
       generation_ == 0 ? now : std::max(now, last_written_ + std::chrono::seconds(1));
   std::vector<std::pair<const char*, const std::string*>> files = {{kKeyName, &pem.key},
                                                                    {kChainName, &pem.chain}};
   if (!pem.client_ca.empty()) files.emplace_back(kClientCaName, &pem.client_ca);
-  absl::Status written = error ? absl::FailedPreconditionError(absl::StrCat(
-                                     "cannot make ", next_dir.string(), ": ", error.message()))
-                               : absl::OkStatus();
-  for (const auto& [name, text] : files) {
-    if (!written.ok()) break;
-    written = WriteFile(next_dir / name, *text);
-    if (!written.ok()) break;
-    fs::last_write_time(next_dir / name, stamp, error);
-    if (error) {
-      written = absl::FailedPreconditionError(
-          absl::StrCat("cannot stamp ", (next_dir / name).string(), ": ", error.message()));
-    }
+  absl::Status published = WriteGeneration(next_dir, files, stamp);
+  if (published.ok()) published = PointCurrentAt(dir_, next_dir.filename());
+  std::error_code ignored;
+  if (!published.ok()) {
+    fs::remove_all(next_dir, ignored);
+    return published;
   }
-  // rename() replaces the symlink <dir>/current in one step: a path through it resolves to the
-  // old generation or to the new one, never to a missing file.
-  const fs::path link = dir_ / "next";
-  if (written.ok()) {
-    fs::remove(link, error);
-    fs::create_directory_symlink(next_dir.filename(), link, error);
-    if (!error) fs::rename(link, dir_ / "current", error);
-    if (error) {
-      written = absl::FailedPreconditionError(
-          absl::StrCat("cannot publish ", next_dir.string(), ": ", error.message()));
-    }
-  }
-  if (!written.ok()) {
-    fs::remove_all(next_dir, error);
-    return written;
-  }
-  // The generation before the one just replaced is no longer read by anyone; the replaced one
-  // may still be, by a pass that resolved the symlink just before the swap.
-  fs::remove_all(GenerationDir(dir_, next - 2), error);
+  // The generation just replaced may still be read by a pass that resolved the symlink before
+  // the swap; the one before it by nobody.
+  fs::remove_all(GenerationDir(dir_, next - 2), ignored);
   generation_ = next;
   last_written_ = stamp;
   return absl::OkStatus();

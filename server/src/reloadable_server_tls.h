@@ -23,14 +23,14 @@ namespace inscribe::server {
 inline constexpr unsigned kTlsRefreshSeconds = 1;
 
 // gRPC 1.51's TLS credentials take their certificates from a provider, and the only provider
-// whose data can change after the server starts is its FileWatcherCertificateProvider, which
-// re-reads files every kTlsRefreshSeconds. It watches copies, never the operator's files: the
-// copies are written only after the new files have been checked (PEM parses, the key matches
-// the certificate), so a half-written or mismatched pair never reaches a handshake and the old
-// pair keeps serving. The copies live in a private directory (mode 0700, under the temporary
-// directory) removed by the destructor: <dir>/current is a symlink to the generation being
-// served, swapped with one rename so that the key and the certificate change together.
-// Connections already open keep the certificates they were made with. Thread-safe.
+// in its public API whose data can change after the server starts is its
+// FileWatcherCertificateProvider, which re-reads files every kTlsRefreshSeconds. It watches copies,
+// never the operator's files: the copies are written only after the new files have been checked
+// (PEM parses, the key matches the certificate), so a half-written or mismatched pair never reaches
+// a handshake and the old pair keeps serving. The copies live in a private directory (mode 0700,
+// under the temporary directory) removed by the destructor: <dir>/current is a symlink to the
+// generation being served, swapped with one rename so that the key and the certificate change
+// together. Connections already open keep the certificates they were made with. Thread-safe.
 class ReloadableServerTls {
  public:
   // Reads and checks the files of `tls` (which must be enabled) and publishes them. Errors name

@@ -78,7 +78,9 @@ class InscribeServer {
   // Binds and starts serving. UNAVAILABLE when the address cannot be bound, INVALID_ARGUMENT
   // for options out of range; for the TLS and token files, FAILED_PRECONDITION naming one that
   // cannot be read and INVALID_ARGUMENT naming one that holds the wrong thing (no PEM
-  // certificate, a key not matching the certificate, a malformed token or none).
+  // certificate, a key not matching the certificate, a malformed token or none). With TLS, also
+  // FAILED_PRECONDITION when the private directory of the certificates gRPC watches cannot be
+  // made or written (under $TMPDIR; see Reload).
   static absl::StatusOr<std::unique_ptr<InscribeServer>> Start(const ServerOptions& options);
 
   // Shutdown(now) if not done yet, then waits for running jobs.
@@ -109,7 +111,9 @@ class InscribeServer {
   // passes Start's checks; a set that fails keeps what was in use, so a bad file never leaves
   // the server open or locked out. Calls and connections already open are not touched: a call
   // admitted with a token that is no longer accepted runs on, a connection keeps the
-  // certificate it was made with. Thread-safe.
+  // certificate it was made with. TLS files that pass are copied into a private directory
+  // (mode 0700, under $TMPDIR, removed with the server) that gRPC re-reads every second.
+  // Thread-safe.
   ReloadResult Reload();
 
   // Graceful stop: marks health NOT_SERVING, answers new calls with UNAVAILABLE, lets accepted

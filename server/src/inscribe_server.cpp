@@ -71,7 +71,8 @@ int ResolveJobs(int jobs) {
 
 }  // namespace
 
-// Declaration order is construction order: the gRPC server is destroyed first, the pool last.
+// Declaration order is construction order: the gRPC server is destroyed first, then the
+// service, cache and pool, and last the TLS files gRPC watches and the accepted tokens.
 struct InscribeServer::Parts {
   Parts(const JobPoolOptions& pool_options, std::unique_ptr<ResultCache> result_cache,
         const ServiceLimits& limits, CallObserver observer,

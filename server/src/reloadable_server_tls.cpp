@@ -1,10 +1,13 @@
 #include "reloadable_server_tls.h"
 
+#include <fcntl.h>
 #include <openssl/bio.h>
 #include <openssl/err.h>
 #include <openssl/pem.h>
 #include <openssl/x509.h>
 #include <stdlib.h>
+#include <sys/file.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -33,6 +36,11 @@ struct ReloadableServerTls::Pem {
 };
 
 namespace {
+
+// The private directories are <temp>/<kDirPrefix>XXXXXX.
+constexpr char kDirPrefix[] = "inscribed-tls-";
+// The lock file a server holds (flock) for as long as its directory is in use.
+constexpr char kLockName[] = "lock";
 
 // Names of the published copies inside a generation's directory.
 constexpr char kKeyName[] = "key.pem";
@@ -90,6 +98,49 @@ bool KeyMatchesCertificate(const std::string& chain, const std::string& key_pem)
       cert != nullptr && key != nullptr && X509_check_private_key(cert.get(), key.get()) == 1;
   ERR_clear_error();
   return matches;
+}
+
+// Removes the private directories in `temp` whose server is gone without removing its own
+// (killed): their lock can be taken. Another user's cannot be opened, and a live server's lock
+// is held, so both stay. flock, unlike a process id, means the same across containers that
+// share `temp`.
+void RemoveAbandonedDirs(const fs::path& temp) {
+  std::error_code error;
+  for (fs::directory_iterator it(temp, error), end; !error && it != end; it.increment(error)) {
+    const fs::path dir = it->path();
+    if (dir.filename().string().rfind(kDirPrefix, 0) != 0) continue;
+    const int fd = open((dir / kLockName).c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) continue;
+    if (flock(fd, LOCK_EX | LOCK_NB) == 0) {
+      std::error_code ignored;
+      fs::remove_all(dir, ignored);
+    }
+    close(fd);
+  }
+}
+
+// Makes the private directory and takes its lock; the lock's descriptor (held until the
+// directory is removed) and the directory.
+absl::StatusOr<std::pair<int, fs::path>> MakeLockedDir(const fs::path& temp) {
+  std::string dir = (temp / absl::StrCat(kDirPrefix, "XXXXXX")).string();
+  if (mkdtemp(dir.data()) == nullptr) {
+    return absl::FailedPreconditionError(absl::StrCat(
+        "cannot make a private directory for the TLS files: ", dir, ": ", std::strerror(errno)));
+  }
+  // Locked under another name, then renamed: a lock file that RemoveAbandonedDirs can open is
+  // always held already.
+  const fs::path staging = fs::path(dir) / "lock.new";
+  const int fd = open(staging.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+  if (fd < 0 || flock(fd, LOCK_EX) != 0 ||
+      rename(staging.c_str(), (fs::path(dir) / kLockName).c_str()) != 0) {
+    const std::string reason = std::strerror(errno);
+    if (fd >= 0) close(fd);
+    std::error_code ignored;
+    fs::remove_all(dir, ignored);
+    return absl::FailedPreconditionError(
+        absl::StrCat("cannot lock the private directory for the TLS files ", dir, ": ", reason));
+  }
+  return std::pair<int, fs::path>(fd, dir);
 }
 
 fs::path GenerationDir(const fs::path& dir, int generation) {
@@ -164,13 +215,16 @@ absl::StatusOr<std::unique_ptr<ReloadableServerTls>> ReloadableServerTls::Start(
   absl::StatusOr<Pem> pem = Read(tls);
   if (!pem.ok()) return pem.status();
   std::error_code error;
-  std::string pattern = (fs::temp_directory_path(error) / "inscribed-tls-XXXXXX").string();
-  if (error || mkdtemp(pattern.data()) == nullptr) {
+  const fs::path temp = fs::temp_directory_path(error);
+  if (error) {
     return absl::FailedPreconditionError(
-        absl::StrCat("cannot make a private directory for the TLS files: ", pattern, ": ",
-                     error ? error.message() : std::strerror(errno)));
+        absl::StrCat("no temporary directory for the TLS files: ", error.message()));
   }
-  auto server_tls = std::unique_ptr<ReloadableServerTls>(new ReloadableServerTls(tls, pattern));
+  RemoveAbandonedDirs(temp);
+  absl::StatusOr<std::pair<int, fs::path>> locked = MakeLockedDir(temp);
+  if (!locked.ok()) return locked.status();
+  auto server_tls = std::unique_ptr<ReloadableServerTls>(
+      new ReloadableServerTls(tls, locked->second, locked->first));
   {
     std::lock_guard<std::mutex> lock(server_tls->mutex_);
     if (absl::Status published = server_tls->Publish(*pem); !published.ok()) return published;
@@ -194,8 +248,8 @@ absl::StatusOr<std::unique_ptr<ReloadableServerTls>> ReloadableServerTls::Start(
   return server_tls;
 }
 
-ReloadableServerTls::ReloadableServerTls(ServerTlsOptions tls, fs::path dir)
-    : tls_(std::move(tls)), dir_(std::move(dir)) {}
+ReloadableServerTls::ReloadableServerTls(ServerTlsOptions tls, fs::path dir, int lock_fd)
+    : tls_(std::move(tls)), dir_(std::move(dir)), lock_fd_(lock_fd) {}
 
 ReloadableServerTls::~ReloadableServerTls() {
   // The watcher's last reference (and its thread) goes with the credentials, when the server
@@ -203,6 +257,7 @@ ReloadableServerTls::~ReloadableServerTls() {
   credentials_.reset();
   std::error_code ignored;
   fs::remove_all(dir_, ignored);
+  close(lock_fd_);
 }
 
 absl::Status ReloadableServerTls::Reload() {

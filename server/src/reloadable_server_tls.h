@@ -55,7 +55,7 @@ class ReloadableServerTls {
   absl::Status Reload();
 
  private:
-  explicit ReloadableServerTls(ServerTlsOptions tls, std::filesystem::path dir);
+  ReloadableServerTls(ServerTlsOptions tls, std::filesystem::path dir, int lock_fd);
 
   struct Pem;
   // Start's and Reload's one reading of the files, with every check.
@@ -65,6 +65,7 @@ class ReloadableServerTls {
 
   const ServerTlsOptions tls_;
   const std::filesystem::path dir_;
+  const int lock_fd_;  // flock held on <dir>/lock while the directory is in use
   std::shared_ptr<grpc::ServerCredentials> credentials_;
 
   std::mutex mutex_;    // one Publish at a time

@@ -1,14 +1,18 @@
 // InscribeServer::Reload (inscribed's SIGHUP) on loopback: the token file and the TLS files are
 // read again while serving; what fails to read or check keeps the old set in use, and calls
 // and connections already open are not touched. The signal itself: inscribed_test.cpp.
+#include <fcntl.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <sys/file.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <memory>
+#include <random>
 #include <string>
 #include <thread>
 
@@ -239,6 +243,30 @@ TEST_F(ReloadTest, NewClientCaDecidesWhichClientCertificatesAreAccepted) {
   ASSERT_TRUE((*server)->Reload().tls->ok());
   EXPECT_TRUE(EventuallyServedTo(**server, client_of(*next_)));
   EXPECT_FALSE(ServedTo(**server, client_of(*certs_)));
+}
+
+// A server killed before its destructor ran leaves its private directory, with a copy of its
+// key; the next server to start removes it, but never one whose lock is held.
+TEST_F(ReloadTest, StartRemovesPrivateDirectoriesOfKilledServersOnly) {
+  const std::filesystem::path temp = std::filesystem::temp_directory_path();
+  const std::string id = std::to_string(std::random_device{}());
+  const std::filesystem::path abandoned = temp / ("inscribed-tls-test-abandoned-" + id);
+  const std::filesystem::path held = temp / ("inscribed-tls-test-held-" + id);
+  for (const std::filesystem::path& dir : {abandoned, held}) {
+    std::filesystem::create_directories(dir / "g1");
+    std::ofstream(dir / "g1" / "key.pem") << Read(certs_->server_key);
+    std::ofstream(dir / "lock") << "";
+  }
+  const int lock = open((held / "lock").c_str(), O_RDONLY | O_CLOEXEC);
+  ASSERT_GE(lock, 0);
+  ASSERT_EQ(flock(lock, LOCK_EX | LOCK_NB), 0);
+
+  auto server = Start(WithTls);
+  ASSERT_TRUE(server.ok()) << server.status();
+  EXPECT_FALSE(std::filesystem::exists(abandoned));
+  EXPECT_TRUE(std::filesystem::exists(held / "g1" / "key.pem"));
+  close(lock);
+  std::filesystem::remove_all(held);
 }
 
 // --- Calls in flight ---------------------------------------------------------------------

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <memory>
 #include <utility>
 
 #include "absl/strings/ascii.h"
@@ -25,6 +26,34 @@ constexpr absl::string_view kScheme = "Bearer";
 }  // namespace
 
 absl::StatusOr<BearerAuthenticator> BearerAuthenticator::FromFile(const std::string& path) {
+  absl::StatusOr<Digests> digests = ReadFile(path);
+  if (!digests.ok()) return digests.status();
+  return BearerAuthenticator(path, *std::move(digests));
+}
+
+absl::StatusOr<BearerAuthenticator> BearerAuthenticator::FromText(absl::string_view text,
+                                                                  absl::string_view source) {
+  absl::StatusOr<Digests> digests = Parse(text, source);
+  if (!digests.ok()) return digests.status();
+  return BearerAuthenticator(std::string(), *std::move(digests));
+}
+
+absl::Status BearerAuthenticator::Reload() {
+  if (path_.empty()) {
+    return absl::FailedPreconditionError("these bearer tokens were not read from a file");
+  }
+  absl::StatusOr<Digests> digests = ReadFile(path_);
+  if (!digests.ok()) return digests.status();
+  std::atomic_store(&digests_, std::make_shared<const Digests>(*std::move(digests)));
+  return absl::OkStatus();
+}
+
+std::shared_ptr<const BearerAuthenticator::Digests> BearerAuthenticator::Accepted() const {
+  return std::atomic_load(&digests_);
+}
+
+absl::StatusOr<BearerAuthenticator::Digests> BearerAuthenticator::ReadFile(
+    const std::string& path) {
   errno = 0;
   std::ifstream in(path, std::ios::binary);
   if (!in) {
@@ -44,12 +73,12 @@ absl::StatusOr<BearerAuthenticator> BearerAuthenticator::FromFile(const std::str
     return absl::FailedPreconditionError(
         absl::StrCat("cannot read --auth-tokens file ", path, " (a directory?)"));
   }
-  return FromText(text, path);
+  return Parse(text, path);
 }
 
-absl::StatusOr<BearerAuthenticator> BearerAuthenticator::FromText(absl::string_view text,
-                                                                  absl::string_view source) {
-  std::vector<Digest> digests;
+absl::StatusOr<BearerAuthenticator::Digests> BearerAuthenticator::Parse(absl::string_view text,
+                                                                        absl::string_view source) {
+  Digests digests;
   int line_number = 0;
   for (absl::string_view line : absl::StrSplit(text, '\n')) {
     ++line_number;
@@ -75,7 +104,7 @@ absl::StatusOr<BearerAuthenticator> BearerAuthenticator::FromText(absl::string_v
     return absl::InvalidArgumentError(absl::StrCat(
         "--auth-tokens file ", source, " holds no token (only blank lines and # comments)"));
   }
-  return BearerAuthenticator(std::move(digests));
+  return digests;
 }
 
 absl::Status BearerAuthenticator::Check(const grpc::ServerContextBase& context) const {
@@ -108,8 +137,9 @@ absl::Status BearerAuthenticator::CheckHeader(
   const Digest presented = Sha256(absl::StripLeadingAsciiWhitespace(value.substr(kScheme.size())));
   // Comparing digests rather than the tokens makes every comparison 32 bytes whatever the
   // lengths; going through all of them makes the time independent of which one matched.
+  const std::shared_ptr<const Digests> accepted_now = Accepted();
   int matched = 0;
-  for (const Digest& accepted : digests_) {
+  for (const Digest& accepted : *accepted_now) {
     matched |=
         static_cast<int>(CRYPTO_memcmp(presented.data(), accepted.data(), presented.size()) == 0);
   }

@@ -1,10 +1,11 @@
 // Bearer-token authentication of inscribe.v1 calls (inscribed --auth-tokens). Private to the
 // server: InscribeServer::Start loads the file and hands the service a CallAuthenticator that
-// calls Check.
+// calls Check; InscribeServer::Reload (inscribed on SIGHUP) calls Reload.
 #pragma once
 
 #include <array>
 #include <cstddef>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -28,9 +29,10 @@ inline constexpr std::size_t kMinBearerTokenLength = 16;
 // all metadata of a call is 8 KiB).
 inline constexpr std::size_t kMaxBearerTokenLength = 4096;
 
-// The accepted tokens, kept only as SHA-256 digests. Immutable after loading; Check is
-// thread-safe and costs one SHA-256 of the presented token plus one 32-byte comparison per
-// accepted token (microseconds for a handful of tokens), on the calling gRPC thread.
+// The accepted tokens, kept only as SHA-256 digests. The set is replaced whole by Reload, never
+// changed in place. Check and Reload are thread-safe; Check costs one SHA-256 of the presented
+// token plus one 32-byte comparison per accepted token (microseconds for a handful of tokens),
+// on the calling gRPC thread, and never waits for a Reload.
 class BearerAuthenticator {
  public:
   // Reads `path`: one token per line; surrounding whitespace (and a CR) is dropped, blank lines
@@ -44,6 +46,12 @@ class BearerAuthenticator {
   static absl::StatusOr<BearerAuthenticator> FromText(absl::string_view text,
                                                       absl::string_view source);
 
+  // Reads the file given to FromFile again, by the same rules and with the same errors. On
+  // success its tokens replace the accepted ones for every later Check (calls already admitted
+  // go on); on any error the accepted tokens stay as they were. FAILED_PRECONDITION for one
+  // made by FromText: there is no file.
+  absl::Status Reload();
+
   // OK when the call's "authorization" metadata is "Bearer <token>" (the scheme in any case,
   // then spaces) with an accepted token; else UNAUTHENTICATED, "missing bearer token" (no
   // header, several, or another scheme) or "invalid bearer token". Messages never include what
@@ -54,13 +62,27 @@ class BearerAuthenticator {
   // Check on the header's value; nullopt = no header.
   absl::Status CheckHeader(std::optional<absl::string_view> authorization) const;
 
-  std::size_t token_count() const { return digests_.size(); }
+  // Tokens accepted now.
+  std::size_t token_count() const { return Accepted()->size(); }
 
  private:
   using Digest = Sha256Digest;
-  explicit BearerAuthenticator(std::vector<Digest> digests) : digests_(std::move(digests)) {}
+  using Digests = std::vector<Digest>;
 
-  std::vector<Digest> digests_;
+  // The one reader and the one parser of token files; FromFile, FromText and Reload use them.
+  static absl::StatusOr<Digests> ReadFile(const std::string& path);
+  static absl::StatusOr<Digests> Parse(absl::string_view text, absl::string_view source);
+
+  BearerAuthenticator(std::string path, Digests digests)
+      : path_(std::move(path)), digests_(std::make_shared<const Digests>(std::move(digests))) {}
+
+  // The set accepted now; a Reload after this returns does not change it.
+  std::shared_ptr<const Digests> Accepted() const;
+
+  std::string path_;  // FromFile's file; empty for FromText
+  // Read with std::atomic_load and replaced with std::atomic_store (C++17's atomic shared_ptr):
+  // a Check uses one whole set, old or new.
+  std::shared_ptr<const Digests> digests_;
 };
 
 }  // namespace inscribe::server

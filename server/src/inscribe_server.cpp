@@ -1,16 +1,7 @@
 #include "inscribe/server/inscribe_server.h"
 
-#include <openssl/bio.h>
-#include <openssl/err.h>
-#include <openssl/pem.h>
-#include <openssl/x509.h>
-
 #include <algorithm>
-#include <cerrno>
 #include <condition_variable>
-#include <cstring>
-#include <fstream>
-#include <iterator>
 #include <mutex>
 #include <thread>
 #include <utility>
@@ -25,6 +16,7 @@
 #include "grpcpp/server.h"
 #include "grpcpp/server_builder.h"
 #include "grpcpp/support/channel_arguments.h"
+#include "reloadable_server_tls.h"
 #include "service_metrics.h"
 
 namespace inscribe::server {
@@ -65,90 +57,11 @@ absl::Status CheckOptions(const ServerOptions& options) {
   return absl::OkStatus();
 }
 
-// The text of PEM file `path` (given as `flag`), after OpenSSL has parsed what it must hold:
-// `certificates` >= 1 certificates, or else one private key. FAILED_PRECONDITION when it cannot
-// be read, INVALID_ARGUMENT when it holds something else. Read once at start; a few KiB.
-absl::StatusOr<std::string> ReadPemFile(const std::string& path, const char* flag,
-                                        bool certificates) {
-  errno = 0;
-  std::ifstream in(path, std::ios::binary);
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (!in) {
-    return absl::FailedPreconditionError(absl::StrCat("cannot read ", flag, " file ", path, ": ",
-                                                      errno != 0 ? std::strerror(errno) : "?"));
-  }
-  const std::unique_ptr<BIO, decltype(&BIO_free)> bio(
-      BIO_new_mem_buf(text.data(), static_cast<int>(text.size())), BIO_free);
-  bool parsed = false;
-  if (certificates) {
-    X509* cert = PEM_read_bio_X509(bio.get(), nullptr, nullptr, nullptr);
-    parsed = cert != nullptr;
-    X509_free(cert);
-  } else {
-    // No passphrase callback: an encrypted key fails here rather than prompting a terminal.
-    EVP_PKEY* key = PEM_read_bio_PrivateKey(bio.get(), nullptr, nullptr, const_cast<char*>(""));
-    parsed = key != nullptr;
-    EVP_PKEY_free(key);
-  }
-  // OpenSSL's per-thread error queue would otherwise hold these for gRPC's next TLS call.
-  ERR_clear_error();
-  if (!parsed) {
-    return absl::InvalidArgumentError(
-        absl::StrCat(flag, " file ", path, " holds no ",
-                     certificates ? "PEM certificate" : "unencrypted PEM private key"));
-  }
-  return text;
-}
-
-// Whether the private key belongs to the first certificate of the chain; a mismatch would
-// otherwise only show up as every client's handshake failing.
-bool KeyMatchesCertificate(const std::string& chain, const std::string& key_pem) {
-  const std::unique_ptr<BIO, decltype(&BIO_free)> cert_bio(
-      BIO_new_mem_buf(chain.data(), static_cast<int>(chain.size())), BIO_free);
-  const std::unique_ptr<BIO, decltype(&BIO_free)> key_bio(
-      BIO_new_mem_buf(key_pem.data(), static_cast<int>(key_pem.size())), BIO_free);
-  const std::unique_ptr<X509, decltype(&X509_free)> cert(
-      PEM_read_bio_X509(cert_bio.get(), nullptr, nullptr, nullptr), X509_free);
-  const std::unique_ptr<EVP_PKEY, decltype(&EVP_PKEY_free)> key(
-      PEM_read_bio_PrivateKey(key_bio.get(), nullptr, nullptr, const_cast<char*>("")),
-      EVP_PKEY_free);
-  const bool matches =
-      cert != nullptr && key != nullptr && X509_check_private_key(cert.get(), key.get()) == 1;
-  ERR_clear_error();
-  return matches;
-}
-
-// Plaintext, TLS, or TLS requiring a client certificate signed by --tls-client-ca.
-absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> MakeServerCredentials(
-    const ServerTlsOptions& tls) {
-  if (!tls.enabled()) return grpc::InsecureServerCredentials();
-  absl::StatusOr<std::string> chain = ReadPemFile(tls.cert_file, "--tls-cert", true);
-  if (!chain.ok()) return chain.status();
-  absl::StatusOr<std::string> key = ReadPemFile(tls.key_file, "--tls-key", false);
-  if (!key.ok()) return key.status();
-  if (!KeyMatchesCertificate(*chain, *key)) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "--tls-key file ", tls.key_file, " is not the key of --tls-cert file ", tls.cert_file));
-  }
-  grpc::SslServerCredentialsOptions ssl(GRPC_SSL_DONT_REQUEST_CLIENT_CERTIFICATE);
-  ssl.pem_key_cert_pairs.push_back({*std::move(key), *std::move(chain)});
-  if (!tls.client_ca_file.empty()) {
-    absl::StatusOr<std::string> roots = ReadPemFile(tls.client_ca_file, "--tls-client-ca", true);
-    if (!roots.ok()) return roots.status();
-    ssl.pem_root_certs = *std::move(roots);
-    ssl.client_certificate_request = GRPC_SSL_REQUEST_AND_REQUIRE_CLIENT_CERTIFICATE_AND_VERIFY;
-  }
-  return grpc::SslServerCredentials(ssl);
-}
-
-// The service's view of --auth-tokens; empty (admit all) when not given.
-absl::StatusOr<CallAuthenticator> MakeAuthenticator(const std::string& tokens_file) {
-  if (tokens_file.empty()) return CallAuthenticator();
-  absl::StatusOr<BearerAuthenticator> tokens = BearerAuthenticator::FromFile(tokens_file);
-  if (!tokens.ok()) return tokens.status();
-  auto shared = std::make_shared<const BearerAuthenticator>(*std::move(tokens));
+// The service's view of `tokens`; empty (admit all) when there are none.
+CallAuthenticator MakeAuthenticator(std::shared_ptr<const BearerAuthenticator> tokens) {
+  if (tokens == nullptr) return CallAuthenticator();
   return CallAuthenticator(
-      [shared](const grpc::CallbackServerContext& context) { return shared->Check(context); });
+      [tokens](const grpc::CallbackServerContext& context) { return tokens->Check(context); });
 }
 
 int ResolveJobs(int jobs) {
@@ -158,14 +71,21 @@ int ResolveJobs(int jobs) {
 
 }  // namespace
 
-// Declaration order is construction order: the gRPC server is destroyed first, the pool last.
+// Declaration order is construction order: the gRPC server is destroyed first, then the
+// service, cache and pool, and last the TLS files gRPC watches and the accepted tokens.
 struct InscribeServer::Parts {
   Parts(const JobPoolOptions& pool_options, std::unique_ptr<ResultCache> result_cache,
-        const ServiceLimits& limits, CallObserver observer, CallAuthenticator authenticate)
-      : pool(pool_options),
+        const ServiceLimits& limits, CallObserver observer,
+        std::shared_ptr<BearerAuthenticator> bearer_tokens,
+        std::unique_ptr<ReloadableServerTls> server_tls)
+      : tls(std::move(server_tls)),
+        tokens(std::move(bearer_tokens)),
+        pool(pool_options),
         cache(std::move(result_cache)),
-        service(&pool, cache.get(), limits, std::move(observer), std::move(authenticate)) {}
+        service(&pool, cache.get(), limits, std::move(observer), MakeAuthenticator(tokens)) {}
 
+  std::unique_ptr<ReloadableServerTls> tls;     // null: plaintext
+  std::shared_ptr<BearerAuthenticator> tokens;  // null: no --auth-tokens
   JobPool pool;
   std::unique_ptr<ResultCache> cache;
   int metrics_port = 0;       // 0: no metrics endpoint
@@ -183,11 +103,20 @@ absl::StatusOr<std::unique_ptr<InscribeServer>> InscribeServer::Start(
     const ServerOptions& options) {
   if (absl::Status s = CheckOptions(options); !s.ok()) return s;
   const int jobs = ResolveJobs(options.jobs);
-  absl::StatusOr<std::shared_ptr<grpc::ServerCredentials>> credentials =
-      MakeServerCredentials(options.tls);
-  if (!credentials.ok()) return credentials.status();
-  absl::StatusOr<CallAuthenticator> authenticate = MakeAuthenticator(options.auth_tokens_file);
-  if (!authenticate.ok()) return authenticate.status();
+  std::unique_ptr<ReloadableServerTls> tls;
+  if (options.tls.enabled()) {
+    absl::StatusOr<std::unique_ptr<ReloadableServerTls>> started =
+        ReloadableServerTls::Start(options.tls);
+    if (!started.ok()) return started.status();
+    tls = *std::move(started);
+  }
+  std::shared_ptr<BearerAuthenticator> tokens;
+  if (!options.auth_tokens_file.empty()) {
+    absl::StatusOr<BearerAuthenticator> read =
+        BearerAuthenticator::FromFile(options.auth_tokens_file);
+    if (!read.ok()) return read.status();
+    tokens = std::make_shared<BearerAuthenticator>(*std::move(read));
+  }
   absl::StatusOr<std::unique_ptr<ResultCache>> cache = ResultCache::Open(options.cache);
   if (!cache.ok()) return cache.status();
   // The metrics see every call the caller's observer sees. They are made after the parts they
@@ -198,9 +127,9 @@ absl::StatusOr<std::unique_ptr<InscribeServer>> InscribeServer::Start(
     if (*metrics) (*metrics)->RecordCall(call);
     if (user) user(call);
   };
-  auto parts =
-      std::make_unique<Parts>(JobPoolOptions{jobs, options.max_queue}, *std::move(cache),
-                              options.limits, std::move(observe), *std::move(authenticate));
+  auto parts = std::make_unique<Parts>(JobPoolOptions{jobs, options.max_queue}, *std::move(cache),
+                                       options.limits, std::move(observe), std::move(tokens),
+                                       std::move(tls));
   if (!options.metrics_listen.empty()) {
     // Set before the server starts, so call threads read it without a lock.
     absl::StatusOr<std::unique_ptr<ServiceMetrics>> started = ServiceMetrics::Start(
@@ -216,8 +145,12 @@ absl::StatusOr<std::unique_ptr<InscribeServer>> InscribeServer::Start(
 
   grpc::ServerBuilder builder;
   int port = 0;
-  if (!options.listen.empty())
-    builder.AddListeningPort(options.listen, *std::move(credentials), &port);
+  if (!options.listen.empty()) {
+    builder.AddListeningPort(
+        options.listen,
+        parts->tls != nullptr ? parts->tls->credentials() : grpc::InsecureServerCredentials(),
+        &port);
+  }
   builder.RegisterService(&parts->service);
   builder.SetMaxReceiveMessageSize(options.max_message_bytes);
   // gRPC sets SO_REUSEPORT by default on Linux, which would let a second server silently share
@@ -268,6 +201,13 @@ void InscribeServer::Shutdown(std::chrono::system_clock::time_point deadline) {
     parts_->shutdown_done = true;
   }
   parts_->stopped.notify_all();
+}
+
+ReloadResult InscribeServer::Reload() {
+  ReloadResult result;
+  if (parts_->tokens != nullptr) result.tokens = parts_->tokens->Reload();
+  if (parts_->tls != nullptr) result.tls = parts_->tls->Reload();
+  return result;
 }
 
 int InscribeServer::metrics_port() const { return parts_->metrics_port; }

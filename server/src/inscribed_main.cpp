@@ -1,5 +1,6 @@
 // inscribed: the inscribe gRPC server. Logs go to stderr as key=value pairs; the one plain line
 // "inscribed listening on HOST:PORT" says the server is ready (scripts and tests read it).
+// SIGTERM/SIGINT drain and stop it; SIGHUP reloads the token and TLS files.
 #include <pthread.h>
 #include <signal.h>
 
@@ -9,12 +10,15 @@
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
+#include <optional>
 #include <string>
 #include <thread>
+#include <utility>
 
 #include "CLI/CLI.hpp"
 #include "absl/status/status.h"
 #include "inscribe/server/inscribe_server.h"
+#include "spdlog/fmt/fmt.h"
 #include "spdlog/sinks/stdout_sinks.h"
 #include "spdlog/spdlog.h"
 
@@ -66,6 +70,27 @@ void LogDiskTier(const inscribe::server::DiskTierEvent& event) {
   }
 }
 
+// One line per SIGHUP: for the token file and the TLS files, "reloaded", "off" (not configured)
+// or "kept" with the error that made the server keep the ones it had; an error level when
+// either was kept.
+void LogReload(const inscribe::server::ReloadResult& result) {
+  std::string line = "event=reload signal=SIGHUP";
+  bool kept = false;
+  for (const auto& [name, status] :
+       {std::pair{"tokens", &result.tokens}, std::pair{"tls", &result.tls}}) {
+    if (!status->has_value()) {
+      line += fmt::format(" {}=off", name);
+    } else if ((*status)->ok()) {
+      line += fmt::format(" {}=reloaded", name);
+    } else {
+      line +=
+          fmt::format(" {}=kept {}_error=\"{}\"", name, name, std::string((*status)->message()));
+      kept = true;
+    }
+  }
+  spdlog::log(kept ? spdlog::level::err : spdlog::level::info, "{}", line);
+}
+
 // Whether HOST of --listen HOST:PORT is a loopback address, where plaintext cannot be sniffed
 // from another machine. 0.0.0.0 and [::] listen on every interface: not loopback.
 bool IsLoopbackListen(const std::string& listen) {
@@ -79,13 +104,15 @@ bool IsLoopbackListen(const std::string& listen) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  // Block the stop signals before any thread exists so every thread (gRPC's, TBB's) inherits
-  // the mask; this thread then takes them synchronously with sigwait, outside signal context.
-  sigset_t stop_signals;
-  sigemptyset(&stop_signals);
-  sigaddset(&stop_signals, SIGINT);
-  sigaddset(&stop_signals, SIGTERM);
-  pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
+  // Block the handled signals before any thread exists so every thread (gRPC's, TBB's)
+  // inherits the mask; this thread then takes them synchronously with sigwait, outside signal
+  // context, where reloading and stopping may take locks and do I/O.
+  sigset_t handled_signals;
+  sigemptyset(&handled_signals);
+  sigaddset(&handled_signals, SIGINT);
+  sigaddset(&handled_signals, SIGTERM);
+  sigaddset(&handled_signals, SIGHUP);
+  pthread_sigmask(SIG_BLOCK, &handled_signals, nullptr);
   // A cache file growing past RLIMIT_FSIZE must fail its write with EFBIG (the disk tier then
   // stops writing) rather than kill the server with SIGXFSZ.
   signal(SIGXFSZ, SIG_IGN);
@@ -159,7 +186,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--tls-cert", options.tls.cert_file,
                  "PEM certificate chain of the server; with --tls-key serves TLS instead of "
-                 "plaintext")
+                 "plaintext. The TLS files are read again on SIGHUP")
       ->check(CLI::ExistingFile);
   app.add_option("--tls-key", options.tls.key_file, "PEM private key of --tls-cert")
       ->check(CLI::ExistingFile);
@@ -169,7 +196,7 @@ int main(int argc, char** argv) {
       ->check(CLI::ExistingFile);
   app.add_option("--auth-tokens", options.auth_tokens_file,
                  "file of accepted bearer tokens, one per line; calls without one get "
-                 "UNAUTHENTICATED")
+                 "UNAUTHENTICATED. Read again on SIGHUP")
       ->check(CLI::ExistingFile);
   app.add_option("--metrics-listen", options.metrics_listen,
                  "HOST:PORT of the Prometheus endpoint (/metrics); empty = none")
@@ -223,7 +250,10 @@ int main(int argc, char** argv) {
   std::fflush(stderr);
 
   int signal_number = 0;
-  while (sigwait(&stop_signals, &signal_number) != 0) {
+  for (;;) {
+    if (sigwait(&handled_signals, &signal_number) != 0) continue;
+    if (signal_number != SIGHUP) break;
+    LogReload((*server)->Reload());
   }
   spdlog::info("event=draining signal={} grace_s={}",
                signal_number == SIGTERM ? "SIGTERM" : "SIGINT", shutdown_grace_seconds);

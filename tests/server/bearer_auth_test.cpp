@@ -5,10 +5,13 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <filesystem>
 #include <fstream>
 #include <random>
 #include <string>
+#include <thread>
+#include <vector>
 
 #include "inscribe/client/connection.h"
 #include "support/test_certificates.h"
@@ -107,6 +110,72 @@ TEST(BearerAuthenticator, UnreadableFileIsFailedPrecondition) {
   absl::StatusOr<BearerAuthenticator> auth = BearerAuthenticator::FromFile(path);
   EXPECT_EQ(auth.status().code(), absl::StatusCode::kFailedPrecondition);
   EXPECT_THAT(auth.status().message(), HasSubstr(path));
+}
+
+TEST(BearerAuthenticator, ReloadReplacesTheTokensWholeOrKeepsThem) {
+  const std::filesystem::path path = std::filesystem::temp_directory_path() /
+                                     ("inscribe-tokens-" + std::to_string(std::random_device{}()));
+  const auto write = [&](const std::string& text) {
+    std::ofstream(path, std::ios::binary) << text;
+  };
+  write(std::string(kToken) + "\n");
+  absl::StatusOr<BearerAuthenticator> auth = BearerAuthenticator::FromFile(path.string());
+  ASSERT_TRUE(auth.ok()) << auth.status();
+  const std::string token = std::string("Bearer ") + kToken;
+  const std::string other = std::string("Bearer ") + kOther;
+
+  write(std::string(kOther) + "\n");
+  EXPECT_TRUE(auth->CheckHeader(token).ok()) << "the file is read on Reload only";
+  ASSERT_TRUE(auth->Reload().ok());
+  EXPECT_EQ(auth->token_count(), 1u);
+  EXPECT_FALSE(auth->CheckHeader(token).ok());
+  EXPECT_TRUE(auth->CheckHeader(other).ok());
+
+  // A file that fails any rule changes nothing, not even its valid lines.
+  write(std::string(kToken) + "\nshort\n");
+  const absl::Status bad = auth->Reload();
+  EXPECT_EQ(bad.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(bad.message(), HasSubstr("line 2"));
+  EXPECT_FALSE(auth->CheckHeader(token).ok());
+  EXPECT_TRUE(auth->CheckHeader(other).ok());
+
+  std::filesystem::remove(path);
+  EXPECT_EQ(auth->Reload().code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_TRUE(auth->CheckHeader(other).ok());
+
+  // Tokens given as text have no file to read again.
+  BearerAuthenticator from_text = Make(kToken);
+  EXPECT_EQ(from_text.Reload().code(), absl::StatusCode::kFailedPrecondition);
+  EXPECT_TRUE(from_text.CheckHeader(token).ok());
+}
+
+// Checks on several threads while the set is replaced: each sees one whole set, old or new.
+TEST(BearerAuthenticator, ChecksDuringReloadsSeeOneWholeSet) {
+  const std::filesystem::path path = std::filesystem::temp_directory_path() /
+                                     ("inscribe-tokens-" + std::to_string(std::random_device{}()));
+  std::ofstream(path, std::ios::binary) << kToken << "\n" << kOther << "\n";
+  absl::StatusOr<BearerAuthenticator> auth = BearerAuthenticator::FromFile(path.string());
+  ASSERT_TRUE(auth.ok()) << auth.status();
+  std::atomic<bool> stop{false};
+  std::atomic<int> refused{0};
+  std::vector<std::thread> checkers;
+  for (int t = 0; t < 3; ++t) {
+    checkers.emplace_back([&] {
+      while (!stop.load()) {
+        // kToken is in every version of the file.
+        if (!auth->CheckHeader(std::string("Bearer ") + kToken).ok()) ++refused;
+      }
+    });
+  }
+  for (int i = 0; i < 200; ++i) {
+    std::ofstream(path, std::ios::binary) << kToken << "\n"
+                                          << (i % 2 == 0 ? "" : std::string(kOther) + "\n");
+    EXPECT_TRUE(auth->Reload().ok());
+  }
+  stop = true;
+  for (std::thread& checker : checkers) checker.join();
+  EXPECT_EQ(refused.load(), 0);
+  std::filesystem::remove(path);
 }
 
 // --- The client side's files ------------------------------------------------------------

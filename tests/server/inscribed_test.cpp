@@ -1,5 +1,5 @@
 // The inscribed executable as an operator runs it: start, learn the port from stderr, serve a
-// call, stop on SIGTERM with exit status 0.
+// call, reload its token file on SIGHUP, stop on SIGTERM with exit status 0.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <signal.h>
@@ -8,11 +8,15 @@
 
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <random>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "inscribe/client/client.h"
+#include "inscribe/client/connection.h"
 #include "support/inscribed_process.h"
 #include "support/synthetic_meshes.h"
 
@@ -52,6 +56,64 @@ TEST(Inscribed, SigintAlsoStopsIt) {
   const int status = inscribed.StopWith(SIGINT, std::chrono::seconds(30));
   ASSERT_TRUE(status != -1 && WIFEXITED(status)) << inscribed.log();
   EXPECT_EQ(WEXITSTATUS(status), 0);
+}
+
+// Polls (up to 30 s; the log arrives on a pipe) until `inscribed`'s log holds `count` lines
+// with `text`.
+bool LogShows(const testing::InscribedProcess& inscribed, const std::string& text, int count) {
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  for (;;) {
+    const std::string log = inscribed.log();
+    int seen = 0;
+    for (std::size_t at = log.find(text); at != std::string::npos; at = log.find(text, at + 1)) {
+      ++seen;
+    }
+    if (seen >= count) return true;
+    if (std::chrono::steady_clock::now() > give_up) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+}
+
+TEST(Inscribed, SighupReloadsTheTokenFileAndKeepsItWhenBad) {
+  const std::filesystem::path tokens =
+      std::filesystem::temp_directory_path() /
+      ("inscribed-tokens-" + std::to_string(std::random_device{}()));
+  const std::string old_token = "old-token-0123456789abcdef";
+  const std::string new_token = "new-token-fedcba9876543210";
+  std::ofstream(tokens) << old_token << "\n";
+  testing::InscribedProcess inscribed(
+      INSCRIBED, {"--listen", "127.0.0.1:0", "--jobs", "1", "--auth-tokens", tokens.string()});
+  ASSERT_TRUE(inscribed.started());
+  const std::string address = inscribed.WaitUntilListening();
+  ASSERT_FALSE(address.empty()) << inscribed.log();
+  inscribed.DrainLogInBackground();
+  const auto stats_with = [&](const std::string& token) {
+    client::ConnectionOptions options;
+    options.bearer_token = token;
+    client::Client client(client::MakeGrpcConnection(address, options));
+    return client.CacheStats().status().code();
+  };
+  EXPECT_EQ(stats_with(new_token), absl::StatusCode::kUnauthenticated);
+
+  std::ofstream(tokens) << new_token << "\n";
+  kill(inscribed.pid(), SIGHUP);
+  ASSERT_TRUE(LogShows(inscribed, "event=reload", 1)) << inscribed.log();
+  EXPECT_THAT(inscribed.log(),
+              HasSubstr("level=info event=reload signal=SIGHUP tokens=reloaded tls=off"));
+  EXPECT_EQ(stats_with(new_token), absl::StatusCode::kOk);
+  EXPECT_EQ(stats_with(old_token), absl::StatusCode::kUnauthenticated);
+
+  std::ofstream(tokens) << "# all retired\n";
+  kill(inscribed.pid(), SIGHUP);
+  ASSERT_TRUE(LogShows(inscribed, "event=reload", 2)) << inscribed.log();
+  EXPECT_THAT(inscribed.log(), HasSubstr("level=error event=reload signal=SIGHUP tokens=kept"));
+  EXPECT_THAT(inscribed.log(), HasSubstr("holds no token"));
+  EXPECT_EQ(stats_with(new_token), absl::StatusCode::kOk);
+
+  const int status = inscribed.StopWith(SIGTERM, std::chrono::seconds(30));
+  ASSERT_TRUE(status != -1 && WIFEXITED(status)) << inscribed.log();
+  EXPECT_EQ(WEXITSTATUS(status), 0);
+  std::filesystem::remove(tokens);
 }
 
 TEST(Inscribed, BadFlagValueIsAUsageError) {

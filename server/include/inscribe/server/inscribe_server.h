@@ -4,8 +4,10 @@
 #include <chrono>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 
+#include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "inscribe/server/inscribe_service.h"
 
@@ -15,7 +17,7 @@ class Channel;
 
 namespace inscribe::server {
 
-// TLS on the listening port. PEM files, read once at start.
+// TLS on the listening port. PEM files, read at start and again by InscribeServer::Reload.
 struct ServerTlsOptions {
   // --tls-cert and --tls-key: the server's certificate chain and private key. Both or neither;
   // with neither the port is plaintext.
@@ -48,12 +50,24 @@ struct ServerOptions {
   // --auth-tokens: file of accepted bearer tokens, one per line (blank lines and lines
   // starting with '#' ignored); empty = no authentication. When set, every inscribe.v1 call
   // must carry "authorization: Bearer <token>" with one of them, else UNAUTHENTICATED. The
-  // health service stays open (probes carry no token).
+  // health service stays open (probes carry no token). Read at start and again by
+  // InscribeServer::Reload.
   std::string auth_tokens_file;
   // --metrics-listen: HOST:PORT of the Prometheus endpoint (GET /metrics); empty = none.
   std::string metrics_listen;
   // Told about every finished call; see CallObserver. May be empty.
   CallObserver on_call;
+};
+
+// What InscribeServer::Reload did with each set of files; nullopt for a set the server does not
+// use (no --auth-tokens; plaintext).
+struct ReloadResult {
+  // --auth-tokens: OK when the file's tokens replaced the accepted ones; else why the accepted
+  // tokens stay as they were (the errors of InscribeServer::Start for that file).
+  std::optional<absl::Status> tokens;
+  // --tls-cert, --tls-key, --tls-client-ca: OK when the files are in use for new connections
+  // (within ~1 s); else why the files served before stay in use.
+  std::optional<absl::Status> tls;
 };
 
 // Owns the grpc::Server, the service and the pool, and shuts them down in that order. Serves
@@ -64,7 +78,9 @@ class InscribeServer {
   // Binds and starts serving. UNAVAILABLE when the address cannot be bound, INVALID_ARGUMENT
   // for options out of range; for the TLS and token files, FAILED_PRECONDITION naming one that
   // cannot be read and INVALID_ARGUMENT naming one that holds the wrong thing (no PEM
-  // certificate, a key not matching the certificate, a malformed token or none).
+  // certificate, a key not matching the certificate, a malformed token or none). With TLS, also
+  // FAILED_PRECONDITION when the private directory of the certificates gRPC watches cannot be
+  // made or written (under $TMPDIR; see Reload).
   static absl::StatusOr<std::unique_ptr<InscribeServer>> Start(const ServerOptions& options);
 
   // Shutdown(now) if not done yet, then waits for running jobs.
@@ -90,6 +106,15 @@ class InscribeServer {
   // SceneStream calls open now, each holding its scene; a call's scene is freed when the call
   // is done (finished, cancelled, or its client gone).
   std::int64_t open_scenes() const;
+
+  // Reads the token file and the TLS files again (inscribed does on SIGHUP) and uses what
+  // passes Start's checks; a set that fails keeps what was in use, so a bad file never leaves
+  // the server open or locked out. Calls and connections already open are not touched: a call
+  // admitted with a token that is no longer accepted runs on, a connection keeps the
+  // certificate it was made with. TLS files that pass are copied into a private directory
+  // (mode 0700, under $TMPDIR, removed with the server) that gRPC re-reads every second.
+  // Thread-safe.
+  ReloadResult Reload();
 
   // Graceful stop: marks health NOT_SERVING, answers new calls with UNAVAILABLE, lets accepted
   // calls finish until `deadline`, then cancels what is left, closes every connection and waits

@@ -20,6 +20,17 @@ def free_dead_endpoint():
         return f"127.0.0.1:{s.getsockname()[1]}"
 
 
+def held_dead_endpoints(count):
+    # `count` ports held bound without listening (connections are refused) until the returned
+    # sockets are closed: distinct addresses, which a freed port asked for again is not.
+    sockets = []
+    for _ in range(count):
+        s = socket.socket()
+        s.bind(("127.0.0.1", 0))
+        sockets.append(s)
+    return sockets, [f"127.0.0.1:{s.getsockname()[1]}" for s in sockets]
+
+
 @pytest.fixture(scope="module")
 def eight():
     return inscribe.load_mesh(mesh_path("eight.off"))
@@ -165,6 +176,7 @@ def test_an_unreachable_server_is_unavailable_after_the_retries(eight):
 
 def test_routing_picks_the_cpp_clients_replica_and_fails_over(tmp_path, eight):
     a, b = Server("--jobs", "1"), Server("--jobs", "1")
+    held = []
     try:
         endpoints = [a.address, b.address]
         cli = json.loads(run_cli("generate", mesh_path("eight.off"), "--max-spheres", "40",
@@ -188,12 +200,12 @@ def test_routing_picks_the_cpp_clients_replica_and_fails_over(tmp_path, eight):
         # Failover: a dead replica that the mesh routes to first; the call moves on to the
         # live one at once (no backoff), as the C++ client's does.
         route = inscribe._inscribe._route_key(result.mesh_sha256)
-        for _ in range(64):
-            dead = free_dead_endpoint()
+        held, candidates = held_dead_endpoints(64)
+        for dead in candidates:
             if inscribe._inscribe._rendezvous_order(route, [dead, owner.address])[0] == 0:
                 break
         else:
-            pytest.fail("no dead endpoint routed first in 64 tries")
+            pytest.fail("none of 64 dead endpoints routed first")
         retry = inscribe.RetryPolicy(max_attempts=2, initial_backoff=30.0)
         with inscribe.Client([dead, owner.address], retry=retry, timeout=20.0) as client:
             start = time.monotonic()
@@ -210,6 +222,8 @@ def test_routing_picks_the_cpp_clients_replica_and_fails_over(tmp_path, eight):
                 local = inscribe.generate(eight, max_spheres=40, evaluate=False)
                 assert reply.distance[0] == inscribe.distance(local, local, shifted).distance
     finally:
+        for sock in held:
+            sock.close()
         a.stop()
         b.stop()
 

@@ -17,8 +17,9 @@ struct EdgeUse {
   bool forward;           // true when the triangle walks it lo -> hi
 };
 
-// All sides of all triangles with three distinct in-range corners, sorted by (lo, hi,
-// triangle, side) so that the uses of one edge are adjacent. Cost O(#T log #T).
+// All sides of all triangles with three distinct corners, sorted by (lo, hi, triangle, side)
+// so that the uses of one edge are adjacent. Cost O(#T + #V) when every corner is a vertex
+// index (a counting sort by lo, then each vertex's uses by hi), O(#T log #T) otherwise.
 std::vector<EdgeUse> SortedEdgeUses(const Mesh& mesh);
 
 // Disjoint sets with path halving and union by size.

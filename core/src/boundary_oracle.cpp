@@ -1,8 +1,6 @@
 #include "inscribe/boundary_oracle.h"
 
 #include <embree3/rtcore.h>
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
@@ -13,6 +11,7 @@
 #include "absl/strings/str_cat.h"
 #include "closest_point_triangle.h"
 #include "mesh_topology.h"
+#include "parallel.h"
 #include "triangle_bvh.h"
 
 namespace inscribe {
@@ -102,26 +101,25 @@ void BoundaryOracle::Impl::ComputeNormals() {
   vertex_normals.assign(static_cast<std::size_t>(mesh.num_vertices()), Vector3::Zero());
   edge_normals.assign(3 * nt, Vector3::Zero());
   std::vector<double> angles(3 * nt, 0.0);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nt, 512),
-                    [&](const tbb::blocked_range<std::size_t>& range) {
-                      for (std::size_t t = range.begin(); t != range.end(); ++t) {
-                        const auto ti = static_cast<std::int32_t>(t);
-                        const Vector3 corners[3] = {Corner(ti, 0), Corner(ti, 1), Corner(ti, 2)};
-                        const Vector3 n = (corners[1] - corners[0]).cross(corners[2] - corners[0]);
-                        const double length = n.norm();
-                        if (!(length > 0.0)) continue;
-                        face_normals[t] = n / length;
-                        // |e1 x e2| is `length` at every corner, and the three angles sum to
-                        // pi: two atan2 calls instead of three.
-                        double* angle = &angles[3 * t];
-                        for (int k = 0; k < 2; ++k) {
-                          const Vector3 e1 = corners[(k + 1) % 3] - corners[k];
-                          const Vector3 e2 = corners[(k + 2) % 3] - corners[k];
-                          angle[k] = std::atan2(length, e1.dot(e2));
-                        }
-                        angle[2] = std::max(0.0, kPi - angle[0] - angle[1]);
-                      }
-                    });
+  internal::ParallelForRange(std::size_t{0}, nt, 512, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t t = begin; t != end; ++t) {
+      const auto ti = static_cast<std::int32_t>(t);
+      const Vector3 corners[3] = {Corner(ti, 0), Corner(ti, 1), Corner(ti, 2)};
+      const Vector3 n = (corners[1] - corners[0]).cross(corners[2] - corners[0]);
+      const double length = n.norm();
+      if (!(length > 0.0)) continue;
+      face_normals[t] = n / length;
+      // |e1 x e2| is `length` at every corner, and the three angles sum to
+      // pi: two atan2 calls instead of three.
+      double* angle = &angles[3 * t];
+      for (int k = 0; k < 2; ++k) {
+        const Vector3 e1 = corners[(k + 1) % 3] - corners[k];
+        const Vector3 e2 = corners[(k + 2) % 3] - corners[k];
+        angle[k] = std::atan2(length, e1.dot(e2));
+      }
+      angle[2] = std::max(0.0, kPi - angle[0] - angle[1]);
+    }
+  });
   for (std::size_t t = 0; t < nt; ++t) {
     if (face_normals[t].isZero()) continue;
     for (int k = 0; k < 3; ++k) {
@@ -129,15 +127,13 @@ void BoundaryOracle::Impl::ComputeNormals() {
           angles[3 * t + static_cast<std::size_t>(k)] * face_normals[t];
     }
   }
-  tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, 3 * nt, 2048),
-      [&](const tbb::blocked_range<std::size_t>& range) {
-        for (std::size_t side = range.begin(); side != range.end(); ++side) {
-          const Vector3& own = face_normals[side / 3];
-          edge_normals[side] =
-              across[side] >= 0 ? own + face_normals[static_cast<std::size_t>(across[side])] : own;
-        }
-      });
+  internal::ParallelForRange(std::size_t{0}, 3 * nt, 2048, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t side = begin; side != end; ++side) {
+      const Vector3& own = face_normals[side / 3];
+      edge_normals[side] =
+          across[side] >= 0 ? own + face_normals[static_cast<std::size_t>(across[side])] : own;
+    }
+  });
 }
 
 absl::Status BoundaryOracle::Impl::BuildScene() {
@@ -464,7 +460,7 @@ double BoundaryOracle::SignedDistance(const Vector3& query) const {
 
 std::vector<BoundaryPoint> BoundaryOracle::ClosestPoints(const Vertices& queries) const {
   std::vector<BoundaryPoint> out(static_cast<std::size_t>(queries.rows()));
-  tbb::parallel_for(Eigen::Index{0}, queries.rows(), [&](Eigen::Index i) {
+  internal::ParallelFor(Eigen::Index{0}, queries.rows(), [&](Eigen::Index i) {
     out[static_cast<std::size_t>(i)] = impl_->Closest(queries.row(i).transpose());
   });
   return out;
@@ -472,7 +468,7 @@ std::vector<BoundaryPoint> BoundaryOracle::ClosestPoints(const Vertices& queries
 
 std::vector<Side> BoundaryOracle::ClassifyAll(const Vertices& queries) const {
   std::vector<Side> out(static_cast<std::size_t>(queries.rows()));
-  tbb::parallel_for(Eigen::Index{0}, queries.rows(), [&](Eigen::Index i) {
+  internal::ParallelFor(Eigen::Index{0}, queries.rows(), [&](Eigen::Index i) {
     out[static_cast<std::size_t>(i)] = Classify(queries.row(i).transpose());
   });
   return out;
@@ -480,7 +476,7 @@ std::vector<Side> BoundaryOracle::ClassifyAll(const Vertices& queries) const {
 
 std::vector<double> BoundaryOracle::SignedDistances(const Vertices& queries) const {
   std::vector<double> out(static_cast<std::size_t>(queries.rows()));
-  tbb::parallel_for(Eigen::Index{0}, queries.rows(), [&](Eigen::Index i) {
+  internal::ParallelFor(Eigen::Index{0}, queries.rows(), [&](Eigen::Index i) {
     out[static_cast<std::size_t>(i)] = SignedDistance(queries.row(i).transpose());
   });
   return out;

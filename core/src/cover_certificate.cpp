@@ -1,7 +1,6 @@
 #include "inscribe/cover_certificate.h"
 
 #include <tbb/combinable.h>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <array>
@@ -16,6 +15,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "cover_cells.h"
+#include "parallel.h"
 
 namespace inscribe {
 namespace {
@@ -162,7 +162,7 @@ class Certifier {
       Visit(level + 1, sub, near, child_bound);
     };
     if (level < kParallelLevels) {
-      tbb::parallel_for(0, 8, child);
+      internal::ParallelFor(0, 8, child);
     } else {
       for (int c = 0; c < 8; ++c) child(c);
     }
@@ -211,7 +211,7 @@ absl::StatusOr<std::vector<double>> SphereProtrusions(const Solid& solid,
   const double scale = std::max(
       {box.extent().maxCoeff(), box.min.cwiseAbs().maxCoeff(), box.max.cwiseAbs().maxCoeff()});
   std::vector<double> protrusions(spheres.size());
-  tbb::parallel_for(std::size_t{0}, spheres.size(), [&](std::size_t i) {
+  internal::ParallelFor(std::size_t{0}, spheres.size(), [&](std::size_t i) {
     const Sphere& s = spheres[i];
     const BoundaryPoint closest = solid.oracle.ClosestPoint(s.center);
     // Depth of the centre: + inside, - outside. A centre too close to the boundary for its

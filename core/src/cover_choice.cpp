@@ -1,10 +1,10 @@
 #include "cover_choice.h"
 
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <limits>
 #include <queue>
+
+#include "parallel.h"
 
 namespace inscribe::internal {
 namespace {
@@ -33,7 +33,7 @@ std::pair<std::vector<std::size_t>, double> FarthestFirst(
     chosen.push_back(next);
     taken[next] = 1;
     const Sphere& s = candidates[next];
-    tbb::parallel_for(std::size_t{0}, samples.points.size(), [&](std::size_t p) {
+    ParallelFor(std::size_t{0}, samples.points.size(), [&](std::size_t p) {
       served[p] = std::min(served[p], Growth(s, samples.points[p]));
     });
     const auto at = std::max_element(served.begin(), served.end());
@@ -68,7 +68,7 @@ std::vector<double> FarthestFirstThresholds(const std::vector<Sphere>& candidate
 ReachLists MakeReachLists(const std::vector<Sphere>& candidates, const CoverSamples& samples,
                           const PointGrid& grid, double limit) {
   std::vector<std::vector<std::pair<float, std::int32_t>>> lists(candidates.size());
-  tbb::parallel_for(std::size_t{0}, candidates.size(), [&](std::size_t i) {
+  ParallelFor(std::size_t{0}, candidates.size(), [&](std::size_t i) {
     std::vector<std::pair<float, std::int32_t>>& list = lists[i];
     grid.ForEachNear(candidates[i].center, candidates[i].radius + limit, [&](std::size_t p) {
       const double g = Growth(candidates[i], samples.points[p]);
@@ -83,7 +83,7 @@ ReachLists MakeReachLists(const std::vector<Sphere>& candidates, const CoverSamp
   }
   out.growth.resize(out.begin.back());
   out.sample.resize(out.begin.back());
-  tbb::parallel_for(std::size_t{0}, candidates.size(), [&](std::size_t i) {
+  ParallelFor(std::size_t{0}, candidates.size(), [&](std::size_t i) {
     for (std::size_t k = 0; k < lists[i].size(); ++k) {
       out.growth[out.begin[i] + k] = lists[i][k].first;
       out.sample[out.begin[i] + k] = lists[i][k].second;

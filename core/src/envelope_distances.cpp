@@ -1,9 +1,6 @@
 // ComputeEnvelopeDistances: see envelope_distances.h.
 #include "inscribe/envelope_distances.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -14,6 +11,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "inscribe/sphere_hierarchy.h"
+#include "parallel.h"
 #include "surface_sampling.h"
 
 namespace inscribe {
@@ -165,13 +163,13 @@ absl::StatusOr<EnvelopeDistanceResult> ComputeEnvelopeDistances(
       return absl::InvalidArgumentError("the mesh has no triangle of positive area to sample");
     }
     result.boundary_to_envelope.resize(static_cast<std::size_t>(request.boundary_samples));
-    tbb::parallel_for(tbb::blocked_range<std::int64_t>(0, request.boundary_samples, 256),
-                      [&](const tbb::blocked_range<std::int64_t>& range) {
-                        for (std::int64_t i = range.begin(); i != range.end(); ++i) {
-                          result.boundary_to_envelope[static_cast<std::size_t>(i)] =
-                              -SmallestGap(*tree, result.boundary_points.row(i).transpose());
-                        }
-                      });
+    internal::ParallelForRange(
+        std::int64_t{0}, request.boundary_samples, 256, [&](std::int64_t begin, std::int64_t end) {
+          for (std::int64_t i = begin; i != end; ++i) {
+            result.boundary_to_envelope[static_cast<std::size_t>(i)] =
+                -SmallestGap(*tree, result.boundary_points.row(i).transpose());
+          }
+        });
     result.boundary_to_envelope_summary = Summarize(result.boundary_to_envelope);
   }
 
@@ -189,45 +187,43 @@ absl::StatusOr<EnvelopeDistanceResult> ComputeEnvelopeDistances(
     result.envelope_to_boundary.resize(static_cast<std::size_t>(m));
     std::vector<std::int64_t> attempts(static_cast<std::size_t>(m), 0);
     std::atomic<bool> exhausted{false};
-    tbb::parallel_for(
-        tbb::blocked_range<std::int64_t>(0, m, 64),
-        [&](const tbb::blocked_range<std::int64_t>& range) {
-          for (std::int64_t k = range.begin(); k != range.end(); ++k) {
-            if (exhausted.load(std::memory_order_relaxed)) return;
-            // One generator per sample, seeded by (seed, k) apart from the boundary samples'
-            // streams: the points do not depend on scheduling.
-            const auto kk = static_cast<std::uint64_t>(k);
-            std::seed_seq seq{static_cast<std::uint32_t>(request.seed),
-                              static_cast<std::uint32_t>(request.seed >> 32),
-                              static_cast<std::uint32_t>(kk), static_cast<std::uint32_t>(kk >> 32),
-                              std::uint32_t{2}};
-            std::mt19937_64 random(seq);
-            auto uniform = [&random] { return static_cast<double>(random() >> 11) * 0x1.0p-53; };
-            std::int64_t tries = 0;
-            for (;;) {
-              if (++tries > request.max_attempts_per_sample) {
-                exhausted.store(true, std::memory_order_relaxed);
-                return;
-              }
-              const std::int32_t own = static_cast<std::int32_t>(std::min<std::ptrdiff_t>(
-                  static_cast<std::ptrdiff_t>(spheres.size()) - 1,
-                  std::upper_bound(cumulative.begin(), cumulative.end(), uniform() * total) -
-                      cumulative.begin()));
-              const double z = 2.0 * uniform() - 1.0;
-              const double phi = 2.0 * M_PI * uniform();
-              const double ring = std::sqrt(std::max(0.0, 1.0 - z * z));
-              const Sphere& s = spheres[static_cast<std::size_t>(own)];
-              const Vector3 q =
-                  s.center + s.radius * Vector3(ring * std::cos(phi), ring * std::sin(phi), z);
-              if (IsCoveredByAnotherBall(*tree, q, own)) continue;
-              result.envelope_points.row(k) = q.transpose();
-              result.envelope_sphere[static_cast<std::size_t>(k)] = own;
-              result.envelope_to_boundary[static_cast<std::size_t>(k)] = oracle.SignedDistance(q);
-              attempts[static_cast<std::size_t>(k)] = tries;
-              break;
-            }
+    internal::ParallelForRange(std::int64_t{0}, m, 64, [&](std::int64_t begin, std::int64_t end) {
+      for (std::int64_t k = begin; k != end; ++k) {
+        if (exhausted.load(std::memory_order_relaxed)) return;
+        // One generator per sample, seeded by (seed, k) apart from the boundary samples'
+        // streams: the points do not depend on scheduling.
+        const auto kk = static_cast<std::uint64_t>(k);
+        std::seed_seq seq{static_cast<std::uint32_t>(request.seed),
+                          static_cast<std::uint32_t>(request.seed >> 32),
+                          static_cast<std::uint32_t>(kk), static_cast<std::uint32_t>(kk >> 32),
+                          std::uint32_t{2}};
+        std::mt19937_64 random(seq);
+        auto uniform = [&random] { return static_cast<double>(random() >> 11) * 0x1.0p-53; };
+        std::int64_t tries = 0;
+        for (;;) {
+          if (++tries > request.max_attempts_per_sample) {
+            exhausted.store(true, std::memory_order_relaxed);
+            return;
           }
-        });
+          const std::int32_t own = static_cast<std::int32_t>(std::min<std::ptrdiff_t>(
+              static_cast<std::ptrdiff_t>(spheres.size()) - 1,
+              std::upper_bound(cumulative.begin(), cumulative.end(), uniform() * total) -
+                  cumulative.begin()));
+          const double z = 2.0 * uniform() - 1.0;
+          const double phi = 2.0 * M_PI * uniform();
+          const double ring = std::sqrt(std::max(0.0, 1.0 - z * z));
+          const Sphere& s = spheres[static_cast<std::size_t>(own)];
+          const Vector3 q =
+              s.center + s.radius * Vector3(ring * std::cos(phi), ring * std::sin(phi), z);
+          if (IsCoveredByAnotherBall(*tree, q, own)) continue;
+          result.envelope_points.row(k) = q.transpose();
+          result.envelope_sphere[static_cast<std::size_t>(k)] = own;
+          result.envelope_to_boundary[static_cast<std::size_t>(k)] = oracle.SignedDistance(q);
+          attempts[static_cast<std::size_t>(k)] = tries;
+          break;
+        }
+      }
+    });
     if (exhausted.load()) {
       return absl::ResourceExhaustedError(absl::StrCat(
           "an envelope sample needed more than ", request.max_attempts_per_sample,

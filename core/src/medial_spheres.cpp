@@ -10,9 +10,6 @@
 // removes the most volume error.
 #include "inscribe/medial_spheres.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -23,6 +20,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "parallel.h"
 #include "voxel_grid.h"
 
 namespace inscribe {
@@ -397,33 +395,30 @@ absl::StatusOr<MedialSphereResult> GenerateMedialSpheres(const BoundaryOracle& o
     const std::size_t last = std::min(voxels.size(), first + batch);
     std::vector<Candidate> found((last - first) * static_cast<std::size_t>(slots));
     std::vector<VoxelCounters> counters(last - first);
-    tbb::parallel_for(
-        tbb::blocked_range<std::size_t>(first, last, 8),
-        [&](const tbb::blocked_range<std::size_t>& range) {
-          for (std::size_t v = range.begin(); v != range.end(); ++v) {
-            if (control.cancelled()) return;
-            if (!screened_in.empty() && !screened_in[v]) continue;
-            const VisitedVoxel& voxel = voxels[v];
-            const Vector3 corner = grid->corner(voxel.index[0], voxel.index[1], voxel.index[2]);
-            VoxelCounters& count = counters[v - first];
-            Candidate* out = &found[(v - first) * static_cast<std::size_t>(slots)];
-            if (!options.subdivide_boundary || !voxel.boundary) {
-              out[0] = search.Run(corner, size, count);
-              continue;
-            }
-            const double half = 0.5 * size;
-            for (int octant = 0; octant < 8; ++octant) {
-              const Vector3 sub_corner =
-                  corner + half * Vector3((octant & 1) ? 1.0 : 0.0, (octant & 2) ? 1.0 : 0.0,
-                                          (octant & 4) ? 1.0 : 0.0);
-              ++count.queries;
-              const double distance =
-                  oracle.SignedDistance(sub_corner + Vector3::Constant(0.5 * half));
-              if (distance > 0.5 * kSqrt3 * half) continue;  // this half is wholly outside
-              out[octant] = search.Run(sub_corner, half, count);
-            }
-          }
-        });
+    internal::ParallelForRange(first, last, 8, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t v = begin; v != end; ++v) {
+        if (control.cancelled()) return;
+        if (!screened_in.empty() && !screened_in[v]) continue;
+        const VisitedVoxel& voxel = voxels[v];
+        const Vector3 corner = grid->corner(voxel.index[0], voxel.index[1], voxel.index[2]);
+        VoxelCounters& count = counters[v - first];
+        Candidate* out = &found[(v - first) * static_cast<std::size_t>(slots)];
+        if (!options.subdivide_boundary || !voxel.boundary) {
+          out[0] = search.Run(corner, size, count);
+          continue;
+        }
+        const double half = 0.5 * size;
+        for (int octant = 0; octant < 8; ++octant) {
+          const Vector3 sub_corner =
+              corner + half * Vector3((octant & 1) ? 1.0 : 0.0, (octant & 2) ? 1.0 : 0.0,
+                                      (octant & 4) ? 1.0 : 0.0);
+          ++count.queries;
+          const double distance = oracle.SignedDistance(sub_corner + Vector3::Constant(0.5 * half));
+          if (distance > 0.5 * kSqrt3 * half) continue;  // this half is wholly outside
+          out[octant] = search.Run(sub_corner, half, count);
+        }
+      }
+    });
     if (control.cancelled()) return absl::CancelledError("medial-sphere generation cancelled");
     for (const Candidate& candidate : found) {
       if (!candidate.valid) continue;

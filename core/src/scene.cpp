@@ -1,8 +1,5 @@
 #include "inscribe/scene.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -12,6 +9,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "float_rounding.h"
+#include "parallel.h"
 #include "scene_sweep.h"
 #include "sphere_pair_search.h"
 
@@ -423,8 +421,7 @@ absl::StatusOr<SceneFrame> Scene::ClosePairs(const SceneQuery& query,
       run(begin, std::min(candidates.size(), begin + kNarrowChunk));
     }
   } else {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, candidates.size(), kNarrowChunk),
-                      [&](const tbb::blocked_range<std::size_t>& r) { run(r.begin(), r.end()); });
+    internal::ParallelForRange(std::size_t{0}, candidates.size(), kNarrowChunk, run);
   }
   if (cancelled()) return absl::CancelledError("scene frame cancelled");
   last_narrow_seconds_ = 1e-9 * static_cast<double>(work_ns.load());

@@ -9,8 +9,10 @@
 #include <array>
 #include <iterator>
 #include <limits>
+#include <type_traits>
 
 #include "mesh_topology.h"
+#include "parallel.h"
 
 namespace inscribe::internal {
 namespace {
@@ -80,9 +82,12 @@ std::optional<std::vector<std::pair<std::int32_t, std::int32_t>>> SelfIntersecti
     PMP::polygon_soup_to_polygon_mesh(points, polygons, surface);
     if (surface.number_of_faces() != polygons.size()) return std::nullopt;
     std::vector<std::pair<SurfaceMesh::Face_index, SurfaceMesh::Face_index>> faces;
-    // Parallel over the box pairs (TBB); the pairs are sorted below, so the order they come
-    // in does not matter.
-    PMP::self_intersections<CGAL::Parallel_if_available_tag>(surface, std::back_inserter(faces));
+    // Parallel over the box pairs (TBB), except under ThreadSanitizer, which cannot see the
+    // start and join of CGAL's own loops (parallel.h); the pairs are sorted below, so the
+    // order they come in does not matter.
+    using Concurrency =
+        std::conditional_t<kThreadSanitizer, CGAL::Sequential_tag, CGAL::Parallel_if_available_tag>;
+    PMP::self_intersections<Concurrency>(surface, std::back_inserter(faces));
     // polygon_soup_to_polygon_mesh adds faces in input order, so face i is polygon i.
     std::vector<std::pair<std::int32_t, std::int32_t>> pairs;
     pairs.reserve(faces.size());

@@ -1,13 +1,11 @@
 #include "inscribe/separation_distance.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <cmath>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "parallel.h"
 #include "sphere_pair_search.h"
 
 namespace inscribe {
@@ -250,7 +248,7 @@ absl::StatusOr<std::vector<DistanceResult>> SeparationDistances(
   }
   std::vector<DistanceResult> out(poses_b.size());
   const RigidPose identity;
-  tbb::parallel_for(std::size_t{0}, poses_b.size(), [&](std::size_t i) {
+  internal::ParallelFor(std::size_t{0}, poses_b.size(), [&](std::size_t i) {
     out[i] = internal::CheckedSeparationDistance(a, identity, b, poses_b[i], request);
   });
   return out;
@@ -284,8 +282,7 @@ absl::StatusOr<std::vector<DistanceResult>> PairSeparationDistances(
   if (pairs.size() <= kChunk) {
     run(0, pairs.size());
   } else {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pairs.size(), kChunk),
-                      [&](const tbb::blocked_range<std::size_t>& r) { run(r.begin(), r.end()); });
+    internal::ParallelForRange(std::size_t{0}, pairs.size(), kChunk, run);
   }
   if (cancelled()) return absl::CancelledError("distance batch cancelled");
   return out;

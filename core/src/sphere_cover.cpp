@@ -1,7 +1,6 @@
 #include "inscribe/sphere_cover.h"
 
 #include <tbb/combinable.h>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <array>
@@ -19,6 +18,7 @@
 #include "cover_cells.h"
 #include "cover_choice.h"
 #include "inscribe/sphere_set_generation.h"
+#include "parallel.h"
 #include "surface_sampling.h"
 
 namespace inscribe {
@@ -112,12 +112,12 @@ std::vector<Sphere> HoldBoundary(const Mesh& mesh, const std::vector<Sphere>& ch
         hold(rp, qr, r, near, reach);
         hold(pq, qr, rp, near, reach);
       };
-  tbb::parallel_for(Eigen::Index{0}, mesh.triangles.rows(), [&](Eigen::Index t) {
+  internal::ParallelFor(Eigen::Index{0}, mesh.triangles.rows(), [&](Eigen::Index t) {
     hold(mesh.vertices.row(mesh.triangles(t, 0)).transpose(),
          mesh.vertices.row(mesh.triangles(t, 1)).transpose(),
          mesh.vertices.row(mesh.triangles(t, 2)).transpose(), all, reaches.local());
   });
-  tbb::parallel_for(std::size_t{0}, interior.size(), [&](std::size_t p) {
+  internal::ParallelFor(std::size_t{0}, interior.size(), [&](std::size_t p) {
     std::size_t pick = 0;
     double least = std::numeric_limits<double>::infinity();
     for (std::size_t i = 0; i < n; ++i) {
@@ -203,7 +203,7 @@ std::vector<Sphere> Candidates(const Solid& solid, const std::vector<LadderBase>
   const int rungs = ladder + 1;  // the last slot: the deepest centre on the normal
   std::vector<Sphere> slots(base.size() * static_cast<std::size_t>(rungs),
                             Sphere{Vector3::Zero(), 0.0});
-  tbb::parallel_for(std::size_t{0}, base.size(), [&](std::size_t b) {
+  internal::ParallelFor(std::size_t{0}, base.size(), [&](std::size_t b) {
     const Vector3& p = base[b].point;
     Vector3 normal;
     if (base[b].vertex >= 0) {

@@ -1,7 +1,5 @@
 #include "inscribe/sphere_deformation.h"
 
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -11,6 +9,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "inscribe/union_of_balls.h"
+#include "parallel.h"
 
 namespace inscribe {
 namespace {
@@ -249,7 +248,7 @@ absl::StatusOr<DeformedSpheres> SphereDeformer::Update(const Vertices& deformed_
     bool dropped = false;
   };
   std::vector<Moved> moved(n);
-  tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
+  internal::ParallelFor(std::size_t{0}, n, [&](std::size_t i) {
     const SurfaceContact& contact = ref.spheres.contacts[i];
     const ContactPoint at =
         ContactFrame(mesh, oracle.vertex_normals(), oracle.face_normals(), contact);
@@ -335,7 +334,7 @@ absl::StatusOr<DeformationErrorBounds> BoundDeformationError(const BoundaryOracl
   }
   // Depth of every centre (positive inside).
   std::vector<double> depth(spheres.size());
-  tbb::parallel_for(std::size_t{0}, spheres.size(), [&](std::size_t i) {
+  internal::ParallelFor(std::size_t{0}, spheres.size(), [&](std::size_t i) {
     const BoundaryPoint closest = oracle.ClosestPoint(spheres[i].center);
     const Side side = oracle.Classify(spheres[i].center, closest);
     depth[i] = side == Side::kInside    ? closest.distance

@@ -3,9 +3,6 @@
 // sphere" test, and the growth to the boundary points nearest to the envelope points.
 #include "inscribe/sphere_dilation.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <chrono>
@@ -15,6 +12,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "inscribe/union_of_balls.h"
+#include "parallel.h"
 
 namespace inscribe {
 namespace {
@@ -257,20 +255,20 @@ template <typename Item, typename Make>
 std::int64_t CollectPoints(const std::vector<Item>& items, const BallTree& tree, const Make& make,
                            std::vector<EnvelopePoint>* points) {
   std::vector<Candidates> candidates(items.size());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, items.size(), 256),
-                    [&](const tbb::blocked_range<std::size_t>& range) {
-                      for (std::size_t t = range.begin(); t != range.end(); ++t) {
-                        Candidates c = make(items[t]);
-                        int kept = 0;
-                        for (int s = 0; s < c.count; ++s) {
-                          if (!tree.InsideAnyOther(c.points[s].point, c.points[s].spheres)) {
-                            c.points[kept++] = c.points[s];
-                          }
-                        }
-                        c.count = kept;
-                        candidates[t] = c;
-                      }
-                    });
+  internal::ParallelForRange(
+      std::size_t{0}, items.size(), 256, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t t = begin; t != end; ++t) {
+          Candidates c = make(items[t]);
+          int kept = 0;
+          for (int s = 0; s < c.count; ++s) {
+            if (!tree.InsideAnyOther(c.points[s].point, c.points[s].spheres)) {
+              c.points[kept++] = c.points[s];
+            }
+          }
+          c.count = kept;
+          candidates[t] = c;
+        }
+      });
   std::int64_t degenerate = 0;
   for (const Candidates& c : candidates) {
     degenerate += c.degenerate;
@@ -355,12 +353,12 @@ absl::StatusOr<DilationResult> DilateSpheres(const BoundaryOracle& oracle, const
   // Nearest boundary point of each centre: |x - m_s| bounds the search from an envelope point
   // x on sphere s, which then only visits the boundary near x.
   std::vector<Vector3> centre_closest(balls.size());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, balls.size(), 64),
-                    [&](const tbb::blocked_range<std::size_t>& range) {
-                      for (std::size_t s = range.begin(); s != range.end(); ++s) {
-                        centre_closest[s] = oracle.ClosestPoint(balls[s].center).point;
-                      }
-                    });
+  internal::ParallelForRange(std::size_t{0}, balls.size(), 64,
+                             [&](std::size_t begin, std::size_t end) {
+                               for (std::size_t s = begin; s != end; ++s) {
+                                 centre_closest[s] = oracle.ClosestPoint(balls[s].center).point;
+                               }
+                             });
 
   // Per envelope point and sphere slot: the radius that reaches the point's nearest boundary
   // point from that sphere's (original) centre.
@@ -369,10 +367,9 @@ absl::StatusOr<DilationResult> DilateSpheres(const BoundaryOracle& oracle, const
   for (const EnvelopePoint& p : envelope->v_points) points.push_back(&p);
   for (const EnvelopePoint& p : envelope->circle_points) points.push_back(&p);
   std::vector<std::array<double, 3>> reach(points.size());
-  tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, points.size(), 64),
-      [&](const tbb::blocked_range<std::size_t>& range) {
-        for (std::size_t q = range.begin(); q != range.end(); ++q) {
+  internal::ParallelForRange(
+      std::size_t{0}, points.size(), 64, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t q = begin; q != end; ++q) {
           const EnvelopePoint& p = *points[q];
           double bound = std::numeric_limits<double>::infinity();
           for (std::int32_t s : p.spheres) {

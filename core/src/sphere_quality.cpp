@@ -1,9 +1,6 @@
 // EvaluateSpheres: see sphere_quality.h.
 #include "inscribe/sphere_quality.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -11,6 +8,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "inscribe/union_of_balls.h"
+#include "parallel.h"
 #include "surface_sampling.h"
 
 namespace inscribe {
@@ -37,13 +35,13 @@ double DistanceToUnion(const Vector3& x, const std::vector<Sphere>& spheres) {
 std::vector<double> SphereProtrusions(const BoundaryOracle& oracle,
                                       const std::vector<Sphere>& spheres) {
   std::vector<double> protrusion(spheres.size());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, spheres.size(), 64),
-                    [&](const tbb::blocked_range<std::size_t>& range) {
-                      for (std::size_t i = range.begin(); i != range.end(); ++i) {
-                        protrusion[i] = std::max(
-                            0.0, spheres[i].radius + oracle.SignedDistance(spheres[i].center));
-                      }
-                    });
+  internal::ParallelForRange(
+      std::size_t{0}, spheres.size(), 64, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i != end; ++i) {
+          protrusion[i] =
+              std::max(0.0, spheres[i].radius + oracle.SignedDistance(spheres[i].center));
+        }
+      });
   return protrusion;
 }
 
@@ -116,15 +114,14 @@ absl::StatusOr<QualityReport> EvaluateSpheres(const BoundaryOracle& oracle,
     // Per-sample distances first, then serial sums: the report is the same bit for bit on
     // every run.
     std::vector<double> distances(static_cast<std::size_t>(samples.rows()));
-    tbb::parallel_for(tbb::blocked_range<std::int64_t>(0, samples.rows(), 256),
-                      [&](const tbb::blocked_range<std::int64_t>& range) {
-                        for (std::int64_t i = range.begin(); i != range.end(); ++i) {
-                          distances[static_cast<std::size_t>(i)] =
-                              spheres.empty()
-                                  ? std::numeric_limits<double>::infinity()
-                                  : DistanceToUnion(samples.row(i).transpose(), spheres);
-                        }
-                      });
+    internal::ParallelForRange(
+        std::int64_t{0}, samples.rows(), 256, [&](std::int64_t begin, std::int64_t end) {
+          for (std::int64_t i = begin; i != end; ++i) {
+            distances[static_cast<std::size_t>(i)] =
+                spheres.empty() ? std::numeric_limits<double>::infinity()
+                                : DistanceToUnion(samples.row(i).transpose(), spheres);
+          }
+        });
     double sum = 0.0;
     std::int64_t covered = 0;
     for (double distance : distances) {

@@ -6,9 +6,6 @@
 // points, so counting a ball's gain is a popcount over its runs and choosing it clears them.
 #include "inscribe/sphere_selection.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -19,6 +16,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "coverage_grid.h"
+#include "parallel.h"
 #include "voxel_grid.h"
 
 namespace inscribe {
@@ -108,13 +106,12 @@ SelectByCoverage(const std::vector<Sphere>& balls, const CoverageSelectionOption
 
   const std::size_t n = balls.size();
   std::vector<std::int64_t> gains(n);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 64),
-                    [&](const tbb::blocked_range<std::size_t>& range) {
-                      if (control.cancelled()) return;
-                      for (std::size_t i = range.begin(); i != range.end(); ++i) {
-                        gains[i] = uncovered.CountIn(balls[i]);
-                      }
-                    });
+  internal::ParallelForRange(std::size_t{0}, n, 64, [&](std::size_t begin, std::size_t end) {
+    if (control.cancelled()) return;
+    for (std::size_t i = begin; i != end; ++i) {
+      gains[i] = uncovered.CountIn(balls[i]);
+    }
+  });
   if (control.cancelled()) return Cancelled();
   // The gains up front count as a quarter of the work, the greedy choice as the rest.
   if (control.on_progress) control.on_progress(0.25);

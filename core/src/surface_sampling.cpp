@@ -1,14 +1,12 @@
 #include "surface_sampling.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <cmath>
 #include <random>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "parallel.h"
 
 namespace inscribe::internal {
 
@@ -25,28 +23,26 @@ Vertices SampleBoundaryByArea(const Mesh& mesh, std::int64_t count, std::uint64_
   }
   if (!(total > 0.0)) return Vertices(0, 3);
   Vertices points(count, 3);
-  tbb::parallel_for(
-      tbb::blocked_range<std::int64_t>(0, count, 1024),
-      [&](const tbb::blocked_range<std::int64_t>& range) {
-        for (std::int64_t i = range.begin(); i != range.end(); ++i) {
-          std::mt19937_64 random(seed * 0x9E3779B97F4A7C15ull + static_cast<std::uint64_t>(i));
-          auto uniform = [&random] { return static_cast<double>(random() >> 11) * 0x1.0p-53; };
-          const double pick = uniform() * total;
-          const std::int64_t t = std::min<std::int64_t>(
-              triangles - 1,
-              std::upper_bound(cumulative.begin(), cumulative.end(), pick) - cumulative.begin());
-          double u = uniform();
-          double v = uniform();
-          if (u + v > 1.0) {
-            u = 1.0 - u;
-            v = 1.0 - v;
-          }
-          const Vector3 a = mesh.vertices.row(mesh.triangles(t, 0));
-          const Vector3 b = mesh.vertices.row(mesh.triangles(t, 1));
-          const Vector3 c = mesh.vertices.row(mesh.triangles(t, 2));
-          points.row(i) = a + u * (b - a) + v * (c - a);
-        }
-      });
+  ParallelForRange(std::int64_t{0}, count, 1024, [&](std::int64_t begin, std::int64_t end) {
+    for (std::int64_t i = begin; i != end; ++i) {
+      std::mt19937_64 random(seed * 0x9E3779B97F4A7C15ull + static_cast<std::uint64_t>(i));
+      auto uniform = [&random] { return static_cast<double>(random() >> 11) * 0x1.0p-53; };
+      const double pick = uniform() * total;
+      const std::int64_t t = std::min<std::int64_t>(
+          triangles - 1,
+          std::upper_bound(cumulative.begin(), cumulative.end(), pick) - cumulative.begin());
+      double u = uniform();
+      double v = uniform();
+      if (u + v > 1.0) {
+        u = 1.0 - u;
+        v = 1.0 - v;
+      }
+      const Vector3 a = mesh.vertices.row(mesh.triangles(t, 0));
+      const Vector3 b = mesh.vertices.row(mesh.triangles(t, 1));
+      const Vector3 c = mesh.vertices.row(mesh.triangles(t, 2));
+      points.row(i) = a + u * (b - a) + v * (c - a);
+    }
+  });
   return points;
 }
 

@@ -1,14 +1,12 @@
 #include "triangle_bvh.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_reduce.h>
-
 #include <algorithm>
 #include <array>
 #include <cassert>
 #include <cmath>
 
 #include "closest_point_triangle.h"
+#include "parallel.h"
 
 namespace inscribe::internal {
 namespace {
@@ -365,10 +363,10 @@ void TriangleBvh::Refit(const Mesh& mesh) { Fit(mesh); }
 void TriangleBvh::Fit(const Mesh& mesh) {
   corners_.resize(3 * slot_triangle_.size());
   slot_boxes_.resize(slot_triangle_.size());
-  magnitude_ = tbb::parallel_reduce(
-      tbb::blocked_range<std::size_t>(0, leaves_.size(), 64), 0.0,
-      [&](const tbb::blocked_range<std::size_t>& range, double magnitude) {
-        for (std::size_t i = range.begin(); i != range.end(); ++i) {
+  magnitude_ = ParallelReduce(
+      std::size_t{0}, leaves_.size(), 64, 0.0,
+      [&](std::size_t begin, std::size_t end, double magnitude) {
+        for (std::size_t i = begin; i != end; ++i) {
           TriangleBvhLeaf& leaf = leaves_[i];
           const auto first = static_cast<std::size_t>(leaf.first);
           for (std::size_t s = first; s < first + static_cast<std::size_t>(leaf.count); ++s) {

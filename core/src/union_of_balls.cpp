@@ -10,8 +10,6 @@
 #include <CGAL/Triangulation_cell_base_with_info_3.h>
 #include <CGAL/Triangulation_data_structure_3.h>
 #include <CGAL/Triangulation_vertex_base_with_info_3.h>
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <array>
@@ -28,6 +26,7 @@
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
 #include "ball_intersection_volumes.h"
+#include "parallel.h"
 
 namespace inscribe {
 namespace {
@@ -143,10 +142,9 @@ std::array<std::int32_t, N> SortedTuple(std::array<std::int32_t, N> t) {
 // so the result does not depend on the thread count or the schedule.
 template <typename F>
 void ForEachIndex(std::size_t n, const F& f) {
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024),
-                    [&f](const tbb::blocked_range<std::size_t>& range) {
-                      for (std::size_t i = range.begin(); i != range.end(); ++i) f(i);
-                    });
+  internal::ParallelForRange(std::size_t{0}, n, 1024, [&f](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i != end; ++i) f(i);
+  });
 }
 
 // The regular triangulation of the distinct balls, padded to dimension 3 if the centres span

@@ -1,13 +1,11 @@
 // The voxel grid, culling and corner screen of medial-sphere generation; see voxel_grid.h.
 #include "voxel_grid.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <cmath>
 
 #include "absl/strings/str_format.h"
+#include "parallel.h"
 
 namespace inscribe::internal {
 namespace {
@@ -95,18 +93,16 @@ std::vector<VisitedVoxel> CullVoxels(const BoundaryOracle& oracle, const Grid& g
   while (!blocks.empty() && !cancelled()) {
     std::vector<double> distances(blocks.size());
     std::vector<double> radii(blocks.size());
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks.size(), 64),
-                      [&](const tbb::blocked_range<std::size_t>& range) {
-                        if (cancelled()) return;  // the result is discarded
-                        for (std::size_t b = range.begin(); b != range.end(); ++b) {
-                          const Block& block = blocks[b];
-                          Vector3 lo = grid.corner(block.start[0], block.start[1], block.start[2]);
-                          Vector3 hi = grid.corner(block_end(block, 0), block_end(block, 1),
-                                                   block_end(block, 2));
-                          radii[b] = 0.5 * (hi - lo).norm();
-                          distances[b] = oracle.SignedDistance(0.5 * (lo + hi));
-                        }
-                      });
+    ParallelForRange(std::size_t{0}, blocks.size(), 64, [&](std::size_t begin, std::size_t end) {
+      if (cancelled()) return;  // the result is discarded
+      for (std::size_t b = begin; b != end; ++b) {
+        const Block& block = blocks[b];
+        Vector3 lo = grid.corner(block.start[0], block.start[1], block.start[2]);
+        Vector3 hi = grid.corner(block_end(block, 0), block_end(block, 1), block_end(block, 2));
+        radii[b] = 0.5 * (hi - lo).norm();
+        distances[b] = oracle.SignedDistance(0.5 * (lo + hi));
+      }
+    });
     queries += static_cast<std::int64_t>(blocks.size());
     std::vector<Block> next;
     for (std::size_t b = 0; b < blocks.size(); ++b) {
@@ -162,42 +158,39 @@ std::vector<char> ScreenByCorners(const BoundaryOracle& oracle, const Grid& grid
   vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
   std::vector<Vector3> directions(vertices.size());
   const Mesh& mesh = oracle.mesh();
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, vertices.size(), 256),
-                    [&](const tbb::blocked_range<std::size_t>& range) {
-                      // Cancelled: stop; the caller discards the (incomplete) result.
-                      if (cancel != nullptr && cancel->load(std::memory_order_relaxed)) return;
-                      for (std::size_t v = range.begin(); v != range.end(); ++v) {
-                        const std::int64_t id = vertices[v];
-                        const Vector3 x = grid.corner(id % vx, (id / vx) % vy, id / (vx * vy));
-                        directions[v] = InwardDirectionAtFoot(mesh, x, oracle.ClosestPoint(x));
-                      }
-                    });
+  ParallelForRange(std::size_t{0}, vertices.size(), 256, [&](std::size_t begin, std::size_t end) {
+    // Cancelled: stop; the caller discards the (incomplete) result.
+    if (cancel != nullptr && cancel->load(std::memory_order_relaxed)) return;
+    for (std::size_t v = begin; v != end; ++v) {
+      const std::int64_t id = vertices[v];
+      const Vector3 x = grid.corner(id % vx, (id / vx) % vy, id / (vx * vy));
+      directions[v] = InwardDirectionAtFoot(mesh, x, oracle.ClosestPoint(x));
+    }
+  });
   queries += static_cast<std::int64_t>(vertices.size());
   const double max_cosine = std::cos(std::max(0.0, min_angle));
   std::vector<char> pass(voxels.size(), 0);
-  tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, voxels.size(), 256),
-      [&](const tbb::blocked_range<std::size_t>& range) {
-        for (std::size_t n = range.begin(); n != range.end(); ++n) {
-          const VisitedVoxel& voxel = voxels[n];
-          std::array<Vector3, 8> corner_directions;
-          for (int corner = 0; corner < 8; ++corner) {
-            const std::int64_t id =
-                vertex_id(voxel.index[0] + (corner & 1), voxel.index[1] + ((corner >> 1) & 1),
-                          voxel.index[2] + ((corner >> 2) & 1));
-            corner_directions[corner] = directions[static_cast<std::size_t>(
-                std::lower_bound(vertices.begin(), vertices.end(), id) - vertices.begin())];
-          }
-          for (int x = 0; x < 8 && !pass[n]; ++x) {
-            for (int y = x + 1; y < 8; ++y) {
-              if (corner_directions[x].dot(corner_directions[y]) <= max_cosine) {
-                pass[n] = 1;
-                break;
-              }
-            }
+  ParallelForRange(std::size_t{0}, voxels.size(), 256, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t n = begin; n != end; ++n) {
+      const VisitedVoxel& voxel = voxels[n];
+      std::array<Vector3, 8> corner_directions;
+      for (int corner = 0; corner < 8; ++corner) {
+        const std::int64_t id =
+            vertex_id(voxel.index[0] + (corner & 1), voxel.index[1] + ((corner >> 1) & 1),
+                      voxel.index[2] + ((corner >> 2) & 1));
+        corner_directions[corner] = directions[static_cast<std::size_t>(
+            std::lower_bound(vertices.begin(), vertices.end(), id) - vertices.begin())];
+      }
+      for (int x = 0; x < 8 && !pass[n]; ++x) {
+        for (int y = x + 1; y < 8; ++y) {
+          if (corner_directions[x].dot(corner_directions[y]) <= max_cosine) {
+            pass[n] = 1;
+            break;
           }
         }
-      });
+      }
+    }
+  });
   return pass;
 }
 

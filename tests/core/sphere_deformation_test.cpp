@@ -1,8 +1,6 @@
 #include "inscribe/sphere_deformation.h"
 
 #include <gtest/gtest.h>
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_reduce.h>
 
 #include <cmath>
 #include <limits>
@@ -14,6 +12,7 @@
 #include "deformation_sequences.h"
 #include "inscribe/medial_spheres.h"
 #include "inscribe/union_of_balls.h"
+#include "parallel.h"
 #include "support/brute_force_closest_point.h"
 #include "support/synthetic_meshes.h"
 #include "support/test_meshes.h"
@@ -249,10 +248,10 @@ ErrorEstimate MonteCarloError(const BoundaryOracle& oracle, const std::vector<Sp
   const Vector3 hi = box.max.cwiseMax(grid.hi());
   constexpr std::int64_t kBlock = 4096;
   const std::int64_t blocks = (samples + kBlock - 1) / kBlock;
-  const std::int64_t hits = tbb::parallel_reduce(
-      tbb::blocked_range<std::int64_t>(0, blocks), std::int64_t{0},
-      [&](const tbb::blocked_range<std::int64_t>& range, std::int64_t count) {
-        for (std::int64_t b = range.begin(); b < range.end(); ++b) {
+  const std::int64_t hits = internal::ParallelReduce(
+      std::int64_t{0}, blocks, 1, std::int64_t{0},
+      [&](std::int64_t begin, std::int64_t end, std::int64_t count) {
+        for (std::int64_t b = begin; b < end; ++b) {
           std::mt19937_64 rng(977 + static_cast<std::uint64_t>(b));
           std::uniform_real_distribution<double> unit(0.0, 1.0);
           for (std::int64_t k = 0; k < kBlock; ++k) {

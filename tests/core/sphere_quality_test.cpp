@@ -1,13 +1,12 @@
 #include "inscribe/sphere_quality.h"
 
 #include <gtest/gtest.h>
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_reduce.h>
 
 #include <cmath>
 #include <random>
 
 #include "inscribe/medial_spheres.h"
+#include "parallel.h"
 #include "support/synthetic_meshes.h"
 #include "support/test_meshes.h"
 
@@ -37,12 +36,12 @@ std::pair<double, double> MonteCarloError(const BoundaryOracle& oracle,
                                           std::int64_t samples) {
   const BoundingBox box = ComputeBoundingBox(oracle.mesh().vertices);
   const double box_volume = box.extent().prod();
-  const std::int64_t hits = tbb::parallel_reduce(
-      tbb::blocked_range<std::int64_t>(0, samples, 4096), std::int64_t{0},
-      [&](const tbb::blocked_range<std::int64_t>& range, std::int64_t count) {
-        std::mt19937_64 random(static_cast<std::uint64_t>(range.begin()) * 7919u + 17u);
+  const std::int64_t hits = internal::ParallelReduce(
+      std::int64_t{0}, samples, 4096, std::int64_t{0},
+      [&](std::int64_t begin, std::int64_t end, std::int64_t count) {
+        std::mt19937_64 random(static_cast<std::uint64_t>(begin) * 7919u + 17u);
         std::uniform_real_distribution<double> unit(0.0, 1.0);
-        for (std::int64_t i = range.begin(); i != range.end(); ++i) {
+        for (std::int64_t i = begin; i != end; ++i) {
           const Vector3 x = box.min + box.extent().cwiseProduct(
                                           Vector3(unit(random), unit(random), unit(random)));
           const bool in_mesh = oracle.Classify(x) == Side::kInside;

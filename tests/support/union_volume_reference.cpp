@@ -1,8 +1,5 @@
 #include "support/union_volume_reference.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_reduce.h>
-
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
@@ -11,6 +8,8 @@
 #include <random>
 #include <utility>
 #include <vector>
+
+#include "parallel.h"
 
 namespace inscribe::testing {
 namespace {
@@ -241,10 +240,10 @@ MonteCarloEstimate MonteCarloVolume(const std::vector<Sphere>& balls, std::int64
   const std::int64_t blocks = (samples + kBlock - 1) / kBlock;
   const Vector3 lo = grid.lo();
   const Vector3 size = grid.hi() - grid.lo();
-  const std::int64_t hits = tbb::parallel_reduce(
-      tbb::blocked_range<std::int64_t>(0, blocks), std::int64_t{0},
-      [&](const tbb::blocked_range<std::int64_t>& range, std::int64_t count) {
-        for (std::int64_t block = range.begin(); block != range.end(); ++block) {
+  const std::int64_t hits = internal::ParallelReduce(
+      std::int64_t{0}, blocks, 1, std::int64_t{0},
+      [&](std::int64_t first, std::int64_t last, std::int64_t count) {
+        for (std::int64_t block = first; block != last; ++block) {
           std::mt19937_64 rng(seed * 0x9E3779B97F4A7C15ull + static_cast<std::uint64_t>(block));
           const auto uniform = [&rng] { return static_cast<double>(rng() >> 11) * 0x1.0p-53; };
           const std::int64_t end = std::min(samples, (block + 1) * kBlock);

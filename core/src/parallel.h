@@ -1,0 +1,122 @@
+// Private: core's parallel loops. Every parallel loop in core goes through these, so that
+// ThreadSanitizer sees how each loop is ordered with the code around it.
+//
+// The loops run on TBB. Debian's libtbb is not built for ThreadSanitizer, and a TBB loop hands
+// its tasks between threads inside it, unseen: TSan then reports TBB's own task objects, and the
+// writes before a loop and after its join, as races. So in TSan builds the same loops run their
+// subranges on std::threads that the loop starts and joins, which TSan sees; the subranges stay
+// unordered with one another, so races between the bodies of a loop are still reported. The
+// chunks of ParallelReduce, and so its result, are the same in both builds.
+#pragma once
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cstddef>
+#include <exception>
+#include <mutex>
+#include <thread>
+#include <utility>
+#include <vector>
+
+#if defined(__SANITIZE_THREAD__)
+#define INSCRIBE_TSAN_LOOPS 1
+#else
+#define INSCRIBE_TSAN_LOOPS 0
+#endif
+
+namespace inscribe::internal {
+
+// True in ThreadSanitizer builds. Parallel code that is not ours and runs its own TBB loops
+// (CGAL's) runs sequentially there.
+inline constexpr bool kThreadSanitizer = INSCRIBE_TSAN_LOOPS != 0;
+
+// The TSan builds' loop: chunks of `grain` indices, taken in turn by as many threads as the
+// current task arena allows (the caller's included). The first exception a body throws stops
+// the remaining chunks and is rethrown here.
+template <typename Index, typename Body>
+void RunOnThreads(Index first, Index last, std::size_t grain, const Body& body) {
+  if (last <= first) return;
+  const auto step = static_cast<Index>(std::max<std::size_t>(grain, 1));
+  const std::size_t chunks = static_cast<std::size_t>((last - first - 1) / step) + 1;
+  const std::size_t threads = std::min(
+      chunks, static_cast<std::size_t>(std::max(1, tbb::this_task_arena::max_concurrency())));
+  // Relaxed: taking a chunk orders nothing, so TSan keeps the bodies unordered.
+  std::atomic<std::size_t> next{0};
+  std::mutex error_mutex;
+  std::exception_ptr error;
+  const auto work = [&] {
+    for (;;) {
+      const std::size_t c = next.fetch_add(1, std::memory_order_relaxed);
+      if (c >= chunks) return;
+      const Index begin = first + static_cast<Index>(c) * step;
+      const Index end = last - begin > step ? begin + step : last;
+      try {
+        body(begin, end);
+      } catch (...) {
+        const std::lock_guard<std::mutex> lock(error_mutex);
+        if (!error) error = std::current_exception();
+        next.store(chunks, std::memory_order_relaxed);
+        return;
+      }
+    }
+  };
+  std::vector<std::thread> helpers;
+  helpers.reserve(threads - 1);
+  for (std::size_t t = 1; t < threads; ++t) helpers.emplace_back(work);
+  work();
+  for (std::thread& helper : helpers) helper.join();
+  if (error) std::rethrow_exception(error);
+}
+
+// Calls body(begin, end) on subranges of [first, last), in parallel; TBB splits the range down
+// to subranges of about `grain` indices.
+template <typename Index, typename Body>
+void ParallelForRange(Index first, Index last, std::size_t grain, const Body& body) {
+#if INSCRIBE_TSAN_LOOPS
+  RunOnThreads(first, last, grain, body);
+#else
+  tbb::parallel_for(
+      tbb::blocked_range<Index>(first, last, grain),
+      [&](const tbb::blocked_range<Index>& range) { body(range.begin(), range.end()); });
+#endif
+}
+
+// Calls f(i) for every i in [first, last), in parallel.
+template <typename Index, typename F>
+void ParallelFor(Index first, Index last, const F& f) {
+#if INSCRIBE_TSAN_LOOPS
+  const std::size_t n = last > first ? static_cast<std::size_t>(last - first) : 0;
+  RunOnThreads(first, last, std::max<std::size_t>(n / 64, 1), [&](Index begin, Index end) {
+    for (Index i = begin; i < end; ++i) f(i);
+  });
+#else
+  tbb::parallel_for(first, last, f);
+#endif
+}
+
+// Folds [first, last): body(begin, end, value) folds a subrange into value and returns it, on
+// chunks of `grain` indices in parallel, each starting from `identity`; join(a, b) then combines
+// the chunks' values in index order, on the calling thread. The chunks and the order of the
+// joins do not depend on the schedule, so neither does the result.
+template <typename Index, typename Value, typename Body, typename Join>
+Value ParallelReduce(Index first, Index last, std::size_t grain, const Value& identity,
+                     const Body& body, const Join& join) {
+  if (last <= first) return identity;
+  const auto step = static_cast<Index>(grain > 0 ? grain : 1);
+  const std::size_t chunks = static_cast<std::size_t>((last - first - 1) / step) + 1;
+  std::vector<Value> values(chunks, identity);
+  ParallelFor(std::size_t{0}, chunks, [&](std::size_t c) {
+    const Index begin = first + static_cast<Index>(c) * step;
+    const Index end = last - begin > step ? begin + step : last;
+    values[c] = body(begin, end, std::move(values[c]));
+  });
+  Value result = identity;
+  for (Value& value : values) result = join(std::move(result), std::move(value));
+  return result;
+}
+
+}  // namespace inscribe::internal

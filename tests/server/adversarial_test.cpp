@@ -552,7 +552,11 @@ TEST(Adversarial, MemoryStaysUnderTheBudgetUnderConcurrentAbuse) {
   EXPECT_GT(answered.load(), 0);
   EXPECT_GT(refused_by_budget.load(), 0);
   EXPECT_EQ(other.load(), 0) << ::testing::PrintToString(unexpected);
-  EXPECT_LT(peak, bound);
+  if (testing::kSanitizedBuild) {
+    std::cout << "abuse: the RSS bound is not checked under a sanitizer (its shadow memory)\n";
+  } else {
+    EXPECT_LT(peak, bound);
+  }
   ExpectServes(server);
 }
 

@@ -53,6 +53,14 @@ class InscribedProcess {
   std::thread drain_;
 };
 
+// Whether this build (and so the inscribed it starts) runs under ASan or TSan: resident memory
+// then includes the sanitizer's shadow memory and quarantine, so bounds on it do not apply.
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+inline constexpr bool kSanitizedBuild = true;
+#else
+inline constexpr bool kSanitizedBuild = false;
+#endif
+
 // Memory of a process from /proc/<pid>/status, bytes; -1 where unreadable (e.g. it exited).
 struct ProcessMemory {
   std::int64_t resident = -1;       // VmRSS: resident now

@@ -34,16 +34,32 @@ namespace inscribe::internal {
 // (CGAL's) runs sequentially there.
 inline constexpr bool kThreadSanitizer = INSCRIBE_TSAN_LOOPS != 0;
 
-// The TSan builds' loop: chunks of `grain` indices, taken in turn by as many threads as the
-// current task arena allows (the caller's included). The first exception a body throws stops
-// the remaining chunks and is rethrown here.
+// [first, last) cut into chunks of `grain` indices (at least 1); the last may be shorter.
+template <typename Index>
+class Chunks {
+ public:
+  Chunks(Index first, Index last, std::size_t grain)
+      : first_(first), last_(last), step_(static_cast<Index>(std::max<std::size_t>(grain, 1))) {}
+  std::size_t size() const {
+    return last_ <= first_ ? 0 : static_cast<std::size_t>((last_ - first_ - 1) / step_) + 1;
+  }
+  Index begin(std::size_t c) const { return first_ + static_cast<Index>(c) * step_; }
+  Index end(std::size_t c) const { return last_ - begin(c) > step_ ? begin(c) + step_ : last_; }
+
+ private:
+  Index first_, last_, step_;
+};
+
+// The TSan builds' loop: the chunks, taken in turn by as many threads as the current task arena
+// allows (the caller's included). The first exception a body throws stops the remaining chunks
+// and is rethrown here.
 template <typename Index, typename Body>
 void RunOnThreads(Index first, Index last, std::size_t grain, const Body& body) {
-  if (last <= first) return;
-  const auto step = static_cast<Index>(std::max<std::size_t>(grain, 1));
-  const std::size_t chunks = static_cast<std::size_t>((last - first - 1) / step) + 1;
+  const Chunks<Index> chunks(first, last, grain);
+  const std::size_t count = chunks.size();
+  if (count == 0) return;
   const std::size_t threads = std::min(
-      chunks, static_cast<std::size_t>(std::max(1, tbb::this_task_arena::max_concurrency())));
+      count, static_cast<std::size_t>(std::max(1, tbb::this_task_arena::max_concurrency())));
   // Relaxed: taking a chunk orders nothing, so TSan keeps the bodies unordered.
   std::atomic<std::size_t> next{0};
   std::mutex error_mutex;
@@ -51,15 +67,13 @@ void RunOnThreads(Index first, Index last, std::size_t grain, const Body& body) 
   const auto work = [&] {
     for (;;) {
       const std::size_t c = next.fetch_add(1, std::memory_order_relaxed);
-      if (c >= chunks) return;
-      const Index begin = first + static_cast<Index>(c) * step;
-      const Index end = last - begin > step ? begin + step : last;
+      if (c >= count) return;
       try {
-        body(begin, end);
+        body(chunks.begin(c), chunks.end(c));
       } catch (...) {
         const std::lock_guard<std::mutex> lock(error_mutex);
         if (!error) error = std::current_exception();
-        next.store(chunks, std::memory_order_relaxed);
+        next.store(count, std::memory_order_relaxed);
         return;
       }
     }
@@ -105,14 +119,10 @@ void ParallelFor(Index first, Index last, const F& f) {
 template <typename Index, typename Value, typename Body, typename Join>
 Value ParallelReduce(Index first, Index last, std::size_t grain, const Value& identity,
                      const Body& body, const Join& join) {
-  if (last <= first) return identity;
-  const auto step = static_cast<Index>(grain > 0 ? grain : 1);
-  const std::size_t chunks = static_cast<std::size_t>((last - first - 1) / step) + 1;
-  std::vector<Value> values(chunks, identity);
-  ParallelFor(std::size_t{0}, chunks, [&](std::size_t c) {
-    const Index begin = first + static_cast<Index>(c) * step;
-    const Index end = last - begin > step ? begin + step : last;
-    values[c] = body(begin, end, std::move(values[c]));
+  const Chunks<Index> chunks(first, last, grain);
+  std::vector<Value> values(chunks.size(), identity);
+  ParallelFor(std::size_t{0}, chunks.size(), [&](std::size_t c) {
+    values[c] = body(chunks.begin(c), chunks.end(c), std::move(values[c]));
   });
   Value result = identity;
   for (Value& value : values) result = join(std::move(result), std::move(value));

@@ -171,12 +171,11 @@ grpc::ServerUnaryReactor* InscribeService::UpdateDeformation(
     grpc::CallbackServerContext* context, const v1::UpdateDeformationRequest* request,
     v1::UpdateDeformationResponse* response) {
   absl::Status precheck = CheckKey(request->sphere_set_key(), "sphere_set_key");
-  if (precheck.ok() && request->vertices_size() / 3 > 3 * limits_.max_triangles) {
-    // A closed mesh has about half as many vertices as triangles; 3x leaves room.
+  if (precheck.ok() && request->vertices_size() / 3 > limits_.MaxDeformVertices()) {
     precheck = absl::ResourceExhaustedError(
         absl::StrCat("vertices has ", request->vertices_size() / 3,
                      " vertices; no stored mesh has more than 3 x --max-triangles = ",
-                     3 * limits_.max_triangles));
+                     limits_.MaxDeformVertices()));
   }
   if (precheck.ok() && !(std::isfinite(request->xi()) && request->xi() >= 0.0)) {
     precheck = absl::InvalidArgumentError(

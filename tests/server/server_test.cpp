@@ -2,6 +2,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <memory>
 
 #include "grpc/health/v1/health.grpc.pb.h"
@@ -63,6 +64,20 @@ class InscribeServerTest : public ::testing::Test {
 };
 
 InscribeServer* InscribeServerTest::server_ = nullptr;
+
+// The embedded service (the CLI's) runs with every limit at the int64 maximum; deriving the
+// deformation's vertex limit from it must not overflow (UBSan found 3 x max once).
+TEST(ServiceLimits, DeformVertexLimitIsThreeTimesTrianglesAndSaturates) {
+  ServiceLimits limits;
+  limits.max_triangles = 1000;
+  EXPECT_EQ(limits.MaxDeformVertices(), 3000);
+  constexpr std::int64_t kMax = std::numeric_limits<std::int64_t>::max();
+  for (std::int64_t triangles : {kMax / 3, kMax / 3 + 1, kMax - 1, kMax}) {
+    limits.max_triangles = triangles;
+    EXPECT_EQ(limits.MaxDeformVertices(), triangles == kMax / 3 ? 3 * triangles : kMax)
+        << triangles;
+  }
+}
 
 TEST_F(InscribeServerTest, BindsTheLoopbackPortItPicked) {
   EXPECT_GT(server_->port(), 0);

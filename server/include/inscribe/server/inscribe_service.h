@@ -6,6 +6,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <set>
@@ -40,6 +41,12 @@ struct ServiceLimits {
   // --max-triangles: triangles in one mesh. Validation costs O(#T log #T) time and ~100 bytes
   // of memory per triangle on top of the request.
   std::int64_t max_triangles = 5'000'000;
+  // Vertices in one UpdateDeformation: 3 x max_triangles (a closed mesh has about half as
+  // many vertices as triangles), saturating, so an unlimited max_triangles stays unlimited.
+  std::int64_t MaxDeformVertices() const {
+    constexpr std::int64_t kMax = std::numeric_limits<std::int64_t>::max();
+    return max_triangles > kMax / 3 ? kMax : 3 * max_triangles;
+  }
   // --max-voxels: voxels in one generation grid (a finer grid is INVALID_ARGUMENT up front).
   std::int64_t max_voxels = 20'000'000;
   // --max-spheres: a Generate sphere budget, and spheres in one inline sphere set.

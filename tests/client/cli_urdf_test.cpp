@@ -339,8 +339,11 @@ TEST_F(CliUrdf, ARobotBudgetIsSharedAndPaddingAndProtrusionBoundsHold) {
   const CliRun pinned = RunCli(Args() + " --max-spheres 24 --link-max-spheres plate=3 -o " +
                                Quote(Out("pinned.urdf")) + " --json");
   ASSERT_EQ(pinned.exit_code, 1) << pinned.err;
-  for (const nlohmann::json& link : nlohmann::json::parse(pinned.out).at("links")) {
-    if (link.at("link") == "plate") EXPECT_EQ(link.at("budget"), 3);
+  const nlohmann::json pinned_report = nlohmann::json::parse(pinned.out);
+  for (const nlohmann::json& link : pinned_report.at("links")) {
+    if (link.at("link") == "plate") {
+      EXPECT_EQ(link.at("budget"), 3);
+    }
   }
 
   const CliRun within =
@@ -348,7 +351,9 @@ TEST_F(CliUrdf, ARobotBudgetIsSharedAndPaddingAndProtrusionBoundsHold) {
   ASSERT_EQ(within.exit_code, 1) << within.err;
   const nlohmann::json bounded = nlohmann::json::parse(within.out);
   for (const nlohmann::json& link : bounded.at("links")) {
-    if (link.at("status") == "spherized") EXPECT_LE(link.at("delta").get<double>(), 0.02);
+    if (link.at("status") == "spherized") {
+      EXPECT_LE(link.at("delta").get<double>(), 0.02);
+    }
   }
   ExpectCertifiedCovers(bounded, Out("within.urdf"), 0.0);
 

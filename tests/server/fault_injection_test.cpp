@@ -499,8 +499,12 @@ TEST(ClientFaults, CancelledGenerateAndKilledStreamClientFreeTheWork) {
       return settled - baseline < kSlack;
     });
     largest_after = std::max(largest_after, settled - baseline);
-    EXPECT_TRUE(returned) << "RSS stays " << (settled - baseline) / (1 << 20)
-                          << " MiB above the baseline";
+    // Under a sanitizer freed memory stays resident (ASan's quarantine, shadow memory); there
+    // only the work's end (in_flight() above) is checked.
+    if (!testing::kSanitizedBuild) {
+      EXPECT_TRUE(returned) << "RSS stays " << (settled - baseline) / (1 << 20)
+                            << " MiB above the baseline";
+    }
   }
   std::cout << "[ stats    ] baseline RSS " << baseline / (1 << 20) << " MiB; one frame +"
             << frame_bytes / (1 << 20) << " MiB; after cancelling up to +"

@@ -17,6 +17,7 @@
 #include "inscribe/server/inscribe_server.h"
 #include "inscribe/v1/service.grpc.pb.h"
 #include "inscribe/wire/convert.h"
+#include "support/inscribed_process.h"
 
 namespace inscribe::server {
 
@@ -50,10 +51,12 @@ class SpheresRpcTest : public ::testing::Test {
         grpc::CreateChannel(server_->address(), grpc::InsecureChannelCredentials()));
   }
 
+  // A context whose deadline is `seconds` from now (longer under a sanitizer).
   std::unique_ptr<grpc::ClientContext> Context(double seconds = 60.0) {
     auto context = std::make_unique<grpc::ClientContext>();
     context->set_deadline(std::chrono::system_clock::now() +
-                          std::chrono::milliseconds(static_cast<int>(1000 * seconds)));
+                          std::chrono::milliseconds(static_cast<std::int64_t>(
+                              1000 * seconds * testing::kSanitizerTimeScale)));
     return context;
   }
 

@@ -113,9 +113,10 @@ TEST_F(StreamDispatchTest, SmallFramesAreAnsweredInlineInOrderLikeBruteForce) {
   EXPECT_TRUE(record.status.ok()) << record.status;
   EXPECT_EQ(record.frames, kFrames);
   // The first frame's cost is unknown (and it looks the sets up): never inline. Most of the
-  // others are, unless the machine is so loaded that the frames measure over the budget.
+  // others are, unless the machine is so loaded (or the build so slow: a sanitizer's) that
+  // the frames measure over the budget.
   EXPECT_LT(record.inline_frames, kFrames);
-  EXPECT_GT(record.inline_frames, kFrames / 2);
+  EXPECT_GT(record.inline_frames, testing::kSanitizedBuild ? 0 : kFrames / 2);
 }
 
 // Frames over kSerialFramePairs pairs would run parallel loops, and frames naming a set the

@@ -60,6 +60,9 @@ inline constexpr bool kSanitizedBuild = true;
 #else
 inline constexpr bool kSanitizedBuild = false;
 #endif
+// How much longer a call's deadline in a test is there: the same factor as ctest's time limits
+// (inscribe_timeout_scale in tests/CMakeLists.txt).
+inline constexpr double kSanitizerTimeScale = kSanitizedBuild ? 5.0 : 1.0;
 
 // Memory of a process from /proc/<pid>/status, bytes; -1 where unreadable (e.g. it exited).
 struct ProcessMemory {

@@ -209,7 +209,7 @@ struct PosePair {
   RigidPose pose_b;
   // For DistanceSession::QueryCertified: the covers of the two solids (DistanceOptions'
   // cover_a and cover_b); empty for Query.
-  std::string cover_a, cover_b;
+  std::string cover_a = {}, cover_b = {};
 };
 
 struct DistanceSessionOptions {

@@ -177,7 +177,11 @@ TEST_F(StreamDispatchTest, LimitsApplyToInlineFrames) {
     EXPECT_THAT(s.error_message(), HasSubstr(last == 4 ? "--memory-budget" : "--max-poses"));
   }
   const std::vector<CallRecord> records = Streams(2);
-  EXPECT_GT(records[0].inline_frames + records[1].inline_frames, 0);
+  // Some frames ran inline, so the limits were met there too; a sanitizer's build can be too
+  // slow for any frame to fit the inline time budget (kInlineFrameSeconds).
+  if (!testing::kSanitizedBuild) {
+    EXPECT_GT(records[0].inline_frames + records[1].inline_frames, 0);
+  }
 }
 
 // Clients streaming small frames as fast as they can while the server drains, or while they

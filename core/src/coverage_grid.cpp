@@ -1,6 +1,8 @@
 // The selection's sample grid and bit fields. See coverage_grid.h.
 #include "coverage_grid.h"
 
+#include "cpu_clones.h"
+
 namespace inscribe::internal {
 namespace {
 
@@ -54,8 +56,7 @@ std::int64_t BitField::CountAll() const {
 
 // Cloned for x86-64-v2 (popcnt, SSE4.1 rounding), chosen at load time: with the baseline's
 // library popcount and floor the count runs at half speed.
-__attribute__((target_clones("arch=x86-64-v2", "default"))) std::int64_t BitField::CountIn(
-    const Sphere& sphere) const {
+INSCRIBE_CLONES_X86_64_V2 std::int64_t BitField::CountIn(const Sphere& sphere) const {
   const SampleGrid::Ball ball = grid_.ToGrid(sphere);
   // The blocks looked at: ForEachRun's slices along z; along x and y its runs end where square
   // roots of rounded differences put them, so one point further.

@@ -16,6 +16,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "coverage_grid.h"
+#include "cpu_clones.h"
 #include "parallel.h"
 #include "voxel_grid.h"
 
@@ -74,9 +75,9 @@ absl::StatusOr<SphereSelection> ParseSphereSelection(absl::string_view name) {
 
 // Cloned for x86-64-v2 as BitField::CountIn is (coverage_grid.cpp): the clears and the row
 // walks inlined here popcount and round too.
-__attribute__((target_clones("arch=x86-64-v2", "default"))) absl::StatusOr<CoverageSelection>
-SelectByCoverage(const std::vector<Sphere>& balls, const CoverageSelectionOptions& options,
-                 const GenerationControl& control) {
+INSCRIBE_CLONES_X86_64_V2 absl::StatusOr<CoverageSelection> SelectByCoverage(
+    const std::vector<Sphere>& balls, const CoverageSelectionOptions& options,
+    const GenerationControl& control) {
   if (options.max_spheres <= 0) {
     return absl::InvalidArgumentError(
         absl::StrCat("the sphere budget must be at least 1, got ", options.max_spheres));

@@ -60,9 +60,12 @@ inline constexpr bool kSanitizedBuild = true;
 #else
 inline constexpr bool kSanitizedBuild = false;
 #endif
-// How much longer a call's deadline in a test is there: the same factor as ctest's time limits
-// (inscribe_timeout_scale in tests/CMakeLists.txt).
-inline constexpr double kSanitizerTimeScale = kSanitizedBuild ? 5.0 : 1.0;
+// How much longer a call's deadline in a test is under a sanitizer: ctest's factor for its time
+// limits, which tests/CMakeLists.txt defines for every target linking inscribe_test_support.
+#ifndef INSCRIBE_TEST_TIME_SCALE
+#error "INSCRIBE_TEST_TIME_SCALE comes from inscribe_test_support (tests/CMakeLists.txt)"
+#endif
+inline constexpr double kSanitizerTimeScale = INSCRIBE_TEST_TIME_SCALE;
 
 // Memory of a process from /proc/<pid>/status, bytes; -1 where unreadable (e.g. it exited).
 struct ProcessMemory {

@@ -195,12 +195,20 @@ class FrameStreamReactor : public grpc::ServerBidiReactor<Request, Reply>, publi
       ++record_.frames;
       if (place == FramePlace::kInline) ++record_.inline_frames;
     }
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (!status.ok()) {
-      FinishLocked(InFrame(status));
-      return;
+    // On the pool this is no gRPC reaction, so once Finish is called gRPC may run OnDone, and
+    // delete the stream, on another thread before the lock below is released: the frame holds
+    // a reference until it is done with the stream (TSan saw the mutex unlocked after it was
+    // freed in StreamDispatchTest.DrainAndCancelInTheMiddleOfInlineFrames).
+    this->Ref();
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (status.ok()) {
+        this->StartWrite(&reply_);
+      } else {
+        FinishLocked(InFrame(status));
+      }
     }
-    this->StartWrite(&reply_);
+    this->Unref();
   }
 
   InscribeService* const service_;

@@ -77,6 +77,7 @@ struct BoundaryOracle::Impl {
 
   void ComputeNormals();
   absl::Status BuildScene();
+  absl::Status CommitScene();
   // upper_bound: see BoundaryOracle::ClosestPoint; infinity for none.
   BoundaryPoint Closest(const Vector3& p,
                         double upper_bound = std::numeric_limits<double>::infinity()) const;
@@ -167,6 +168,7 @@ absl::Status BoundaryOracle::Impl::BuildScene() {
       geometry,
       [](const RTCBoundsFunctionArguments* args) {
         const auto* self = static_cast<const Impl*>(args->geometryUserPtr);
+        internal::TsanAcquire(self);  // see CommitScene
         const auto t = static_cast<std::int32_t>(args->primID);
         Vector3 lo = self->Corner(t, 0), hi = lo;
         for (int k = 1; k < 3; ++k) {
@@ -180,6 +182,7 @@ absl::Status BoundaryOracle::Impl::BuildScene() {
         b->upper_x = RoundUp(hi.x()) + self->pad;
         b->upper_y = RoundUp(hi.y()) + self->pad;
         b->upper_z = RoundUp(hi.z()) + self->pad;
+        internal::TsanRelease(self);
       },
       nullptr);
   // Rays only count crossings (kRayParity); occlusion rays are not used.
@@ -187,7 +190,15 @@ absl::Status BoundaryOracle::Impl::BuildScene() {
   rtcSetGeometryOccludedFunction(geometry, [](const RTCOccludedFunctionNArguments*) {});
   rtcCommitGeometry(geometry);
   rtcAttachGeometry(scene, geometry);
+  return CommitScene();
+}
+
+// Embree computes the bounds on its own TBB threads, whose start and join TSan does not see: the
+// release before and the acquire after, with the pair in the bounds callback, are those edges.
+absl::Status BoundaryOracle::Impl::CommitScene() {
+  internal::TsanRelease(this);
   rtcCommitScene(scene);
+  internal::TsanAcquire(this);
   std::lock_guard<std::mutex> lock(error_mutex);
   if (!error.empty()) return absl::InternalError(error);
   return absl::OkStatus();
@@ -424,10 +435,7 @@ absl::Status BoundaryOracle::Refit(const Vertices& new_vertices) {
     return absl::OkStatus();
   }
   rtcCommitGeometry(impl_->geometry);
-  rtcCommitScene(impl_->scene);
-  std::lock_guard<std::mutex> lock(impl_->error_mutex);
-  if (!impl_->error.empty()) return absl::InternalError(impl_->error);
-  return absl::OkStatus();
+  return impl_->CommitScene();
 }
 
 const Mesh& BoundaryOracle::mesh() const { return impl_->mesh; }

@@ -1,5 +1,5 @@
-// Private: core's parallel loops. Every parallel loop in core goes through these, so that
-// ThreadSanitizer sees how each loop is ordered with the code around it.
+// Private: core's parallel loops. Every parallel loop in core and robot goes through these, so
+// that ThreadSanitizer sees how each loop is ordered with the code around it.
 //
 // The loops run on TBB. Debian's libtbb is not built for ThreadSanitizer, and a TBB loop hands
 // its tasks between threads inside it, unseen: TSan then reports TBB's own task objects, and the
@@ -16,13 +16,16 @@
 #include <algorithm>
 #include <atomic>
 #include <cstddef>
+#include <cstdint>
 #include <exception>
+#include <functional>
 #include <mutex>
 #include <thread>
 #include <utility>
 #include <vector>
 
 #if defined(__SANITIZE_THREAD__)
+#include <sanitizer/tsan_interface.h>
 #define INSCRIBE_TSAN_LOOPS 1
 #else
 #define INSCRIBE_TSAN_LOOPS 0
@@ -33,6 +36,37 @@ namespace inscribe::internal {
 // True in ThreadSanitizer builds. Parallel code that is not ours and runs its own TBB loops
 // (CGAL's) runs sequentially there.
 inline constexpr bool kThreadSanitizer = INSCRIBE_TSAN_LOOPS != 0;
+
+// Happens-before edges through a library whose threads TSan cannot follow (Embree builds its
+// BVH on its own TBB threads, calling our callbacks there): what a thread did before
+// TsanRelease(key) happens before what any thread does after a later TsanAcquire(key). Each
+// release adds to what the key carries, so one acquire after many releases sees them all.
+// Nothing outside TSan builds.
+inline void TsanRelease(const void* key) {
+#if INSCRIBE_TSAN_LOOPS
+  __tsan_release(const_cast<void*>(key));
+#else
+  static_cast<void>(key);
+#endif
+}
+inline void TsanAcquire(const void* key) {
+#if INSCRIBE_TSAN_LOOPS
+  __tsan_acquire(const_cast<void*>(key));
+#else
+  static_cast<void>(key);
+#endif
+}
+
+// A key for TsanRelease/TsanAcquire per thread id. A finished thread's id is reused (and TBB's
+// thread-local containers, keyed by it, hand its slot to the new thread: the cover certificate's,
+// the cover growth's and robot's self-collision matrix's) only after that thread has ended, an
+// order glibc makes where TSan does not see it; RunOnThreads' helpers release their id's key as
+// they end and acquire it as they start, which is that order.
+inline const void* ThreadIdKey() {
+  static char keys[4096];
+  const std::uint64_t h = std::hash<std::thread::id>{}(std::this_thread::get_id());
+  return &keys[(h * 0x9E3779B97F4A7C15ull) >> 52];  // the top 12 bits of a Fibonacci hash
+}
 
 // [first, last) cut into chunks of `grain` indices (at least 1); the last may be shorter.
 template <typename Index>
@@ -80,7 +114,13 @@ void RunOnThreads(Index first, Index last, std::size_t grain, const Body& body) 
   };
   std::vector<std::thread> helpers;
   helpers.reserve(threads - 1);
-  for (std::size_t t = 1; t < threads; ++t) helpers.emplace_back(work);
+  for (std::size_t t = 1; t < threads; ++t) {
+    helpers.emplace_back([&work] {
+      TsanAcquire(ThreadIdKey());
+      work();
+      TsanRelease(ThreadIdKey());
+    });
+  }
   work();
   for (std::thread& helper : helpers) helper.join();
   if (error) std::rethrow_exception(error);

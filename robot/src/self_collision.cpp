@@ -1,8 +1,6 @@
 #include "inscribe/robot/self_collision.h"
 
-#include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <chrono>
@@ -14,6 +12,7 @@
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
 #include "inscribe/certified_distance.h"
+#include "parallel.h"  // core's loops (core/src)
 
 namespace inscribe::robot {
 namespace {
@@ -439,20 +438,19 @@ absl::StatusOr<SelfCollisionMatrix> ComputeSelfCollisionMatrix(
     for (std::int64_t s = 0; s < count; ++s) {
       sampler.Next(absl::MakeSpan(block.data() + s * variables, variables));
     }
-    tbb::parallel_for(tbb::blocked_range<std::int64_t>(0, count, 16),
-                      [&](const tbb::blocked_range<std::int64_t>& range) {
-                        Local& local = locals.local();
-                        for (std::int64_t s = range.begin(); s < range.end(); ++s) {
-                          const absl::Status status = VisitIntervals(
-                              kinematics, prepared,
-                              absl::MakeConstSpan(block.data() + s * variables, variables),
-                              &local.work, &local.statistics.minima,
-                              [&](std::size_t k, const LinkPairInterval& interval) {
-                                local.statistics.Add(k, interval);
-                              });
-                          if (!status.ok() && local.status.ok()) local.status = status;
-                        }
-                      });
+    internal::ParallelForRange(
+        std::int64_t{0}, count, 16, [&](std::int64_t begin, std::int64_t end) {
+          Local& local = locals.local();
+          for (std::int64_t s = begin; s < end; ++s) {
+            const absl::Status status = VisitIntervals(
+                kinematics, prepared, absl::MakeConstSpan(block.data() + s * variables, variables),
+                &local.work, &local.statistics.minima,
+                [&](std::size_t k, const LinkPairInterval& interval) {
+                  local.statistics.Add(k, interval);
+                });
+            if (!status.ok() && local.status.ok()) local.status = status;
+          }
+        });
     if (options.control.on_progress) {
       options.control.on_progress(static_cast<double>(first + count) /
                                   static_cast<double>(options.samples));

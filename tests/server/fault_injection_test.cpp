@@ -377,7 +377,8 @@ TEST(CrashFaults, KillDuringWritesNeverLeavesAPartialEntry) {
         }
       });
     }
-    std::this_thread::sleep_for(milliseconds(std::uniform_int_distribution<int>(150, 600)(rng)));
+    std::this_thread::sleep_for(
+        testing::Stretched(milliseconds(std::uniform_int_distribution<int>(150, 600)(rng))));
     EXPECT_NE(server.Kill(), -1);
     stop.store(true);
     for (std::thread& thread : threads) thread.join();
@@ -423,7 +424,7 @@ void GenerateAndCancel(const std::string& address, const std::string& mesh_sha25
   auto stub =
       v1::Inscribe::NewStub(grpc::CreateChannel(address, grpc::InsecureChannelCredentials()));
   grpc::ClientContext context;
-  context.set_deadline(std::chrono::system_clock::now() + seconds(60));
+  context.set_deadline(std::chrono::system_clock::now() + testing::Stretched(seconds(60)));
   v1::GenerateRequest request;
   request.set_mesh_sha256(mesh_sha256);
   request.mutable_parameters()->set_voxel_size(voxel_size);
@@ -474,18 +475,18 @@ TEST(ClientFaults, CancelledGenerateAndKilledStreamClientFreeTheWork) {
     SCOPED_TRACE("cycle " + std::to_string(cycle));
     GenerateAndCancel(server.address(), stored->mesh_sha256, diagonal * (0.0040 + 0.0001 * cycle),
                       0.3);
-    ASSERT_TRUE(WaitFor(seconds(10), [&] { return in_flight() == 0; }))
+    ASSERT_TRUE(WaitFor(testing::Stretched(seconds(10)), [&] { return in_flight() == 0; }))
         << "cancelled Generate still running";
 
     const std::int64_t before_stream = rss();
     faults::StreamClientChild child(server.address(), 100'000 + cycle);
     ASSERT_TRUE(child.WaitUntilFrameSent()) << "stream client failed to start";
-    ASSERT_TRUE(WaitFor(seconds(10), [&] { return in_flight() > 0; }))
+    ASSERT_TRUE(WaitFor(testing::Stretched(seconds(10)), [&] { return in_flight() > 0; }))
         << "the frame never reached the pool";
     // The first frame's memory (its message, queries, results), measured from cold.
     if (cycle == 0) frame_bytes = rss() - before_stream;
     child.Kill();
-    ASSERT_TRUE(WaitFor(seconds(10), [&] { return in_flight() == 0; }))
+    ASSERT_TRUE(WaitFor(testing::Stretched(seconds(10)), [&] { return in_flight() == 0; }))
         << "abandoned stream frame still running";
 
     if (cycle == 0) {
@@ -494,7 +495,7 @@ TEST(ClientFaults, CancelledGenerateAndKilledStreamClientFreeTheWork) {
     }
     // Released within seconds of the work stopping; leaked work would stay.
     std::int64_t settled = rss();
-    const bool returned = WaitFor(seconds(10), [&] {
+    const bool returned = WaitFor(testing::Stretched(seconds(10)), [&] {
       settled = rss();
       return settled - baseline < kSlack;
     });

@@ -113,10 +113,10 @@ TEST_F(StreamDispatchTest, SmallFramesAreAnsweredInlineInOrderLikeBruteForce) {
   EXPECT_TRUE(record.status.ok()) << record.status;
   EXPECT_EQ(record.frames, kFrames);
   // The first frame's cost is unknown (and it looks the sets up): never inline. Most of the
-  // others are, unless the machine is so loaded (or the build so slow: a sanitizer's) that
-  // the frames measure over the budget.
+  // others are, unless the machine is so loaded that the frames measure over the budget; under
+  // a sanitizer they may all do (none did under TSan), so the count is checked at normal speed.
   EXPECT_LT(record.inline_frames, kFrames);
-  EXPECT_GT(record.inline_frames, testing::kSanitizedBuild ? 0 : kFrames / 2);
+  if (!testing::kSanitizedBuild) EXPECT_GT(record.inline_frames, kFrames / 2);
 }
 
 // Frames over kSerialFramePairs pairs would run parallel loops, and frames naming a set the
@@ -238,7 +238,9 @@ TEST_F(StreamDispatchTest, DrainAndCancelInTheMiddleOfInlineFrames) {
         << record.status;
     inline_frames += record.inline_frames;
   }
-  EXPECT_GT(inline_frames, 0);
+  // Under a sanitizer the frames may all measure over the inline budget and run on the pool
+  // (they did under TSan), which this test then exercises instead.
+  if (!testing::kSanitizedBuild) EXPECT_GT(inline_frames, 0);
 
   // A new stream is answered: no cancelled frame kept its reservation.
   {
@@ -270,7 +272,7 @@ TEST_F(StreamDispatchTest, DrainAndCancelInTheMiddleOfInlineFrames) {
   EXPECT_EQ(drained.error_code(), grpc::StatusCode::UNAVAILABLE) << drained.error_message();
   records = Streams(7);
   EXPECT_EQ(records.back().status.code(), absl::StatusCode::kUnavailable) << records.back().status;
-  EXPECT_GT(records.back().inline_frames, 0);
+  if (!testing::kSanitizedBuild) EXPECT_GT(records.back().inline_frames, 0);
 }
 
 }  // namespace

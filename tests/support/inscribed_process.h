@@ -67,6 +67,12 @@ inline constexpr bool kSanitizedBuild = false;
 #endif
 inline constexpr double kSanitizerTimeScale = INSCRIBE_TEST_TIME_SCALE;
 
+// A test's wait or deadline `d`, stretched by kSanitizerTimeScale.
+template <typename Rep, typename Period>
+std::chrono::milliseconds Stretched(std::chrono::duration<Rep, Period> d) {
+  return std::chrono::duration_cast<std::chrono::milliseconds>(d * kSanitizerTimeScale);
+}
+
 // Memory of a process from /proc/<pid>/status, bytes; -1 where unreadable (e.g. it exited).
 struct ProcessMemory {
   std::int64_t resident = -1;       // VmRSS: resident now

@@ -1,7 +1,5 @@
 #include "inscribe/cover_certificate.h"
 
-#include <tbb/combinable.h>
-
 #include <algorithm>
 #include <array>
 #include <atomic>
@@ -46,17 +44,61 @@ bool Before(const Failure& a, const Failure& b) {
   return std::tie(a.level, a.index) < std::tie(b.level, b.index);
 }
 
-struct Counts {
-  std::int64_t cells = 0, in_sphere = 0, outside = 0, failed = 0;
-  std::vector<Failure> failures;
-  std::optional<Failure> deepest;  // the deepest witness
-};
-
 // The deeper witness; of two as deep, the one with the smaller index (so the choice does not
 // depend on which thread found which).
 bool Deeper(const Failure& a, const Failure& b) {
   return a.depth > b.depth || (a.depth == b.depth && Before(a, b));
 }
+
+// The counts of a subtree of the octree. Of its failed cells it keeps the `keep` first in
+// Before order (and at most 2 * keep between trims), so merging subtrees in any order keeps
+// the same cells: the result does not depend on the schedule.
+class Counts {
+ public:
+  explicit Counts(std::int64_t keep) : keep_(static_cast<std::size_t>(keep)) {}
+
+  std::int64_t cells = 0, in_sphere = 0, outside = 0, failed = 0;
+  std::optional<Failure> deepest;  // the deepest witness
+
+  // A failed cell; a witness's centre is a point of the solid in no sphere.
+  void Fail(const Failure& failure, bool witness) {
+    ++failed;
+    if (witness && (!deepest || Deeper(failure, *deepest))) deepest = failure;
+    if (keep_ == 0) return;
+    failures_.push_back(failure);
+    if (failures_.size() > 2 * keep_) Trim();
+  }
+
+  void Merge(Counts&& other) {
+    cells += other.cells;
+    in_sphere += other.in_sphere;
+    outside += other.outside;
+    failed += other.failed;
+    if (other.deepest && (!deepest || Deeper(*other.deepest, *deepest))) {
+      deepest = other.deepest;
+    }
+    failures_.insert(failures_.end(), other.failures_.begin(), other.failures_.end());
+    if (failures_.size() > 2 * keep_) Trim();
+  }
+
+  // The kept failed cells, sorted.
+  std::vector<Failure> TakeFailures() && {
+    Trim();
+    std::sort(failures_.begin(), failures_.end(), Before);
+    return std::move(failures_);
+  }
+
+ private:
+  void Trim() {
+    if (failures_.size() <= keep_) return;
+    std::nth_element(failures_.begin(), failures_.begin() + static_cast<std::ptrdiff_t>(keep_),
+                     failures_.end(), Before);
+    failures_.resize(keep_);
+  }
+
+  std::size_t keep_;
+  std::vector<Failure> failures_;
+};
 
 class Certifier {
  public:
@@ -74,35 +116,24 @@ class Certifier {
   double finest_side() const { return std::ldexp(side_, -finest_); }
   double scale() const { return scale_; }
 
-  absl::Status Run(Counts* total) {
+  absl::StatusOr<Counts> Run() {
     std::vector<std::int32_t> all(spheres_.size());
     for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<std::int32_t>(i);
-    Visit(0, {0, 0, 0}, all, std::numeric_limits<double>::infinity());
+    Counts counts(options_.max_failures_kept);
+    Visit(0, {0, 0, 0}, all, std::numeric_limits<double>::infinity(), &counts);
     if (Cancelled()) return absl::CancelledError("cover certification cancelled");
-    counts_.combine_each([total](const Counts& c) {
-      total->cells += c.cells;
-      total->in_sphere += c.in_sphere;
-      total->outside += c.outside;
-      total->failed += c.failed;
-      total->failures.insert(total->failures.end(), c.failures.begin(), c.failures.end());
-      if (c.deepest && (!total->deepest || Deeper(*c.deepest, *total->deepest))) {
-        total->deepest = c.deepest;
-      }
-    });
-    std::sort(total->failures.begin(), total->failures.end(), Before);
-    if (static_cast<std::int64_t>(total->failures.size()) > options_.max_failures_kept) {
-      total->failures.resize(static_cast<std::size_t>(options_.max_failures_kept));
-    }
-    return absl::OkStatus();
+    return counts;
   }
 
  private:
   bool Cancelled() const { return control_.cancelled(); }
 
+  // Settles the cell or splits it, counting into `out`; the first levels' children run in
+  // parallel, each into counts of its own merged into the parent's as it ends.
   void Visit(int level, const Index& index, const std::vector<std::int32_t>& candidates,
-             double distance_bound) {
+             double distance_bound, Counts* out) {
     if (Cancelled()) return;
-    Counts& counts = counts_.local();
+    Counts& counts = *out;
     ++counts.cells;
     const double side = std::ldexp(side_, -level);
     Vector3 lo, hi;
@@ -143,28 +174,28 @@ class Certifier {
     }
     const bool witness = centre_side == Side::kInside && !InAny(centre, near);
     if (level == finest_ || (witness && options_.stop_at_witness)) {
-      ++counts.failed;
       Failure failure{level, index, lo, centre, side, 0.0};
-      if (witness) {
-        failure.depth = closest.distance;
-        if (!counts.deepest || Deeper(failure, *counts.deepest)) counts.deepest = failure;
-      }
-      if (static_cast<std::int64_t>(counts.failures.size()) < options_.max_failures_kept) {
-        counts.failures.push_back(failure);
-      }
+      if (witness) failure.depth = closest.distance;
+      counts.Fail(failure, witness);
       Settled(level);
       return;
     }
     const double child_bound = closest.distance + half_diagonal;
-    const auto child = [&](int c) {
+    const auto child = [&](int c, Counts* into) {
       const Index sub = {2 * index[0] + (c & 1), 2 * index[1] + ((c >> 1) & 1),
                          2 * index[2] + ((c >> 2) & 1)};
-      Visit(level + 1, sub, near, child_bound);
+      Visit(level + 1, sub, near, child_bound, into);
     };
     if (level < kParallelLevels) {
-      internal::ParallelFor(0, 8, child);
+      std::mutex merge_mutex;
+      internal::ParallelFor(0, 8, [&](int c) {
+        Counts sub(options_.max_failures_kept);
+        child(c, &sub);
+        const std::lock_guard<std::mutex> lock(merge_mutex);
+        counts.Merge(std::move(sub));
+      });
     } else {
-      for (int c = 0; c < 8; ++c) child(c);
+      for (int c = 0; c < 8; ++c) child(c, &counts);
     }
     if (level == kParallelLevels) Settled(level);
   }
@@ -196,7 +227,6 @@ class Certifier {
   double scale_ = 1.0, side_ = 1.0;
   Vector3 origin_ = Vector3::Zero();
   int finest_ = 0;
-  tbb::combinable<Counts> counts_;
   std::atomic<std::int64_t> settled_{0};
   std::mutex progress_mutex_;
 };
@@ -281,32 +311,35 @@ absl::StatusOr<CoverCertificate> CertifyCover(const Solid& solid,
   GenerationControl quiet;
   quiet.cancel = control.cancel;
   Certifier first(solid, spheres, coarse, quiet);
-  Counts counts;
+  std::optional<Counts> counts;
   if (two_passes) {
-    if (absl::Status s = first.Run(&counts); !s.ok()) return s;
+    absl::StatusOr<Counts> coarse_counts = first.Run();
+    if (!coarse_counts.ok()) return coarse_counts.status();
+    counts = *std::move(coarse_counts);
   }
   Certifier full(solid, spheres, options, control);
-  const bool disproved = two_passes && counts.deepest.has_value();
+  const bool disproved = counts && counts->deepest.has_value();
   if (!disproved) {
-    counts = Counts{};
-    if (absl::Status s = full.Run(&counts); !s.ok()) return s;
+    absl::StatusOr<Counts> full_counts = full.Run();
+    if (!full_counts.ok()) return full_counts.status();
+    counts = *std::move(full_counts);
   }
   const Certifier& certifier = disproved ? first : full;
 
   CoverCertificate out;
-  out.certified = counts.failed == 0;
+  out.certified = counts->failed == 0;
   for (const double p : *protrusions) out.delta = std::max(out.delta, p);
   out.protrusions = *std::move(protrusions);
   out.resolution = certifier.finest_side();
-  out.cells = counts.cells;
-  out.cells_in_sphere = counts.in_sphere;
-  out.cells_outside = counts.outside;
-  out.failed_cells = counts.failed;
-  out.failures.reserve(counts.failures.size());
-  for (const Failure& f : counts.failures) {
-    out.failures.push_back(CoverCell{f.min, f.side});
-  }
-  if (const std::optional<Failure>& deepest = counts.deepest) {
+  out.cells = counts->cells;
+  out.cells_in_sphere = counts->in_sphere;
+  out.cells_outside = counts->outside;
+  out.failed_cells = counts->failed;
+  const std::optional<Failure> deepest = counts->deepest;
+  const std::vector<Failure> failures = std::move(*counts).TakeFailures();
+  out.failures.reserve(failures.size());
+  for (const Failure& f : failures) out.failures.push_back(CoverCell{f.min, f.side});
+  if (deepest) {
     out.uncovered_point = deepest->centre;
     out.uncovered_depth = deepest->depth;
     double gap = std::numeric_limits<double>::infinity();

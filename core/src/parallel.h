@@ -58,8 +58,8 @@ inline void TsanAcquire(const void* key) {
 }
 
 // A key for TsanRelease/TsanAcquire per thread id. A finished thread's id is reused (and TBB's
-// thread-local containers, keyed by it, hand its slot to the new thread: the cover certificate's,
-// the cover growth's and robot's self-collision matrix's) only after that thread has ended, an
+// thread-local containers, keyed by it, hand its slot to the new thread: robot's self-collision
+// matrix's) only after that thread has ended, an
 // order glibc makes where TSan does not see it; RunOnThreads' helpers release their id's key as
 // they end and acquire it as they start, which is that order.
 inline const void* ThreadIdKey() {

@@ -1,7 +1,5 @@
 #include "inscribe/sphere_cover.h"
 
-#include <tbb/combinable.h>
-
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -54,6 +52,10 @@ constexpr double kDeltaModeAim = 0.95;
 constexpr std::int64_t kGrowthSamplesPerSphere = 40;
 constexpr std::int64_t kMinGrowthSamples = 2'000;
 
+// A grain that cuts `count` items into about 64 chunks: enough for the threads to share, few
+// enough that each chunk's copy of a per-sphere array costs little.
+std::size_t ReduceGrain(std::size_t count) { return std::max<std::size_t>(count / 64, 1); }
+
 // The chosen spheres grown to hold the boundary exactly, with `margin` to spare: every mesh
 // triangle goes whole to the sphere whose radius must grow least to hold its corners, or is
 // split in four until that costs at most `edge` more than the least growth any sphere needs at
@@ -64,7 +66,6 @@ constexpr std::int64_t kMinGrowthSamples = 2'000;
 std::vector<Sphere> HoldBoundary(const Mesh& mesh, const std::vector<Sphere>& chosen,
                                  const std::vector<Vector3>& interior, double edge, double margin) {
   const std::size_t n = chosen.size();
-  tbb::combinable<std::vector<double>> reaches([n] { return std::vector<double>(n, 0.0); });
   const auto growth = [&chosen](std::size_t i, const Vector3& p) {
     return (p - chosen[i].center).norm() - chosen[i].radius;
   };
@@ -112,28 +113,43 @@ std::vector<Sphere> HoldBoundary(const Mesh& mesh, const std::vector<Sphere>& ch
         hold(rp, qr, r, near, reach);
         hold(pq, qr, rp, near, reach);
       };
-  internal::ParallelFor(Eigen::Index{0}, mesh.triangles.rows(), [&](Eigen::Index t) {
-    hold(mesh.vertices.row(mesh.triangles(t, 0)).transpose(),
-         mesh.vertices.row(mesh.triangles(t, 1)).transpose(),
-         mesh.vertices.row(mesh.triangles(t, 2)).transpose(), all, reaches.local());
-  });
-  internal::ParallelFor(std::size_t{0}, interior.size(), [&](std::size_t p) {
-    std::size_t pick = 0;
-    double least = std::numeric_limits<double>::infinity();
-    for (std::size_t i = 0; i < n; ++i) {
-      const double g = growth(i, interior[p]);
-      if (g < least) {
-        least = g;
-        pick = i;
-      }
-    }
-    double& reach = reaches.local()[pick];
-    reach = std::max(reach, (interior[p] - chosen[pick].center).norm());
-  });
-  std::vector<double> reach(n, 0.0);
-  reaches.combine_each([&reach](const std::vector<double>& local) {
-    for (std::size_t i = 0; i < reach.size(); ++i) reach[i] = std::max(reach[i], local[i]);
-  });
+  // Each chunk's reaches, joined by their maximum.
+  const auto farther = [](std::vector<double> a, std::vector<double> b) {
+    for (std::size_t i = 0; i < a.size(); ++i) a[i] = std::max(a[i], b[i]);
+    return a;
+  };
+  const std::vector<double> none(n, 0.0);
+  const Eigen::Index triangles = mesh.triangles.rows();
+  const std::vector<double> held = internal::ParallelReduce(
+      Eigen::Index{0}, triangles, ReduceGrain(static_cast<std::size_t>(triangles)), none,
+      [&](Eigen::Index begin, Eigen::Index end, std::vector<double> reach) {
+        for (Eigen::Index t = begin; t < end; ++t) {
+          hold(mesh.vertices.row(mesh.triangles(t, 0)).transpose(),
+               mesh.vertices.row(mesh.triangles(t, 1)).transpose(),
+               mesh.vertices.row(mesh.triangles(t, 2)).transpose(), all, reach);
+        }
+        return reach;
+      },
+      farther);
+  const std::vector<double> reach = farther(
+      held, internal::ParallelReduce(
+                std::size_t{0}, interior.size(), ReduceGrain(interior.size()), none,
+                [&](std::size_t begin, std::size_t end, std::vector<double> local) {
+                  for (std::size_t p = begin; p < end; ++p) {
+                    std::size_t pick = 0;
+                    double least = std::numeric_limits<double>::infinity();
+                    for (std::size_t i = 0; i < n; ++i) {
+                      const double g = growth(i, interior[p]);
+                      if (g < least) {
+                        least = g;
+                        pick = i;
+                      }
+                    }
+                    local[pick] = std::max(local[pick], (interior[p] - chosen[pick].center).norm());
+                  }
+                  return local;
+                },
+                farther));
 
   std::vector<Sphere> out = chosen;
   for (std::size_t i = 0; i < n; ++i) {

@@ -12,6 +12,7 @@
 #include <limits>
 #include <random>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "inscribe/cover_certificate.h"
@@ -162,6 +163,44 @@ TEST(CertifyCover, InternalSpheresAreRefusedWithARealWitness) {
   // Internal spheres barely protrude: delta is near 0.
   const double largest = ComputeBoundingBox(solid.mesh().vertices).extent().maxCoeff();
   EXPECT_LT(certificate->delta, 1e-3 * largest);
+}
+
+// The failed cells kept are the first in their order, however many are kept and however the
+// octree's subtrees were scheduled.
+TEST(CertifyCover, KeepsTheFirstFailedCellsInOrder) {
+  INSCRIBE_REQUIRE_MESH("eight.off");
+  const Solid solid = MakeTestSolid(testing::LoadTestMesh("eight.off"));
+  SphereSetParameters parameters;
+  parameters.max_spheres = 60;
+  parameters.evaluate = false;
+  absl::StatusOr<GeneratedSphereSet> internal = GenerateSphereSet(solid, parameters);
+  ASSERT_TRUE(internal.ok()) << internal.status();
+  CoverCertifyOptions options;
+  options.resolution = 1.0 / 128;
+  options.stop_at_witness = false;
+  absl::StatusOr<CoverCertificate> all = CertifyCover(solid, internal->set.spheres, options);
+  ASSERT_TRUE(all.ok()) << all.status();
+  ASSERT_GT(all->failed_cells, 100);
+  ASSERT_EQ(static_cast<std::int64_t>(all->failures.size()), all->failed_cells);
+  const auto key = [](const CoverCell& c) {
+    return std::make_tuple(-c.side, c.min.x(), c.min.y(), c.min.z());
+  };
+  for (std::size_t i = 1; i < all->failures.size(); ++i) {
+    ASSERT_LT(key(all->failures[i - 1]), key(all->failures[i])) << i;
+  }
+  for (const std::int64_t keep : {std::int64_t{0}, std::int64_t{7}, all->failed_cells / 3}) {
+    options.max_failures_kept = keep;
+    absl::StatusOr<CoverCertificate> some = CertifyCover(solid, internal->set.spheres, options);
+    ASSERT_TRUE(some.ok()) << some.status();
+    EXPECT_EQ(some->failed_cells, all->failed_cells);
+    EXPECT_EQ(some->cells, all->cells);
+    ASSERT_EQ(static_cast<std::int64_t>(some->failures.size()), keep);
+    for (std::size_t i = 0; i < some->failures.size(); ++i) {
+      EXPECT_EQ(some->failures[i].min, all->failures[i].min) << "keep " << keep << ", cell " << i;
+      EXPECT_EQ(some->failures[i].side, all->failures[i].side);
+    }
+    EXPECT_EQ(some->uncovered_point, all->uncovered_point);
+  }
 }
 
 class CoverOnMesh : public ::testing::TestWithParam<const char*> {};

@@ -63,9 +63,8 @@ struct CoverCertificate {
   // failed cells: finest cells left unsettled, and (with stop_at_witness) cells whose centre
   // is a point of the solid in no sphere (0 when certified).
   std::int64_t cells = 0, cells_in_sphere = 0, cells_outside = 0, failed_cells = 0;
-  // Up to CoverCertifyOptions::max_failures_kept of the failed cells, sorted (coarse first,
-  // then x, y, z); all of them when fewer failed (which are kept of more may vary between
-  // runs).
+  // The failed cells, sorted (coarse first, then x, y, z): the first
+  // CoverCertifyOptions::max_failures_kept of them in that order when more failed.
   std::vector<CoverCell> failures;
   // A point of the solid in no sphere, when a failed cell's centre is one (the deepest such
   // centre): the proof that the set is not a cover. Its depth inside the solid

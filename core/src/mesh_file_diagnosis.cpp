@@ -256,17 +256,34 @@ class OffScanner {
   std::size_t pos_ = 0;
 };
 
-// The numbers CGAL's scanner takes from a record: `>> double` in a loop (IO::iformat<double>
-// is plain `>>` outside MSVC), up to the first that fails; "3-1" is 3 then -1.
+}  // namespace
+
 std::vector<double> CgalRecordNumbers(absl::string_view record) {
+  // Fast path: whitespace and plain digit runs of at most 15 digits, which `>> double` reads
+  // as the exact integers (a face record is nearly always this); else the stream itself.
   std::vector<double> numbers;
+  bool plain = true;
+  for (std::size_t i = 0; i < record.size() && plain;) {
+    const auto at = [&record](std::size_t k) { return static_cast<unsigned char>(record[k]); };
+    if (absl::ascii_isspace(at(i))) {
+      ++i;
+      continue;
+    }
+    std::int64_t value = 0;
+    std::size_t digits = 0;
+    for (; i < record.size() && absl::ascii_isdigit(at(i)) && digits < 16; ++i, ++digits) {
+      value = value * 10 + (record[i] - '0');
+    }
+    plain = digits > 0 && digits <= 15 && (i == record.size() || absl::ascii_isspace(at(i)));
+    numbers.push_back(static_cast<double>(value));
+  }
+  if (plain) return numbers;
+  numbers.clear();
   std::istringstream in{std::string(record)};
   double value = 0;
   while (in >> value) numbers.push_back(value);
   return numbers;
 }
-
-}  // namespace
 
 std::string CheckOffCounts(const std::string& bytes) {
   // Nothing is stored; cost O(file).

@@ -4,6 +4,9 @@
 #pragma once
 
 #include <string>
+#include <vector>
+
+#include "absl/strings/string_view.h"
 
 namespace inscribe::internal {
 
@@ -19,6 +22,11 @@ std::string DiagnoseMeshText(const std::string& bytes, const std::string& format
 // OFF: the header's vertex and face counts must fit in the file, and every face's corner count
 // in its line. Binary OFF is refused. Cost O(file), nothing stored.
 std::string CheckOffCounts(const std::string& bytes);
+
+// The numbers CGAL's OFF scanner takes from one record: `>> double` in a loop
+// (IO::iformat<double> is plain `>>` outside MSVC) up to the first that fails, so "3-1" is 3
+// then -1 and "3 x 1" is 3.
+std::vector<double> CgalRecordNumbers(absl::string_view record);
 
 // PLY: a well-formed header (CGAL crashes on a "property" before any "element"), and, for
 // lists with counts wider than 16 bits, every list count within the rest of the file.

@@ -5,14 +5,18 @@
 #include <unistd.h>
 
 #include <array>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <random>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "inscribe/mesh_hash.h"
 #include "inscribe/mesh_io.h"
 #include "inscribe/mesh_validation.h"
+#include "mesh_file_diagnosis.h"
 #include "support/cgal_mesh_writer.h"
 #include "support/synthetic_meshes.h"
 
@@ -97,6 +101,66 @@ TEST(MeshIoMutation, NeverCrashesAndAlwaysNamesTheFile) {
   // Both outcomes must occur, or the mutations are not exercising anything.
   EXPECT_GT(parsed, 50);
   EXPECT_GT(refused, 50);
+}
+
+// The OFF guard's reading of a record (its fast path for plain integers) against the stream
+// CGAL reads with, on records made of plain numbers, signs, decimals, exponents, long digit
+// runs, glued tokens and junk.
+TEST(MeshIoMutation, OffRecordNumbersAreTheStreamsNumbers) {
+  const auto stream_numbers = [](const std::string& record) {
+    std::vector<double> numbers;
+    std::istringstream in(record);
+    double value = 0;
+    while (in >> value) numbers.push_back(value);
+    return numbers;
+  };
+  const std::vector<std::string> pieces = {"3",
+                                           "0",
+                                           "12",
+                                           "007",
+                                           "123456789012345",
+                                           "1234567890123456",
+                                           "99999999999999999999",
+                                           "-1",
+                                           "+4",
+                                           "3-1",
+                                           "1.5",
+                                           ".5",
+                                           "1e3",
+                                           "2E-2",
+                                           "x",
+                                           "0x10",
+                                           "nan",
+                                           "inf",
+                                           "-",
+                                           "4a",
+                                           "1,2",
+                                           "\t",
+                                           " ",
+                                           "  ",
+                                           "\r",
+                                           "\v",
+                                           "\f",
+                                           "18446744073709551617"};
+  std::mt19937 random(7);
+  for (int trial = 0; trial < 20000; ++trial) {
+    std::string record;
+    const int tokens = static_cast<int>(random() % 7);
+    for (int t = 0; t < tokens; ++t) {
+      record += pieces[random() % pieces.size()];
+      if (random() % 4 != 0) record += (random() % 2 == 0) ? " " : "\t";
+    }
+    const std::vector<double> expected = stream_numbers(record);
+    const std::vector<double> got = internal::CgalRecordNumbers(record);
+    ASSERT_EQ(got.size(), expected.size()) << "record '" << record << "'";
+    for (std::size_t i = 0; i < got.size(); ++i) {
+      // Bit for bit (NaN compared as NaN).
+      ASSERT_TRUE(got[i] == expected[i] || (std::isnan(got[i]) && std::isnan(expected[i])))
+          << "record '" << record << "' number " << i << ": " << got[i] << " vs " << expected[i];
+    }
+  }
+  EXPECT_EQ(internal::CgalRecordNumbers("3 10 11 12"), (std::vector<double>{3, 10, 11, 12}));
+  EXPECT_EQ(internal::CgalRecordNumbers("3-1"), (std::vector<double>{3, -1}));
 }
 
 }  // namespace

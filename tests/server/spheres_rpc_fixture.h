@@ -55,8 +55,7 @@ class SpheresRpcTest : public ::testing::Test {
   std::unique_ptr<grpc::ClientContext> Context(double seconds = 60.0) {
     auto context = std::make_unique<grpc::ClientContext>();
     context->set_deadline(std::chrono::system_clock::now() +
-                          std::chrono::milliseconds(static_cast<std::int64_t>(
-                              1000 * seconds * testing::kSanitizerTimeScale)));
+                          testing::Stretched(std::chrono::duration<double>(seconds)));
     return context;
   }
 

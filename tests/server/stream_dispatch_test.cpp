@@ -116,7 +116,9 @@ TEST_F(StreamDispatchTest, SmallFramesAreAnsweredInlineInOrderLikeBruteForce) {
   // others are, unless the machine is so loaded that the frames measure over the budget; under
   // a sanitizer they may all do (none did under TSan), so the count is checked at normal speed.
   EXPECT_LT(record.inline_frames, kFrames);
-  if (!testing::kSanitizedBuild) EXPECT_GT(record.inline_frames, kFrames / 2);
+  if (!testing::kSanitizedBuild) {
+    EXPECT_GT(record.inline_frames, kFrames / 2);
+  }
 }
 
 // Frames over kSerialFramePairs pairs would run parallel loops, and frames naming a set the
@@ -240,7 +242,9 @@ TEST_F(StreamDispatchTest, DrainAndCancelInTheMiddleOfInlineFrames) {
   }
   // Under a sanitizer the frames may all measure over the inline budget and run on the pool
   // (they did under TSan), which this test then exercises instead.
-  if (!testing::kSanitizedBuild) EXPECT_GT(inline_frames, 0);
+  if (!testing::kSanitizedBuild) {
+    EXPECT_GT(inline_frames, 0);
+  }
 
   // A new stream is answered: no cancelled frame kept its reservation.
   {
@@ -272,7 +276,9 @@ TEST_F(StreamDispatchTest, DrainAndCancelInTheMiddleOfInlineFrames) {
   EXPECT_EQ(drained.error_code(), grpc::StatusCode::UNAVAILABLE) << drained.error_message();
   records = Streams(7);
   EXPECT_EQ(records.back().status.code(), absl::StatusCode::kUnavailable) << records.back().status;
-  if (!testing::kSanitizedBuild) EXPECT_GT(records.back().inline_frames, 0);
+  if (!testing::kSanitizedBuild) {
+    EXPECT_GT(records.back().inline_frames, 0);
+  }
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 #include "inscribe/boundary_oracle.h"
 
 #include <embree3/rtcore.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cmath>
@@ -168,7 +169,6 @@ absl::Status BoundaryOracle::Impl::BuildScene() {
       geometry,
       [](const RTCBoundsFunctionArguments* args) {
         const auto* self = static_cast<const Impl*>(args->geometryUserPtr);
-        internal::TsanAcquire(self);  // see CommitScene
         const auto t = static_cast<std::int32_t>(args->primID);
         Vector3 lo = self->Corner(t, 0), hi = lo;
         for (int k = 1; k < 3; ++k) {
@@ -182,7 +182,6 @@ absl::Status BoundaryOracle::Impl::BuildScene() {
         b->upper_x = RoundUp(hi.x()) + self->pad;
         b->upper_y = RoundUp(hi.y()) + self->pad;
         b->upper_z = RoundUp(hi.z()) + self->pad;
-        internal::TsanRelease(self);
       },
       nullptr);
   // Rays only count crossings (kRayParity); occlusion rays are not used.
@@ -193,12 +192,16 @@ absl::Status BoundaryOracle::Impl::BuildScene() {
   return CommitScene();
 }
 
-// Embree computes the bounds on its own TBB threads, whose start and join TSan does not see: the
-// release before and the acquire after, with the pair in the bounds callback, are those edges.
+// Embree builds in the caller's task arena, on TBB's threads, whose start and join TSan does not
+// see. Under TSan the build runs in an arena of one, on the calling thread alone, so TSan sees
+// the build and its bounds callbacks in order with the code around them.
 absl::Status BoundaryOracle::Impl::CommitScene() {
-  internal::TsanRelease(this);
-  rtcCommitScene(scene);
-  internal::TsanAcquire(this);
+  if constexpr (internal::kThreadSanitizer) {
+    tbb::task_arena calling_thread_only(1);
+    calling_thread_only.execute([this] { rtcCommitScene(scene); });
+  } else {
+    rtcCommitScene(scene);
+  }
   std::lock_guard<std::mutex> lock(error_mutex);
   if (!error.empty()) return absl::InternalError(error);
   return absl::OkStatus();

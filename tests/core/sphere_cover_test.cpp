@@ -122,6 +122,16 @@ void ExpectSoundCover(const Solid& solid, const GeneratedCover& cover, const std
             << cover.repair_rounds << " repair rounds, " << cover.seconds << " s\n";
 }
 
+// The paper's internal spheres of `solid`, at most `max_spheres` of them, unevaluated.
+std::vector<Sphere> InternalSpheres(const Solid& solid, int max_spheres) {
+  SphereSetParameters parameters;
+  parameters.max_spheres = max_spheres;
+  parameters.evaluate = false;
+  absl::StatusOr<GeneratedSphereSet> generated = GenerateSphereSet(solid, parameters);
+  EXPECT_TRUE(generated.ok()) << generated.status();
+  return generated.ok() ? generated->set.spheres : std::vector<Sphere>{};
+}
+
 TEST(CertifyCover, OneBallAroundABoxIsCertifiedWithItsExactReach) {
   const Solid solid = MakeTestSolid(testing::UnitCube());
   const Sphere ball{Vector3::Constant(0.5), std::sqrt(3.0) / 2.0 + 0.01};
@@ -145,12 +155,9 @@ TEST(CertifyCover, OneBallAroundABoxIsCertifiedWithItsExactReach) {
 TEST(CertifyCover, InternalSpheresAreRefusedWithARealWitness) {
   INSCRIBE_REQUIRE_MESH("eight.off");
   const Solid solid = MakeTestSolid(testing::LoadTestMesh("eight.off"));
-  SphereSetParameters parameters;
-  parameters.max_spheres = 100;
-  parameters.evaluate = false;
-  absl::StatusOr<GeneratedSphereSet> internal = GenerateSphereSet(solid, parameters);
-  ASSERT_TRUE(internal.ok()) << internal.status();
-  absl::StatusOr<CoverCertificate> certificate = CertifyCover(solid, internal->set.spheres);
+  const std::vector<Sphere> spheres = InternalSpheres(solid, 100);
+  ASSERT_FALSE(spheres.empty());
+  absl::StatusOr<CoverCertificate> certificate = CertifyCover(solid, spheres);
   ASSERT_TRUE(certificate.ok()) << certificate.status();
   EXPECT_FALSE(certificate->certified);
   EXPECT_GT(certificate->failed_cells, 0);
@@ -158,7 +165,7 @@ TEST(CertifyCover, InternalSpheresAreRefusedWithARealWitness) {
   const Vector3 p = *certificate->uncovered_point;
   EXPECT_EQ(solid.oracle.Classify(p), Side::kInside);
   EXPECT_NEAR(certificate->uncovered_depth, solid.oracle.ClosestPoint(p).distance, 1e-12);
-  for (const Sphere& s : internal->set.spheres) EXPECT_GT((p - s.center).norm(), s.radius);
+  for (const Sphere& s : spheres) EXPECT_GT((p - s.center).norm(), s.radius);
   EXPECT_GT(certificate->uncovered_gap, 0.0);
   // Internal spheres barely protrude: delta is near 0.
   const double largest = ComputeBoundingBox(solid.mesh().vertices).extent().maxCoeff();
@@ -170,15 +177,12 @@ TEST(CertifyCover, InternalSpheresAreRefusedWithARealWitness) {
 TEST(CertifyCover, KeepsTheFirstFailedCellsInOrder) {
   INSCRIBE_REQUIRE_MESH("eight.off");
   const Solid solid = MakeTestSolid(testing::LoadTestMesh("eight.off"));
-  SphereSetParameters parameters;
-  parameters.max_spheres = 60;
-  parameters.evaluate = false;
-  absl::StatusOr<GeneratedSphereSet> internal = GenerateSphereSet(solid, parameters);
-  ASSERT_TRUE(internal.ok()) << internal.status();
+  const std::vector<Sphere> spheres = InternalSpheres(solid, 60);
+  ASSERT_FALSE(spheres.empty());
   CoverCertifyOptions options;
   options.resolution = 1.0 / 128;
   options.stop_at_witness = false;
-  absl::StatusOr<CoverCertificate> all = CertifyCover(solid, internal->set.spheres, options);
+  absl::StatusOr<CoverCertificate> all = CertifyCover(solid, spheres, options);
   ASSERT_TRUE(all.ok()) << all.status();
   ASSERT_GT(all->failed_cells, 100);
   ASSERT_EQ(static_cast<std::int64_t>(all->failures.size()), all->failed_cells);
@@ -190,7 +194,7 @@ TEST(CertifyCover, KeepsTheFirstFailedCellsInOrder) {
   }
   for (const std::int64_t keep : {std::int64_t{0}, std::int64_t{7}, all->failed_cells / 3}) {
     options.max_failures_kept = keep;
-    absl::StatusOr<CoverCertificate> some = CertifyCover(solid, internal->set.spheres, options);
+    absl::StatusOr<CoverCertificate> some = CertifyCover(solid, spheres, options);
     ASSERT_TRUE(some.ok()) << some.status();
     EXPECT_EQ(some->failed_cells, all->failed_cells);
     EXPECT_EQ(some->cells, all->cells);

@@ -1,6 +1,7 @@
 // Private: exact self-intersection test of a closed triangle mesh (CGAL).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <utility>
@@ -14,8 +15,10 @@ namespace inscribe::internal {
 // vertices or edge, using exact predicates. Triangles with repeated corners are ignored.
 // Returns nullopt when the mesh is not a polygon mesh CGAL can build (e.g. non-manifold
 // vertices); the caller then reports the check as not done. Cost O(#T log #T) typically.
+// The search runs in `slab_count` parallel parts (0: by the mesh's size and the thread count);
+// the pairs do not depend on it.
 std::optional<std::vector<std::pair<std::int32_t, std::int32_t>>> SelfIntersectingPairs(
-    const Mesh& mesh);
+    const Mesh& mesh, std::size_t slab_count = 0);
 
 // Whether the triangles with distinct corners form an oriented 2-manifold with boundary, the
 // soup CGAL's polygon_soup_to_polygon_mesh needs: every edge in at most two of them, walked in

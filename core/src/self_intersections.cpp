@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <iterator>
 #include <limits>
@@ -26,6 +27,81 @@ using SurfaceMesh = CGAL::Surface_mesh<Point>;
 Point VertexPoint(const Mesh& mesh, Eigen::Index v) {
   return Point(mesh.vertices(v, 0), mesh.vertices(v, 1), mesh.vertices(v, 2));
 }
+
+using Point2 = Kernel::Point_2;
+
+// The coordinates of `p` other than `drop`, as a point of the plane.
+Point2 Projected(const Vector3& p, int drop) {
+  return Point2(p[drop == 0 ? 1 : 0], p[drop == 2 ? 1 : 2]);
+}
+
+Vector3 ToVector(const Point& p) { return Vector3(p.x(), p.y(), p.z()); }
+
+// Whether some edge line of the convex polygon `a` (2 or 3 points) has all of `b` strictly on
+// the side away from `a`. A segment's line has `a` on no side, so it separates when all of `b`
+// is strictly on one side of it.
+bool SomeEdgeSeparates(const Point2* a, int a_count, const Point2* b, int b_count) {
+  for (int i = 0; i < a_count; ++i) {
+    const int j = (i + 1) % a_count;
+    if (a_count == 2 && i == 1) break;  // a segment has one line
+    CGAL::Orientation away;
+    if (a_count == 3) {
+      away = -CGAL::orientation(a[i], a[j], a[3 - i - j]);
+      if (away == CGAL::COLLINEAR) return false;  // a flat projection: no edge is an outside
+    } else {
+      away = CGAL::orientation(a[i], a[j], b[0]);
+      if (away == CGAL::COLLINEAR) continue;
+    }
+    bool all = true;
+    for (int k = 0; k < b_count && all; ++k) all = CGAL::orientation(a[i], a[j], b[k]) == away;
+    if (all) return true;
+  }
+  return false;
+}
+
+// CGAL's triangle-triangle and triangle-segment tests with a screen in front: when the shapes'
+// shadows on the coordinate plane facing the triangle are strictly apart (a line separates
+// them, decided by exact 2D orientations), the shapes share no point, since a common point
+// would cast its shadow into both. Neighbouring triangles of a nearly flat surface (midpoint
+// subdivision, CAD faces) then skip CGAL's 3D test, whose filters fail on near-coplanar points
+// and fall back to exact multi-precision arithmetic. Every other pair gets CGAL's test, so the
+// answers are CGAL's.
+struct ScreenedTraits : Kernel {
+  struct Do_intersect_3 {
+    using result_type = bool;
+    Kernel::Do_intersect_3 exact;
+
+    bool operator()(const Kernel::Triangle_3& t, const Kernel::Segment_3& s) const {
+      const Vector3 triangle[3] = {ToVector(t[0]), ToVector(t[1]), ToVector(t[2])};
+      const Vector3 other[2] = {ToVector(s.source()), ToVector(s.target())};
+      return !ShadowsApart(triangle, other, 2) && exact(t, s);
+    }
+    bool operator()(const Kernel::Triangle_3& t, const Kernel::Triangle_3& u) const {
+      const Vector3 triangle[3] = {ToVector(t[0]), ToVector(t[1]), ToVector(t[2])};
+      const Vector3 other[3] = {ToVector(u[0]), ToVector(u[1]), ToVector(u[2])};
+      return !ShadowsApart(triangle, other, 3) && exact(t, u);
+    }
+  };
+  Do_intersect_3 do_intersect_3_object() const { return {}; }
+};
+
+}  // namespace
+
+bool ShadowsApart(const Vector3 triangle[3], const Vector3* other, int count) {
+  // Any plane gives a sound answer; the one facing the triangle most often separates.
+  const Vector3 normal = (triangle[1] - triangle[0]).cross(triangle[2] - triangle[0]);
+  int drop = 0;
+  for (int k = 1; k < 3; ++k) {
+    if (std::abs(normal[k]) > std::abs(normal[drop])) drop = k;
+  }
+  const Point2 a[3] = {Projected(triangle[0], drop), Projected(triangle[1], drop),
+                       Projected(triangle[2], drop)};
+  Point2 b[3];
+  for (int k = 0; k < count; ++k) b[k] = Projected(other[k], drop);
+  return SomeEdgeSeparates(a, 3, b, count) || SomeEdgeSeparates(b, count, a, 3);
+}
+
+namespace {
 
 // Slabs for a search over `faces` faces: one per kFacesPerSlab, at most four per thread.
 std::size_t AutomaticSlabCount(std::size_t faces) {
@@ -148,8 +224,9 @@ std::optional<std::vector<std::pair<std::int32_t, std::int32_t>>> SelfIntersecti
     std::vector<std::vector<std::pair<SurfaceMesh::Face_index, SurfaceMesh::Face_index>>> found(
         slabs.size());
     ParallelFor(std::size_t{0}, slabs.size(), [&](std::size_t k) {
-      PMP::self_intersections<CGAL::Sequential_tag>(slabs[k], surface,
-                                                    std::back_inserter(found[k]));
+      PMP::self_intersections<CGAL::Sequential_tag>(
+          slabs[k], surface, std::back_inserter(found[k]),
+          CGAL::parameters::geom_traits(ScreenedTraits()));
     });
     // polygon_soup_to_polygon_mesh adds faces in input order, so face i is polygon i.
     std::vector<std::pair<std::int32_t, std::int32_t>> pairs;

@@ -20,6 +20,13 @@ namespace inscribe::internal {
 std::optional<std::vector<std::pair<std::int32_t, std::int32_t>>> SelfIntersectingPairs(
     const Mesh& mesh, std::size_t slab_count = 0);
 
+// Whether the shadows of `triangle` and of the convex hull of `other` (count 2: a segment, 3: a
+// triangle) on the coordinate plane facing the triangle are strictly apart, with exact 2D
+// orientations: when true, the two share no point. Used before CGAL's 3D test in
+// SelfIntersectingPairs, where it decides most neighbouring pairs of nearly flat surfaces
+// without CGAL's exact fallback.
+bool ShadowsApart(const Vector3 triangle[3], const Vector3* other, int count);
+
 // Whether the triangles with distinct corners form an oriented 2-manifold with boundary, the
 // soup CGAL's polygon_soup_to_polygon_mesh needs: every edge in at most two of them, walked in
 // opposite directions when in two, and the triangles around each vertex one fan (connected

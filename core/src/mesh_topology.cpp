@@ -96,4 +96,15 @@ void DisjointSets::Union(std::size_t a, std::size_t b) {
   size_[a] += size_[b];
 }
 
+EdgeGroups GroupEdges(const std::vector<EdgeUse>& uses) {
+  EdgeGroups groups;
+  for (std::size_t i = 0; i < uses.size();) {
+    std::size_t j = i + 1;
+    while (j < uses.size() && uses[j].lo == uses[i].lo && uses[j].hi == uses[i].hi) ++j;
+    groups.ranges.emplace_back(i, j);
+    i = j;
+  }
+  return groups;
+}
+
 }  // namespace inscribe::internal

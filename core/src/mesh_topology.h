@@ -2,7 +2,9 @@
 // boundary oracle.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "inscribe/mesh.h"
@@ -21,6 +23,13 @@ struct EdgeUse {
 // so that the uses of one edge are adjacent. Cost O(#T + #V) when every corner is a vertex
 // index (a counting sort by lo, then each vertex's uses by hi), O(#T log #T) otherwise.
 std::vector<EdgeUse> SortedEdgeUses(const Mesh& mesh);
+
+// The uses of each undirected edge in SortedEdgeUses' output: index ranges [begin, end), one
+// per edge, in order.
+struct EdgeGroups {
+  std::vector<std::pair<std::size_t, std::size_t>> ranges;
+};
+EdgeGroups GroupEdges(const std::vector<EdgeUse>& uses);
 
 // Disjoint sets with path halving and union by size.
 class DisjointSets {

@@ -9,6 +9,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "hole_filling.h"
+#include "mesh_orientation.h"
 #include "mesh_topology.h"
 #include "self_intersections.h"
 #include "vertex_welding.h"
@@ -17,11 +18,9 @@ namespace inscribe {
 namespace {
 
 using internal::DisjointSets;
+using internal::EdgeGroups;
 using internal::EdgeUse;
-
-// Above this many components, nesting (which shells are cavities) costs O(#components * #T)
-// and is skipped: every component is then oriented to enclose positive volume.
-constexpr std::int64_t kMaxComponentsForNesting = 256;
+using internal::GroupEdges;
 
 void AddIssue(MeshReport& report, Severity severity, std::string code, std::string message,
               std::int64_t count) {
@@ -30,39 +29,6 @@ void AddIssue(MeshReport& report, Severity severity, std::string code, std::stri
 
 std::string Plural(std::int64_t n, const char* singular, const char* plural) {
   return absl::StrCat(n, " ", n == 1 ? singular : plural);
-}
-
-// Generalized winding number of the closed surface made of `triangles` at `p`: the sum of the
-// signed solid angles / 4 pi (Van Oosterom & Strackee). +-1 inside, 0 outside.
-double WindingNumber(const Mesh& mesh, const std::vector<std::int32_t>& triangles,
-                     const Vector3& p) {
-  double total = 0.0;
-  for (std::int32_t t : triangles) {
-    const Vector3 a = mesh.vertices.row(mesh.triangles(t, 0)).transpose() - p;
-    const Vector3 b = mesh.vertices.row(mesh.triangles(t, 1)).transpose() - p;
-    const Vector3 c = mesh.vertices.row(mesh.triangles(t, 2)).transpose() - p;
-    const double la = a.norm(), lb = b.norm(), lc = c.norm();
-    const double numerator = a.dot(b.cross(c));
-    const double denominator = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
-    total += 2.0 * std::atan2(numerator, denominator);
-  }
-  return total / (4.0 * M_PI);
-}
-
-double ComponentVolume(const Mesh& mesh, const std::vector<std::int32_t>& triangles,
-                       const Vector3& origin) {
-  double six_volume = 0.0;
-  for (std::int32_t t : triangles) {
-    const Vector3 a = mesh.vertices.row(mesh.triangles(t, 0)).transpose() - origin;
-    const Vector3 b = mesh.vertices.row(mesh.triangles(t, 1)).transpose() - origin;
-    const Vector3 c = mesh.vertices.row(mesh.triangles(t, 2)).transpose() - origin;
-    six_volume += a.dot(b.cross(c));
-  }
-  return six_volume / 6.0;
-}
-
-void FlipTriangle(Mesh& mesh, Eigen::Index t) {
-  std::swap(mesh.triangles(t, 1), mesh.triangles(t, 2));
 }
 
 // Checks that every coordinate is finite and every index names a vertex. Returns false when
@@ -170,22 +136,6 @@ void CheckDegenerateAndDuplicate(const Mesh& mesh, MeshReport& report) {
                           " in no triangle (ignored)"),
              report.unreferenced_vertices);
   }
-}
-
-struct EdgeGroups {
-  // Index ranges [begin, end) into the sorted uses, one per undirected edge.
-  std::vector<std::pair<std::size_t, std::size_t>> ranges;
-};
-
-EdgeGroups GroupEdges(const std::vector<EdgeUse>& uses) {
-  EdgeGroups groups;
-  for (std::size_t i = 0; i < uses.size();) {
-    std::size_t j = i + 1;
-    while (j < uses.size() && uses[j].lo == uses[i].lo && uses[j].hi == uses[i].hi) ++j;
-    groups.ranges.emplace_back(i, j);
-    i = j;
-  }
-  return groups;
 }
 
 void CheckEdges(const Mesh& mesh, const std::vector<EdgeUse>& uses, const EdgeGroups& groups,
@@ -302,120 +252,16 @@ std::vector<std::int32_t> LabelComponents(const Mesh& mesh, const std::vector<Ed
   return label;
 }
 
-// Makes orientation consistent across every manifold edge by breadth-first search, keeping
-// the majority orientation of each component; returns false if a component is not orientable.
-bool MakeConsistent(Mesh& mesh, const std::vector<EdgeUse>& uses, const EdgeGroups& groups,
-                    const std::vector<std::int32_t>& component, std::int64_t num_components,
-                    std::vector<char>& flip, std::int64_t* non_orientable_triangle) {
-  const std::size_t nt = static_cast<std::size_t>(mesh.num_triangles());
-  // Adjacency through manifold edges: neighbour and whether the pair currently agrees.
-  std::vector<std::vector<std::pair<std::int32_t, bool>>> adjacent(nt);
-  for (const auto& [begin, end] : groups.ranges) {
-    if (end - begin != 2) continue;
-    const EdgeUse& a = uses[begin];
-    const EdgeUse& b = uses[begin + 1];
-    const bool agree = a.forward != b.forward;
-    adjacent[static_cast<std::size_t>(a.triangle)].emplace_back(b.triangle, agree);
-    adjacent[static_cast<std::size_t>(b.triangle)].emplace_back(a.triangle, agree);
-  }
-  flip.assign(nt, 0);
-  std::vector<char> seen(nt, 0);
-  std::vector<std::int64_t> flips_in(static_cast<std::size_t>(num_components), 0);
-  std::vector<std::int64_t> size_of(static_cast<std::size_t>(num_components), 0);
-  std::deque<std::int32_t> queue;
-  for (std::size_t start = 0; start < nt; ++start) {
-    if (seen[start] || component[start] < 0) continue;
-    seen[start] = 1;
-    queue.push_back(static_cast<std::int32_t>(start));
-    while (!queue.empty()) {
-      const std::int32_t t = queue.front();
-      queue.pop_front();
-      const auto c = static_cast<std::size_t>(component[static_cast<std::size_t>(t)]);
-      ++size_of[c];
-      flips_in[c] += flip[static_cast<std::size_t>(t)];
-      for (const auto& [u, agree] : adjacent[static_cast<std::size_t>(t)]) {
-        // After flipping, t and u agree iff (agree XOR flip[t] XOR flip[u]).
-        const char wanted = static_cast<char>(flip[static_cast<std::size_t>(t)] ^ !agree);
-        if (!seen[static_cast<std::size_t>(u)]) {
-          seen[static_cast<std::size_t>(u)] = 1;
-          flip[static_cast<std::size_t>(u)] = wanted;
-          queue.push_back(u);
-        } else if (flip[static_cast<std::size_t>(u)] != wanted) {
-          *non_orientable_triangle = t;
-          return false;
-        }
-      }
-    }
-  }
-  for (std::size_t t = 0; t < nt; ++t) {
-    if (component[t] < 0) continue;
-    const auto c = static_cast<std::size_t>(component[t]);
-    if (2 * flips_in[c] > size_of[c]) flip[t] ^= 1;  // keep the majority as it is
-    if (flip[t]) FlipTriangle(mesh, static_cast<Eigen::Index>(t));
-  }
-  return true;
-}
-
-// Points every component's normals away from the solid: a shell inside an even number of
-// other shells bounds material from outside (positive volume), one inside an odd number is a
-// cavity (negative volume).
+// internal::OrientComponentsOutward, with a warning when there were too many components to
+// find the cavities.
 void OrientOutward(Mesh& mesh, const std::vector<std::int32_t>& component,
                    std::int64_t num_components, std::vector<char>& flip, MeshReport& report) {
-  std::vector<std::vector<std::int32_t>> members(static_cast<std::size_t>(num_components));
-  for (std::size_t t = 0; t < component.size(); ++t) {
-    if (component[t] >= 0)
-      members[static_cast<std::size_t>(component[t])].push_back(static_cast<std::int32_t>(t));
-  }
-  const BoundingBox box = ComputeBoundingBox(mesh.vertices);
-  const Vector3 origin = 0.5 * (box.min + box.max);
-  const bool nesting = num_components <= kMaxComponentsForNesting;
-  if (!nesting) {
+  if (!internal::OrientComponentsOutward(mesh, component, num_components, flip)) {
     AddIssue(report, Severity::kWarning, "nesting_not_checked",
              absl::StrCat("mesh has ", num_components,
                           " components; cavities were not detected, every component was "
                           "oriented to enclose positive volume"),
              num_components);
-  }
-  // Per component: its bounding box and up to kSamples of its vertices, spread over it.
-  constexpr std::size_t kSamples = 16;
-  std::vector<BoundingBox> boxes(members.size());
-  std::vector<std::vector<Vector3>> samples(members.size());
-  for (std::size_t c = 0; c < members.size(); ++c) {
-    Vector3 lo = Vector3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
-    for (std::int32_t t : members[c]) {
-      for (int k = 0; k < 3; ++k) {
-        lo = lo.cwiseMin(mesh.vertices.row(mesh.triangles(t, k)).transpose());
-        hi = hi.cwiseMax(mesh.vertices.row(mesh.triangles(t, k)).transpose());
-      }
-    }
-    boxes[c] = BoundingBox{lo, hi};
-    const std::size_t step = std::max<std::size_t>(1, members[c].size() / kSamples);
-    for (std::size_t i = 0; i < members[c].size() && samples[c].size() < kSamples; i += step) {
-      samples[c].push_back(mesh.vertices.row(mesh.triangles(members[c][i], 0)).transpose());
-    }
-  }
-  auto box_inside = [](const BoundingBox& a, const BoundingBox& b) {
-    return (a.min.array() >= b.min.array()).all() && (a.max.array() <= b.max.array()).all();
-  };
-  for (std::size_t c = 0; c < members.size(); ++c) {
-    const double volume = ComponentVolume(mesh, members[c], origin);
-    // Depth = how many other shells enclose this one entirely (every sample inside). Shells
-    // that merely overlap (a self-intersecting union) do not count: they are not cavities.
-    int depth = 0;
-    for (std::size_t other = 0; nesting && other < members.size(); ++other) {
-      if (other == c || !box_inside(boxes[c], boxes[other])) continue;
-      const bool enclosed = std::all_of(
-          samples[c].begin(), samples[c].end(),
-          [&](const Vector3& p) { return std::abs(WindingNumber(mesh, members[other], p)) > 0.5; });
-      if (enclosed) ++depth;
-    }
-    const bool want_positive = depth % 2 == 0;
-    if ((volume > 0) != want_positive && volume != 0.0) {
-      for (std::int32_t t : members[c]) {
-        FlipTriangle(mesh, t);
-        flip[static_cast<std::size_t>(t)] ^= 1;
-      }
-    }
   }
 }
 
@@ -457,7 +303,8 @@ void CheckOrientation(Mesh& mesh, const std::vector<EdgeUse>& uses, const EdgeGr
   }
   std::vector<char> flip;
   std::int64_t bad_triangle = -1;
-  if (!MakeConsistent(mesh, uses, groups, component, report.components, flip, &bad_triangle)) {
+  if (!internal::MakeOrientationConsistent(mesh, uses, groups, component, report.components, flip,
+                                           &bad_triangle)) {
     AddIssue(report, Severity::kError, "not_orientable",
              absl::StrCat("mesh is not orientable (a Moebius-like component contains triangle ",
                           bad_triangle, ")"),
@@ -496,7 +343,8 @@ void FillHolesAndOrient(Mesh& mesh, const std::vector<EdgeUse>& uses, const Edge
   std::vector<char> flip(static_cast<std::size_t>(mesh.num_triangles()), 0);
   std::int64_t bad_triangle = -1;
   if (options.fix_orientation &&
-      !MakeConsistent(closed, uses, groups, component, report.components, flip, &bad_triangle)) {
+      !internal::MakeOrientationConsistent(closed, uses, groups, component, report.components, flip,
+                                           &bad_triangle)) {
     return keep_open(
         absl::StrCat("holes were not filled: a component is not orientable "
                      "(it contains triangle ",

@@ -38,22 +38,18 @@ Point2 Projected(const Vector3& p, int drop) {
 Vector3 ToVector(const Point& p) { return Vector3(p.x(), p.y(), p.z()); }
 
 // Whether some edge line of the convex polygon `a` (2 or 3 points) has all of `b` strictly on
-// the side away from `a`. A segment's line has `a` on no side, so it separates when all of `b`
-// is strictly on one side of it.
+// one side: for a triangle, the side away from its third corner; a segment has one line, and
+// either side will do.
 bool SomeEdgeSeparates(const Point2* a, int a_count, const Point2* b, int b_count) {
-  for (int i = 0; i < a_count; ++i) {
-    const int j = (i + 1) % a_count;
-    if (a_count == 2 && i == 1) break;  // a segment has one line
-    CGAL::Orientation away;
-    if (a_count == 3) {
-      away = -CGAL::orientation(a[i], a[j], a[3 - i - j]);
-      if (away == CGAL::COLLINEAR) return false;  // a flat projection: no edge is an outside
-    } else {
-      away = CGAL::orientation(a[i], a[j], b[0]);
-      if (away == CGAL::COLLINEAR) continue;
-    }
+  const int lines = a_count == 3 ? 3 : 1;
+  for (int i = 0; i < lines; ++i) {
+    const Point2& p = a[i];
+    const Point2& q = a[(i + 1) % a_count];
+    const CGAL::Orientation side =
+        a_count == 3 ? -CGAL::orientation(p, q, a[(i + 2) % 3]) : CGAL::orientation(p, q, b[0]);
+    if (side == CGAL::COLLINEAR) continue;
     bool all = true;
-    for (int k = 0; k < b_count && all; ++k) all = CGAL::orientation(a[i], a[j], b[k]) == away;
+    for (int k = 0; k < b_count && all; ++k) all = CGAL::orientation(p, q, b[k]) == side;
     if (all) return true;
   }
   return false;
@@ -169,9 +165,7 @@ bool IsOrientedManifold(const Mesh& mesh) {
     const int k = mesh.triangles(use.triangle, use.side) == vertex ? use.side : (use.side + 1) % 3;
     return static_cast<std::size_t>(use.triangle) * 3 + static_cast<std::size_t>(k);
   };
-  for (std::size_t i = 0; i < uses.size();) {
-    std::size_t j = i + 1;
-    while (j < uses.size() && uses[j].lo == uses[i].lo && uses[j].hi == uses[i].hi) ++j;
+  for (const auto& [i, j] : GroupEdges(uses).ranges) {
     if (j - i > 2) return false;
     if (j - i == 2) {
       if (uses[i].forward == uses[i + 1].forward) return false;
@@ -179,7 +173,6 @@ bool IsOrientedManifold(const Mesh& mesh) {
         fans.Union(corner(uses[i], vertex), corner(uses[i + 1], vertex));
       }
     }
-    i = j;
   }
   std::vector<std::size_t> fan_of(static_cast<std::size_t>(mesh.num_vertices()),
                                   std::numeric_limits<std::size_t>::max());

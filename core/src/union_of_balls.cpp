@@ -493,6 +493,11 @@ absl::StatusOr<double> UnionVolume(const std::vector<Sphere>& balls, const DualC
   // The tetrahedra on each triangle (0, 1 or 2): a tetrahedron's term leaves out its faces'
   // angle terms, which its triangles weigh by 1 - cofaces / 2 instead, so that a triangle
   // inside the complex (two tetrahedra) needs no angle at all.
+  // A face is looked up among the few triangles with the same lowest ball: `first_triangle[b]`
+  // is where they start in the (sorted) list.
+  std::vector<std::size_t> first_triangle(balls.size() + 1, 0);
+  for (const auto& t : complex.triangles) ++first_triangle[static_cast<std::size_t>(t[0]) + 1];
+  std::partial_sum(first_triangle.begin(), first_triangle.end(), first_triangle.begin());
   std::vector<std::atomic<std::uint8_t>> cofaces(complex.triangles.size());
   ForEachIndex(complex.tetrahedra.size(), [&](std::size_t s) {
     const std::array<std::int32_t, 4>& t = complex.tetrahedra[s];
@@ -501,8 +506,13 @@ absl::StatusOr<double> UnionVolume(const std::vector<Sphere>& balls, const DualC
       for (std::size_t k = 0, j = 0; k < 4; ++k) {
         if (k != skip) face[j++] = t[k];
       }
-      const auto it = std::lower_bound(complex.triangles.begin(), complex.triangles.end(), face);
-      if (it != complex.triangles.end() && *it == face) {
+      const std::size_t lowest = static_cast<std::size_t>(face[0]);
+      const auto end = complex.triangles.begin() +
+                       static_cast<std::ptrdiff_t>(first_triangle[lowest + 1]);
+      const auto it = std::lower_bound(
+          complex.triangles.begin() + static_cast<std::ptrdiff_t>(first_triangle[lowest]), end,
+          face);
+      if (it != end && *it == face) {
         cofaces[static_cast<std::size_t>(it - complex.triangles.begin())].fetch_add(
             1, std::memory_order_relaxed);
       }

@@ -105,24 +105,26 @@ class VoxelSearch {
 
   // Best candidate in the cube [corner, corner + size)^3. The screening subset runs first; a
   // voxel where none of its segments crosses the medial surface inside the voxel is left empty
-  // without the other samples.
-  Candidate Run(const Vector3& corner, double size, VoxelCounters& counters) const {
+  // without the other samples. `last_foot`: a boundary point found before (the previous
+  // voxel's), which bounds the first sample's query; updated to this voxel's last.
+  Candidate Run(const Vector3& corner, double size, VoxelCounters& counters,
+                std::optional<Vector3>& last_foot) const {
     Candidate best;
     best.sphere.radius = -1.0;
     const std::int64_t searched_before = counters.searched_pairs;
-    Sample(0, screen_count_, corner, size, best, counters);
+    Sample(0, screen_count_, corner, size, best, counters, last_foot);
     if (screen_count_ > 0 && counters.searched_pairs == searched_before) return best;
-    Sample(screen_count_, directions_.size(), corner, size, best, counters);
+    Sample(screen_count_, directions_.size(), corner, size, best, counters, last_foot);
     return best;
   }
 
  private:
+  // The previous sample's nearest boundary point bounds the next sample's query.
   void Sample(std::size_t first, std::size_t last, const Vector3& corner, double size,
-              Candidate& best, VoxelCounters& counters) const {
+              Candidate& best, VoxelCounters& counters,
+              std::optional<Vector3>& previous_foot) const {
     const Vector3 centre = corner + Vector3::Constant(0.5 * size);
     const double circumradius = 0.5 * kSqrt3 * size;
-    // The previous sample's nearest boundary point bounds the next sample's query.
-    std::optional<Vector3> previous_foot;
     for (std::size_t d = first; d < last; ++d) {
       const Vector3 p = centre + circumradius * directions_[d];
       const BoundaryPoint bp =
@@ -177,7 +179,7 @@ class VoxelSearch {
   // than it (padded for rounding in the norm).
   BoundaryPoint Query(const Vector3& x, const Vector3& known, VoxelCounters& counters) const {
     ++counters.queries;
-    return oracle_.ClosestPoint(x, (x - known).norm() * (1.0 + 1e-12) + 1e-300);
+    return oracle_.ClosestPointNear(x, known);
   }
 
   // Locates the medial crossing on (p, q) to within epsilon and keeps it in `best` if it passes.
@@ -396,6 +398,7 @@ absl::StatusOr<MedialSphereResult> GenerateMedialSpheres(const BoundaryOracle& o
     std::vector<Candidate> found((last - first) * static_cast<std::size_t>(slots));
     std::vector<VoxelCounters> counters(last - first);
     internal::ParallelForRange(first, last, 8, [&](std::size_t begin, std::size_t end) {
+      std::optional<Vector3> last_foot;  // bounds queries only: the answers do not depend on it
       for (std::size_t v = begin; v != end; ++v) {
         if (control.cancelled()) return;
         if (!screened_in.empty() && !screened_in[v]) continue;
@@ -404,7 +407,7 @@ absl::StatusOr<MedialSphereResult> GenerateMedialSpheres(const BoundaryOracle& o
         VoxelCounters& count = counters[v - first];
         Candidate* out = &found[(v - first) * static_cast<std::size_t>(slots)];
         if (!options.subdivide_boundary || !voxel.boundary) {
-          out[0] = search.Run(corner, size, count);
+          out[0] = search.Run(corner, size, count, last_foot);
           continue;
         }
         const double half = 0.5 * size;
@@ -415,7 +418,7 @@ absl::StatusOr<MedialSphereResult> GenerateMedialSpheres(const BoundaryOracle& o
           ++count.queries;
           const double distance = oracle.SignedDistance(sub_corner + Vector3::Constant(0.5 * half));
           if (distance > 0.5 * kSqrt3 * half) continue;  // this half is wholly outside
-          out[octant] = search.Run(sub_corner, half, count);
+          out[octant] = search.Run(sub_corner, half, count, last_foot);
         }
       }
     });

@@ -82,8 +82,7 @@ struct Depth {
 
 Depth DepthOf(const BoundaryOracle& oracle, const Vector3& query, double bound) {
   Depth out;
-  // The bound is |query - p| for a boundary point p, computed with rounding: pad it.
-  out.closest = oracle.ClosestPoint(query, bound * (1.0 + 1e-12) + 1e-300);
+  out.closest = oracle.ClosestPoint(query, BoundaryOracle::PaddedDistanceBound(bound));
   const Side side = oracle.Classify(query, out.closest);
   out.depth = side == Side::kInside    ? out.closest.distance
               : side == Side::kOutside ? -out.closest.distance

@@ -378,8 +378,8 @@ absl::StatusOr<DilationResult> DilateSpheres(const BoundaryOracle& oracle, const
                   std::min(bound, (p.point - centre_closest[static_cast<std::size_t>(s)]).norm());
             }
           }
-          // The bound is a rounded distance to a boundary point: pad it.
-          const Vector3 m = oracle.ClosestPoint(p.point, bound * (1.0 + 1e-12) + 1e-300).point;
+          const Vector3 m =
+              oracle.ClosestPoint(p.point, BoundaryOracle::PaddedDistanceBound(bound)).point;
           for (int k = 0; k < 3; ++k) {
             const std::int32_t s = p.spheres[static_cast<std::size_t>(k)];
             reach[q][static_cast<std::size_t>(k)] =

@@ -507,8 +507,8 @@ absl::StatusOr<double> UnionVolume(const std::vector<Sphere>& balls, const DualC
         if (k != skip) face[j++] = t[k];
       }
       const std::size_t lowest = static_cast<std::size_t>(face[0]);
-      const auto end = complex.triangles.begin() +
-                       static_cast<std::ptrdiff_t>(first_triangle[lowest + 1]);
+      const auto end =
+          complex.triangles.begin() + static_cast<std::ptrdiff_t>(first_triangle[lowest + 1]);
       const auto it = std::lower_bound(
           complex.triangles.begin() + static_cast<std::ptrdiff_t>(first_triangle[lowest]), end,
           face);

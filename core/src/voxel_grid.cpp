@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "absl/strings/str_format.h"
 #include "parallel.h"
@@ -161,10 +162,15 @@ std::vector<char> ScreenByCorners(const BoundaryOracle& oracle, const Grid& grid
   ParallelForRange(std::size_t{0}, vertices.size(), 256, [&](std::size_t begin, std::size_t end) {
     // Cancelled: stop; the caller discards the (incomplete) result.
     if (cancel != nullptr && cancel->load(std::memory_order_relaxed)) return;
+    // Consecutive vertices are mostly neighbours along x: the previous foot bounds the query.
+    std::optional<Vector3> previous_foot;
     for (std::size_t v = begin; v != end; ++v) {
       const std::int64_t id = vertices[v];
       const Vector3 x = grid.corner(id % vx, (id / vx) % vy, id / (vx * vy));
-      directions[v] = InwardDirectionAtFoot(mesh, x, oracle.ClosestPoint(x));
+      const BoundaryPoint foot =
+          previous_foot ? oracle.ClosestPointNear(x, *previous_foot) : oracle.ClosestPoint(x);
+      previous_foot = foot.point;
+      directions[v] = InwardDirectionAtFoot(mesh, x, foot);
     }
   });
   queries += static_cast<std::int64_t>(vertices.size());

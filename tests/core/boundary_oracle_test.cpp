@@ -329,6 +329,16 @@ TEST_P(OracleOnMesh, BoundedClosestPointEqualsUnbounded) {
                       << " differs from the unbounded query (distance " << expected.distance << ")";
       }
     }
+    // The padded bound from a boundary point: the answer itself (the tightest), the previous
+    // query's foot, a vertex.
+    const Vector3 knowns[] = {expected.point, oracle->ClosestPoint(previous).point,
+                              mesh.vertices.row(pick(rng)).transpose()};
+    for (const Vector3& known : knowns) {
+      if (!Identical(oracle->ClosestPointNear(p, known), expected) && differences++ < 5) {
+        ADD_FAILURE() << "query " << i << " at " << p.transpose() << " near " << known.transpose()
+                      << " differs from the unbounded query (distance " << expected.distance << ")";
+      }
+    }
   }
   EXPECT_EQ(differences, 0);
 }

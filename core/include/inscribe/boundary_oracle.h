@@ -84,6 +84,16 @@ class BoundaryOracle {
   // everything farther from the start. A bound below the true distance (broken guarantee) is
   // detected and answered by the unbounded query: still right, but slower than either.
   BoundaryPoint ClosestPoint(const Vector3& query, double upper_bound) const;
+  // ClosestPoint(query, bound) with the bound taken from `known`, a boundary point the caller
+  // already has (e.g. the foot of a nearby query).
+  BoundaryPoint ClosestPointNear(const Vector3& query, const Vector3& known) const {
+    return ClosestPoint(query, PaddedDistanceBound((query - known).norm()));
+  }
+  // An upper bound for ClosestPoint from a distance to a boundary point computed with rounding:
+  // padded so that the rounding cannot make it smaller than the exact distance.
+  static double PaddedDistanceBound(double rounded_distance) {
+    return rounded_distance * (1.0 + 1e-12) + 1e-300;
+  }
   Side Classify(const Vector3& query) const;
   // The same answer as Classify(query), given `closest` = ClosestPoint(query) (with or without
   // a bound), so the pseudonormal test costs no second query. The ray-parity test casts its

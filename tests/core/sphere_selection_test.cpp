@@ -11,9 +11,12 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
+#include <queue>
 #include <random>
 #include <vector>
 
+#include "coverage_grid.h"
+#include "inscribe/medial_spheres.h"
 #include "inscribe/solid.h"
 #include "inscribe/sphere_set_generation.h"
 #include "inscribe/union_of_balls.h"
@@ -75,6 +78,70 @@ std::vector<Sphere> EagerGreedy(const std::vector<Sphere>& balls, std::size_t n,
     }
   }
   return out;
+}
+
+// The lazy greedy one recount at a time, as written down: pop the largest bound, recount it,
+// take it if no other bound beats its count by more than 1/16 of that bound, else put it back.
+// SelectByCoverage recounts in parallel batches and must choose exactly these balls.
+std::vector<std::int32_t> SequentialLazyGreedy(const std::vector<Sphere>& balls, std::int64_t n,
+                                               std::int64_t grid_points) {
+  const internal::SampleGrid grid(balls, grid_points);
+  internal::BitField uncovered(grid);
+  for (const Sphere& ball : balls) {
+    grid.ForEachRun(ball, [&](std::int64_t row, std::int64_t first, std::int64_t last) {
+      uncovered.Set(row, first, last);
+    });
+  }
+  using Entry = std::pair<std::int64_t, std::int32_t>;  // gain, -index: largest, then lowest
+  std::priority_queue<Entry> queue;
+  for (std::size_t i = 0; i < balls.size(); ++i) {
+    const std::int64_t gain = uncovered.CountIn(balls[i]);
+    if (gain > 0) queue.push({gain, -static_cast<std::int32_t>(i)});
+  }
+  std::vector<std::int32_t> chosen;
+  while (!queue.empty() && static_cast<std::int64_t>(chosen.size()) < n) {
+    const std::int32_t index = -queue.top().second;
+    queue.pop();
+    const Sphere& ball = balls[static_cast<std::size_t>(index)];
+    const std::int64_t gain = uncovered.CountIn(ball);
+    if (gain == 0) continue;
+    if (!queue.empty() && gain < queue.top().first - queue.top().first / 16) {
+      queue.push({gain, -index});
+      continue;
+    }
+    grid.ForEachRun(ball, [&](std::int64_t row, std::int64_t first, std::int64_t last) {
+      uncovered.Clear(row, first, last);
+    });
+    chosen.push_back(index);
+  }
+  std::sort(chosen.begin(), chosen.end());
+  return chosen;
+}
+
+TEST(SelectByCoverage, ChoosesWhatTheSequentialLazyGreedyChooses) {
+  // Random balls, and a real pool (medial spheres of cow on a fine grid), whose large
+  // overlapping balls make every choice recount dozens of others.
+  std::vector<std::vector<Sphere>> pools = {RandomBalls(600, 5.0, 0.1, 1.0, 5),
+                                            RandomBalls(300, 2.0, 0.05, 0.6, 6)};
+  absl::StatusOr<Solid> cow = PrepareSolid(LoadTestMesh("cow.off"));
+  ASSERT_TRUE(cow.ok()) << cow.status();
+  MedialSphereOptions medial;
+  medial.voxel_size = 0.015;
+  absl::StatusOr<MedialSphereResult> pool = GenerateMedialSpheres(cow->oracle, medial);
+  ASSERT_TRUE(pool.ok()) << pool.status();
+  ASSERT_GT(pool->set.size(), 1000u);
+  pools.push_back(pool->set.spheres);
+  for (std::size_t p = 0; p < pools.size(); ++p) {
+    for (std::int64_t n : {1, 37, 300}) {
+      SCOPED_TRACE(::testing::Message() << "pool " << p << ", " << n << " balls");
+      CoverageSelectionOptions options;
+      options.max_spheres = n;
+      options.grid_points = std::int64_t{1} << 20;
+      absl::StatusOr<CoverageSelection> fast = SelectByCoverage(pools[p], options);
+      ASSERT_TRUE(fast.ok()) << fast.status();
+      EXPECT_EQ(fast->chosen, SequentialLazyGreedy(pools[p], n, options.grid_points));
+    }
+  }
 }
 
 TEST(SelectByCoverage, SamplesMeasureTheExactUnionVolume) {

@@ -176,7 +176,7 @@ class VoxelSearch {
   }
 
   // The same answer, faster: `known` is a boundary point, so the nearest one is no farther
-  // than it (padded for rounding in the norm).
+  // than it.
   BoundaryPoint Query(const Vector3& x, const Vector3& known, VoxelCounters& counters) const {
     ++counters.queries;
     return oracle_.ClosestPointNear(x, known);

@@ -14,10 +14,13 @@
 #include <cctype>
 #include <cerrno>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <istream>
 #include <sstream>
+#include <streambuf>
 #include <vector>
 
 #include "absl/strings/match.h"
@@ -39,6 +42,32 @@ std::string Lowercase(std::string s) {
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return s;
 }
+
+// A read-only stream buffer over bytes held elsewhere, with the seeking CGAL's readers use (the
+// STL reader looks ahead to tell ASCII from binary); std::istringstream would copy the bytes.
+class BytesBuffer : public std::streambuf {
+ public:
+  explicit BytesBuffer(const std::string& bytes) {
+    char* const begin = const_cast<char*>(bytes.data());  // read only: no put area
+    setg(begin, begin, begin + bytes.size());
+  }
+
+ protected:
+  pos_type seekoff(off_type off, std::ios_base::seekdir dir,
+                   std::ios_base::openmode which) override {
+    if ((which & std::ios_base::in) == 0) return pos_type(off_type(-1));
+    const off_type base = dir == std::ios_base::beg   ? 0
+                          : dir == std::ios_base::cur ? gptr() - eback()
+                                                      : egptr() - eback();
+    const off_type target = base + off;
+    if (target < 0 || target > egptr() - eback()) return pos_type(off_type(-1));
+    setg(eback(), eback() + target, egptr());
+    return pos_type(target);
+  }
+  pos_type seekpos(pos_type pos, std::ios_base::openmode which) override {
+    return seekoff(off_type(pos), std::ios_base::beg, which);
+  }
+};
 
 bool ReadSoup(std::istream& in, const std::string& format, std::vector<Point>& points,
               std::vector<Polygon>& polygons) {
@@ -199,7 +228,8 @@ absl::StatusOr<Mesh> ParseNamed(const std::string& bytes, const std::string& for
   std::vector<Polygon> polygons;
   bool ok = false;
   try {
-    std::istringstream in(bytes, std::ios::in | std::ios::binary);
+    BytesBuffer buffer(bytes);
+    std::istream in(&buffer);
     ok = ReadSoup(in, format, points, polygons);
   } catch (const std::exception& e) {
     return absl::InvalidArgumentError(
@@ -255,12 +285,25 @@ absl::StatusOr<Mesh> ReadMesh(const std::string& path, ReadMeshInfo* info) {
     return absl::InvalidArgumentError(
         absl::StrCat(path, ": cannot open (", std::strerror(errno), ")"));
   }
-  std::ostringstream contents;
-  contents << file.rdbuf();
+  // Read in one piece into a string of the file's size (a stream copy would grow it, then copy).
+  std::string bytes;
+  const std::uintmax_t size = fs::file_size(path, ec);
+  if (!ec) {
+    bytes.resize(static_cast<std::size_t>(size));
+    file.read(bytes.data(), static_cast<std::streamsize>(size));
+    bytes.resize(static_cast<std::size_t>(file.gcount()));
+  }
   if (file.bad()) {
     return absl::InvalidArgumentError(absl::StrCat(path, ": read error"));
   }
-  return ParseNamed(contents.str(), ext, path, info);
+  // A file that grew while read, or whose size the file system does not report, is read on.
+  if (ec || file.gcount() == static_cast<std::streamsize>(size)) {
+    file.clear();
+    std::ostringstream rest;
+    rest << file.rdbuf();
+    bytes += rest.str();
+  }
+  return ParseNamed(bytes, ext, path, info);
 }
 
 absl::Status WriteMesh(const std::string& path, const Mesh& mesh) {

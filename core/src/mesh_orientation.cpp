@@ -55,15 +55,24 @@ bool MakeOrientationConsistent(Mesh& mesh, const std::vector<EdgeUse>& uses,
                                std::int64_t num_components, std::vector<char>& flip,
                                std::int64_t* non_orientable_triangle) {
   const std::size_t nt = static_cast<std::size_t>(mesh.num_triangles());
-  // Adjacency through manifold edges: neighbour and whether the pair currently agrees.
-  std::vector<std::vector<std::pair<std::int32_t, bool>>> adjacent(nt);
+  // Adjacency through manifold edges: neighbour and whether the pair currently agrees. A
+  // triangle's sides lie on three different edges, so it has at most three neighbours.
+  struct Neighbours {
+    std::array<std::pair<std::int32_t, bool>, 3> list;
+    int count = 0;
+  };
+  std::vector<Neighbours> adjacent(nt);
+  auto add = [&adjacent](std::int32_t t, std::int32_t u, bool agree) {
+    Neighbours& n = adjacent[static_cast<std::size_t>(t)];
+    n.list[static_cast<std::size_t>(n.count++)] = {u, agree};
+  };
   for (const auto& [begin, end] : groups.ranges) {
     if (end - begin != 2) continue;
     const EdgeUse& a = uses[begin];
     const EdgeUse& b = uses[begin + 1];
     const bool agree = a.forward != b.forward;
-    adjacent[static_cast<std::size_t>(a.triangle)].emplace_back(b.triangle, agree);
-    adjacent[static_cast<std::size_t>(b.triangle)].emplace_back(a.triangle, agree);
+    add(a.triangle, b.triangle, agree);
+    add(b.triangle, a.triangle, agree);
   }
   flip.assign(nt, 0);
   std::vector<char> seen(nt, 0);
@@ -80,7 +89,9 @@ bool MakeOrientationConsistent(Mesh& mesh, const std::vector<EdgeUse>& uses,
       const auto c = static_cast<std::size_t>(component[static_cast<std::size_t>(t)]);
       ++size_of[c];
       flips_in[c] += flip[static_cast<std::size_t>(t)];
-      for (const auto& [u, agree] : adjacent[static_cast<std::size_t>(t)]) {
+      const Neighbours& neighbours = adjacent[static_cast<std::size_t>(t)];
+      for (int i = 0; i < neighbours.count; ++i) {
+        const auto [u, agree] = neighbours.list[static_cast<std::size_t>(i)];
         // After flipping, t and u agree iff (agree XOR flip[t] XOR flip[u]).
         const char wanted = static_cast<char>(flip[static_cast<std::size_t>(t)] ^ !agree);
         if (!seen[static_cast<std::size_t>(u)]) {

@@ -155,17 +155,69 @@ std::vector<std::vector<SurfaceMesh::Face_index>> FacesBySlab(const SurfaceMesh&
   return slabs;
 }
 
+// `surface` made from the triangles of `mesh` with distinct corners (`polygon_of`: each
+// triangle's polygon index, -1 when left out), face i for polygon i like CGAL's
+// polygon_soup_to_polygon_mesh, linked straight from the edge groups: each edge's two uses
+// become its two halfedges. O(#T), where CGAL's conversion searches each vertex's fan for every
+// face it adds (about 1 s on 1.2 million triangles). Needs an oriented manifold
+// (IsOrientedManifold) and returns false, leaving `surface` empty, when some edge is a border:
+// a border's links run around its hole, which CGAL's conversion makes.
+bool LinkClosedSurface(const Mesh& mesh, const std::vector<std::int32_t>& polygon_of,
+                       std::size_t polygons, const std::vector<EdgeUse>& uses,
+                       const EdgeGroups& groups, SurfaceMesh& surface) {
+  for (const auto& [i, j] : groups.ranges) {
+    if (j - i != 2) return false;
+  }
+  surface.reserve(static_cast<SurfaceMesh::size_type>(mesh.num_vertices()),
+                  static_cast<SurfaceMesh::size_type>(groups.ranges.size()),
+                  static_cast<SurfaceMesh::size_type>(polygons));
+  for (Eigen::Index v = 0; v < mesh.vertices.rows(); ++v) surface.add_vertex(VertexPoint(mesh, v));
+  // The halfedge along side k of polygon p: corner_halfedge[3p + k].
+  std::vector<SurfaceMesh::Halfedge_index> corner_halfedge(3 * polygons);
+  auto slot = [&polygon_of](const EdgeUse& use) {
+    return 3 * static_cast<std::size_t>(polygon_of[static_cast<std::size_t>(use.triangle)]) +
+           static_cast<std::size_t>(use.side);
+  };
+  for (const auto& [i, j] : groups.ranges) {
+    const SurfaceMesh::Halfedge_index h = surface.add_edge();
+    corner_halfedge[slot(uses[i])] = h;
+    corner_halfedge[slot(uses[i + 1])] = surface.opposite(h);
+  }
+  std::size_t p = 0;
+  for (Eigen::Index t = 0; t < mesh.triangles.rows(); ++t) {
+    if (polygon_of[static_cast<std::size_t>(t)] < 0) continue;
+    const SurfaceMesh::Face_index f = surface.add_face();
+    const SurfaceMesh::Halfedge_index* h = &corner_halfedge[3 * p++];
+    for (int k = 0; k < 3; ++k) {
+      // Side k runs from corner k to corner k + 1.
+      const SurfaceMesh::Vertex_index to(
+          static_cast<SurfaceMesh::size_type>(mesh.triangles(t, (k + 1) % 3)));
+      surface.set_target(h[k], to);
+      surface.set_halfedge(to, h[k]);
+      surface.set_face(h[k], f);
+      surface.set_next(h[k], h[(k + 1) % 3]);
+    }
+    surface.set_halfedge(f, h[0]);
+  }
+  return true;
+}
+
 }  // namespace
 
 bool IsOrientedManifold(const Mesh& mesh) {
   const std::vector<EdgeUse> uses = SortedEdgeUses(mesh);
+  return IsOrientedManifold(mesh, uses, GroupEdges(uses));
+}
+
+bool IsOrientedManifold(const Mesh& mesh, const std::vector<EdgeUse>& uses,
+                        const EdgeGroups& groups) {
   // Corner k of triangle t is 3t + k; the corners of one vertex that share an edge are joined.
   DisjointSets fans(static_cast<std::size_t>(mesh.num_triangles()) * 3);
   auto corner = [&mesh](const EdgeUse& use, std::int32_t vertex) {
     const int k = mesh.triangles(use.triangle, use.side) == vertex ? use.side : (use.side + 1) % 3;
     return static_cast<std::size_t>(use.triangle) * 3 + static_cast<std::size_t>(k);
   };
-  for (const auto& [i, j] : GroupEdges(uses).ranges) {
+  for (const auto& [i, j] : groups.ranges) {
     if (j - i > 2) return false;
     if (j - i == 2) {
       if (uses[i].forward == uses[i + 1].forward) return false;
@@ -190,30 +242,41 @@ bool IsOrientedManifold(const Mesh& mesh) {
 
 std::optional<std::vector<std::pair<std::int32_t, std::int32_t>>> SelfIntersectingPairs(
     const Mesh& mesh, std::size_t slab_count) {
-  std::vector<Point> points;
-  points.reserve(static_cast<std::size_t>(mesh.num_vertices()));
-  for (Eigen::Index v = 0; v < mesh.vertices.rows(); ++v) points.push_back(VertexPoint(mesh, v));
-  std::vector<std::array<std::size_t, 3>> polygons;
+  const std::vector<EdgeUse> uses = SortedEdgeUses(mesh);
+  const EdgeGroups groups = GroupEdges(uses);
+  if (!IsOrientedManifold(mesh, uses, groups)) return std::nullopt;
   std::vector<std::int32_t> original;  // polygon index -> triangle index in `mesh`
+  std::vector<std::int32_t> polygon_of(static_cast<std::size_t>(mesh.num_triangles()), -1);
   for (Eigen::Index t = 0; t < mesh.triangles.rows(); ++t) {
     if (!HasDistinctCorners(mesh, t)) continue;
-    polygons.push_back({static_cast<std::size_t>(mesh.triangles(t, 0)),
-                        static_cast<std::size_t>(mesh.triangles(t, 1)),
-                        static_cast<std::size_t>(mesh.triangles(t, 2))});
+    polygon_of[static_cast<std::size_t>(t)] = static_cast<std::int32_t>(original.size());
     original.push_back(static_cast<std::int32_t>(t));
   }
-  if (!IsOrientedManifold(mesh)) return std::nullopt;
   namespace PMP = CGAL::Polygon_mesh_processing;
   try {
     SurfaceMesh surface;
-    PMP::polygon_soup_to_polygon_mesh(points, polygons, surface);
-    if (surface.number_of_faces() != polygons.size()) return std::nullopt;
+    if (!LinkClosedSurface(mesh, polygon_of, original.size(), uses, groups, surface)) {
+      std::vector<Point> points;
+      points.reserve(static_cast<std::size_t>(mesh.num_vertices()));
+      for (Eigen::Index v = 0; v < mesh.vertices.rows(); ++v) {
+        points.push_back(VertexPoint(mesh, v));
+      }
+      std::vector<std::array<std::size_t, 3>> polygons;
+      polygons.reserve(original.size());
+      for (const std::int32_t t : original) {
+        polygons.push_back({static_cast<std::size_t>(mesh.triangles(t, 0)),
+                            static_cast<std::size_t>(mesh.triangles(t, 1)),
+                            static_cast<std::size_t>(mesh.triangles(t, 2))});
+      }
+      PMP::polygon_soup_to_polygon_mesh(points, polygons, surface);
+    }
+    if (surface.number_of_faces() != original.size()) return std::nullopt;
     // Each slab's search is CGAL's own, sequential; the slabs run in parallel. CGAL's parallel
     // search instead runs 16 searches over quarters of four copies of the boxes, much more
     // work in all (reading and validating 1.2 million triangles: 28.8 s of CPU against 18.7 s
     // with its sequential search), and under ThreadSanitizer its TBB loops would be unseen.
     const std::vector<std::vector<SurfaceMesh::Face_index>> slabs =
-        FacesBySlab(surface, slab_count > 0 ? slab_count : AutomaticSlabCount(polygons.size()));
+        FacesBySlab(surface, slab_count > 0 ? slab_count : AutomaticSlabCount(original.size()));
     std::vector<std::vector<std::pair<SurfaceMesh::Face_index, SurfaceMesh::Face_index>>> found(
         slabs.size());
     ParallelFor(std::size_t{0}, slabs.size(), [&](std::size_t k) {
@@ -221,7 +284,7 @@ std::optional<std::vector<std::pair<std::int32_t, std::int32_t>>> SelfIntersecti
           slabs[k], surface, std::back_inserter(found[k]),
           CGAL::parameters::geom_traits(ScreenedTraits()));
     });
-    // polygon_soup_to_polygon_mesh adds faces in input order, so face i is polygon i.
+    // Face i is polygon i.
     std::vector<std::pair<std::int32_t, std::int32_t>> pairs;
     for (const auto& in_slab : found) {
       for (const auto& [f, g] : in_slab) {

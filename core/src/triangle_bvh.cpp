@@ -196,7 +196,7 @@ class Builder {
  public:
   explicit Builder(const Mesh& mesh) {
     primitives_.resize(static_cast<std::size_t>(mesh.num_triangles()));
-    for (std::size_t t = 0; t < primitives_.size(); ++t) {
+    ParallelFor(std::size_t{0}, primitives_.size(), [&](std::size_t t) {
       Primitive& p = primitives_[t];
       for (int k = 0; k < 3; ++k) {
         p.box.Grow(
@@ -204,7 +204,7 @@ class Builder {
       }
       p.centroid = 0.5 * (p.box.lo + p.box.hi);
       p.triangle = static_cast<std::int32_t>(t);
-    }
+    });
   }
 
   // Fills `nodes` and `leaves` (topology only: bounds are left for
@@ -221,11 +221,15 @@ class Builder {
     nodes->clear();
     nodes->reserve(primitives_.size());
     leaves->clear();
-    std::vector<Work> work = {{-1, 0, 0, static_cast<std::int32_t>(primitives_.size()), 0}};
+    const auto count = static_cast<std::int32_t>(primitives_.size());
+    std::vector<std::int32_t> splits;
+    Splits(0, count, 0, splits);
+    auto next_split = splits.begin();
+    std::vector<Work> work = {{-1, 0, 0, count, 0}};
     while (!work.empty()) {
       const Work w = work.back();
       work.pop_back();
-      const std::int32_t mid = Split(w.begin, w.end, w.depth);
+      const std::int32_t mid = *next_split++;
       TriangleBvhRef ref{static_cast<std::int32_t>(leaves->size()), w.end - w.begin};
       if (mid < 0) {
         TriangleBvhLeaf leaf{};
@@ -247,6 +251,34 @@ class Builder {
   }
 
  private:
+  // Ranges of at least this many primitives split their two parts in parallel.
+  static constexpr std::int32_t kParallelSplit = 16384;
+
+  // Appends the split of primitives_[begin, end) and of every range below it (Split's results)
+  // in the order Run lays the tree out: a range, then its first part's ranges, then its
+  // second's. The two parts of a large range are split in parallel; each touches only its own
+  // primitives and Split depends on nothing else, so the tree does not depend on the schedule.
+  // Recursion depth: the tree's, at most kMaxSahDepth + 31.
+  void Splits(std::int32_t begin, std::int32_t end, int depth, std::vector<std::int32_t>& out) {
+    const std::int32_t mid = Split(begin, end, depth);
+    out.push_back(mid);
+    if (mid < 0) return;
+    if (end - begin < kParallelSplit) {
+      Splits(begin, mid, depth + 1, out);
+      Splits(mid, end, depth + 1, out);
+      return;
+    }
+    std::vector<std::int32_t> second;
+    ParallelFor(0, 2, [&](int part) {
+      if (part == 0) {
+        Splits(begin, mid, depth + 1, out);
+      } else {
+        Splits(mid, end, depth + 1, second);
+      }
+    });
+    out.insert(out.end(), second.begin(), second.end());
+  }
+
   // Partitions primitives_[begin, end) and returns the first index of the second part, or -1
   // for a leaf.
   std::int32_t Split(std::int32_t begin, std::int32_t end, int depth) {

@@ -4,6 +4,7 @@
 #include "triangle_bvh.h"
 
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <array>
@@ -419,6 +420,24 @@ TEST_P(TriangleBvhOnMesh, RefitEqualsFreshBuild) {
   EXPECT_EQ(refit.corners(), fresh.corners());
   EXPECT_EQ(refit.slot_triangles(), fresh.slot_triangles());
   EXPECT_EQ(refit.magnitude(), fresh.magnitude());
+}
+
+// The build splits large ranges in parallel: on one thread and on all, the same tree, bit for bit.
+TEST_P(TriangleBvhOnMesh, BuildDoesNotDependOnTheThreads) {
+  INSCRIBE_REQUIRE_MESH(GetParam());
+  const Mesh mesh = testing::LoadTestMesh(GetParam());
+  const TriangleBvh parallel = TriangleBvh::Build(mesh);
+  tbb::task_arena one_thread(1);
+  const TriangleBvh serial = one_thread.execute([&] { return TriangleBvh::Build(mesh); });
+  ASSERT_EQ(serial.nodes().size(), parallel.nodes().size());
+  ASSERT_EQ(serial.leaves().size(), parallel.leaves().size());
+  EXPECT_EQ(std::memcmp(serial.nodes().data(), parallel.nodes().data(),
+                        parallel.nodes().size() * sizeof(TriangleBvhNode)),
+            0);
+  EXPECT_EQ(std::memcmp(serial.leaves().data(), parallel.leaves().data(),
+                        parallel.leaves().size() * sizeof(TriangleBvhLeaf)),
+            0);
+  EXPECT_EQ(serial.slot_triangles(), parallel.slot_triangles());
 }
 
 // Every bound the queries rely on: each triangle in exactly one leaf, boxes containing what

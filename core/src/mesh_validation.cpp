@@ -202,22 +202,22 @@ void CheckVertexManifold(const Mesh& mesh, const std::vector<EdgeUse>& uses,
     corners.Union(corner_of(a.triangle, a.lo), corner_of(b.triangle, a.lo));
     corners.Union(corner_of(a.triangle, a.hi), corner_of(b.triangle, a.hi));
   }
-  std::vector<std::pair<std::int32_t, std::size_t>> vertex_fan;
+  // Each vertex's first fan; a corner in another fan makes the vertex non-manifold.
+  constexpr std::size_t kNone = std::numeric_limits<std::size_t>::max();
+  std::vector<std::size_t> fan_of(static_cast<std::size_t>(mesh.num_vertices()), kNone);
+  std::vector<char> several(static_cast<std::size_t>(mesh.num_vertices()), 0);
   for (Eigen::Index t = 0; t < mesh.triangles.rows(); ++t) {
     if (!internal::HasDistinctCorners(mesh, t)) continue;
     for (int k = 0; k < 3; ++k) {
-      vertex_fan.emplace_back(mesh.triangles(t, k),
-                              corners.Find(static_cast<std::size_t>(t) * 3 + k));
+      const auto v = static_cast<std::size_t>(mesh.triangles(t, k));
+      const std::size_t fan = corners.Find(static_cast<std::size_t>(t) * 3 + k);
+      if (fan_of[v] == kNone) fan_of[v] = fan;
+      if (fan_of[v] != fan) several[v] = 1;
     }
   }
-  std::sort(vertex_fan.begin(), vertex_fan.end());
-  vertex_fan.erase(std::unique(vertex_fan.begin(), vertex_fan.end()), vertex_fan.end());
   std::int64_t first = -1;
-  for (std::size_t i = 1; i < vertex_fan.size(); ++i) {
-    if (vertex_fan[i].first == vertex_fan[i - 1].first &&
-        (i < 2 || vertex_fan[i - 2].first != vertex_fan[i].first)) {
-      if (report.non_manifold_vertices++ == 0) first = vertex_fan[i].first;
-    }
+  for (std::size_t v = 0; v < several.size(); ++v) {
+    if (several[v] && report.non_manifold_vertices++ == 0) first = static_cast<std::int64_t>(v);
   }
   if (report.non_manifold_vertices > 0) {
     AddIssue(report, Severity::kWarning, "non_manifold_vertices",

@@ -107,24 +107,23 @@ std::size_t AutomaticSlabCount(std::size_t faces) {
   return std::clamp<std::size_t>(faces / kFacesPerSlab, 1, 4 * threads);
 }
 
-// The faces of `surface` in `count` slabs across the longest side of its bounding box, cut at
-// quantiles of the faces' box centres so the slabs hold about as many faces each. A face is in
-// every slab its (closed) box reaches, so two faces whose boxes meet are both in a slab that
-// holds a common point of the boxes: searching each slab on its own finds every pair the
-// whole search would.
-std::vector<std::vector<SurfaceMesh::Face_index>> FacesBySlab(const SurfaceMesh& surface,
-                                                              std::size_t count) {
-  std::vector<CGAL::Bbox_3> boxes;
-  boxes.reserve(surface.number_of_faces());
-  CGAL::Bbox_3 all;
-  for (const SurfaceMesh::Face_index f : surface.faces()) {
-    CGAL::Bbox_3 box;
-    for (const SurfaceMesh::Vertex_index v : surface.vertices_around_face(surface.halfedge(f))) {
-      box += surface.point(v).bbox();
+// The faces of the surface (face i: triangle original[i] of `mesh`) in `count` slabs across the
+// longest side of its bounding box, cut at quantiles of the faces' box centres so the slabs hold
+// about as many faces each. A face is in every slab its (closed) box reaches, so two faces
+// whose boxes meet are both in a slab that holds a common point of the boxes: searching each
+// slab on its own finds every pair the whole search would.
+std::vector<std::vector<SurfaceMesh::Face_index>> FacesBySlab(
+    const Mesh& mesh, const std::vector<std::int32_t>& original, std::size_t count) {
+  std::vector<CGAL::Bbox_3> boxes(original.size());
+  ParallelForRange(std::size_t{0}, boxes.size(), 4096, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i != end; ++i) {
+      CGAL::Bbox_3 box;
+      for (int k = 0; k < 3; ++k) box += VertexPoint(mesh, mesh.triangles(original[i], k)).bbox();
+      boxes[i] = box;
     }
-    boxes.push_back(box);
-    all += box;
-  }
+  });
+  CGAL::Bbox_3 all;
+  for (const CGAL::Bbox_3& box : boxes) all += box;
   count = std::clamp<std::size_t>(count, 1, std::max<std::size_t>(boxes.size(), 1));
   int axis = 0;
   for (int a = 1; a < 3; ++a) {
@@ -143,9 +142,9 @@ std::vector<std::vector<SurfaceMesh::Face_index>> FacesBySlab(const SurfaceMesh&
     from = at;
   }
   std::vector<std::vector<SurfaceMesh::Face_index>> slabs(count);
-  std::size_t i = 0;
-  for (const SurfaceMesh::Face_index f : surface.faces()) {
-    const CGAL::Bbox_3& box = boxes[i++];
+  for (std::size_t i = 0; i < boxes.size(); ++i) {
+    const CGAL::Bbox_3& box = boxes[i];
+    const SurfaceMesh::Face_index f(static_cast<SurfaceMesh::size_type>(i));
     // The first slab whose upper cut is at or above the box's low end, through the last whose
     // lower cut is at or below its high end.
     const auto first = std::lower_bound(cuts.begin(), cuts.end(), box.min(axis)) - cuts.begin();
@@ -275,8 +274,8 @@ std::optional<std::vector<std::pair<std::int32_t, std::int32_t>>> SelfIntersecti
     // search instead runs 16 searches over quarters of four copies of the boxes, much more
     // work in all (reading and validating 1.2 million triangles: 28.8 s of CPU against 18.7 s
     // with its sequential search), and under ThreadSanitizer its TBB loops would be unseen.
-    const std::vector<std::vector<SurfaceMesh::Face_index>> slabs =
-        FacesBySlab(surface, slab_count > 0 ? slab_count : AutomaticSlabCount(original.size()));
+    const std::vector<std::vector<SurfaceMesh::Face_index>> slabs = FacesBySlab(
+        mesh, original, slab_count > 0 ? slab_count : AutomaticSlabCount(original.size()));
     std::vector<std::vector<std::pair<SurfaceMesh::Face_index, SurfaceMesh::Face_index>>> found(
         slabs.size());
     ParallelFor(std::size_t{0}, slabs.size(), [&](std::size_t k) {

@@ -296,7 +296,25 @@ absl::StatusOr<OptimisedSphereResult> GenerateOptimisedSpheres(
   };
 
   OptimisedSphereResult result;
-  std::optional<MedialSphereResult> pool;
+  // Every run's spheres are medial spheres of the mesh. A run that falls short of the target
+  // is followed by a finer one, and its spheres join that run's in the pool: the pool of run i
+  // is its own spheres and those of every earlier run with fewer (the coarser ones).
+  std::vector<MedialSphereResult> runs;
+  auto pool_count = [&runs](std::size_t i) {
+    std::size_t count = runs[i].set.size();
+    for (std::size_t j = 0; j < i; ++j) {
+      if (runs[j].set.size() < runs[i].set.size()) count += runs[j].set.size();
+    }
+    return static_cast<double>(count);
+  };
+  // Keep the run whose pool is nearest the target (in ratio) among those with more spheres
+  // than the budget, else the richest.
+  auto score = [&](std::size_t i) {
+    const double c = pool_count(i);
+    const bool rich = c > static_cast<double>(options.max_spheres);
+    return std::make_pair(rich, rich ? -std::abs(std::log(c / target)) : c);
+  };
+  std::size_t kept = 0;
   for (int run = 0; run < options.max_pool_runs; ++run) {
     MedialSphereOptions run_options = options.base;
     run_options.voxel_size = sigma;
@@ -312,20 +330,27 @@ absl::StatusOr<OptimisedSphereResult> GenerateOptimisedSpheres(
         GenerateMedialSpheres(oracle, run_options, run_control);
     if (!attempt.ok()) return attempt.status();
     ++result.runs;
-    const double count = static_cast<double>(attempt->set.size());
-    // Keep the run nearest the target (in ratio) among those with more spheres than the budget,
-    // else the richest.
-    auto score = [&](const MedialSphereResult& r) {
-      const double c = static_cast<double>(r.set.size());
-      const bool rich = c > static_cast<double>(options.max_spheres);
-      return std::make_pair(rich, rich ? -std::abs(std::log(c / target)) : c);
-    };
-    if (!pool || score(*attempt) > score(*pool)) pool = std::move(*attempt);
-    if (count >= 0.5 * target && count <= 2.0 * target) break;
-    if (count < 0.5 * target && sigma <= finest) break;  // the voxel limit stops refinement
-    // The count falls roughly like sigma^-2.
-    const double factor = std::sqrt(std::max(count, 1.0) / target);
+    runs.push_back(*std::move(attempt));
+    const std::size_t last = runs.size() - 1;
+    if (last == 0 || score(last) > score(kept)) kept = last;
+    const double count = static_cast<double>(runs[last].set.size());
+    const double pooled = pool_count(last);
+    if (pooled >= 0.5 * target && pooled <= 2.0 * target) break;
+    if (pooled < 0.5 * target && sigma <= finest) break;  // the voxel limit stops refinement
+    // The count falls roughly like sigma^-2. Short of the target, the next run aims at the rest
+    // (this run's pool joins it); over it, at the target alone.
+    const double aim = pooled < 0.5 * target ? target - pooled : target;
+    const double factor = std::sqrt(std::max(count, 1.0) / aim);
     sigma = std::max(finest, sigma * std::clamp(factor, 0.25, 4.0));
+  }
+  // The kept run first, then the coarser runs in the order made: with one run, its own order.
+  MedialSphereResult& pool_run = runs[kept];
+  SphereSet pool = pool_run.set;
+  for (std::size_t j = 0; j < kept; ++j) {
+    if (runs[j].set.size() >= pool_run.set.size()) continue;
+    pool.spheres.insert(pool.spheres.end(), runs[j].set.spheres.begin(), runs[j].set.spheres.end());
+    pool.contacts.insert(pool.contacts.end(), runs[j].set.contacts.begin(),
+                         runs[j].set.contacts.end());
   }
 
   CoverageSelectionOptions select;
@@ -340,18 +365,17 @@ absl::StatusOr<OptimisedSphereResult> GenerateOptimisedSpheres(
       report(kPoolShare + (1.0 - kPoolShare) * fraction);
     };
   }
-  absl::StatusOr<CoverageSelection> chosen =
-      SelectByCoverage(pool->set.spheres, select, select_control);
+  absl::StatusOr<CoverageSelection> chosen = SelectByCoverage(pool.spheres, select, select_control);
   if (!chosen.ok()) return chosen.status();
-  result.pool_size = static_cast<std::int64_t>(pool->set.size());
+  result.pool_size = static_cast<std::int64_t>(pool.size());
   SphereSet set;
   set.spheres.reserve(chosen->chosen.size());
   set.contacts.reserve(chosen->chosen.size());
   for (std::int32_t index : chosen->chosen) {
-    set.spheres.push_back(pool->set.spheres[static_cast<std::size_t>(index)]);
-    set.contacts.push_back(pool->set.contacts[static_cast<std::size_t>(index)]);
+    set.spheres.push_back(pool.spheres[static_cast<std::size_t>(index)]);
+    set.contacts.push_back(pool.contacts[static_cast<std::size_t>(index)]);
   }
-  result.best = *std::move(pool);
+  result.best = std::move(pool_run);
   result.best.set = std::move(set);
   result.selection = *std::move(chosen);
   result.seconds = SecondsSince(start);

@@ -23,6 +23,7 @@
 #include "support/medial_checks.h"
 #include "support/sphere_sets.h"
 #include "support/test_meshes.h"
+#include "voxel_grid.h"
 
 namespace inscribe {
 namespace {
@@ -231,7 +232,7 @@ Solid SolidOf(const char* name) {
 }
 
 TEST(OptimisedSpheres, InternalTangentWithinBudgetAndNeverWorseThanThePaper) {
-  for (const char* name : {"eight.off", "cow.off", "fandisk.off", "elephant.off"}) {
+  for (const char* name : {"eight.off", "cow.off", "fandisk.off", "elephant.off", "knot1.off"}) {
     SCOPED_TRACE(name);
     const Solid solid = SolidOf(name);
     SphereSetParameters parameters;
@@ -249,6 +250,43 @@ TEST(OptimisedSpheres, InternalTangentWithinBudgetAndNeverWorseThanThePaper) {
     ASSERT_TRUE(optimised->quality->nerr_is_exact);
     EXPECT_LE(optimised->quality->nerr, paper->quality->nerr)
         << "optimised " << optimised->quality->nerr << ", paper " << paper->quality->nerr;
+  }
+}
+
+// knot1 is a tube: its first pool run, sized by the count model of a medial sheet, falls short,
+// and a finer run follows. The short run's spheres join the pool: the pool is exactly the two
+// runs' spheres, the finer run's first, and the chosen spheres come from both.
+TEST(OptimisedSpheres, AShortRunsSpheresJoinTheFinerRunsPool) {
+  const Solid solid = SolidOf("knot1.off");
+  OptimisedSphereOptions options;
+  options.max_spheres = 150;
+  absl::StatusOr<OptimisedSphereResult> result = GenerateOptimisedSpheres(solid.oracle, options);
+  ASSERT_TRUE(result.ok()) << result.status();
+  ASSERT_EQ(result->runs, 2);
+  const double diagonal = ComputeBoundingBox(solid.oracle.mesh().vertices).diagonal();
+  MedialSphereOptions first;
+  first.voxel_size = internal::VoxelSizeForCount(diagonal, options.pool_factor * 150);
+  MedialSphereOptions second;
+  second.voxel_size = result->best.voxel_size;
+  ASSERT_LT(second.voxel_size, first.voxel_size);
+  const absl::StatusOr<MedialSphereResult> coarse = GenerateMedialSpheres(solid.oracle, first);
+  const absl::StatusOr<MedialSphereResult> fine = GenerateMedialSpheres(solid.oracle, second);
+  ASSERT_TRUE(coarse.ok() && fine.ok());
+  ASSERT_LT(coarse->set.size(), fine->set.size());
+  EXPECT_LT(static_cast<double>(coarse->set.size()), 0.5 * options.pool_factor * 150);
+  EXPECT_EQ(result->pool_size, static_cast<std::int64_t>(coarse->set.size() + fine->set.size()));
+  const auto fine_count = static_cast<std::int32_t>(fine->set.size());
+  const auto& chosen = result->selection.chosen;
+  EXPECT_TRUE(
+      std::any_of(chosen.begin(), chosen.end(), [&](std::int32_t i) { return i < fine_count; }));
+  EXPECT_TRUE(
+      std::any_of(chosen.begin(), chosen.end(), [&](std::int32_t i) { return i >= fine_count; }));
+  for (std::size_t k = 0; k < chosen.size(); ++k) {
+    const auto i = static_cast<std::size_t>(chosen[k]);
+    const Sphere& expected =
+        i < fine->set.size() ? fine->set.spheres[i] : coarse->set.spheres[i - fine->set.size()];
+    EXPECT_EQ(result->best.set.spheres[k].center, expected.center) << k;
+    EXPECT_EQ(result->best.set.spheres[k].radius, expected.radius) << k;
   }
 }
 

@@ -93,10 +93,11 @@ struct OptimisedSphereOptions {
 std::int64_t DefaultSelectionGridPoints(std::int64_t max_spheres);
 
 struct OptimisedSphereResult {
-  // The pool run with `set` replaced by the chosen spheres and their contacts, in pool order
-  // (by voxel); voxel_size is the pool's sigma, stats the pool run's.
+  // The kept pool run with `set` replaced by the chosen spheres and their contacts, in pool
+  // order (the kept run's by voxel, then the coarser runs'); voxel_size and stats are the kept
+  // run's.
   MedialSphereResult best;
-  std::int64_t pool_size = 0;  // medial spheres in the pool
+  std::int64_t pool_size = 0;  // medial spheres in the pool (of every run it took)
   int runs = 0;                // pool runs made (generation runs, as SphereBudgetResult::runs)
   CoverageSelection selection;
   double seconds = 0.0;  // wall time: every pool run and the selection
@@ -108,7 +109,9 @@ absl::Status CheckOptimisedSphereOptions(const OptimisedSphereOptions& options);
 
 // The optimised selection: a pool of medial spheres (GenerateMedialSpheres on a grid whose
 // sigma is corrected until the pool holds between half and twice pool_factor * N spheres, or
-// the voxel limit or max_pool_runs stops it), then SelectByCoverage over it. Deterministic.
+// the voxel limit or max_pool_runs stops it; a run that falls short is followed by a finer
+// one aimed at the rest, and the pool is the kept run's spheres followed by those of every
+// earlier run with fewer), then SelectByCoverage over it. Deterministic.
 // Errors: CheckOptimisedSphereOptions', GenerateMedialSpheres', SelectByCoverage's; CANCELLED.
 absl::StatusOr<OptimisedSphereResult> GenerateOptimisedSpheres(
     const BoundaryOracle& oracle, const OptimisedSphereOptions& options,

@@ -27,9 +27,10 @@ struct MedialSphereOptions {
   // two closest-point queries plus a search where the segment crosses the medial surface.
   int samples = 32;
   // Screening: each voxel first tries this many samples (a separate Fibonacci set, so they
-  // add to the K) and takes the full set only if one of their segments crosses the medial
-  // surface inside the voxel. 0 (or >= samples) turns it off: every voxel gets the full set.
-  // Can miss a sheet that only a few of the K segments cross.
+  // add to the K) and takes the full set only if one of their segments through the voxel has
+  // ends with different nearest boundary points (a pair that is searched, wherever its
+  // crossing lies). 0 (or >= samples) turns it off: every voxel gets the full set. Can miss a
+  // sheet that only a few of the K segments cross.
   int screen_samples = 8;
   // Corner screening, before any sampling: one closest-point query per grid vertex (shared by
   // the 8 voxels around it); a voxel whose 8 corners' inward directions at their nearest

@@ -136,9 +136,9 @@ TEST(EnvelopeDistances, MatchBruteForceOnARealMesh) {
   // They trade gaps for protrusions one for one, so the mean |d| itself does not shrink; with
   // half the growth (sphere_dilation.h) it does, both ways.
   const auto uncovered_mean = [](const EnvelopeDistanceResult& e) {
-    double sum = 0.0;
-    for (double v : e.boundary_to_envelope) sum += std::max(0.0, -v);
-    return sum / static_cast<double>(e.boundary_to_envelope.size());
+    double total = 0.0;
+    for (double v : e.boundary_to_envelope) total += std::max(0.0, -v);
+    return total / static_cast<double>(e.boundary_to_envelope.size());
   };
   absl::StatusOr<DilationResult> grown = DilateSpheres(oracle, medial->set);
   ASSERT_TRUE(grown.ok()) << grown.status();

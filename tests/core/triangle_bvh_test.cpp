@@ -378,6 +378,27 @@ TEST_P(TriangleBvhOnMesh, CountCrossingsEqualsScan) {
   EXPECT_EQ(failures, 0);
 }
 
+// Every stored bit of two trees: topology, boxes, leaf frames, copied corners.
+void ExpectSameTree(const TriangleBvh& a, const TriangleBvh& b) {
+  ASSERT_EQ(a.nodes().size(), b.nodes().size());
+  ASSERT_EQ(a.leaves().size(), b.leaves().size());
+  ASSERT_EQ(a.slot_boxes().size(), b.slot_boxes().size());
+  EXPECT_EQ(a.root().index, b.root().index);
+  EXPECT_EQ(a.root().count, b.root().count);
+  EXPECT_EQ(
+      std::memcmp(a.nodes().data(), b.nodes().data(), b.nodes().size() * sizeof(TriangleBvhNode)),
+      0);
+  EXPECT_EQ(std::memcmp(a.leaves().data(), b.leaves().data(),
+                        b.leaves().size() * sizeof(TriangleBvhLeaf)),
+            0);
+  EXPECT_EQ(std::memcmp(a.slot_boxes().data(), b.slot_boxes().data(),
+                        b.slot_boxes().size() * sizeof(TriangleBvhSlotBox)),
+            0);
+  EXPECT_EQ(a.corners(), b.corners());
+  EXPECT_EQ(a.slot_triangles(), b.slot_triangles());
+  EXPECT_EQ(a.magnitude(), b.magnitude());
+}
+
 TEST_P(TriangleBvhOnMesh, RefitEqualsFreshBuild) {
   INSCRIBE_REQUIRE_MESH(GetParam());
   const Mesh mesh = testing::LoadTestMesh(GetParam());
@@ -406,20 +427,7 @@ TEST_P(TriangleBvhOnMesh, RefitEqualsFreshBuild) {
   ExpectClosestMatchesBruteForce(deformed, refit, points);
   // Refit back to the original positions: every stored bit as Build left it.
   refit.Refit(mesh);
-  ASSERT_EQ(refit.nodes().size(), fresh.nodes().size());
-  ASSERT_EQ(refit.leaves().size(), fresh.leaves().size());
-  EXPECT_EQ(std::memcmp(refit.nodes().data(), fresh.nodes().data(),
-                        fresh.nodes().size() * sizeof(TriangleBvhNode)),
-            0);
-  EXPECT_EQ(std::memcmp(refit.leaves().data(), fresh.leaves().data(),
-                        fresh.leaves().size() * sizeof(TriangleBvhLeaf)),
-            0);
-  EXPECT_EQ(std::memcmp(refit.slot_boxes().data(), fresh.slot_boxes().data(),
-                        fresh.slot_boxes().size() * sizeof(TriangleBvhSlotBox)),
-            0);
-  EXPECT_EQ(refit.corners(), fresh.corners());
-  EXPECT_EQ(refit.slot_triangles(), fresh.slot_triangles());
-  EXPECT_EQ(refit.magnitude(), fresh.magnitude());
+  ExpectSameTree(refit, fresh);
 }
 
 // The build splits large ranges in parallel: on one thread and on all, the same tree, bit for bit.
@@ -429,15 +437,7 @@ TEST_P(TriangleBvhOnMesh, BuildDoesNotDependOnTheThreads) {
   const TriangleBvh parallel = TriangleBvh::Build(mesh);
   tbb::task_arena one_thread(1);
   const TriangleBvh serial = one_thread.execute([&] { return TriangleBvh::Build(mesh); });
-  ASSERT_EQ(serial.nodes().size(), parallel.nodes().size());
-  ASSERT_EQ(serial.leaves().size(), parallel.leaves().size());
-  EXPECT_EQ(std::memcmp(serial.nodes().data(), parallel.nodes().data(),
-                        parallel.nodes().size() * sizeof(TriangleBvhNode)),
-            0);
-  EXPECT_EQ(std::memcmp(serial.leaves().data(), parallel.leaves().data(),
-                        parallel.leaves().size() * sizeof(TriangleBvhLeaf)),
-            0);
-  EXPECT_EQ(serial.slot_triangles(), parallel.slot_triangles());
+  ExpectSameTree(serial, parallel);
 }
 
 // Every bound the queries rely on: each triangle in exactly one leaf, boxes containing what

@@ -251,7 +251,9 @@ TEST(RobotViewData, JointsCarryTheirVariableAndComposedMimics) {
   for (int i = 0; i < 5; ++i) position[order[i]] = i;
   for (int l = 0; l < 5; ++l) {
     const int parent = data.at("links")[l].at("parent");
-    if (parent >= 0) EXPECT_LT(position[parent], position[l]);
+    if (parent >= 0) {
+      EXPECT_LT(position[parent], position[l]);
+    }
   }
 }
 

@@ -31,10 +31,6 @@ using internal::VisitedVoxel;
 
 constexpr double kSqrt3 = 1.7320508075688772;
 
-// The corner screen passes a voxel whose corner directions differ by theta minus this (radians):
-// corners sit up to sqrt(3) sigma from the sheet, where the directions have turned a little.
-constexpr double kCornerScreenMargin = 0.1;
-
 using Clock = std::chrono::steady_clock;
 
 double SecondsSince(Clock::time_point start) {
@@ -385,7 +381,8 @@ absl::StatusOr<MedialSphereResult> GenerateMedialSpheres(const BoundaryOracle& o
   std::vector<char> screened_in;
   if (options.corner_screen) {
     screened_in = internal::ScreenByCorners(
-        oracle, *grid, voxels, options.object_angle - kCornerScreenMargin, queries, control.cancel);
+        oracle, *grid, voxels, options.object_angle - internal::kCornerScreenMargin,
+        internal::kCornerScreenReach * grid->size, queries, control.cancel);
     if (control.cancelled()) return absl::CancelledError("medial-sphere generation cancelled");
   }
   for (char pass : screened_in) result.stats.screened_voxels += pass == 0;

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <optional>
 
 #include "absl/strings/str_format.h"
@@ -134,13 +135,34 @@ std::vector<VisitedVoxel> CullVoxels(const BoundaryOracle& oracle, const Grid& g
   return visited;
 }
 
+bool SheetEstimateNearVoxel(const Vector3& foot_i, const Vector3& inward_i, const Vector3& foot_j,
+                            const Vector3& inward_j, const Vector3& lo, const Vector3& hi,
+                            double reach) {
+  if (!(reach < std::numeric_limits<double>::infinity())) return true;
+  const double parallel = 1.0 - inward_i.dot(inward_j);
+  auto near_from = [&](const Vector3& foot, const Vector3& inward, const Vector3& other_foot,
+                       const Vector3& other_inward) {
+    const double t = other_inward.dot(foot - other_foot) / parallel;
+    if (!(t > 0.0) || !std::isfinite(t)) return true;
+    const Vector3 m = foot + t * inward;
+    const Vector3 gap = (lo - m).cwiseMax(m - hi).cwiseMax(Vector3::Zero());
+    return !(gap.squaredNorm() > reach * reach);
+  };
+  return near_from(foot_i, inward_i, foot_j, inward_j) ||
+         near_from(foot_j, inward_j, foot_i, inward_i);
+}
+
 // Corner screening: one closest-point query per grid vertex, shared by the 8 voxels around it.
 // A medial sheet of object angle phi that cuts a voxel separates its corners into two groups
 // whose inward directions differ by about phi; a voxel whose 8 corner directions are all
-// within (theta - margin) of each other is skipped. Returns one flag per visited voxel.
+// within (theta - margin) of each other is skipped. So is one whose wide pairs all straddle a
+// sheet estimated well outside it: near a tube's axis the directions turn by more than theta
+// across voxels a few sigma away, while the sheet they point to (the axis) lies elsewhere.
+// Returns one flag per visited voxel.
 std::vector<char> ScreenByCorners(const BoundaryOracle& oracle, const Grid& grid,
                                   const std::vector<VisitedVoxel>& voxels, double min_angle,
-                                  std::int64_t& queries, const std::atomic<bool>* cancel) {
+                                  double reach, std::int64_t& queries,
+                                  const std::atomic<bool>* cancel) {
   const std::int64_t vx = grid.dims[0] + 1;
   const std::int64_t vy = grid.dims[1] + 1;
   auto vertex_id = [&](std::int64_t i, std::int64_t j, std::int64_t k) {
@@ -157,6 +179,7 @@ std::vector<char> ScreenByCorners(const BoundaryOracle& oracle, const Grid& grid
   }
   std::sort(vertices.begin(), vertices.end());
   vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+  std::vector<Vector3> feet(vertices.size());
   std::vector<Vector3> directions(vertices.size());
   const Mesh& mesh = oracle.mesh();
   ParallelForRange(std::size_t{0}, vertices.size(), 256, [&](std::size_t begin, std::size_t end) {
@@ -170,6 +193,7 @@ std::vector<char> ScreenByCorners(const BoundaryOracle& oracle, const Grid& grid
       const BoundaryPoint foot =
           previous_foot ? oracle.ClosestPointNear(x, *previous_foot) : oracle.ClosestPoint(x);
       previous_foot = foot.point;
+      feet[v] = foot.point;
       directions[v] = InwardDirectionAtFoot(mesh, x, foot);
     }
   });
@@ -179,17 +203,23 @@ std::vector<char> ScreenByCorners(const BoundaryOracle& oracle, const Grid& grid
   ParallelForRange(std::size_t{0}, voxels.size(), 256, [&](std::size_t begin, std::size_t end) {
     for (std::size_t n = begin; n != end; ++n) {
       const VisitedVoxel& voxel = voxels[n];
-      std::array<Vector3, 8> corner_directions;
+      std::array<std::size_t, 8> corner_vertex;
       for (int corner = 0; corner < 8; ++corner) {
         const std::int64_t id =
             vertex_id(voxel.index[0] + (corner & 1), voxel.index[1] + ((corner >> 1) & 1),
                       voxel.index[2] + ((corner >> 2) & 1));
-        corner_directions[corner] = directions[static_cast<std::size_t>(
-            std::lower_bound(vertices.begin(), vertices.end(), id) - vertices.begin())];
+        corner_vertex[corner] = static_cast<std::size_t>(
+            std::lower_bound(vertices.begin(), vertices.end(), id) - vertices.begin());
       }
+      const Vector3 lo = grid.corner(voxel.index[0], voxel.index[1], voxel.index[2]);
+      const Vector3 hi = lo + Vector3::Constant(grid.size);
       for (int x = 0; x < 8 && !pass[n]; ++x) {
+        const std::size_t a = corner_vertex[x];
         for (int y = x + 1; y < 8; ++y) {
-          if (corner_directions[x].dot(corner_directions[y]) <= max_cosine) {
+          const std::size_t b = corner_vertex[y];
+          if (directions[a].dot(directions[b]) <= max_cosine &&
+              SheetEstimateNearVoxel(feet[a], directions[a], feet[b], directions[b], lo, hi,
+                                     reach)) {
             pass[n] = 1;
             break;
           }

@@ -56,10 +56,33 @@ std::vector<VisitedVoxel> CullVoxels(const BoundaryOracle& oracle, const Grid& g
                                      std::int64_t& queries,
                                      const std::atomic<bool>* cancel = nullptr);
 
-// One flag per voxel: 1 when its 8 corners' inward directions at their nearest boundary
-// points differ by at least `min_angle` (radians) for some pair. Adds its queries to `queries`.
+// The corner screen of medial-sphere generation passes a voxel whose corner directions differ
+// by theta minus this (radians): corners sit up to sqrt(3) sigma from the sheet, where the
+// directions have turned a little ...
+inline constexpr double kCornerScreenMargin = 0.1;
+// ... and whose sheet estimate for such a pair lies within this many voxel sizes of it: the
+// estimate is exact between planar faces and drifts where the boundary curves.
+inline constexpr double kCornerScreenReach = 0.5;
+
+// One flag per voxel: 1 when some pair of its 8 corners has inward directions at their nearest
+// boundary points differing by at least `min_angle` (radians) and a sheet estimate
+// (SheetEstimateNearVoxel) within `reach` (mesh units; infinity: the directions alone decide).
+// Adds its queries to `queries`.
 std::vector<char> ScreenByCorners(const BoundaryOracle& oracle, const Grid& grid,
                                   const std::vector<VisitedVoxel>& voxels, double min_angle,
-                                  std::int64_t& queries, const std::atomic<bool>* cancel = nullptr);
+                                  double reach, std::int64_t& queries,
+                                  const std::atomic<bool>* cancel = nullptr);
+
+// Where the medial sheet between two points lies, from their nearest boundary points (feet)
+// f_i, f_j and unit inward directions u_i, u_j there: the point m = f_i + t u_i on i's inward
+// normal at equal distance from the tangent planes at both feet,
+// t = u_j . (f_i - f_j) / (1 - u_i . u_j). Along that normal the distance to the boundary is t
+// until the normal meets a sheet, so m is that sheet's crossing when both feet lie on planar
+// faces, and near it where the boundary curves. False only when both sides (m from i's normal
+// and from j's) give a finite t > 0 and put m farther than `reach` from the box [lo, hi]: a side
+// without an estimate does not rule the pair out.
+bool SheetEstimateNearVoxel(const Vector3& foot_i, const Vector3& inward_i, const Vector3& foot_j,
+                            const Vector3& inward_j, const Vector3& lo, const Vector3& hi,
+                            double reach);
 
 }  // namespace inscribe::internal

@@ -34,10 +34,12 @@ struct MedialSphereOptions {
   int screen_samples = 8;
   // Corner screening, before any sampling: one closest-point query per grid vertex (shared by
   // the 8 voxels around it); a voxel whose 8 corners' inward directions at their nearest
-  // boundary points all lie within (object_angle - 0.1 rad) of each other is
-  // skipped, since a medial sheet of that angle cutting the voxel would split its corners into
-  // two groups differing by about that angle. Can miss a sheet that enters and leaves a voxel
-  // through one face.
+  // boundary points all lie within (object_angle - 0.1 rad) of each other is skipped, since a
+  // medial sheet of that angle cutting the voxel would split its corners into two groups
+  // differing by about that angle. So is a voxel where every corner pair differing by that
+  // much points to a sheet (estimated from the two nearest points' tangent planes) more than
+  // half a voxel away: near a thin tube's axis the directions turn fast across voxels that the
+  // axis does not reach. Can miss a sheet that enters and leaves a voxel through one face.
   bool corner_screen = true;
   // Optional pruning, off by default (pi): a crossing pair whose two ends' nearest boundary
   // points both lie inside faces is searched only if the angle between the ends' directions to

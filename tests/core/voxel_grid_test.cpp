@@ -115,7 +115,7 @@ using VoxelKey = std::tuple<std::int64_t, std::int64_t, std::int64_t>;
 // every sample), those in voxels the estimate keeps are nearly all those in voxels the
 // directions keep.
 TEST(CornerScreen, SheetEstimatesDropVoxelsButNotThePlainMethodsSpheres) {
-  for (const char* name : {"knot1.off", "eight.off", "elephant.off", "fandisk.off"}) {
+  for (const char* name : {"knot1.off", "eight.off", "cow.off", "elephant.off", "fandisk.off"}) {
     SCOPED_TRACE(name);
     INSCRIBE_REQUIRE_MESH(name);
     const Mesh mesh = LoadTestMesh(name);

@@ -152,6 +152,71 @@ bool SheetEstimateNearVoxel(const Vector3& foot_i, const Vector3& inward_i, cons
          near_from(foot_j, inward_j, foot_i, inward_i);
 }
 
+CornerVertices ListCornerVertices(const Grid& grid, const std::vector<VisitedVoxel>& voxels) {
+  const std::int64_t vx = grid.dims[0] + 1;
+  const std::int64_t vy = grid.dims[1] + 1;
+  const std::int64_t vz = grid.dims[2] + 1;
+  auto corner_id = [vx, vy](const VisitedVoxel& voxel, int corner) {
+    return (voxel.index[0] + (corner & 1)) +
+           vx * ((voxel.index[1] + ((corner >> 1) & 1)) + vy * (voxel.index[2] + (corner >> 2)));
+  };
+  CornerVertices out;
+  out.of_voxel.resize(8 * voxels.size());
+  const std::int64_t words = (vx * vy * vz + 63) / 64;
+  if (words <= static_cast<std::int64_t>(8 * voxels.size())) {
+    // Dense: one bit per grid vertex and the number of set bits before each word, so a
+    // vertex's place in the list is that number plus a popcount.
+    std::vector<std::uint64_t> bits(static_cast<std::size_t>(words), 0);
+    for (const VisitedVoxel& voxel : voxels) {
+      for (int corner = 0; corner < 8; ++corner) {
+        const std::int64_t id = corner_id(voxel, corner);
+        bits[static_cast<std::size_t>(id >> 6)] |= std::uint64_t{1} << (id & 63);
+      }
+    }
+    std::vector<std::int64_t> before(bits.size());
+    std::int64_t count = 0;
+    for (std::size_t w = 0; w < bits.size(); ++w) {
+      before[w] = count;
+      count += __builtin_popcountll(bits[w]);
+    }
+    out.ids.reserve(static_cast<std::size_t>(count));
+    for (std::size_t w = 0; w < bits.size(); ++w) {
+      for (std::uint64_t b = bits[w]; b != 0; b &= b - 1) {
+        out.ids.push_back(static_cast<std::int64_t>(64 * w) + __builtin_ctzll(b));
+      }
+    }
+    ParallelForRange(std::size_t{0}, voxels.size(), 1024, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t v = begin; v != end; ++v) {
+        for (int corner = 0; corner < 8; ++corner) {
+          const std::int64_t id = corner_id(voxels[v], corner);
+          const auto w = static_cast<std::size_t>(id >> 6);
+          const std::uint64_t below = bits[w] & ((std::uint64_t{1} << (id & 63)) - 1);
+          out.of_voxel[8 * v + static_cast<std::size_t>(corner)] =
+              before[w] + __builtin_popcountll(below);
+        }
+      }
+    });
+    return out;
+  }
+  // Sparse (a few voxels in a large grid): the corners sorted, then found by binary search.
+  out.ids.reserve(8 * voxels.size());
+  for (const VisitedVoxel& voxel : voxels) {
+    for (int corner = 0; corner < 8; ++corner) out.ids.push_back(corner_id(voxel, corner));
+  }
+  std::sort(out.ids.begin(), out.ids.end());
+  out.ids.erase(std::unique(out.ids.begin(), out.ids.end()), out.ids.end());
+  ParallelForRange(std::size_t{0}, voxels.size(), 1024, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t v = begin; v != end; ++v) {
+      for (int corner = 0; corner < 8; ++corner) {
+        out.of_voxel[8 * v + static_cast<std::size_t>(corner)] =
+            std::lower_bound(out.ids.begin(), out.ids.end(), corner_id(voxels[v], corner)) -
+            out.ids.begin();
+      }
+    }
+  });
+  return out;
+}
+
 // Corner screening: one closest-point query per grid vertex, shared by the 8 voxels around it.
 // A medial sheet of object angle phi that cuts a voxel separates its corners into two groups
 // whose inward directions differ by about phi; a voxel whose 8 corner directions are all
@@ -165,20 +230,8 @@ std::vector<char> ScreenByCorners(const BoundaryOracle& oracle, const Grid& grid
                                   const std::atomic<bool>* cancel) {
   const std::int64_t vx = grid.dims[0] + 1;
   const std::int64_t vy = grid.dims[1] + 1;
-  auto vertex_id = [&](std::int64_t i, std::int64_t j, std::int64_t k) {
-    return i + vx * (j + vy * k);
-  };
-  std::vector<std::int64_t> vertices;
-  vertices.reserve(voxels.size() * 8);
-  for (const VisitedVoxel& voxel : voxels) {
-    for (int corner = 0; corner < 8; ++corner) {
-      vertices.push_back(vertex_id(voxel.index[0] + (corner & 1),
-                                   voxel.index[1] + ((corner >> 1) & 1),
-                                   voxel.index[2] + ((corner >> 2) & 1)));
-    }
-  }
-  std::sort(vertices.begin(), vertices.end());
-  vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+  const CornerVertices corners = ListCornerVertices(grid, voxels);
+  const std::vector<std::int64_t>& vertices = corners.ids;
   std::vector<Vector3> feet(vertices.size());
   std::vector<Vector3> directions(vertices.size());
   const Mesh& mesh = oracle.mesh();
@@ -203,20 +256,13 @@ std::vector<char> ScreenByCorners(const BoundaryOracle& oracle, const Grid& grid
   ParallelForRange(std::size_t{0}, voxels.size(), 256, [&](std::size_t begin, std::size_t end) {
     for (std::size_t n = begin; n != end; ++n) {
       const VisitedVoxel& voxel = voxels[n];
-      std::array<std::size_t, 8> corner_vertex;
-      for (int corner = 0; corner < 8; ++corner) {
-        const std::int64_t id =
-            vertex_id(voxel.index[0] + (corner & 1), voxel.index[1] + ((corner >> 1) & 1),
-                      voxel.index[2] + ((corner >> 2) & 1));
-        corner_vertex[corner] = static_cast<std::size_t>(
-            std::lower_bound(vertices.begin(), vertices.end(), id) - vertices.begin());
-      }
+      const std::int64_t* corner_vertex = &corners.of_voxel[8 * n];
       const Vector3 lo = grid.corner(voxel.index[0], voxel.index[1], voxel.index[2]);
       const Vector3 hi = lo + Vector3::Constant(grid.size);
       for (int x = 0; x < 8 && !pass[n]; ++x) {
-        const std::size_t a = corner_vertex[x];
+        const auto a = static_cast<std::size_t>(corner_vertex[x]);
         for (int y = x + 1; y < 8; ++y) {
-          const std::size_t b = corner_vertex[y];
+          const auto b = static_cast<std::size_t>(corner_vertex[y]);
           if (directions[a].dot(directions[b]) <= max_cosine &&
               SheetEstimateNearVoxel(feet[a], directions[a], feet[b], directions[b], lo, hi,
                                      reach)) {

@@ -56,6 +56,19 @@ std::vector<VisitedVoxel> CullVoxels(const BoundaryOracle& oracle, const Grid& g
                                      std::int64_t& queries,
                                      const std::atomic<bool>* cancel = nullptr);
 
+// The grid vertices that are corners of `voxels` (vertex (i, j, k) has id
+// i + (nx + 1) (j + (ny + 1) k)), in increasing id order, and where each voxel's corners are in
+// that list: corner c of voxels[v] (offset (c & 1, c >> 1 & 1, c >> 2 & 1)) is
+// ids[of_voxel[8 v + c]].
+struct CornerVertices {
+  std::vector<std::int64_t> ids;
+  std::vector<std::int64_t> of_voxel;
+};
+// A bit per grid vertex with a count per word when that takes no more memory than sorting the
+// corners (O(grid vertices / 64 + voxels)); otherwise the corners sorted. The same answer
+// either way.
+CornerVertices ListCornerVertices(const Grid& grid, const std::vector<VisitedVoxel>& voxels);
+
 // The corner screen of medial-sphere generation passes a voxel whose corner directions differ
 // by theta minus this (radians): corners sit up to sqrt(3) sigma from the sheet, where the
 // directions have turned a little ...

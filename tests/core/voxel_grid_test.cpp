@@ -8,9 +8,12 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <optional>
 #include <random>
+#include <set>
 #include <string>
 #include <tuple>
+#include <vector>
 
 #include "inscribe/boundary_oracle.h"
 #include "inscribe/medial_spheres.h"
@@ -108,6 +111,86 @@ TEST(SheetEstimate, WithoutAnEstimateThePairStays) {
   EXPECT_TRUE(SheetEstimateNearVoxel(f_i, u_i, f_j, u_j, far, far + Vector3::Constant(1.0), 0.1));
 }
 
+// A demo mesh's oracle, a grid of cubes of side `fraction` of its diagonal, and the voxels the
+// culling keeps; nullopt (with a test failure) if any step fails.
+struct Culled {
+  BoundaryOracle oracle;
+  Grid grid;
+  std::vector<VisitedVoxel> voxels;
+};
+std::optional<Culled> Cull(const char* name, double fraction) {
+  const Mesh mesh = LoadTestMesh(name);
+  absl::StatusOr<BoundaryOracle> oracle = BoundaryOracle::Build(mesh);
+  if (!oracle.ok()) {
+    ADD_FAILURE() << oracle.status();
+    return std::nullopt;
+  }
+  const BoundingBox box = ComputeBoundingBox(mesh.vertices);
+  const absl::StatusOr<Grid> grid = MakeGrid(box, fraction * box.diagonal(), 20'000'000);
+  if (!grid.ok()) {
+    ADD_FAILURE() << grid.status();
+    return std::nullopt;
+  }
+  std::int64_t queries = 0;
+  std::vector<VisitedVoxel> voxels = CullVoxels(*oracle, *grid, queries);
+  return Culled{*std::move(oracle), *grid, std::move(voxels)};
+}
+
+// The slow obvious list: every corner of every voxel into a std::set.
+void ExpectCornersAsASetFindsThem(const Grid& grid, const std::vector<VisitedVoxel>& voxels) {
+  const std::int64_t vx = grid.dims[0] + 1;
+  const std::int64_t vy = grid.dims[1] + 1;
+  auto id_of = [&](const VisitedVoxel& voxel, int corner) {
+    return (voxel.index[0] + (corner & 1)) +
+           vx * ((voxel.index[1] + ((corner >> 1) & 1)) + vy * (voxel.index[2] + (corner >> 2)));
+  };
+  std::set<std::int64_t> all;
+  for (const VisitedVoxel& voxel : voxels) {
+    for (int corner = 0; corner < 8; ++corner) all.insert(id_of(voxel, corner));
+  }
+  const CornerVertices listed = ListCornerVertices(grid, voxels);
+  EXPECT_EQ(listed.ids, std::vector<std::int64_t>(all.begin(), all.end()));
+  ASSERT_EQ(listed.of_voxel.size(), 8 * voxels.size());
+  for (std::size_t v = 0; v < voxels.size(); ++v) {
+    for (int corner = 0; corner < 8; ++corner) {
+      const std::int64_t at = listed.of_voxel[8 * v + static_cast<std::size_t>(corner)];
+      ASSERT_GE(at, 0);
+      ASSERT_LT(at, static_cast<std::int64_t>(listed.ids.size()));
+      ASSERT_EQ(listed.ids[static_cast<std::size_t>(at)], id_of(voxels[v], corner))
+          << "voxel " << v << " corner " << corner;
+    }
+  }
+}
+
+// Both ways of listing: the bit per grid vertex (a real mesh's culled voxels fill a good part
+// of their grid) and the sorted corners (a few voxels scattered in a large grid).
+TEST(CornerVertices, BothWaysListWhatASetFinds) {
+  for (const char* name : {"eight.off", "knot1.off"}) {
+    SCOPED_TRACE(name);
+    INSCRIBE_REQUIRE_MESH(name);
+    const std::optional<Culled> culled = Cull(name, 0.02);
+    ASSERT_TRUE(culled);
+    ExpectCornersAsASetFindsThem(culled->grid, culled->voxels);
+  }
+  Grid sparse;
+  sparse.size = 1.0;
+  sparse.dims = {1000, 700, 900};
+  std::mt19937 random(3);
+  std::vector<VisitedVoxel> voxels;
+  for (int v = 0; v < 300; ++v) {
+    // Clusters of neighbours, so that voxels share corners.
+    const std::int64_t i = random() % 998, j = random() % 698, k = random() % 898;
+    for (int d = 0; d < 3; ++d) {
+      VisitedVoxel voxel;
+      voxel.index = {i + (d & 1), j + (d >> 1), k};
+      voxel.linear = voxel.index[0] + sparse.dims[0] * (voxel.index[1] + sparse.dims[1] * k);
+      voxels.push_back(voxel);
+    }
+  }
+  ExpectCornersAsASetFindsThem(sparse, voxels);
+  ExpectCornersAsASetFindsThem(sparse, {});
+}
+
 using VoxelKey = std::tuple<std::int64_t, std::int64_t, std::int64_t>;
 
 // On real meshes: every voxel the estimate lets through, the directions alone let through too;
@@ -118,20 +201,18 @@ TEST(CornerScreen, SheetEstimatesDropVoxelsButNotThePlainMethodsSpheres) {
   for (const char* name : {"knot1.off", "eight.off", "cow.off", "elephant.off", "fandisk.off"}) {
     SCOPED_TRACE(name);
     INSCRIBE_REQUIRE_MESH(name);
-    const Mesh mesh = LoadTestMesh(name);
-    const absl::StatusOr<BoundaryOracle> oracle = BoundaryOracle::Build(mesh);
-    ASSERT_TRUE(oracle.ok()) << oracle.status();
-    const BoundingBox box = ComputeBoundingBox(mesh.vertices);
-    const double sigma = 0.012 * box.diagonal();
-    const absl::StatusOr<Grid> grid = MakeGrid(box, sigma, 20'000'000);
-    ASSERT_TRUE(grid.ok()) << grid.status();
+    const std::optional<Culled> culled = Cull(name, 0.012);
+    ASSERT_TRUE(culled);
+    const BoundaryOracle& oracle = culled->oracle;
+    const Grid& grid = culled->grid;
+    const std::vector<VisitedVoxel>& voxels = culled->voxels;
+    const double sigma = grid.size;
     std::int64_t queries = 0;
-    const std::vector<VisitedVoxel> voxels = CullVoxels(*oracle, *grid, queries);
     const double min_angle = MedialSphereOptions{}.object_angle - kCornerScreenMargin;
     const std::vector<char> by_directions =
-        ScreenByCorners(*oracle, *grid, voxels, min_angle, kNoReach, queries);
+        ScreenByCorners(oracle, grid, voxels, min_angle, kNoReach, queries);
     const std::vector<char> by_estimates =
-        ScreenByCorners(*oracle, *grid, voxels, min_angle, kCornerScreenReach * sigma, queries);
+        ScreenByCorners(oracle, grid, voxels, min_angle, kCornerScreenReach * sigma, queries);
     ASSERT_EQ(by_directions.size(), voxels.size());
     ASSERT_EQ(by_estimates.size(), voxels.size());
     std::map<VoxelKey, std::pair<bool, bool>> passes;
@@ -151,12 +232,12 @@ TEST(CornerScreen, SheetEstimatesDropVoxelsButNotThePlainMethodsSpheres) {
     plain.voxel_size = sigma;
     plain.corner_screen = false;
     plain.screen_samples = 0;
-    const absl::StatusOr<MedialSphereResult> all = GenerateMedialSpheres(*oracle, plain);
+    const absl::StatusOr<MedialSphereResult> all = GenerateMedialSpheres(oracle, plain);
     ASSERT_TRUE(all.ok()) << all.status();
     ASSERT_GT(all->set.size(), 50u);
     int kept_by_directions = 0, kept_by_estimates = 0;
     for (const Sphere& s : all->set.spheres) {
-      const Vector3 cell = (s.center - grid->origin) / sigma;
+      const Vector3 cell = (s.center - grid.origin) / sigma;
       const auto it = passes.find({static_cast<std::int64_t>(std::floor(cell.x())),
                                    static_cast<std::int64_t>(std::floor(cell.y())),
                                    static_cast<std::int64_t>(std::floor(cell.z()))});

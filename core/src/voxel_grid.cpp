@@ -163,7 +163,7 @@ CornerVertices ListCornerVertices(const Grid& grid, const std::vector<VisitedVox
   CornerVertices out;
   out.of_voxel.resize(8 * voxels.size());
   const std::int64_t words = (vx * vy * vz + 63) / 64;
-  if (words <= static_cast<std::int64_t>(8 * voxels.size())) {
+  if (words <= static_cast<std::int64_t>(voxels.size())) {
     // Dense: one bit per grid vertex and the number of set bits before each word, so a
     // vertex's place in the list is that number plus a popcount.
     std::vector<std::uint64_t> bits(static_cast<std::size_t>(words), 0);

@@ -64,9 +64,9 @@ struct CornerVertices {
   std::vector<std::int64_t> ids;
   std::vector<std::int64_t> of_voxel;
 };
-// A bit per grid vertex with a count per word when that takes no more memory than sorting the
-// corners (O(grid vertices / 64 + voxels)); otherwise the corners sorted. The same answer
-// either way.
+// A bit per grid vertex with a count per word when the grid has at most 64 vertices per voxel
+// listed (16 bytes per voxel at most; O(grid vertices / 64 + voxels)); otherwise, for a few
+// voxels in a large grid, the corners sorted. The same answer either way.
 CornerVertices ListCornerVertices(const Grid& grid, const std::vector<VisitedVoxel>& voxels);
 
 // The corner screen of medial-sphere generation passes a voxel whose corner directions differ

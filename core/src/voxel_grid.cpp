@@ -153,16 +153,13 @@ bool SheetEstimateNearVoxel(const Vector3& foot_i, const Vector3& inward_i, cons
 }
 
 CornerVertices ListCornerVertices(const Grid& grid, const std::vector<VisitedVoxel>& voxels) {
-  const std::int64_t vx = grid.dims[0] + 1;
-  const std::int64_t vy = grid.dims[1] + 1;
-  const std::int64_t vz = grid.dims[2] + 1;
-  auto corner_id = [vx, vy](const VisitedVoxel& voxel, int corner) {
-    return (voxel.index[0] + (corner & 1)) +
-           vx * ((voxel.index[1] + ((corner >> 1) & 1)) + vy * (voxel.index[2] + (corner >> 2)));
+  auto corner_id = [&grid](const VisitedVoxel& voxel, int corner) {
+    return grid.vertex_id(voxel.index[0] + (corner & 1), voxel.index[1] + ((corner >> 1) & 1),
+                          voxel.index[2] + (corner >> 2));
   };
   CornerVertices out;
   out.of_voxel.resize(8 * voxels.size());
-  const std::int64_t words = (vx * vy * vz + 63) / 64;
+  const std::int64_t words = (grid.vertex_count() + 63) / 64;
   if (words <= static_cast<std::int64_t>(voxels.size())) {
     // Dense: one bit per grid vertex and the number of set bits before each word, so a
     // vertex's place in the list is that number plus a popcount.
@@ -228,8 +225,6 @@ std::vector<char> ScreenByCorners(const BoundaryOracle& oracle, const Grid& grid
                                   const std::vector<VisitedVoxel>& voxels, double min_angle,
                                   double reach, std::int64_t& queries,
                                   const std::atomic<bool>* cancel) {
-  const std::int64_t vx = grid.dims[0] + 1;
-  const std::int64_t vy = grid.dims[1] + 1;
   const CornerVertices corners = ListCornerVertices(grid, voxels);
   const std::vector<std::int64_t>& vertices = corners.ids;
   std::vector<Vector3> feet(vertices.size());
@@ -242,7 +237,7 @@ std::vector<char> ScreenByCorners(const BoundaryOracle& oracle, const Grid& grid
     std::optional<Vector3> previous_foot;
     for (std::size_t v = begin; v != end; ++v) {
       const std::int64_t id = vertices[v];
-      const Vector3 x = grid.corner(id % vx, (id / vx) % vy, id / (vx * vy));
+      const Vector3 x = grid.vertex(id);
       const BoundaryPoint foot =
           previous_foot ? oracle.ClosestPointNear(x, *previous_foot) : oracle.ClosestPoint(x);
       previous_foot = foot.point;

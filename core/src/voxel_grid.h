@@ -25,6 +25,17 @@ struct Grid {
     return origin +
            size * Vector3(static_cast<double>(i), static_cast<double>(j), static_cast<double>(k));
   }
+  // Grid vertices (voxel corners) (i, j, k), 0 <= i <= dims[0] etc., numbered
+  // i + (dims[0] + 1) (j + (dims[1] + 1) k); vertex_count() of them.
+  std::int64_t vertex_count() const { return (dims[0] + 1) * (dims[1] + 1) * (dims[2] + 1); }
+  std::int64_t vertex_id(std::int64_t i, std::int64_t j, std::int64_t k) const {
+    return i + (dims[0] + 1) * (j + (dims[1] + 1) * k);
+  }
+  Vector3 vertex(std::int64_t id) const {
+    const std::int64_t vx = dims[0] + 1;
+    const std::int64_t vy = dims[1] + 1;
+    return corner(id % vx, (id / vx) % vy, id / (vx * vy));
+  }
 };
 
 // A voxel that survived culling. `boundary` when the boundary may cross it.
@@ -56,8 +67,8 @@ std::vector<VisitedVoxel> CullVoxels(const BoundaryOracle& oracle, const Grid& g
                                      std::int64_t& queries,
                                      const std::atomic<bool>* cancel = nullptr);
 
-// The grid vertices that are corners of `voxels` (vertex (i, j, k) has id
-// i + (nx + 1) (j + (ny + 1) k)), in increasing id order, and where each voxel's corners are in
+// The grid vertices that are corners of `voxels` (by Grid::vertex_id), in increasing id order,
+// and where each voxel's corners are in
 // that list: corner c of voxels[v] (offset (c & 1, c >> 1 & 1, c >> 2 & 1)) is
 // ids[of_voxel[8 v + c]].
 struct CornerVertices {

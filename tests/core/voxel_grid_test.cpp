@@ -138,11 +138,9 @@ std::optional<Culled> Cull(const char* name, double fraction) {
 
 // The slow obvious list: every corner of every voxel into a std::set.
 void ExpectCornersAsASetFindsThem(const Grid& grid, const std::vector<VisitedVoxel>& voxels) {
-  const std::int64_t vx = grid.dims[0] + 1;
-  const std::int64_t vy = grid.dims[1] + 1;
   auto id_of = [&](const VisitedVoxel& voxel, int corner) {
-    return (voxel.index[0] + (corner & 1)) +
-           vx * ((voxel.index[1] + ((corner >> 1) & 1)) + vy * (voxel.index[2] + (corner >> 2)));
+    return grid.vertex_id(voxel.index[0] + (corner & 1), voxel.index[1] + ((corner >> 1) & 1),
+                          voxel.index[2] + (corner >> 2));
   };
   std::set<std::int64_t> all;
   for (const VisitedVoxel& voxel : voxels) {

@@ -1,7 +1,10 @@
 // The selection's sample grid and bit fields. See coverage_grid.h.
 #include "coverage_grid.h"
 
+#include <limits>
+
 #include "cpu_clones.h"
+#include "parallel.h"
 
 namespace inscribe::internal {
 namespace {
@@ -39,6 +42,14 @@ SampleGrid::SampleGrid(const std::vector<Sphere>& balls, std::int64_t max_points
   words_per_row_ = (dims_[0] + 63) / 64;
 }
 
+INSCRIBE_CLONES_X86_64_V2 std::int64_t SampleGrid::CountPoints(const Sphere& ball) const {
+  std::int64_t count = 0;
+  ForEachRun(ball, [&count](std::int64_t, std::int64_t first, std::int64_t last) {
+    count += last - first + 1;
+  });
+  return count;
+}
+
 BitField::BitField(const SampleGrid& grid)
     : grid_(grid),
       words_per_row_(grid.words_per_row()),
@@ -48,6 +59,19 @@ BitField::BitField(const SampleGrid& grid)
                                              ((grid.dim(2) + kBlockRows - 1) / kBlockRows)),
                     0) {}
 
+INSCRIBE_CLONES_X86_64_V2 void BitField::SetAll(const std::vector<Sphere>& balls) {
+  // In parallel over slabs of kBlockRows slices, which share no word and no block count.
+  const std::int64_t slabs = (grid_.dim(2) + kBlockRows - 1) / kBlockRows;
+  ParallelForRange(std::int64_t{0}, slabs, 1, [&](std::int64_t begin, std::int64_t end) {
+    for (const Sphere& ball : balls) {
+      grid_.ForEachRunInSlices(ball, begin * kBlockRows, end * kBlockRows - 1,
+                               [this](std::int64_t row, std::int64_t first, std::int64_t last) {
+                                 Set(row, first, last);
+                               });
+    }
+  });
+}
+
 std::int64_t BitField::CountAll() const {
   std::int64_t count = 0;
   for (std::int32_t block : block_counts_) count += block;
@@ -56,18 +80,25 @@ std::int64_t BitField::CountAll() const {
 
 // Cloned for x86-64-v2 (popcnt, SSE4.1 rounding), chosen at load time: with the baseline's
 // library popcount and floor the count runs at half speed.
-INSCRIBE_CLONES_X86_64_V2 std::int64_t BitField::CountIn(const Sphere& sphere) const {
+std::int64_t BitField::CountIn(const Sphere& sphere) const {
+  return CountIn(sphere, {0, 0, 0}, {grid_.dim(0) - 1, grid_.dim(1) - 1, grid_.dim(2) - 1});
+}
+
+INSCRIBE_CLONES_X86_64_V2 std::int64_t BitField::CountIn(
+    const Sphere& sphere, const std::array<std::int64_t, 3>& box_low,
+    const std::array<std::int64_t, 3>& box_high) const {
   const SampleGrid::Ball ball = grid_.ToGrid(sphere);
   // The blocks looked at: ForEachRun's slices along z; along x and y its runs end where square
   // roots of rounded differences put them, so one point further.
   std::int64_t k0, k1;
   grid_.SliceRange(ball, k0, k1);
+  k0 = std::max(k0, box_low[2]);
+  k1 = std::min(k1, box_high[2]);
   if (k0 > k1) return 0;
   std::int64_t low[2], high[2];
   for (int axis = 0; axis < 2; ++axis) {
-    low[axis] = std::max<std::int64_t>(0, SampleGrid::Ceil(ball.c[axis] - ball.r) - 1);
-    high[axis] =
-        std::min<std::int64_t>(grid_.dim(axis) - 1, SampleGrid::Floor(ball.c[axis] + ball.r) + 1);
+    low[axis] = std::max(box_low[axis], SampleGrid::Ceil(ball.c[axis] - ball.r) - 1);
+    high[axis] = std::min(box_high[axis], SampleGrid::Floor(ball.c[axis] + ball.r) + 1);
     if (low[axis] > high[axis]) return 0;
   }
   const double r2 = ball.r * ball.r;
@@ -133,6 +164,53 @@ INSCRIBE_CLONES_X86_64_V2 std::int64_t BitField::CountIn(const Sphere& sphere) c
     }
   }
   return count;
+}
+
+INSCRIBE_CLONES_X86_64_V2 void ClearedPoints::Take(BitField& field, const Sphere& sphere) {
+  for (const Run& run : runs_) kept_.Clear(run.row, run.first, run.last);
+  runs_.clear();
+  low_.fill(std::numeric_limits<std::int64_t>::max());
+  high_.fill(std::numeric_limits<std::int64_t>::min());
+  const SampleGrid::Ball ball = grid_.ToGrid(sphere);
+  std::int64_t k0, k1;
+  grid_.SliceRange(ball, k0, k1);
+  for (std::int64_t k = k0; k <= k1; ++k) {
+    double slice;
+    std::int64_t j0, j1;
+    if (!grid_.Slice(ball, k, slice, j0, j1)) continue;
+    for (std::int64_t j = j0; j <= j1; ++j) {
+      std::int64_t first, last;
+      if (!grid_.Chord(ball, slice, j, first, last)) continue;
+      const std::int64_t row = grid_.row(j, k);
+      field.MoveTo(row, first, last, kept_);
+      const std::int64_t lowest = kept_.FirstSet(row, first, last);
+      if (lowest > last) continue;
+      runs_.push_back(Run{row, first, last});
+      const std::int64_t highest = kept_.LastSet(row, first, last);
+      const std::int64_t point_low[3] = {lowest, j, k};
+      const std::int64_t point_high[3] = {highest, j, k};
+      for (int axis = 0; axis < 3; ++axis) {
+        low_[axis] = std::min(low_[axis], point_low[axis]);
+        high_[axis] = std::max(high_[axis], point_high[axis]);
+      }
+    }
+  }
+}
+
+INSCRIBE_CLONES_X86_64_V2 std::int64_t ClearedPoints::CountIn(const Sphere& sphere) const {
+  if (runs_.empty()) return 0;
+  // Balls clear of the kept points' box by a point's width (far above the row rule's
+  // rounding) hold none of them.
+  const SampleGrid::Ball ball = grid_.ToGrid(sphere);
+  double gap2 = 0.0;
+  for (int axis = 0; axis < 3; ++axis) {
+    const double below = static_cast<double>(low_[axis]) - ball.c[axis];
+    const double above = ball.c[axis] - static_cast<double>(high_[axis]);
+    const double gap = std::max({below, above, 0.0});
+    gap2 += gap * gap;
+  }
+  if (gap2 > (ball.r + 1.0) * (ball.r + 1.0)) return 0;
+  return kept_.CountIn(sphere, low_, high_);
 }
 
 void CoverCounts::Change(const Sphere& ball, int step) {

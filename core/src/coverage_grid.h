@@ -3,8 +3,8 @@
 // along x, and a ball meets each row in one run of points, so counting the points of a ball
 // still set is a popcount over its runs. Each bit field also keeps the number of set bits of
 // every block of 64 x 4 x 4 points (one word of 4 x 4 rows), so a count can take a block
-// wholly inside the ball at once and skip an empty one: late in a greedy choice, a large
-// ball's recount touches its surface's blocks instead of all its rows.
+// wholly inside the ball at once and skip an empty one. The greedy keeps each ball's gain by
+// counting, in a field holding only the points a choice cleared, the blocks of their overlap.
 #pragma once
 
 #include <algorithm>
@@ -80,9 +80,17 @@ class SampleGrid {
   // (inclusive) inside the ball.
   template <typename F>
   __attribute__((always_inline)) void ForEachRun(const Sphere& sphere, F&& f) const {
+    ForEachRunInSlices(sphere, 0, dims_[2] - 1, f);
+  }
+  // The same, for the slices k_low..k_high only.
+  template <typename F>
+  __attribute__((always_inline)) void ForEachRunInSlices(const Sphere& sphere, std::int64_t k_low,
+                                                         std::int64_t k_high, F&& f) const {
     const Ball ball = ToGrid(sphere);
     std::int64_t k0, k1;
     SliceRange(ball, k0, k1);
+    k0 = std::max(k0, k_low);
+    k1 = std::min(k1, k_high);
     for (std::int64_t k = k0; k <= k1; ++k) {
       double slice;
       std::int64_t j0, j1;
@@ -93,6 +101,9 @@ class SampleGrid {
       }
     }
   }
+
+  // The number of points inside the ball (those ForEachRun gives).
+  std::int64_t CountPoints(const Sphere& ball) const;
 
   static std::int64_t Ceil(double x) { return static_cast<std::int64_t>(std::ceil(x)); }
   static std::int64_t Floor(double x) { return static_cast<std::int64_t>(std::floor(x)); }
@@ -126,7 +137,24 @@ class BitField {
       return -removed;
     });
   }
+  // Clears first..last of `row` and sets the points it cleared (those that were set) in
+  // `into`, a field of the same grid.
+  void MoveTo(std::int64_t row, std::int64_t first, std::int64_t last, BitField& into) {
+    std::uint64_t* into_words = &into.words_[Word(row, 0)];
+    std::int32_t* into_blocks = &into.block_counts_[Block(row, 0)];
+    ForEachWord(row, first, last, [&](std::uint64_t& word, std::uint64_t mask) {
+      const std::uint64_t moved = word & mask;
+      const std::int32_t count = __builtin_popcountll(moved);
+      const std::ptrdiff_t w = &word - &words_[Word(row, 0)];
+      into_words[w] |= moved;
+      into_blocks[w] += count;
+      word &= ~mask;
+      return -count;
+    });
+  }
   void Set(std::int64_t row, std::int64_t i) { Set(row, i, i); }
+  // Sets every point inside any of the balls (in parallel).
+  void SetAll(const std::vector<Sphere>& balls);
   void Clear(std::int64_t row, std::int64_t i) { Clear(row, i, i); }
 
   // Set points among first..last of `row`.
@@ -142,9 +170,35 @@ class BitField {
     return count + __builtin_popcountll(words[w1] & tail);
   }
   std::int64_t CountAll() const;
+  // The first set point among first..last of `row`, last + 1 if none; the last, first - 1 if
+  // none.
+  std::int64_t FirstSet(std::int64_t row, std::int64_t first, std::int64_t last) const {
+    const std::uint64_t* words = &words_[Word(row, 0)];
+    for (std::int64_t w = first >> 6; w <= last >> 6; ++w) {
+      std::uint64_t bits = words[w];
+      if (w == first >> 6) bits &= ~std::uint64_t{0} << (first & 63);
+      if (w == last >> 6) bits &= ~std::uint64_t{0} >> (63 - (last & 63));
+      if (bits != 0) return w * 64 + __builtin_ctzll(bits);
+    }
+    return last + 1;
+  }
+  std::int64_t LastSet(std::int64_t row, std::int64_t first, std::int64_t last) const {
+    const std::uint64_t* words = &words_[Word(row, 0)];
+    for (std::int64_t w = last >> 6; w >= first >> 6; --w) {
+      std::uint64_t bits = words[w];
+      if (w == first >> 6) bits &= ~std::uint64_t{0} << (first & 63);
+      if (w == last >> 6) bits &= ~std::uint64_t{0} >> (63 - (last & 63));
+      if (bits != 0) return w * 64 + 63 - __builtin_clzll(bits);
+    }
+    return first - 1;
+  }
 
   // Set points inside `ball`; the same as summing Count over grid.ForEachRun(ball), faster.
   std::int64_t CountIn(const Sphere& ball) const;
+  // The same, for a field whose set points all lie in the box low..high (grid points,
+  // inclusive): only the blocks in the box are looked at.
+  std::int64_t CountIn(const Sphere& ball, const std::array<std::int64_t, 3>& low,
+                       const std::array<std::int64_t, 3>& high) const;
 
  private:
   std::size_t Word(std::int64_t row, std::int64_t w) const {
@@ -180,6 +234,32 @@ class BitField {
   std::int64_t blocks_y_ = 0;
   std::vector<std::uint64_t> words_;
   std::vector<std::int32_t> block_counts_;
+};
+
+// The points one greedy choice cleared from a bit field, in a field of their own: the gain of
+// a ball near the choice then falls by exactly the points it shares with them, counted over
+// the blocks of their box, instead of being recounted over the whole ball.
+class ClearedPoints {
+ public:
+  explicit ClearedPoints(const SampleGrid& grid) : grid_(grid), kept_(grid) {}
+
+  // Clears the ball's points from `field` and keeps those that were set (only these), in
+  // place of the last Take's.
+  void Take(BitField& field, const Sphere& ball);
+  // Kept points inside `ball`: what field.CountIn(ball) lost to the last Take.
+  std::int64_t CountIn(const Sphere& ball) const;
+
+ private:
+  struct Run {
+    std::int64_t row, first, last;
+  };
+
+  const SampleGrid& grid_;
+  BitField kept_;
+  std::vector<Run> runs_;  // the last Take's runs (with a kept point), to clear kept_
+  // The box of the kept points, in grid points (empty: low > high).
+  std::array<std::int64_t, 3> low_ = {0, 0, 0};
+  std::array<std::int64_t, 3> high_ = {-1, -1, -1};
 };
 
 // The chosen balls' cover of the samples, point by point, for the swap search: how many chosen

@@ -36,17 +36,8 @@ using internal::BitField;
 using internal::CoverCounts;
 using internal::SampleGrid;
 
-// The lazy greedy chooses a ball whose fresh gain is within 2^-kSlackShift of the best upper
-// bound left, rather than recounting the others: each choice then covers at least (1 - 2^-4)
-// of the best gain, which keeps a guarantee of 1 - e^-(1 - 2^-4) of the optimum and saves most
-// recounts of large balls whose gains fall a little at every choice near them.
-constexpr int kSlackShift = 4;
-
-// Balls recounted together (in parallel) when the lazy greedy needs a recount. Only the cost
-// depends on it: too few leave cores idle, too many count balls the choice does not reach.
-constexpr std::size_t kRecountBatch = 8;
-
-// A ball's last counted gain; the queue's top is the largest gain, then the lowest index.
+// A ball's gain when queued, an upper bound of its gain now (gains only fall); the queue's top
+// is the largest, then the lowest index.
 struct Pending {
   std::int64_t gain = 0;
   std::int32_t index = 0;
@@ -101,21 +92,16 @@ INSCRIBE_CLONES_X86_64_V2 absl::StatusOr<CoverageSelection> SelectByCoverage(
   const SampleGrid grid(balls, options.grid_points);
   out.grid_spacing = grid.spacing();
   BitField uncovered(grid);
-  for (const Sphere& ball : balls) {
-    grid.ForEachRun(ball, [&uncovered](std::int64_t row, std::int64_t first, std::int64_t last) {
-      uncovered.Set(row, first, last);
-    });
-  }
+  uncovered.SetAll(balls);
   out.samples = uncovered.CountAll();
   if (control.cancelled()) return Cancelled();
 
+  // Every point of every ball is set: a ball's gain is its number of points.
   const std::size_t n = balls.size();
   std::vector<std::int64_t> gains(n);
   internal::ParallelForRange(std::size_t{0}, n, 64, [&](std::size_t begin, std::size_t end) {
     if (control.cancelled()) return;
-    for (std::size_t i = begin; i != end; ++i) {
-      gains[i] = uncovered.CountIn(balls[i]);
-    }
+    for (std::size_t i = begin; i != end; ++i) gains[i] = grid.CountPoints(balls[i]);
   });
   if (control.cancelled()) return Cancelled();
   // The gains up front count as a quarter of the work, the greedy choice as the rest.
@@ -128,56 +114,39 @@ INSCRIBE_CLONES_X86_64_V2 absl::StatusOr<CoverageSelection> SelectByCoverage(
   }
   std::priority_queue<Pending> queue(std::less<Pending>(), std::move(heap));
 
-  // Greedy: lazy evaluation of the ball with the largest gain. Between two choices the
-  // greedy recounts balls in queue order until one is chosen (about 35 per choice on real
-  // pools), so when it needs a recount it also counts the next kRecountBatch - 1 balls of the
-  // queue in parallel and keeps their counts for this choice: the same counts the sequential
-  // greedy would make, so the same choices, whatever the thread count.
-  std::vector<std::int64_t> fresh_gain(n, 0);
-  std::vector<std::size_t> fresh_for(n, std::numeric_limits<std::size_t>::max());
-  std::vector<Pending> batch;
-  const auto fresh = [&](std::int32_t index) {
-    return fresh_for[static_cast<std::size_t>(index)] == out.chosen.size();
-  };
-  std::int64_t iterations = 0;
+  // Greedy: the ball with the largest gain, kept exact. A choice clears its points, and every
+  // ball with a gain loses exactly the points it shares with them (ClearedPoints: counted over
+  // the blocks both meet, nothing for balls clear of them). The queue holds every ball with a
+  // gain once, under its gain when queued, an upper bound of its gain now: a popped ball whose
+  // gain has fallen since goes back under its gain now, and one whose gain has not is the
+  // largest (lowest index first) and is chosen.
+  internal::ClearedPoints cleared(grid);
+  std::vector<std::int32_t> live;  // the balls with a gain, refreshed every 64 choices
   while (!queue.empty() && static_cast<std::int64_t>(out.chosen.size()) < options.max_spheres) {
-    if ((++iterations & 255) == 0 && control.cancelled()) return Cancelled();
-    Pending top = queue.top();
+    if (control.cancelled()) return Cancelled();
+    const Pending top = queue.top();
     queue.pop();
-    if (!fresh(top.index)) {
-      batch.assign(1, top);
-      while (batch.size() < kRecountBatch && !queue.empty()) {
-        batch.push_back(queue.top());
-        queue.pop();
-      }
-      internal::ParallelForRange(std::size_t{0}, batch.size(), 1,
-                                 [&](std::size_t begin, std::size_t end) {
-                                   for (std::size_t b = begin; b != end; ++b) {
-                                     const auto i = static_cast<std::size_t>(batch[b].index);
-                                     if (fresh(batch[b].index)) continue;
-                                     fresh_gain[i] = uncovered.CountIn(balls[i]);
-                                   }
-                                 });
-      for (std::size_t b = 0; b < batch.size(); ++b) {
-        const auto i = static_cast<std::size_t>(batch[b].index);
-        if (!fresh(batch[b].index)) ++out.evaluations;
-        fresh_for[i] = out.chosen.size();
-        if (b > 0) queue.push(batch[b]);  // with its old bound, as the sequential greedy sees it
-      }
-    }
-    top.gain = fresh_gain[static_cast<std::size_t>(top.index)];
-    const Sphere& ball = balls[static_cast<std::size_t>(top.index)];
-    if (top.gain == 0) continue;
-    // Every other ball's last count bounds its gain from above: when one of them may still
-    // beat this ball's fresh count by more than the slack, recount that one first.
-    if (!queue.empty() && top.gain < queue.top().gain - (queue.top().gain >> kSlackShift)) {
-      queue.push(top);
+    const auto i = static_cast<std::size_t>(top.index);
+    if (gains[i] != top.gain) {
+      if (gains[i] > 0) queue.push({gains[i], top.index});
       continue;
     }
-    grid.ForEachRun(ball, [&uncovered](std::int64_t row, std::int64_t first, std::int64_t last) {
-      uncovered.Clear(row, first, last);
-    });
+    cleared.Take(uncovered, balls[i]);
+    gains[i] = 0;
     out.chosen.push_back(top.index);
+    if (live.empty() || (out.chosen.size() & 63) == 0) {
+      live.clear();
+      for (std::size_t b = 0; b < n; ++b) {
+        if (gains[b] > 0) live.push_back(static_cast<std::int32_t>(b));
+      }
+    }
+    internal::ParallelForRange(std::size_t{0}, live.size(), 64,
+                               [&](std::size_t begin, std::size_t end) {
+                                 for (std::size_t b = begin; b != end; ++b) {
+                                   const auto j = static_cast<std::size_t>(live[b]);
+                                   if (gains[j] > 0) gains[j] -= cleared.CountIn(balls[j]);
+                                 }
+                               });
     if (control.on_progress && out.chosen.size() % 16 == 0) {
       control.on_progress(0.25 + 0.75 * static_cast<double>(out.chosen.size()) /
                                      static_cast<double>(options.max_spheres));

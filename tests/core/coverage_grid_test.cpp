@@ -1,6 +1,7 @@
 // The selection's bit field: its block-wise count of a ball's set points against the plain
 // row-by-row count (SampleGrid::ForEachRun and BitField::Count) on random and adversarial balls
-// and fields, and its block totals against a full recount.
+// and fields, its block totals against a full recount, its parallel fill against ball-by-ball
+// sets, and the cleared points of a choice against what each ball's count loses.
 #include "coverage_grid.h"
 
 #include <gtest/gtest.h>
@@ -98,6 +99,63 @@ TEST(CoverageGrid, BallsThroughSamplePointsCountAsTheRowsSay) {
     // Knock out points now and then so blocks differ.
     field.Clear(std::uniform_int_distribution<std::int64_t>(0, grid.rows() - 1)(rng),
                 std::uniform_int_distribution<std::int64_t>(0, grid.row_length() - 1)(rng));
+  }
+}
+
+TEST(CoverageGrid, SetAllAndCountPointsMatchBallByBall) {
+  for (std::uint64_t seed : {4, 5}) {
+    SCOPED_TRACE(seed);
+    const std::vector<Sphere> balls = RandomBalls(80, 4.0, 0.1, 1.4, seed);
+    // An odd grid so that slabs of four slices end short at the top.
+    const SampleGrid grid(balls, (std::int64_t{1} << 19) + 4099);
+    BitField serial(grid), parallel(grid);
+    for (const Sphere& ball : balls) {
+      grid.ForEachRun(ball, [&](std::int64_t row, std::int64_t first, std::int64_t last) {
+        serial.Set(row, first, last);
+      });
+    }
+    parallel.SetAll(balls);
+    for (std::int64_t row = 0; row < grid.rows(); ++row) {
+      ASSERT_EQ(parallel.Count(row, 0, grid.row_length() - 1),
+                serial.Count(row, 0, grid.row_length() - 1));
+    }
+    ASSERT_EQ(parallel.CountAll(), serial.CountAll());
+    for (const Sphere& ball : balls) {
+      ASSERT_EQ(grid.CountPoints(ball), RowByRowCount(grid, parallel, ball));
+    }
+  }
+}
+
+// Choosing ball after ball as the greedy does: what a choice takes is exactly what every other
+// ball's count loses, and Take clears exactly the ball's points.
+TEST(CoverageGrid, ClearedPointsAreWhatEachBallsCountLoses) {
+  for (std::uint64_t seed : {6, 7}) {
+    SCOPED_TRACE(seed);
+    std::mt19937_64 rng(seed);
+    const std::vector<Sphere> balls = RandomBalls(50, 4.0, 0.1, 1.6, seed);
+    const SampleGrid grid(balls, std::int64_t{1} << 20);
+    BitField field(grid);
+    field.SetAll(balls);
+    std::vector<Sphere> probes = Probes(grid, rng, 150);
+    probes.insert(probes.end(), balls.begin(), balls.end());
+    std::uniform_int_distribution<std::int64_t> row_of(0, grid.rows() - 1);
+    std::uniform_int_distribution<std::int64_t> point_of(0, grid.row_length() - 1);
+    ClearedPoints cleared(grid);
+    std::vector<std::int64_t> before(probes.size());
+    for (std::size_t step = 0; step < balls.size(); ++step) {
+      for (std::size_t p = 0; p < probes.size(); ++p) before[p] = field.CountIn(probes[p]);
+      const std::int64_t total = field.CountAll();
+      cleared.Take(field, balls[step]);
+      ASSERT_EQ(field.CountAll(), FullRecount(grid, field));
+      EXPECT_EQ(field.CountIn(balls[step]), 0);
+      ASSERT_EQ(total - field.CountAll(), before[probes.size() - balls.size() + step]);
+      for (std::size_t p = 0; p < probes.size(); ++p) {
+        ASSERT_EQ(cleared.CountIn(probes[p]), before[p] - field.CountIn(probes[p]))
+            << "step " << step << " probe " << p;
+      }
+      // Stray points set and cleared between choices, as a swap or a caller might.
+      for (int i = 0; i < 20; ++i) field.Set(row_of(rng), point_of(rng));
+    }
   }
 }
 

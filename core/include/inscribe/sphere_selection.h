@@ -48,7 +48,7 @@ struct CoverageSelection {
   std::vector<std::int32_t> chosen;  // indices into the input balls, ascending
   std::int64_t samples = 0;          // grid points inside at least one ball
   std::int64_t covered = 0;          // of those, inside a chosen ball
-  std::int64_t evaluations = 0;      // gains counted (up front, lazily and in the swap passes)
+  std::int64_t evaluations = 0;      // gains counted over whole balls (up front, swap passes)
   std::int64_t swaps = 0;            // chosen balls replaced in the swap passes
   double grid_spacing = 0.0;         // distance between neighbouring sample points
 
@@ -58,16 +58,17 @@ struct CoverageSelection {
   }
 };
 
-// Chooses at most N of `balls` whose union holds the most sample points: greedy maximum
-// coverage with lazy gain evaluation. Coverage is submodular, so a ball's gain only falls as
-// others are chosen and its last count bounds it from above; each step takes a ball whose
-// fresh gain is within 1/16 of the best bound left, so the set covers at least
-// 1 - e^(-15/16) (61%) of what the best N balls cover, and in practice far more. Stops early when
-// no ball adds a sample. Deterministic (ties go to the lower index) whatever the thread count.
+// Chooses at most N of `balls` whose union holds the most sample points: the greedy maximum
+// coverage, each step taking the ball that adds the most points (the lowest index among
+// equals). Coverage is submodular, so the set covers at least 1 - 1/e (63%) of what the best N
+// balls cover, and in practice far more. The gains are kept exact by subtracting from each
+// ball the points it shares with each choice. Stops early when no ball adds a sample.
+// Deterministic whatever the thread count.
 // Errors: INVALID_ARGUMENT for N <= 0, grid_points out of range, a bad ball (CheckSphere) or
 // more than 2^31 - 1 balls; CANCELLED.
-// Cost: O(sum over balls of (r / h)^2 (1 + r / 64h)) word operations up front (h the grid
-// spacing), then the same per lazy evaluation of a ball; memory grid_points / 8 bytes.
+// Cost: O(sum over balls of (r / h)^2) up front (h the grid spacing), then per choice a test
+// of every ball with a gain and, for those that share points with it, a count over the blocks
+// of their overlap; memory 2 grid_points / 8 bytes.
 absl::StatusOr<CoverageSelection> SelectByCoverage(const std::vector<Sphere>& balls,
                                                    const CoverageSelectionOptions& options,
                                                    const GenerationControl& control = {});

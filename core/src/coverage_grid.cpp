@@ -59,17 +59,22 @@ BitField::BitField(const SampleGrid& grid)
                                              ((grid.dim(2) + kBlockRows - 1) / kBlockRows)),
                     0) {}
 
-INSCRIBE_CLONES_X86_64_V2 void BitField::SetAll(const std::vector<Sphere>& balls) {
+void BitField::SetAll(const std::vector<Sphere>& balls) {
   // In parallel over slabs of kBlockRows slices, which share no word and no block count.
   const std::int64_t slabs = (grid_.dim(2) + kBlockRows - 1) / kBlockRows;
   ParallelForRange(std::int64_t{0}, slabs, 1, [&](std::int64_t begin, std::int64_t end) {
-    for (const Sphere& ball : balls) {
-      grid_.ForEachRunInSlices(ball, begin * kBlockRows, end * kBlockRows - 1,
-                               [this](std::int64_t row, std::int64_t first, std::int64_t last) {
-                                 Set(row, first, last);
-                               });
-    }
+    SetInSlices(balls, begin * kBlockRows, end * kBlockRows - 1);
   });
+}
+
+// Cloned as CountIn is: a loop body of SetAll would be built for the baseline only.
+INSCRIBE_CLONES_X86_64_V2 void BitField::SetInSlices(const std::vector<Sphere>& balls,
+                                                     std::int64_t k_low, std::int64_t k_high) {
+  for (const Sphere& ball : balls) {
+    grid_.ForEachRunInSlices(
+        ball, k_low, k_high,
+        [this](std::int64_t row, std::int64_t first, std::int64_t last) { Set(row, first, last); });
+  }
 }
 
 std::int64_t BitField::CountAll() const {

@@ -139,7 +139,8 @@ class BitField {
   }
   // Clears first..last of `row` and sets the points it cleared (those that were set) in
   // `into`, a field of the same grid.
-  void MoveTo(std::int64_t row, std::int64_t first, std::int64_t last, BitField& into) {
+  __attribute__((always_inline)) void MoveTo(std::int64_t row, std::int64_t first,
+                                             std::int64_t last, BitField& into) {
     std::uint64_t* into_words = &into.words_[Word(row, 0)];
     std::int32_t* into_blocks = &into.block_counts_[Block(row, 0)];
     ForEachWord(row, first, last, [&](std::uint64_t& word, std::uint64_t mask) {
@@ -212,6 +213,8 @@ class BitField {
   std::size_t Block3(std::int64_t w, std::int64_t jb, std::int64_t kb) const {
     return static_cast<std::size_t>(w + words_per_row_ * (jb + blocks_y_ * kb));
   }
+  // Sets the balls' points in slices k_low..k_high.
+  void SetInSlices(const std::vector<Sphere>& balls, std::int64_t k_low, std::int64_t k_high);
   // op(word, mask) changes the word and returns the change in its set bits.
   template <typename Op>
   void ForEachWord(std::int64_t row, std::int64_t first, std::int64_t last, Op&& op) {

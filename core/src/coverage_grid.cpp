@@ -70,10 +70,38 @@ void BitField::SetAll(const std::vector<Sphere>& balls) {
 // Cloned as CountIn is: a loop body of SetAll would be built for the baseline only.
 INSCRIBE_CLONES_X86_64_V2 void BitField::SetInSlices(const std::vector<Sphere>& balls,
                                                      std::int64_t k_low, std::int64_t k_high) {
+  // The runs' bits first, then the blocks of these slices counted once from their words.
   for (const Sphere& ball : balls) {
-    grid_.ForEachRunInSlices(
-        ball, k_low, k_high,
-        [this](std::int64_t row, std::int64_t first, std::int64_t last) { Set(row, first, last); });
+    grid_.ForEachRunInSlices(ball, k_low, k_high,
+                             [this](std::int64_t row, std::int64_t first, std::int64_t last) {
+                               std::uint64_t* words = &words_[Word(row, 0)];
+                               const std::int64_t w0 = first >> 6;
+                               const std::int64_t w1 = last >> 6;
+                               const std::uint64_t head = ~std::uint64_t{0} << (first & 63);
+                               const std::uint64_t tail = ~std::uint64_t{0} >> (63 - (last & 63));
+                               if (w0 == w1) {
+                                 words[w0] |= head & tail;
+                                 return;
+                               }
+                               words[w0] |= head;
+                               for (std::int64_t w = w0 + 1; w < w1; ++w)
+                                 words[w] = ~std::uint64_t{0};
+                               words[w1] |= tail;
+                             });
+  }
+  const std::int64_t k_end = std::min(k_high, grid_.dim(2) - 1);
+  for (std::int64_t kb = k_low / kBlockRows; kb <= k_end / kBlockRows; ++kb) {
+    for (std::int64_t jb = 0; jb < blocks_y_; ++jb) {
+      std::fill_n(&block_counts_[Block3(0, jb, kb)], words_per_row_, 0);
+    }
+  }
+  for (std::int64_t k = k_low; k <= k_end; ++k) {
+    for (std::int64_t j = 0; j < grid_.dim(1); ++j) {
+      const std::int64_t row = grid_.row(j, k);
+      const std::uint64_t* words = &words_[Word(row, 0)];
+      std::int32_t* blocks = &block_counts_[Block(row, 0)];
+      for (std::int64_t w = 0; w < words_per_row_; ++w) blocks[w] += __builtin_popcountll(words[w]);
+    }
   }
 }
 

@@ -75,18 +75,9 @@ INSCRIBE_CLONES_X86_64_V2 void BitField::SetInSlices(const std::vector<Sphere>& 
     grid_.ForEachRunInSlices(ball, k_low, k_high,
                              [this](std::int64_t row, std::int64_t first, std::int64_t last) {
                                std::uint64_t* words = &words_[Word(row, 0)];
-                               const std::int64_t w0 = first >> 6;
-                               const std::int64_t w1 = last >> 6;
-                               const std::uint64_t head = ~std::uint64_t{0} << (first & 63);
-                               const std::uint64_t tail = ~std::uint64_t{0} >> (63 - (last & 63));
-                               if (w0 == w1) {
-                                 words[w0] |= head & tail;
-                                 return;
+                               for (std::int64_t w = first >> 6; w <= last >> 6; ++w) {
+                                 words[w] |= RunMask(w, first, last);
                                }
-                               words[w0] |= head;
-                               for (std::int64_t w = w0 + 1; w < w1; ++w)
-                                 words[w] = ~std::uint64_t{0};
-                               words[w1] |= tail;
                              });
   }
   const std::int64_t k_end = std::min(k_high, grid_.dim(2) - 1);
@@ -186,10 +177,7 @@ INSCRIBE_CLONES_X86_64_V2 std::int64_t BitField::CountIn(
             const std::int64_t to = std::min(last >> 6, chunk_last);
             for (std::int64_t w = from; w <= to; ++w) {
               if (!((straddling >> (w - chunk)) & 1)) continue;
-              std::uint64_t mask = ~std::uint64_t{0};
-              if (w == first >> 6) mask &= ~std::uint64_t{0} << (first & 63);
-              if (w == last >> 6) mask &= ~std::uint64_t{0} >> (63 - (last & 63));
-              count += __builtin_popcountll(words[w] & mask);
+              count += __builtin_popcountll(words[w] & RunMask(w, first, last));
             }
           }
         }

@@ -158,17 +158,22 @@ class BitField {
   void SetAll(const std::vector<Sphere>& balls);
   void Clear(std::int64_t row, std::int64_t i) { Clear(row, i, i); }
 
+  // The bits of a row's word w that its points first..last (inclusive) occupy.
+  static std::uint64_t RunMask(std::int64_t w, std::int64_t first, std::int64_t last) {
+    std::uint64_t mask = ~std::uint64_t{0};
+    if (w == first >> 6) mask &= ~std::uint64_t{0} << (first & 63);
+    if (w == last >> 6) mask &= ~std::uint64_t{0} >> (63 - (last & 63));
+    return mask;
+  }
+
   // Set points among first..last of `row`.
   std::int64_t Count(std::int64_t row, std::int64_t first, std::int64_t last) const {
     const std::uint64_t* words = &words_[Word(row, 0)];
-    const std::int64_t w0 = first >> 6;
-    const std::int64_t w1 = last >> 6;
-    const std::uint64_t head = ~std::uint64_t{0} << (first & 63);
-    const std::uint64_t tail = ~std::uint64_t{0} >> (63 - (last & 63));
-    if (w0 == w1) return __builtin_popcountll(words[w0] & head & tail);
-    std::int64_t count = __builtin_popcountll(words[w0] & head);
-    for (std::int64_t w = w0 + 1; w < w1; ++w) count += __builtin_popcountll(words[w]);
-    return count + __builtin_popcountll(words[w1] & tail);
+    std::int64_t count = 0;
+    for (std::int64_t w = first >> 6; w <= last >> 6; ++w) {
+      count += __builtin_popcountll(words[w] & RunMask(w, first, last));
+    }
+    return count;
   }
   std::int64_t CountAll() const;
   // The first set point among first..last of `row`, last + 1 if none; the last, first - 1 if
@@ -176,9 +181,7 @@ class BitField {
   std::int64_t FirstSet(std::int64_t row, std::int64_t first, std::int64_t last) const {
     const std::uint64_t* words = &words_[Word(row, 0)];
     for (std::int64_t w = first >> 6; w <= last >> 6; ++w) {
-      std::uint64_t bits = words[w];
-      if (w == first >> 6) bits &= ~std::uint64_t{0} << (first & 63);
-      if (w == last >> 6) bits &= ~std::uint64_t{0} >> (63 - (last & 63));
+      const std::uint64_t bits = words[w] & RunMask(w, first, last);
       if (bits != 0) return w * 64 + __builtin_ctzll(bits);
     }
     return last + 1;
@@ -186,9 +189,7 @@ class BitField {
   std::int64_t LastSet(std::int64_t row, std::int64_t first, std::int64_t last) const {
     const std::uint64_t* words = &words_[Word(row, 0)];
     for (std::int64_t w = last >> 6; w >= first >> 6; --w) {
-      std::uint64_t bits = words[w];
-      if (w == first >> 6) bits &= ~std::uint64_t{0} << (first & 63);
-      if (w == last >> 6) bits &= ~std::uint64_t{0} >> (63 - (last & 63));
+      const std::uint64_t bits = words[w] & RunMask(w, first, last);
       if (bits != 0) return w * 64 + 63 - __builtin_clzll(bits);
     }
     return first - 1;
@@ -219,16 +220,9 @@ class BitField {
   template <typename Op>
   void ForEachWord(std::int64_t row, std::int64_t first, std::int64_t last, Op&& op) {
     std::uint64_t* words = &words_[Word(row, 0)];
-    const std::int64_t w0 = first >> 6;
-    const std::int64_t w1 = last >> 6;
-    const std::uint64_t head = ~std::uint64_t{0} << (first & 63);
-    const std::uint64_t tail = ~std::uint64_t{0} >> (63 - (last & 63));
     const std::size_t block = Block(row, 0);
-    for (std::int64_t w = w0; w <= w1; ++w) {
-      std::uint64_t mask = ~std::uint64_t{0};
-      if (w == w0) mask &= head;
-      if (w == w1) mask &= tail;
-      block_counts_[block + static_cast<std::size_t>(w)] += op(words[w], mask);
+    for (std::int64_t w = first >> 6; w <= last >> 6; ++w) {
+      block_counts_[block + static_cast<std::size_t>(w)] += op(words[w], RunMask(w, first, last));
     }
   }
 

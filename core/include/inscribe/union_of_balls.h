@@ -42,9 +42,11 @@ struct DualComplex {
 
 // Dual complex of `balls` (centres in mesh frame, radii in mesh units). Built from CGAL's
 // Regular_triangulation_3 (exact predicates, symbolic perturbation for degenerate input such
-// as co-spherical or coplanar centres), classified at alpha = 0 with Fixed_alpha_shape_3's
-// rules and exact predicates in one pass over its cells (in parallel on the TBB pool; the
-// result does not depend on the thread count). Empty input gives an empty complex.
+// as co-spherical or coplanar centres; from 2,048 balls inserted in parallel on the TBB pool),
+// classified at alpha = 0 with Fixed_alpha_shape_3's rules and exact predicates in one pass
+// over its cells (in parallel too). The regular triangulation with symbolic perturbation is
+// unique, so the result does not depend on the thread count or the insertion order. Empty
+// input gives an empty complex.
 //
 // Errors: INVALID_ARGUMENT naming the first bad ball (non-finite centre or radius, radius <= 0,
 // a coordinate or radius above 1e150) or for more than 2^31 - 1 balls; INTERNAL with CGAL's

@@ -48,6 +48,14 @@ struct Pending {
 
 absl::Status Cancelled() { return absl::CancelledError("sphere selection cancelled"); }
 
+// The best replacement found so far for a chosen ball in a swap pass: its gain, its index (the
+// leaving ball's own while none beats it), and the candidates counted.
+struct SwapChoice {
+  std::int64_t gain = 0;
+  std::int32_t index = 0;
+  std::int64_t evaluations = 0;
+};
+
 }  // namespace
 
 const char* SphereSelectionName(SphereSelection selection) {
@@ -104,6 +112,9 @@ INSCRIBE_CLONES_X86_64_V2 absl::StatusOr<CoverageSelection> SelectByCoverage(
     for (std::size_t i = begin; i != end; ++i) gains[i] = grid.CountPoints(balls[i]);
   });
   if (control.cancelled()) return Cancelled();
+  // Each ball's points, an upper bound of any gain it has later (the swaps' pruning).
+  std::vector<std::int64_t> points;
+  if (options.swap_passes > 0) points = gains;
   // The gains up front count as a quarter of the work, the greedy choice as the rest.
   if (control.on_progress) control.on_progress(0.25);
   out.evaluations = static_cast<std::int64_t>(n);
@@ -176,20 +187,35 @@ INSCRIBE_CLONES_X86_64_V2 absl::StatusOr<CoverageSelection> SelectByCoverage(
         const std::int32_t leaving = order[slot].index;
         const Sphere& s = balls[static_cast<std::size_t>(leaving)];
         cover.Remove(s);
-        std::int32_t best = leaving;
-        std::int64_t best_gain = cover.uncovered().CountIn(s);
-        for (std::size_t c = 0; c < n; ++c) {
-          if (chosen[c]) continue;
-          const Sphere& candidate = balls[c];
-          const double reach = s.radius + candidate.radius;
-          if ((candidate.center - s.center).squaredNorm() >= reach * reach) continue;
-          const std::int64_t gain = cover.uncovered().CountIn(candidate);
-          ++out.evaluations;
-          if (gain > best_gain) {
-            best_gain = gain;
-            best = static_cast<std::int32_t>(c);
-          }
-        }
+        // The candidates in parallel, each chunk in index order: a ball with no more points
+        // than the best gain so far cannot beat it (ties go to the leaving ball, then to the
+        // lowest index), so it is not counted; the result is the sequential scan's.
+        const SwapChoice identity{cover.uncovered().CountIn(s), leaving, 0};
+        const SwapChoice found = internal::ParallelReduce(
+            std::size_t{0}, n, 512, identity,
+            [&](std::size_t begin, std::size_t end, SwapChoice best) {
+              for (std::size_t c = begin; c != end; ++c) {
+                if (chosen[c] || points[c] <= best.gain) continue;
+                const Sphere& candidate = balls[c];
+                const double reach = s.radius + candidate.radius;
+                if ((candidate.center - s.center).squaredNorm() >= reach * reach) continue;
+                const std::int64_t gain = cover.uncovered().CountIn(candidate);
+                ++best.evaluations;
+                if (gain > best.gain) {
+                  best.gain = gain;
+                  best.index = static_cast<std::int32_t>(c);
+                }
+              }
+              return best;
+            },
+            [](SwapChoice a, const SwapChoice& b) {
+              const std::int64_t evaluations = a.evaluations + b.evaluations;
+              if (b.gain > a.gain) a = b;
+              a.evaluations = evaluations;
+              return a;
+            });
+        out.evaluations += found.evaluations;
+        const std::int32_t best = found.index;
         cover.Add(balls[static_cast<std::size_t>(best)]);
         if (best != leaving) {
           chosen[static_cast<std::size_t>(leaving)] = 0;

@@ -167,13 +167,16 @@ constexpr int kLockCellsPerSide = 20;
 
 // The lock grid for the parallel insertion of these balls: a cube about their bounding box
 // (centres and radii, so it has volume), or nothing when they are few, the pool has one
-// thread, or the cube's cells per unit length are not finite (then insertion runs one ball at
+// thread, the build is ThreadSanitizer's, or the cube's cells per unit length are not finite (then insertion runs one ball at
 // a time). CGAL clamps a point's cell to the grid, so only contention, not the triangulation,
 // depends on the cube; but it computes the cell with an unchecked cast to int, so every point
 // inserted under the locks must lie within a bounded multiple of the cube.
 std::optional<LockGrid> LockGridFor(const std::vector<Sphere>& balls,
                                     const std::vector<std::int32_t>& distinct) {
-  if (distinct.size() < kParallelInsertion || tbb::this_task_arena::max_concurrency() < 2) {
+  // CGAL's insertion runs its own TBB loop, whose threads ThreadSanitizer builds cannot follow
+  // (parallel.h): there it runs in order.
+  if (internal::kThreadSanitizer || distinct.size() < kParallelInsertion ||
+      tbb::this_task_arena::max_concurrency() < 2) {
     return std::nullopt;
   }
   Vector3 lo = Vector3::Constant(std::numeric_limits<double>::infinity());

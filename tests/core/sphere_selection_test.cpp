@@ -201,6 +201,87 @@ TEST(SelectByCoverage, SwapsNeverCoverLessThanTheGreedy) {
               0.01);
 }
 
+// The swap passes against the plain sequential scan over explicit point lists: each chosen
+// ball in turn (least sole cover, then lowest index, first) gives way to the unchosen ball
+// overlapping it that covers the most once it is gone, strictly more than it does itself, the
+// lowest index among equals. The selection scans the candidates in parallel and skips balls
+// with no more points than the best gain so far; it must swap exactly the same balls.
+TEST(SelectByCoverage, SwapsAreThoseOfTheSequentialScan) {
+  for (std::uint64_t seed : {11u, 12u, 13u}) {
+    const std::vector<Sphere> balls = RandomBalls(400, 3.0, 0.05, 0.8, seed);
+    CoverageSelectionOptions options;
+    options.max_spheres = 30;
+    options.grid_points = 1 << 17;
+    absl::StatusOr<CoverageSelection> greedy = SelectByCoverage(balls, options);
+    options.swap_passes = 4;
+    absl::StatusOr<CoverageSelection> swapped = SelectByCoverage(balls, options);
+    ASSERT_TRUE(greedy.ok() && swapped.ok());
+
+    const internal::SampleGrid grid(balls, options.grid_points);
+    std::vector<std::vector<std::int64_t>> holds(balls.size());
+    for (std::size_t b = 0; b < balls.size(); ++b) {
+      grid.ForEachRun(balls[b], [&](std::int64_t row, std::int64_t first, std::int64_t last) {
+        for (std::int64_t i = first; i <= last; ++i) holds[b].push_back(row * grid.row_length() + i);
+      });
+    }
+    std::vector<int> count(static_cast<std::size_t>(grid.row_length() * grid.rows()), 0);
+    std::vector<char> chosen(balls.size(), 0);
+    auto change = [&](std::size_t b, int step) {
+      for (std::int64_t p : holds[b]) count[static_cast<std::size_t>(p)] += step;
+      chosen[b] = step > 0;
+    };
+    auto points_at = [&](std::size_t b, int covers) {
+      std::int64_t n = 0;
+      for (std::int64_t p : holds[b]) n += count[static_cast<std::size_t>(p)] == covers;
+      return n;
+    };
+    for (std::int32_t b : greedy->chosen) change(static_cast<std::size_t>(b), +1);
+    std::int64_t swaps = 0;
+    for (int pass = 0; pass < options.swap_passes; ++pass) {
+      std::vector<std::pair<std::int64_t, std::int32_t>> order;  // (sole cover, index)
+      for (std::size_t b = 0; b < balls.size(); ++b) {
+        if (chosen[b]) order.push_back({points_at(b, 1), static_cast<std::int32_t>(b)});
+      }
+      std::sort(order.begin(), order.end());
+      std::int64_t pass_swaps = 0;
+      for (const auto& [sole, leaving] : order) {
+        const Sphere& s = balls[static_cast<std::size_t>(leaving)];
+        change(static_cast<std::size_t>(leaving), -1);
+        std::size_t best = static_cast<std::size_t>(leaving);
+        std::int64_t best_gain = points_at(best, 0);
+        for (std::size_t c = 0; c < balls.size(); ++c) {
+          if (chosen[c] || static_cast<std::int32_t>(c) == leaving) continue;
+          const double reach = s.radius + balls[c].radius;
+          if ((balls[c].center - s.center).squaredNorm() >= reach * reach) continue;
+          const std::int64_t gain = points_at(c, 0);
+          if (gain > best_gain) {
+            best_gain = gain;
+            best = c;
+          }
+        }
+        change(best, +1);
+        pass_swaps += best != static_cast<std::size_t>(leaving);
+      }
+      swaps += pass_swaps;
+      if (pass_swaps == 0) break;
+    }
+    std::vector<std::int32_t> expected;
+    for (std::size_t b = 0; b < balls.size(); ++b) {
+      if (chosen[b]) expected.push_back(static_cast<std::int32_t>(b));
+    }
+    std::int64_t uncovered = 0;
+    std::vector<char> sample(count.size(), 0);
+    for (const auto& list : holds) {
+      for (std::int64_t p : list) sample[static_cast<std::size_t>(p)] = 1;
+    }
+    for (std::size_t p = 0; p < count.size(); ++p) uncovered += sample[p] && count[p] == 0;
+    EXPECT_GT(swaps, 0) << "seed " << seed << ": the test should make swaps";
+    EXPECT_EQ(swapped->swaps, swaps) << "seed " << seed;
+    EXPECT_EQ(swapped->chosen, expected) << "seed " << seed;
+    EXPECT_EQ(swapped->covered, swapped->samples - uncovered) << "seed " << seed;
+  }
+}
+
 TEST(SelectByCoverage, BadInputIsAClearError) {
   const std::vector<Sphere> balls = RandomBalls(10, 1.0, 0.1, 0.2, 1);
   CoverageSelectionOptions options;

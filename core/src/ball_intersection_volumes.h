@@ -1,5 +1,5 @@
 // Private: closed-form volumes of the intersection of 1, 2, 3 and 4 balls, the terms of the
-// inclusion-exclusion over a dual complex (union_of_balls.cpp). Units: mesh units cubed.
+// inclusion-exclusion over a dual complex (union_volume.cpp). Units: mesh units cubed.
 #pragma once
 
 #include "inscribe/sphere.h"

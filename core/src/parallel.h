@@ -152,6 +152,14 @@ void ParallelFor(Index first, Index last, const F& f) {
 #endif
 }
 
+// Calls f(i) for every i in [first, last), in parallel, on subranges of about `grain` indices.
+template <typename Index, typename F>
+void ParallelFor(Index first, Index last, std::size_t grain, const F& f) {
+  ParallelForRange(first, last, grain, [&f](Index begin, Index end) {
+    for (Index i = begin; i != end; ++i) f(i);
+  });
+}
+
 // Folds [first, last): body(begin, end, value) folds a subrange into value and returns it, on
 // chunks of `grain` indices in parallel, each starting from `identity`; join(a, b) then combines
 // the chunks' values in index order, on the calling thread. The chunks and the order of the

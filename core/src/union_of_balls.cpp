@@ -1,6 +1,6 @@
-// Dual complex of a union of balls (CGAL regular triangulation classified at alpha = 0) and the
-// union's volume by inclusion-exclusion over it. The only CGAL translation unit of this
-// feature: a regular triangulation instantiation costs ~12 s and 1 GB to compile.
+// Dual complex of a union of balls: CGAL's regular triangulation classified at alpha = 0 (the
+// volume over it: union_volume.cpp). The only CGAL translation unit of this feature: a regular
+// triangulation instantiation costs ~12 s and 1 GB to compile.
 #include "inscribe/union_of_balls.h"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
@@ -11,10 +11,10 @@
 #include <CGAL/Triangulation_cell_base_with_info_3.h>
 #include <CGAL/Triangulation_data_structure_3.h>
 #include <CGAL/Triangulation_vertex_base_with_info_3.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <exception>
@@ -25,12 +25,10 @@
 #include <utility>
 #include <vector>
 
-#include <tbb/task_arena.h>
-
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
-#include "ball_intersection_volumes.h"
 #include "parallel.h"
+#include "union_ball_checks.h"
 
 namespace inscribe {
 namespace {
@@ -69,25 +67,8 @@ using ParallelTriangulation = CGAL::Regular_triangulation_3<
     LockGrid>;
 
 constexpr std::int32_t kPadding = -1;
-constexpr double kMaxMagnitude = 1e150;
-
-absl::Status ValidateBalls(const std::vector<Sphere>& balls) {
-  if (balls.size() > static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max())) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("too many balls: ", balls.size(), " (at most 2^31 - 1)"));
-  }
-  for (std::size_t i = 0; i < balls.size(); ++i) {
-    const Sphere& b = balls[i];
-    if (absl::Status valid = CheckSphere(b, i); !valid.ok()) return valid;
-    // Weights r^2 and squared distances must not overflow.
-    if (b.radius > kMaxMagnitude || b.center.cwiseAbs().maxCoeff() > kMaxMagnitude) {
-      return absl::InvalidArgumentError(absl::StrCat("ball ", i, ": centre or radius above ",
-                                                     kMaxMagnitude, " (squares would overflow)"));
-    }
-  }
-  return absl::OkStatus();
-}
-
+// Indices per parallel chunk of the classification and the sort.
+constexpr std::size_t kGrain = 1024;
 // Input indices in lexicographic order of (centre, radius, index); exact duplicates after the
 // first go to `duplicates`. CGAL would merge them too, but keep whichever it met first.
 std::vector<std::int32_t> DistinctBalls(const std::vector<Sphere>& balls,
@@ -149,15 +130,6 @@ std::array<std::int32_t, N> SortedTuple(std::array<std::int32_t, N> t) {
   return t;
 }
 
-// f(i) for every i in [0, n) on the TBB pool. Every use writes only to slot i of its outputs,
-// so the result does not depend on the thread count or the schedule.
-template <typename F>
-void ForEachIndex(std::size_t n, const F& f) {
-  internal::ParallelForRange(std::size_t{0}, n, 1024, [&f](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i != end; ++i) f(i);
-  });
-}
-
 // From this many distinct balls on, they are inserted in parallel (CGAL's locking insertion on
 // the TBB pool, which inserts its first 100 one by one anyway); fewer are inserted in order.
 constexpr std::size_t kParallelInsertion = 2048;
@@ -167,10 +139,10 @@ constexpr int kLockCellsPerSide = 20;
 
 // The lock grid for the parallel insertion of these balls: a cube about their bounding box
 // (centres and radii, so it has volume), or nothing when they are few, the pool has one
-// thread, the build is ThreadSanitizer's, or the cube's cells per unit length are not finite (then insertion runs one ball at
-// a time). CGAL clamps a point's cell to the grid, so only contention, not the triangulation,
-// depends on the cube; but it computes the cell with an unchecked cast to int, so every point
-// inserted under the locks must lie within a bounded multiple of the cube.
+// thread, the build is ThreadSanitizer's, or the cube's cells per unit length are not finite (then
+// insertion runs one ball at a time). CGAL clamps a point's cell to the grid, so only contention,
+// not the triangulation, depends on the cube; but it computes the cell with an unchecked cast to
+// int, so every point inserted under the locks must lie within a bounded multiple of the cube.
 std::optional<LockGrid> LockGridFor(const std::vector<Sphere>& balls,
                                     const std::vector<std::int32_t>& distinct) {
   // CGAL's insertion runs its own TBB loop, whose threads ThreadSanitizer builds cannot follow
@@ -191,10 +163,9 @@ std::optional<LockGrid> LockGridFor(const std::vector<Sphere>& balls,
   if (!(half > 0.0) || !std::isfinite(kLockCellsPerSide / half) || !mid.allFinite()) {
     return std::nullopt;
   }
-  return std::make_optional<LockGrid>(
-      CGAL::Bbox_3(mid.x() - half, mid.y() - half, mid.z() - half, mid.x() + half,
-                   mid.y() + half, mid.z() + half),
-      kLockCellsPerSide);
+  return std::make_optional<LockGrid>(CGAL::Bbox_3(mid.x() - half, mid.y() - half, mid.z() - half,
+                                                   mid.x() + half, mid.y() + half, mid.z() + half),
+                                      kLockCellsPerSide);
 }
 
 // The regular triangulation of the distinct balls, padded to dimension 3 if the centres span
@@ -295,7 +266,7 @@ bool ClassifyAtAlphaZero(RegularTriangulation& triangulation,
   const auto number = [](const CellHandle& c) { return c->info(); };
 
   std::vector<std::uint8_t> cell_in(num_cells, 0);
-  ForEachIndex(num_cells, [&](std::size_t c) {
+  internal::ParallelFor(std::size_t{0}, num_cells, kGrain, [&](std::size_t c) {
     const CellHandle& h = cells[c];
     cell_in[c] = !radius_exceeds_zero(h->vertex(0)->point(), h->vertex(1)->point(),
                                       h->vertex(2)->point(), h->vertex(3)->point());
@@ -308,7 +279,7 @@ bool ClassifyAtAlphaZero(RegularTriangulation& triangulation,
     return n < 0 || static_cast<std::int32_t>(c) < n;
   };
   std::vector<std::uint8_t> owned_facet_in(num_cells, 0);
-  ForEachIndex(num_cells, [&](std::size_t c) {
+  internal::ParallelFor(std::size_t{0}, num_cells, kGrain, [&](std::size_t c) {
     const CellHandle& h = cells[c];
     for (int f = 0; f < 4; ++f) {
       const CellHandle n = h->neighbor(f);
@@ -326,7 +297,7 @@ bool ClassifyAtAlphaZero(RegularTriangulation& triangulation,
     }
   });
   std::vector<std::uint8_t> facet_in(num_cells, 0);
-  ForEachIndex(num_cells, [&](std::size_t c) {
+  internal::ParallelFor(std::size_t{0}, num_cells, kGrain, [&](std::size_t c) {
     const CellHandle& h = cells[c];
     std::uint8_t bits = owned_facet_in[c];
     for (int f = 0; f < 4; ++f) {
@@ -341,7 +312,7 @@ bool ClassifyAtAlphaZero(RegularTriangulation& triangulation,
 
   // Bit e: edge kEdgeEnds[e] is in, set in the edge's lowest-numbered finite cell only.
   std::vector<std::uint8_t> owned_edge_in(num_cells, 0);
-  ForEachIndex(num_cells, [&](std::size_t c) {
+  internal::ParallelFor(std::size_t{0}, num_cells, kGrain, [&](std::size_t c) {
     const CellHandle& h = cells[c];
     const auto precedes = [c](std::int32_t n) { return n >= 0 && static_cast<std::size_t>(n) < c; };
     std::int32_t neighbor_number[4];
@@ -462,43 +433,11 @@ void SortSimplices(std::vector<std::array<std::int32_t, N>>* simplices, std::siz
     std::vector<std::size_t> next(start.begin(), start.end() - 1);
     for (const auto& s : *simplices) sorted[next[static_cast<std::size_t>(s[0])]++] = s;
   }
-  ForEachIndex(num_balls, [&](std::size_t b) {
+  internal::ParallelFor(std::size_t{0}, num_balls, kGrain, [&](std::size_t b) {
     std::sort(sorted.begin() + static_cast<std::ptrdiff_t>(start[b]),
               sorted.begin() + static_cast<std::ptrdiff_t>(start[b + 1]));
   });
   simplices->swap(sorted);
-}
-
-// Every index in [0, num_balls), each tuple strictly increasing (the formulas need distinct
-// balls).
-template <std::size_t N>
-absl::Status CheckIndices(const std::vector<std::array<std::int32_t, N>>& simplices,
-                          std::size_t num_balls, const char* what) {
-  for (std::size_t s = 0; s < simplices.size(); ++s) {
-    for (std::size_t k = 0; k < N; ++k) {
-      const std::int32_t i = simplices[s][k];
-      if (i < 0 || static_cast<std::size_t>(i) >= num_balls) {
-        return absl::InvalidArgumentError(
-            absl::StrCat(what, " ", s, ": ball index ", i, " out of range [0, ", num_balls, ")"));
-      }
-      if (k > 0 && simplices[s][k - 1] >= i) {
-        return absl::InvalidArgumentError(
-            absl::StrCat(what, " ", s, ": ball indices not strictly increasing"));
-      }
-    }
-  }
-  return absl::OkStatus();
-}
-
-// Sum of term(s, simplices[s]) over `simplices` in long double, in list order. The terms are
-// evaluated in parallel into their own slots, so the sum's bits do not depend on the thread count.
-template <typename Simplex, typename Term>
-long double OrderedSum(const std::vector<Simplex>& simplices, const Term& term) {
-  std::vector<double> terms(simplices.size());
-  ForEachIndex(simplices.size(), [&](std::size_t s) { terms[s] = term(s, simplices[s]); });
-  long double sum = 0;
-  for (double t : terms) sum += t;
-  return sum;
 }
 
 // The complex of the distinct balls (its simplices unsorted) from a regular triangulation of
@@ -522,7 +461,7 @@ absl::Status ClassifiedTriangulation(const std::vector<Sphere>& balls,
 }  // namespace
 
 absl::StatusOr<DualComplex> ComputeDualComplex(const std::vector<Sphere>& balls) {
-  if (absl::Status s = ValidateBalls(balls); !s.ok()) return s;
+  if (absl::Status s = internal::CheckUnionBalls(balls); !s.ok()) return s;
   DualComplex complex;
   if (balls.empty()) return complex;
 
@@ -530,9 +469,9 @@ absl::StatusOr<DualComplex> ComputeDualComplex(const std::vector<Sphere>& balls)
   try {
     std::optional<LockGrid> locks = LockGridFor(balls, distinct);
     const absl::Status built =
-        locks ? ClassifiedTriangulation<ParallelTriangulation>(balls, distinct, &*locks, &complex)
-              : ClassifiedTriangulation<SequentialTriangulation>(balls, distinct, nullptr,
-                                                                 &complex);
+        locks
+            ? ClassifiedTriangulation<ParallelTriangulation>(balls, distinct, &*locks, &complex)
+            : ClassifiedTriangulation<SequentialTriangulation>(balls, distinct, nullptr, &complex);
     if (!built.ok()) return built;
   } catch (const std::exception& e) {
     return absl::InternalError(absl::StrCat("CGAL: ", e.what()));
@@ -550,74 +489,6 @@ absl::StatusOr<DualComplex> ComputeDualComplex(const std::vector<Sphere>& balls)
   }
   std::sort(complex.redundant.begin(), complex.redundant.end());
   return complex;
-}
-
-absl::StatusOr<double> UnionVolume(const std::vector<Sphere>& balls, const DualComplex& complex) {
-  if (absl::Status s = ValidateBalls(balls); !s.ok()) return s;
-  std::vector<std::array<std::int32_t, 1>> vertices(complex.vertices.size());
-  for (std::size_t v = 0; v < vertices.size(); ++v) vertices[v][0] = complex.vertices[v];
-  if (absl::Status s = CheckIndices(vertices, balls.size(), "vertex"); !s.ok()) return s;
-  if (absl::Status s = CheckIndices(complex.edges, balls.size(), "edge"); !s.ok()) return s;
-  if (absl::Status s = CheckIndices(complex.triangles, balls.size(), "triangle"); !s.ok()) {
-    return s;
-  }
-  if (absl::Status s = CheckIndices(complex.tetrahedra, balls.size(), "tetrahedron"); !s.ok()) {
-    return s;
-  }
-
-  const auto ball = [&balls](std::int32_t i) -> const Sphere& {
-    return balls[static_cast<std::size_t>(i)];
-  };
-  // The tetrahedra on each triangle (0, 1 or 2): a tetrahedron's term leaves out its faces'
-  // angle terms, which its triangles weigh by 1 - cofaces / 2 instead, so that a triangle
-  // inside the complex (two tetrahedra) needs no angle at all.
-  // A face is looked up among the few triangles with the same lowest ball: `first_triangle[b]`
-  // is where they start in the (sorted) list.
-  std::vector<std::size_t> first_triangle(balls.size() + 1, 0);
-  for (const auto& t : complex.triangles) ++first_triangle[static_cast<std::size_t>(t[0]) + 1];
-  std::partial_sum(first_triangle.begin(), first_triangle.end(), first_triangle.begin());
-  std::vector<std::atomic<std::uint8_t>> cofaces(complex.triangles.size());
-  ForEachIndex(complex.tetrahedra.size(), [&](std::size_t s) {
-    const std::array<std::int32_t, 4>& t = complex.tetrahedra[s];
-    for (std::size_t skip = 0; skip < 4; ++skip) {
-      std::array<std::int32_t, 3> face;
-      for (std::size_t k = 0, j = 0; k < 4; ++k) {
-        if (k != skip) face[j++] = t[k];
-      }
-      const std::size_t lowest = static_cast<std::size_t>(face[0]);
-      const auto end =
-          complex.triangles.begin() + static_cast<std::ptrdiff_t>(first_triangle[lowest + 1]);
-      const auto it = std::lower_bound(
-          complex.triangles.begin() + static_cast<std::ptrdiff_t>(first_triangle[lowest]), end,
-          face);
-      if (it != end && *it == face) {
-        cofaces[static_cast<std::size_t>(it - complex.triangles.begin())].fetch_add(
-            1, std::memory_order_relaxed);
-      }
-    }
-  });
-  // One long double accumulator per dimension, formed in list order; the alternating sum of
-  // the four totals is formed once at the end.
-  long double sum[4] = {0, 0, 0, 0};
-  for (std::int32_t i : complex.vertices) sum[0] += internal::BallVolume(ball(i));
-  sum[1] = OrderedSum(complex.edges, [&](std::size_t, const std::array<std::int32_t, 2>& e) {
-    return internal::TwoBallIntersectionVolume(ball(e[0]), ball(e[1]));
-  });
-  sum[2] = OrderedSum(complex.triangles, [&](std::size_t s, const std::array<std::int32_t, 3>& t) {
-    const double angle_weight = 1.0 - 0.5 * cofaces[s].load(std::memory_order_relaxed);
-    return internal::ThreeBallIntersectionVolume(ball(t[0]), ball(t[1]), ball(t[2]), angle_weight);
-  });
-  sum[3] = OrderedSum(complex.tetrahedra, [&](std::size_t, const std::array<std::int32_t, 4>& t) {
-    return internal::FourBallVolumeWithoutFaceAngles(ball(t[0]), ball(t[1]), ball(t[2]),
-                                                     ball(t[3]));
-  });
-  return static_cast<double>(sum[0] - sum[1] + sum[2] - sum[3]);
-}
-
-absl::StatusOr<double> UnionVolume(const std::vector<Sphere>& balls) {
-  absl::StatusOr<DualComplex> complex = ComputeDualComplex(balls);
-  if (!complex.ok()) return complex.status();
-  return UnionVolume(balls, *complex);
 }
 
 }  // namespace inscribe

@@ -169,7 +169,8 @@ TEST(DualComplexClassification, MatchesFixedAlphaShapeWhenInsertedInParallel) {
   ExpectSameComplex(nested, "duplicates and nested");
   std::vector<Sphere> plane;
   for (int i = 0; i < 50; ++i) {
-    for (int j = 0; j < 50; ++j) plane.push_back(Ball(i, j, 0.25, 0.6 + 0.002 * ((i * 7 + j) % 50)));
+    for (int j = 0; j < 50; ++j)
+      plane.push_back(Ball(i, j, 0.25, 0.6 + 0.002 * ((i * 7 + j) % 50)));
   }
   ExpectSameComplex(plane, "50 x 50 plane");
 }

@@ -221,7 +221,8 @@ TEST(SelectByCoverage, SwapsAreThoseOfTheSequentialScan) {
     std::vector<std::vector<std::int64_t>> holds(balls.size());
     for (std::size_t b = 0; b < balls.size(); ++b) {
       grid.ForEachRun(balls[b], [&](std::int64_t row, std::int64_t first, std::int64_t last) {
-        for (std::int64_t i = first; i <= last; ++i) holds[b].push_back(row * grid.row_length() + i);
+        for (std::int64_t i = first; i <= last; ++i)
+          holds[b].push_back(row * grid.row_length() + i);
       });
     }
     std::vector<int> count(static_cast<std::size_t>(grid.row_length() * grid.rows()), 0);

@@ -168,7 +168,7 @@ absl::Status RunSequence(const SequenceSpec& spec, const Options& options, Resul
   ReferenceRow ref;
   ref.sequence = name;
   ref.triangles = reference.num_triangles();
-  ref.ray_parity = oracle_options.inside_test == InsideTest::kRayParity;
+  ref.ray_parity = oracle_options.inside_test == InsideTest::kExactWinding;
   ref.spheres = generated->best.set.size();
   ref.sigma = generated->best.voxel_size;
   ref.epsilon = generated->best.epsilon;

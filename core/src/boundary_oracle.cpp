@@ -11,6 +11,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "closest_point_triangle.h"
+#include "exact_winding.h"
 #include "mesh_topology.h"
 #include "parallel.h"
 #include "triangle_bvh.h"
@@ -84,12 +85,12 @@ struct BoundaryOracle::Impl {
                         double upper_bound = std::numeric_limits<double>::infinity()) const;
   BoundaryPoint EmbreeClosest(const Vector3& p, double upper_bound) const;
   Side ClassifyFrom(const Vector3& p, const BoundaryPoint& closest) const;
-  Side ClassifyByParity(const Vector3& p) const;
-  int EmbreeCrossings(const Vector3& p, const float direction[3]) const;
+  Side ClassifyByWinding(const Vector3& p) const;
+  int EmbreeWinding(const Vector3& p, bool* on_surface) const;
   void UpdateBoxAndPad();
 
-  struct ParityContext;
-  static void CountCrossing(const RTCIntersectFunctionNArguments* args);
+  struct WindingContext;
+  static void AddCrossing(const RTCIntersectFunctionNArguments* args);
 };
 
 // Face normals, corner angles and edge normals per triangle in parallel; the vertex sums in
@@ -184,8 +185,8 @@ absl::Status BoundaryOracle::Impl::BuildScene() {
         b->upper_z = RoundUp(hi.z()) + self->pad;
       },
       nullptr);
-  // Rays only count crossings (kRayParity); occlusion rays are not used.
-  rtcSetGeometryIntersectFunction(geometry, CountCrossing);
+  // Rays only add up crossings (kExactWinding); occlusion rays are not used.
+  rtcSetGeometryIntersectFunction(geometry, AddCrossing);
   rtcSetGeometryOccludedFunction(geometry, [](const RTCOccludedFunctionNArguments*) {});
   rtcCommitGeometry(geometry);
   rtcAttachGeometry(scene, geometry);
@@ -284,41 +285,46 @@ void BoundaryOracle::Impl::UpdateBoxAndPad() {
   pad = RoundUp(1e-6 * magnitude + 1e-30);
 }
 
-struct BoundaryOracle::Impl::ParityContext {
+struct BoundaryOracle::Impl::WindingContext {
   RTCIntersectContext base;  // must come first: Embree hands back a pointer to it
   const Impl* impl;
   Vector3 origin;
-  Vector3 direction;
-  int crossings;
+  int winding;
+  bool on_surface;
 };
 
 // Called for every triangle whose (padded) box the ray enters. Never shortens the ray, so
-// traversal visits them all; counts proper crossings with t > 0 (the flat BVH's predicate).
-void BoundaryOracle::Impl::CountCrossing(const RTCIntersectFunctionNArguments* args) {
+// traversal visits them all; adds the flat BVH's exact crossing (internal::XRayCrossing).
+void BoundaryOracle::Impl::AddCrossing(const RTCIntersectFunctionNArguments* args) {
   if (args->valid[0] == 0) return;
-  auto* ctx = reinterpret_cast<ParityContext*>(args->context);
+  auto* ctx = reinterpret_cast<WindingContext*>(args->context);
   const auto t = static_cast<std::int32_t>(args->primID);
-  if (internal::RayCrossesTriangle(ctx->origin, ctx->direction, ctx->impl->Corner(t, 0),
-                                   ctx->impl->Corner(t, 1), ctx->impl->Corner(t, 2))) {
-    ++ctx->crossings;
+  const int crossing = internal::XRayCrossing(ctx->origin, ctx->impl->Corner(t, 0),
+                                              ctx->impl->Corner(t, 1), ctx->impl->Corner(t, 2));
+  if (crossing == internal::kOnTriangle) {
+    ctx->on_surface = true;
+  } else {
+    ctx->winding += crossing;
   }
 }
 
-int BoundaryOracle::Impl::EmbreeCrossings(const Vector3& p, const float direction[3]) const {
-  ParityContext ctx;
+int BoundaryOracle::Impl::EmbreeWinding(const Vector3& p, bool* on_surface) const {
+  WindingContext ctx;
   rtcInitIntersectContext(&ctx.base);
   ctx.impl = this;
   ctx.origin = p;
-  ctx.direction = Vector3(direction[0], direction[1], direction[2]);
-  ctx.crossings = 0;
+  ctx.winding = 0;
+  ctx.on_surface = false;
   RTCRayHit rayhit;
   rayhit.ray.org_x = static_cast<float>(p.x());
   rayhit.ray.org_y = static_cast<float>(p.y());
   rayhit.ray.org_z = static_cast<float>(p.z());
-  rayhit.ray.dir_x = direction[0];
-  rayhit.ray.dir_y = direction[1];
-  rayhit.ray.dir_z = direction[2];
+  rayhit.ray.dir_x = 1.0f;
+  rayhit.ray.dir_y = 0.0f;
+  rayhit.ray.dir_z = 0.0f;
+  // From behind the float origin: float(p_x) may lie past p_x.
   rayhit.ray.tnear = 0.0f;
+  rayhit.ray.org_x = std::nextafter(rayhit.ray.org_x, -std::numeric_limits<float>::infinity()) - pad;
   rayhit.ray.tfar = std::numeric_limits<float>::infinity();
   rayhit.ray.time = 0.0f;
   rayhit.ray.mask = 0xFFFFFFFFu;
@@ -328,32 +334,25 @@ int BoundaryOracle::Impl::EmbreeCrossings(const Vector3& p, const float directio
   rayhit.hit.primID = RTC_INVALID_GEOMETRY_ID;
   rayhit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
   rtcIntersect1(scene, &ctx.base, &rayhit);
-  return ctx.crossings;
+  *on_surface = ctx.on_surface;
+  return ctx.winding;
 }
 
-Side BoundaryOracle::Impl::ClassifyByParity(const Vector3& p) const {
+Side BoundaryOracle::Impl::ClassifyByWinding(const Vector3& p) const {
   if ((p.array() < box.min.array()).any() || (p.array() > box.max.array()).any()) {
     return Side::kOutside;
   }
-  // Three fixed directions far from the axes and from each other (exact in float), so that a
-  // ray grazing an edge or vertex, where one crossing may count twice or not at all, is
-  // outvoted by the two others.
-  static constexpr float kDirections[3][3] = {{0.5773503f, 0.4082483f, 0.7071068f},
-                                              {-0.6154797f, 0.7071068f, -0.3481553f},
-                                              {0.2672612f, -0.8017837f, 0.5345225f}};
-  int inside_votes = 0;
-  for (const auto& d : kDirections) {
-    const int crossings = options.backend == BoundaryOracleBackend::kFlatBvh
-                              ? bvh.CountCrossings(p, Vector3(d[0], d[1], d[2]))
-                              : EmbreeCrossings(p, d);
-    inside_votes += crossings % 2;
-  }
-  return inside_votes >= 2 ? Side::kInside : Side::kOutside;
+  bool on_surface = false;
+  const int winding = options.backend == BoundaryOracleBackend::kFlatBvh
+                          ? bvh.XRayWinding(p, &on_surface)
+                          : EmbreeWinding(p, &on_surface);
+  if (on_surface) return Side::kOnBoundary;
+  return winding != 0 ? Side::kInside : Side::kOutside;
 }
 
 Side BoundaryOracle::Impl::ClassifyFrom(const Vector3& p, const BoundaryPoint& closest) const {
   if (closest.distance == 0.0) return Side::kOnBoundary;
-  if (options.inside_test == InsideTest::kRayParity) return ClassifyByParity(p);
+  if (options.inside_test == InsideTest::kExactWinding) return ClassifyByWinding(p);
   const Vector3& w = closest.barycentric;
   const std::int32_t t = closest.triangle;
   Vector3 normal;

@@ -13,6 +13,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "cover_cells.h"
+#include "inscribe/mesh_hash.h"
 #include "parallel.h"
 
 namespace inscribe {
@@ -283,6 +284,38 @@ absl::StatusOr<std::vector<Sphere>> CoverCores(const std::vector<Sphere>& cover,
   return cores;
 }
 
+absl::Status CheckCoverCertificateBinding(const CoverCertificate& certificate,
+                                          const std::vector<Sphere>& spheres,
+                                          absl::string_view mesh_sha256) {
+  if (certificate.spheres_sha256.empty() || certificate.mesh_sha256.empty()) {
+    return absl::FailedPreconditionError(absl::StrCat(
+        "the cover certificate names no ",
+        certificate.spheres_sha256.empty() ? "spheres" : "mesh",
+        " it was proved for (it was recorded without them, or by an older inscribe): certify "
+        "the spheres again against their mesh"));
+  }
+  const std::string given = FormatSha256(SpheresSha256(spheres));
+  if (certificate.spheres_sha256 != given) {
+    return absl::FailedPreconditionError(
+        absl::StrCat("the cover certificate was made for other spheres (", certificate.spheres_sha256,
+                     ") than these ", spheres.size(), " (", given,
+                     "): the spheres were edited after they were certified; certify them again "
+                     "against their mesh"));
+  }
+  if (certificate.protrusions.size() != spheres.size()) {
+    return absl::FailedPreconditionError(
+        absl::StrCat("the cover certificate holds ", certificate.protrusions.size(),
+                     " protrusions for ", spheres.size(),
+                     " spheres (one per sphere is needed); certify them again against their mesh"));
+  }
+  if (!mesh_sha256.empty() && certificate.mesh_sha256 != mesh_sha256) {
+    return absl::FailedPreconditionError(
+        absl::StrCat("the cover certificate was proved against mesh ", certificate.mesh_sha256,
+                     ", not ", mesh_sha256, ": certify the spheres again against this mesh"));
+  }
+  return absl::OkStatus();
+}
+
 absl::Status CheckCoverCertifyOptions(const CoverCertifyOptions& options) {
   if (!(options.resolution > 0.0 && options.resolution <= 1.0)) {
     return absl::InvalidArgumentError(
@@ -328,6 +361,8 @@ absl::StatusOr<CoverCertificate> CertifyCover(const Solid& solid,
 
   CoverCertificate out;
   out.certified = counts->failed == 0;
+  out.mesh_sha256 = solid.sha256;
+  out.spheres_sha256 = FormatSha256(SpheresSha256(spheres));
   for (const double p : *protrusions) out.delta = std::max(out.delta, p);
   out.protrusions = *std::move(protrusions);
   out.resolution = certifier.finest_side();

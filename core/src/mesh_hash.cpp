@@ -10,9 +10,21 @@ namespace {
 
 constexpr char kMagic[16] = {'i', 'n', 's', 'c', 'r', 'i', 'b', 'e',
                              '.', 'm', 'e', 's', 'h', '.', 'v', '1'};
+constexpr char kSpheresMagic[] = "inscribe.spheres.v1";  // 19 bytes and the NUL, not hashed
+
+// Stream in chunks so hashing a large input does not double its memory.
+constexpr std::size_t kChunk = 1 << 16;
 
 void AppendLittleEndian(std::vector<std::uint8_t>& out, std::uint64_t bits, int bytes) {
   for (int i = 0; i < bytes; ++i) out.push_back(static_cast<std::uint8_t>(bits >> (8 * i)));
+}
+
+// The bits of `x`, with -0.0 as +0.0 (both describe the same geometry).
+void AppendCanonicalDouble(std::vector<std::uint8_t>& out, double x) {
+  if (x == 0.0) x = 0.0;
+  std::uint64_t bits;
+  std::memcpy(&bits, &x, sizeof bits);
+  AppendLittleEndian(out, bits, 8);
 }
 
 }  // namespace
@@ -25,8 +37,6 @@ Sha256Digest MeshSha256(const Mesh& mesh) {
   AppendLittleEndian(buffer, static_cast<std::uint64_t>(mesh.num_triangles()), 8);
   hasher.Update(buffer.data(), buffer.size());
 
-  // Stream in chunks so hashing a large mesh does not double its memory.
-  constexpr std::size_t kChunk = 1 << 16;
   buffer.clear();
   buffer.reserve(kChunk + 64);
   auto flush = [&](bool force) {
@@ -36,13 +46,7 @@ Sha256Digest MeshSha256(const Mesh& mesh) {
     }
   };
   for (Eigen::Index v = 0; v < mesh.vertices.rows(); ++v) {
-    for (int k = 0; k < 3; ++k) {
-      double x = mesh.vertices(v, k);
-      if (x == 0.0) x = 0.0;  // canonical zero: -0.0 and +0.0 describe the same mesh
-      std::uint64_t bits;
-      std::memcpy(&bits, &x, sizeof bits);
-      AppendLittleEndian(buffer, bits, 8);
-    }
+    for (int k = 0; k < 3; ++k) AppendCanonicalDouble(buffer, mesh.vertices(v, k));
     flush(false);
   }
   for (Eigen::Index t = 0; t < mesh.triangles.rows(); ++t) {
@@ -53,6 +57,23 @@ Sha256Digest MeshSha256(const Mesh& mesh) {
   }
   flush(true);
 
+  return hasher.Finish();
+}
+
+Sha256Digest SpheresSha256(const std::vector<Sphere>& spheres) {
+  Sha256Hasher hasher;
+  std::vector<std::uint8_t> buffer(kSpheresMagic, kSpheresMagic + sizeof kSpheresMagic - 1);
+  AppendLittleEndian(buffer, static_cast<std::uint64_t>(spheres.size()), 8);
+  buffer.reserve(kChunk + 64);
+  for (const Sphere& s : spheres) {
+    for (int k = 0; k < 3; ++k) AppendCanonicalDouble(buffer, s.center[k]);
+    AppendCanonicalDouble(buffer, s.radius);
+    if (buffer.size() >= kChunk) {
+      hasher.Update(buffer.data(), buffer.size());
+      buffer.clear();
+    }
+  }
+  hasher.Update(buffer.data(), buffer.size());
   return hasher.Finish();
 }
 

@@ -4,7 +4,11 @@
 #include <array>
 #include <cmath>
 #include <deque>
+#include <iterator>
 #include <limits>
+#include <utility>
+
+#include "triangle_bvh.h"
 
 namespace inscribe::internal {
 namespace {
@@ -19,21 +23,6 @@ std::array<Vector3, 3> CornersFrom(const Mesh& mesh, std::int32_t t, const Vecto
   return corners;
 }
 
-// Generalized winding number of the closed surface made of `triangles` at `p`: the sum of the
-// signed solid angles / 4 pi (Van Oosterom & Strackee). +-1 inside, 0 outside.
-double WindingNumber(const Mesh& mesh, const std::vector<std::int32_t>& triangles,
-                     const Vector3& p) {
-  double total = 0.0;
-  for (std::int32_t t : triangles) {
-    const auto [a, b, c] = CornersFrom(mesh, t, p);
-    const double la = a.norm(), lb = b.norm(), lc = c.norm();
-    const double numerator = a.dot(b.cross(c));
-    const double denominator = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
-    total += 2.0 * std::atan2(numerator, denominator);
-  }
-  return total / (4.0 * M_PI);
-}
-
 double ComponentVolume(const Mesh& mesh, const std::vector<std::int32_t>& triangles,
                        const Vector3& origin) {
   double six_volume = 0.0;
@@ -46,6 +35,72 @@ double ComponentVolume(const Mesh& mesh, const std::vector<std::int32_t>& triang
 
 void FlipTriangle(Mesh& mesh, Eigen::Index t) {
   std::swap(mesh.triangles(t, 1), mesh.triangles(t, 2));
+}
+
+// How many other shells enclose each component: shell o encloses c when up to kSamples of c's
+// vertices, spread over it, all lie strictly inside o (o's winding number around them is not
+// zero, and none lies on o). Shells that merely overlap or touch (a self-intersecting union,
+// bodies meeting at a vertex) do not enclose. Every winding number is exact (XRayCrossing along
+// one ray per sample, the crossings added up per component), so the answer holds for any
+// number of components. Cost: one ray per component that no other one may enclose, up to
+// kSamples for the others; O(#T log #T) for the tree, none for a single component.
+std::vector<int> NestingDepths(const Mesh& mesh, const std::vector<std::int32_t>& component,
+                               const std::vector<std::vector<std::int32_t>>& members) {
+  std::vector<int> depth(members.size(), 0);
+  if (members.size() < 2) return depth;
+  constexpr std::size_t kSamples = 16;
+  const TriangleBvh bvh = TriangleBvh::Build(mesh);
+  // Per sample: the components other than `own` whose winding around it is not zero.
+  std::vector<std::pair<std::int32_t, int>> crossings;  // (component, crossing)
+  auto enclosing = [&](const Vector3& p, std::int32_t own) {
+    crossings.clear();
+    std::vector<std::int32_t> touching;
+    bvh.ForEachXRayCrossing(p, [&](std::int32_t t, int crossing) {
+      const std::int32_t c = component[static_cast<std::size_t>(t)];
+      if (c < 0 || c == own) return;
+      if (crossing == kOnTriangle) {
+        touching.push_back(c);
+      } else {
+        crossings.emplace_back(c, crossing);
+      }
+    });
+    std::sort(crossings.begin(), crossings.end());
+    std::sort(touching.begin(), touching.end());
+    std::vector<std::int32_t> out;
+    for (std::size_t i = 0; i < crossings.size();) {
+      std::size_t j = i;
+      int winding = 0;
+      for (; j < crossings.size() && crossings[j].first == crossings[i].first; ++j) {
+        winding += crossings[j].second;
+      }
+      if (winding != 0 &&
+          !std::binary_search(touching.begin(), touching.end(), crossings[i].first)) {
+        out.push_back(crossings[i].first);
+      }
+      i = j;
+    }
+    return out;  // sorted
+  };
+  for (std::size_t c = 0; c < members.size(); ++c) {
+    const auto own = static_cast<std::int32_t>(c);
+    const std::size_t step = std::max<std::size_t>(1, members[c].size() / kSamples);
+    std::vector<std::int32_t> enclosers;
+    for (std::size_t i = 0, n = 0; i < members[c].size() && n < kSamples; i += step, ++n) {
+      const Vector3 p = mesh.vertices.row(mesh.triangles(members[c][i], 0)).transpose();
+      std::vector<std::int32_t> here = enclosing(p, own);
+      if (n == 0) {
+        enclosers = std::move(here);
+      } else {
+        std::vector<std::int32_t> both;
+        std::set_intersection(enclosers.begin(), enclosers.end(), here.begin(), here.end(),
+                              std::back_inserter(both));
+        enclosers = std::move(both);
+      }
+      if (enclosers.empty()) break;
+    }
+    depth[c] = static_cast<int>(enclosers.size());
+  }
+  return depth;
 }
 
 }  // namespace
@@ -114,7 +169,7 @@ bool MakeOrientationConsistent(Mesh& mesh, const std::vector<EdgeUse>& uses,
   return true;
 }
 
-bool OrientComponentsOutward(Mesh& mesh, const std::vector<std::int32_t>& component,
+void OrientComponentsOutward(Mesh& mesh, const std::vector<std::int32_t>& component,
                              std::int64_t num_components, std::vector<char>& flip) {
   std::vector<std::vector<std::int32_t>> members(static_cast<std::size_t>(num_components));
   for (std::size_t t = 0; t < component.size(); ++t) {
@@ -123,41 +178,10 @@ bool OrientComponentsOutward(Mesh& mesh, const std::vector<std::int32_t>& compon
   }
   const BoundingBox box = ComputeBoundingBox(mesh.vertices);
   const Vector3 origin = 0.5 * (box.min + box.max);
-  const bool nesting = num_components <= kMaxComponentsForNesting;
-  // Per component: its bounding box and up to kSamples of its vertices, spread over it.
-  constexpr std::size_t kSamples = 16;
-  std::vector<BoundingBox> boxes(members.size());
-  std::vector<std::vector<Vector3>> samples(members.size());
-  for (std::size_t c = 0; c < members.size(); ++c) {
-    Vector3 lo = Vector3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
-    for (std::int32_t t : members[c]) {
-      for (int k = 0; k < 3; ++k) {
-        lo = lo.cwiseMin(mesh.vertices.row(mesh.triangles(t, k)).transpose());
-        hi = hi.cwiseMax(mesh.vertices.row(mesh.triangles(t, k)).transpose());
-      }
-    }
-    boxes[c] = BoundingBox{lo, hi};
-    const std::size_t step = std::max<std::size_t>(1, members[c].size() / kSamples);
-    for (std::size_t i = 0; i < members[c].size() && samples[c].size() < kSamples; i += step) {
-      samples[c].push_back(mesh.vertices.row(mesh.triangles(members[c][i], 0)).transpose());
-    }
-  }
-  auto box_inside = [](const BoundingBox& a, const BoundingBox& b) {
-    return (a.min.array() >= b.min.array()).all() && (a.max.array() <= b.max.array()).all();
-  };
+  const std::vector<int> depth = NestingDepths(mesh, component, members);
   for (std::size_t c = 0; c < members.size(); ++c) {
     const double volume = ComponentVolume(mesh, members[c], origin);
-    // Depth = how many other shells enclose this one entirely (every sample inside). Shells
-    // that merely overlap (a self-intersecting union) do not count: they are not cavities.
-    int depth = 0;
-    for (std::size_t other = 0; nesting && other < members.size(); ++other) {
-      if (other == c || !box_inside(boxes[c], boxes[other])) continue;
-      const bool enclosed = std::all_of(
-          samples[c].begin(), samples[c].end(),
-          [&](const Vector3& p) { return std::abs(WindingNumber(mesh, members[other], p)) > 0.5; });
-      if (enclosed) ++depth;
-    }
-    const bool want_positive = depth % 2 == 0;
+    const bool want_positive = depth[c] % 2 == 0;
     if ((volume > 0) != want_positive && volume != 0.0) {
       for (std::int32_t t : members[c]) {
         FlipTriangle(mesh, t);
@@ -165,7 +189,6 @@ bool OrientComponentsOutward(Mesh& mesh, const std::vector<std::int32_t>& compon
       }
     }
   }
-  return nesting;
 }
 
 }  // namespace inscribe::internal

@@ -223,7 +223,7 @@ void CheckVertexManifold(const Mesh& mesh, const std::vector<EdgeUse>& uses,
     AddIssue(report, Severity::kWarning, "non_manifold_vertices",
              absl::StrCat(Plural(report.non_manifold_vertices, "vertex joins", "vertices join"),
                           " several separate fans of triangles (first: vertex ", first,
-                          "); inside/outside tests near them may be wrong"),
+                          "); the solid is classified with the exact inside test"),
              report.non_manifold_vertices);
   }
 }
@@ -250,19 +250,6 @@ std::vector<std::int32_t> LabelComponents(const Mesh& mesh, const std::vector<Ed
   }
   report.components = next;
   return label;
-}
-
-// internal::OrientComponentsOutward, with a warning when there were too many components to
-// find the cavities.
-void OrientOutward(Mesh& mesh, const std::vector<std::int32_t>& component,
-                   std::int64_t num_components, std::vector<char>& flip, MeshReport& report) {
-  if (!internal::OrientComponentsOutward(mesh, component, num_components, flip)) {
-    AddIssue(report, Severity::kWarning, "nesting_not_checked",
-             absl::StrCat("mesh has ", num_components,
-                          " components; cavities were not detected, every component was "
-                          "oriented to enclose positive volume"),
-             num_components);
-  }
 }
 
 // Reports the triangles that the orientation fixes reversed: flip[t] for each triangle t of the
@@ -311,7 +298,7 @@ void CheckOrientation(Mesh& mesh, const std::vector<EdgeUse>& uses, const EdgeGr
              1);
     return;
   }
-  OrientOutward(mesh, component, report.components, flip, report);
+  internal::OrientComponentsOutward(mesh, component, report.components, flip);
   ReportFlips(flip, component, report);
 }
 
@@ -386,7 +373,7 @@ void FillHolesAndOrient(Mesh& mesh, const std::vector<EdgeUse>& uses, const Edge
       LabelComponents(closed, closed_uses, closed_groups, closed_report);
   flip.resize(static_cast<std::size_t>(closed.num_triangles()), 0);
   if (options.fix_orientation) {
-    OrientOutward(closed, closed_component, closed_report.components, flip, report);
+    internal::OrientComponentsOutward(closed, closed_component, closed_report.components, flip);
   }
   // Only the triangles as given count as flipped; the patch was made facing its neighbours.
   flip.resize(static_cast<std::size_t>(given));
@@ -417,6 +404,7 @@ bool WeldCoincidentVertices(Mesh& mesh, double tolerance, MeshReport& report) {
   const internal::Weld weld = internal::WeldVertices(mesh, tolerance);
   report.welded_vertices = weld.merged_vertices;
   report.weld_collapsed_triangles = weld.collapsed_triangles;
+  if (tolerance > 0.0 && weld.merged_vertices > 0) report.weld_moved_within = tolerance;
   if (weld.merged_vertices > 0 || weld.collapsed_triangles > 0) {
     AddIssue(report, Severity::kFixed, "welded_vertices",
              absl::StrCat("welded ", Plural(weld.merged_vertices, "vertex", "vertices"),
@@ -457,6 +445,30 @@ const char* SeverityName(Severity severity) {
 bool MeshReport::usable() const {
   return std::none_of(issues.begin(), issues.end(),
                       [](const MeshIssue& i) { return i.severity == Severity::kError; });
+}
+
+std::vector<MeshIssue> MeshReport::notices() const {
+  std::vector<MeshIssue> out;
+  for (const MeshIssue& issue : issues) {
+    if (issue.severity == Severity::kError) continue;
+    if (issue.code == "welded_vertices" && weld_moved_within == 0.0 &&
+        weld_collapsed_triangles == 0) {
+      continue;
+    }
+    out.push_back(issue);
+  }
+  return out;
+}
+
+std::string MeshReport::repairs() const {
+  if (!geometry_repaired()) return "";
+  std::string out;
+  for (const MeshIssue& issue : issues) {
+    if (issue.code == "holes_filled" || issue.code == "welded_vertices") {
+      absl::StrAppend(&out, out.empty() ? "" : "; ", issue.message);
+    }
+  }
+  return out;
 }
 
 std::string MeshReport::first_error() const {
@@ -532,14 +544,18 @@ ValidatedMesh ValidateMesh(Mesh mesh, const ValidateOptions& options) {
                 patch_pairs > 0
                     ? absl::StrCat("; ", patch_pairs, " involve triangles that fill holes")
                     : std::string(),
-                "); inside/outside is ill-defined near them"),
+                "); the solid is the union of what they bound (winding number not zero), classified "
+                "with the exact inside test"),
             report.self_intersecting_pairs);
       }
     }
   }
-  if (!report.self_intersections_checked && options.check_self_intersections && report.usable()) {
+  if (!report.self_intersections_checked && report.usable()) {
     AddIssue(report, Severity::kWarning, "self_intersections_not_checked",
-             "self-intersections were not checked (some vertices are not manifold)", 0);
+             report.non_manifold_vertices > 0
+                 ? "self-intersections were not checked (some vertices are not manifold); the "
+                   "exact inside test is used"
+                 : "self-intersections were not checked; the exact inside test is used", 0);
   }
   std::stable_sort(report.issues.begin(), report.issues.end(),
                    [](const MeshIssue& a, const MeshIssue& b) {

@@ -7,7 +7,11 @@
 namespace inscribe {
 
 InsideTest InsideTestFor(const MeshReport& report) {
-  return report.self_intersecting_pairs > 0 ? InsideTest::kRayParity : InsideTest::kPseudonormal;
+  const bool pseudonormal_proved = report.self_intersections_checked &&
+                                   report.self_intersecting_pairs == 0 &&
+                                   report.non_manifold_vertices == 0 &&
+                                   report.degenerate_triangles == 0;
+  return pseudonormal_proved ? InsideTest::kPseudonormal : InsideTest::kExactWinding;
 }
 
 absl::StatusOr<Solid> MakeSolid(ValidatedMesh validated, std::string sha256,

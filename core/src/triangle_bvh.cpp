@@ -23,6 +23,8 @@ constexpr double kNodeCost = 8.0;
 // median), so the depth never exceeds kMaxSahDepth + 31 and kStackSize always suffices.
 constexpr int kMaxSahDepth = 48;
 constexpr int kStackSize = 96;
+static_assert(TriangleBvh::kTraversalStackSize == kStackSize + 2,
+              "a traversal pushes at most two children past the depth");
 
 // Culling margins. A box is culled only when its squared distance exceeds
 // (d (1 + kCullRelative) + kCullAbsolute * scale)^2, d being the best distance so far and
@@ -35,10 +37,6 @@ constexpr double kCullAbsolute = 1e-12;
 // A caller's upper bound u is honoured when the best squared distance found is at most
 // u^2 (1 + kBoundRelative): the rounding of u = sqrt(d^2) itself. Well inside the cull margin.
 constexpr double kBoundRelative = 1e-13;
-// Rays: boxes grow by kRayPad * scale, covering Moeller-Trumbore's rounding at triangle edges,
-// and the far slab distance by a relative kRayRelative (Ize, "Robust BVH ray traversal").
-constexpr double kRayPad = 1e-10;
-constexpr double kRayRelative = 1e-12;
 
 struct Box {
   Vector3 lo = Vector3::Constant(std::numeric_limits<double>::infinity());
@@ -77,27 +75,6 @@ inline Eigen::Array2d ChildSquaredDistances(const TriangleBvhNode& n, const Vect
   return d2;
 }
 
-// Slab test of the ray against child c's box grown by `pad`; inv_direction[k] = 1 /
-// direction[k].
-inline bool RayNearsChild(const TriangleBvhNode& n, int c, const Vector3& origin,
-                          const Vector3& direction, const Vector3& inv_direction, double pad) {
-  double t_near = 0.0;
-  double t_far = std::numeric_limits<double>::infinity();
-  for (int k = 0; k < 3; ++k) {
-    const double lo = static_cast<double>(n.lo[k][c]) - pad;
-    const double hi = static_cast<double>(n.hi[k][c]) + pad;
-    if (direction[k] == 0.0) {
-      if (origin[k] < lo || origin[k] > hi) return false;
-      continue;
-    }
-    double t0 = (lo - origin[k]) * inv_direction[k];
-    double t1 = (hi - origin[k]) * inv_direction[k];
-    if (t0 > t1) std::swap(t0, t1);
-    t_near = std::max(t_near, t0);
-    t_far = std::min(t_far, t1);
-  }
-  return t_near <= t_far * (1.0 + kRayRelative);
-}
 
 // p in the leaf's frame: (axes[k] . p) for k = 0, 1, 2.
 inline Vector3 ToLeafFrame(const TriangleBvhLeaf& leaf, const Vector3& p) {
@@ -531,55 +508,18 @@ BoundaryPoint TriangleBvh::ClosestPoint(const Vector3& p, double upper_bound,
   return best;
 }
 
-int TriangleBvh::CountCrossings(const Vector3& origin, const Vector3& direction,
-                                TriangleBvhStats* stats) const {
-  const double pad = kRayPad * std::max(magnitude_, origin.cwiseAbs().maxCoeff());
-  const Vector3 inv_direction = direction.cwiseInverse();
-  TriangleBvhRef stack[kStackSize + 2];
-  int top = 0;
-  stack[top++] = root_;
-  int crossings = 0;
-  std::int64_t node_visits = 0, triangle_visits = 0;
-  while (top > 0) {
-    const TriangleBvhRef ref = stack[--top];
-    if (ref.is_leaf()) {
-      const TriangleBvhLeaf& leaf = leaves_[static_cast<std::size_t>(ref.index)];
-      triangle_visits += leaf.count;
-      for (std::int32_t s = leaf.first; s < leaf.first + leaf.count; ++s) {
-        const Vector3* c = &corners_[3 * static_cast<std::size_t>(s)];
-        crossings += RayCrossesTriangle(origin, direction, c[0], c[1], c[2]) ? 1 : 0;
-      }
-      continue;
+int TriangleBvh::XRayWinding(const Vector3& p, bool* on_surface) const {
+  int winding = 0;
+  bool on = false;
+  ForEachXRayCrossing(p, [&](std::int32_t, int crossing) {
+    if (crossing == kOnTriangle) {
+      on = true;
+    } else {
+      winding += crossing;
     }
-    ++node_visits;
-    const TriangleBvhNode& n = nodes_[static_cast<std::size_t>(ref.index)];
-    assert(top + 2 <= kStackSize + 2);
-    for (int c = 1; c >= 0; --c) {
-      if (RayNearsChild(n, c, origin, direction, inv_direction, pad)) stack[top++] = n.child[c];
-    }
-  }
-  if (stats != nullptr) {
-    stats->nodes += node_visits;
-    stats->triangles += triangle_visits;
-  }
-  return crossings;
-}
-
-bool RayCrossesTriangle(const Vector3& origin, const Vector3& direction, const Vector3& a,
-                        const Vector3& b, const Vector3& c) {
-  const Vector3 e1 = b - a;
-  const Vector3 e2 = c - a;
-  const Vector3 pvec = direction.cross(e2);
-  const double det = e1.dot(pvec);
-  if (det == 0.0) return false;  // ray parallel to the triangle's plane
-  const double inv = 1.0 / det;
-  const Vector3 tvec = origin - a;
-  const double u = tvec.dot(pvec) * inv;
-  if (u < 0.0 || u > 1.0) return false;
-  const Vector3 qvec = tvec.cross(e1);
-  const double v = direction.dot(qvec) * inv;
-  if (v < 0.0 || u + v > 1.0) return false;
-  return e2.dot(qvec) * inv > 0.0;
+  });
+  *on_surface = on;
+  return winding;
 }
 
 }  // namespace inscribe::internal

@@ -1,5 +1,5 @@
-// Private: a flat bounding-volume hierarchy over a mesh's triangles, for closest-point and
-// ray-crossing queries in double precision.
+// Private: a flat bounding-volume hierarchy over a mesh's triangles, for closest-point queries in
+// double precision and exact ray crossings.
 #pragma once
 
 #include <cmath>
@@ -8,6 +8,7 @@
 #include <limits>
 #include <vector>
 
+#include "exact_winding.h"
 #include "float_rounding.h"
 #include "inscribe/boundary_oracle.h"
 #include "inscribe/mesh.h"
@@ -79,7 +80,7 @@ struct TriangleBvhStats {
 // triangles; only triangles that pass all three get an exact test.
 //
 // Every distance and crossing is computed in double precision from the copied corners with
-// ClosestPointOnTriangle / RayCrossesTriangle; the boxes only cull, with a margin that keeps
+// ClosestPointOnTriangle / XRayCrossing (exact); the boxes only cull, with a margin that keeps
 // culling conservative, so queries return exactly what a scan over all triangles would, ties
 // going to the lowest triangle index.
 //
@@ -88,6 +89,8 @@ struct TriangleBvhStats {
 class TriangleBvh {
  public:
   static constexpr int kMaxLeafSize = 16;
+  // Depth-first traversal stacks: the tree's depth never exceeds it (see triangle_bvh.cpp).
+  static constexpr int kTraversalStackSize = 98;
 
   TriangleBvh() = default;
 
@@ -114,10 +117,16 @@ class TriangleBvh {
                              double upper_bound = std::numeric_limits<double>::infinity(),
                              TriangleBvhStats* stats = nullptr) const;
 
-  // Number of triangles that RayCrossesTriangle says the ray origin + t direction crosses at
-  // t > 0 (direction nonzero, need not be unit). Visits every leaf whose box the ray nears.
-  int CountCrossings(const Vector3& origin, const Vector3& direction,
-                     TriangleBvhStats* stats = nullptr) const;
+  // Calls visit(triangle, crossing) for every triangle that XRayCrossing (exact_winding.h)
+  // says the symbolically perturbed ray from p along +x crosses (crossing +1 or -1) or that
+  // holds p (crossing kOnTriangle), in no particular order. Visits every leaf whose box
+  // holds p's (y, z) and reaches x >= p_x. Cost O(log #T) plus the triangles the ray passes.
+  template <typename Visit>
+  void ForEachXRayCrossing(const Vector3& p, Visit&& visit) const;
+
+  // The winding number around p (perturbed as XRayCrossing says) of the mesh's triangles: the
+  // sum of their crossings. *on_surface: whether some triangle was found to hold p.
+  int XRayWinding(const Vector3& p, bool* on_surface) const;
 
   TriangleBvhRef root() const { return root_; }
   const std::vector<TriangleBvhNode>& nodes() const { return nodes_; }
@@ -142,10 +151,34 @@ class TriangleBvh {
   double magnitude_ = 0.0;
 };
 
-// True when the ray origin + t direction, t > 0, crosses triangle (a, b, c): Moeller-Trumbore
-// in double precision, boundary of the triangle included, rays in its plane never crossing.
-// Shared by both of BoundaryOracle's backends so that they count the same crossings.
-bool RayCrossesTriangle(const Vector3& origin, const Vector3& direction, const Vector3& a,
-                        const Vector3& b, const Vector3& c);
+template <typename Visit>
+void TriangleBvh::ForEachXRayCrossing(const Vector3& p, Visit&& visit) const {
+  // Boxes are rounded outward from the corners and the tests are closed, so a box that holds
+  // a triangle the perturbed ray meets is never culled.
+  auto holds_ray = [&p](const TriangleBvhNode& n, int c) {
+    return static_cast<double>(n.hi[0][c]) >= p.x() && static_cast<double>(n.lo[1][c]) <= p.y() &&
+           static_cast<double>(n.hi[1][c]) >= p.y() && static_cast<double>(n.lo[2][c]) <= p.z() &&
+           static_cast<double>(n.hi[2][c]) >= p.z();
+  };
+  TriangleBvhRef stack[kTraversalStackSize];
+  int top = 0;
+  stack[top++] = root_;
+  while (top > 0) {
+    const TriangleBvhRef ref = stack[--top];
+    if (ref.is_leaf()) {
+      const TriangleBvhLeaf& leaf = leaves_[static_cast<std::size_t>(ref.index)];
+      for (std::int32_t s = leaf.first; s < leaf.first + leaf.count; ++s) {
+        const Vector3* c = &corners_[3 * static_cast<std::size_t>(s)];
+        const int crossing = XRayCrossing(p, c[0], c[1], c[2]);
+        if (crossing != 0) visit(slot_triangle_[static_cast<std::size_t>(s)], crossing);
+      }
+      continue;
+    }
+    const TriangleBvhNode& n = nodes_[static_cast<std::size_t>(ref.index)];
+    for (int c = 1; c >= 0; --c) {
+      if (holds_ray(n, c)) stack[top++] = n.child[c];
+    }
+  }
+}
 
 }  // namespace inscribe::internal

@@ -398,7 +398,9 @@ class Client:
                             timeout: Optional[float] = None) -> str:
         """Uploads a cover with the certificate it was made with (inscribe.generate(...,
         kind='cover').certificate, or inscribe.certify's), which Distance then takes on the
-        caller's word; returns its key. ValueError when the certificate does not certify."""
+        caller's word; returns its key. ValueError when the certificate does not certify, or
+        does not name these spheres (its spheres_sha256: they were edited after it was made)
+        with one protrusion each."""
         message = _sphere_set_to_proto(spheres)
         proof = spheres_pb2.CoverCertificate(
             certified=certificate.certified, delta=certificate.delta,
@@ -407,7 +409,8 @@ class Client:
             cells_outside=certificate.cells_outside, failed_cells=certificate.failed_cells,
             uncovered_depth=certificate.uncovered_depth,
             uncovered_gap=certificate.uncovered_gap, seconds=certificate.seconds,
-            protrusions=list(certificate.protrusions))
+            protrusions=list(certificate.protrusions), mesh_sha256=certificate.mesh_sha256,
+            spheres_sha256=certificate.spheres_sha256)
         if certificate.uncovered_point is not None:
             proof.uncovered_point.extend(certificate.uncovered_point)
         request = service_pb2.PutSphereSetRequest(spheres=message, certificate=proof)

@@ -106,6 +106,8 @@ class QualityReport:
 
 class CoverCertificate:
     certified: bool
+    mesh_sha256: str
+    spheres_sha256: str
     delta: float
     resolution: float
     cells: int

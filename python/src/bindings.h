@@ -22,7 +22,11 @@ void BindRobot(py::module_& m);
 void BindRouting(py::module_& m);
 void BindScene(py::module_& m);
 
-// PrepareSolid without the GIL; raises as RaiseStatus.
+// warnings.warn(inscribe.MeshWarning) for each of report.notices(), and once more when the
+// geometry was repaired (results hold for the mesh `sha256` only). Needs the GIL.
+void WarnAboutMesh(const MeshReport& report, const std::string& sha256);
+
+// PrepareSolid without the GIL; raises as RaiseStatus; warns as WarnAboutMesh.
 std::shared_ptr<Solid> PrepareSolidReleasingGil(const Mesh& mesh, bool fill_holes,
                                                 bool check_self_intersections);
 

@@ -14,6 +14,7 @@
 #include "bindings.h"
 #include "distance_types.h"
 #include "inscribe/certified_distance.h"
+#include "inscribe/cover_certificate.h"
 #include "inscribe/rigid_pose.h"
 #include "inscribe/separation_distance.h"
 #include "inscribe/sphere_hierarchy.h"
@@ -248,10 +249,13 @@ GIL; Ctrl-C cancels it. Witness points are in the world frame.)doc");
                                     "certified cover with its delta (mesh units).")
       .def(py::init([](py::handle internal, py::handle cover, std::optional<double> delta,
                        std::optional<std::vector<double>> protrusions) {
-             // A cover SphereSet with its certificate gives delta and protrusions by default.
+             // A cover SphereSet with its certificate gives delta and protrusions by default,
+             // when the certificate names its spheres and mesh.
              if (py::isinstance<PySphereSet>(cover)) {
                const PySphereSet& set = cover.cast<const PySphereSet&>();
-               if (set.certificate) {
+               if (set.certificate && (!delta || !protrusions)) {
+                 OkOrRaise(CheckCoverCertificateBinding(*set.certificate, set.set.spheres,
+                                                        set.mesh_sha256));
                  if (!delta) delta = set.certificate->delta;
                  if (!protrusions) protrusions = set.certificate->protrusions;
                }
@@ -288,7 +292,8 @@ GIL; Ctrl-C cancels it. Witness points are in the world frame.)doc");
            "certificate.protrusions, one per cover sphere (mesh units), whose cores (radius "
            "less protrusion, inside the solid) stand in for the internal spheres for a tighter "
            "upper bound, as the service does. A cover SphereSet carrying its certificate gives "
-           "both. "
+           "both (inscribe.Error FAILED_PRECONDITION when the certificate does not name its "
+           "spheres and mesh_sha256). "
            "The caller vouches for the certificate (see inscribe.certify).");
 
   py::class_<CertifiedBatch>(m, "CertifiedDistances",

@@ -177,6 +177,10 @@ void BindGeneration(py::module_& m) {
                                "it reaches outside it (mesh units).")
       .def_readonly("certified", &CoverCertificate::certified,
                     "every point of the solid lies in some sphere (a proof)")
+      .def_readonly("mesh_sha256", &CoverCertificate::mesh_sha256,
+                    "'sha256:<hex>' of the validated mesh it was proved against")
+      .def_readonly("spheres_sha256", &CoverCertificate::spheres_sha256,
+                    "'sha256:<hex>' of the spheres it was proved for, in their order")
       .def_readonly("delta", &CoverCertificate::delta,
                     "no point of any sphere lies farther than this outside the solid")
       .def_readonly("resolution", &CoverCertificate::resolution, "finest cell side, mesh units")

@@ -46,6 +46,19 @@ std::string ReportRepr(const MeshReport& report) {
 
 }  // namespace
 
+void WarnAboutMesh(const MeshReport& report, const std::string& sha256) {
+  const py::object warn = py::module_::import("warnings").attr("warn");
+  const py::object category = py::module_::import("inscribe._inscribe").attr("MeshWarning");
+  for (const MeshIssue& issue : report.notices()) {
+    warn(absl::StrCat(SeverityName(issue.severity), ": ", issue.message), category, 2);
+  }
+  if (report.geometry_repaired()) {
+    warn(absl::StrCat("results and certificates hold for the repaired mesh ", sha256,
+                      ", not for the triangles as given (", report.repairs(), ")"),
+         category, 2);
+  }
+}
+
 std::shared_ptr<Solid> PrepareSolidReleasingGil(const Mesh& mesh, bool fill_holes,
                                                 bool check_self_intersections) {
   SolidOptions options;
@@ -56,7 +69,9 @@ std::shared_ptr<Solid> PrepareSolidReleasingGil(const Mesh& mesh, bool fill_hole
     py::gil_scoped_release release;
     solid = PrepareSolid(mesh, options);
   }
-  return std::make_shared<Solid>(ValueOrRaise(std::move(solid)));
+  auto prepared = std::make_shared<Solid>(ValueOrRaise(std::move(solid)));
+  WarnAboutMesh(prepared->report, prepared->sha256);
+  return prepared;
 }
 
 std::shared_ptr<Solid> SolidOf(py::handle mesh_or_solid) {
@@ -69,6 +84,12 @@ std::shared_ptr<Solid> SolidOf(py::handle mesh_or_solid) {
 }
 
 void BindMesh(py::module_& m) {
+  // Issued (warnings.warn) for every warning and fix validation makes when a Solid is prepared.
+  m.attr("MeshWarning") = py::reinterpret_steal<py::object>(
+      PyErr_NewExceptionWithDoc("inscribe.MeshWarning",
+                                "A validation warning or fix of a mesh being prepared (see "
+                                "MeshReport.issues); the spheres are still made.",
+                                PyExc_UserWarning, nullptr));
   py::enum_<Severity>(m, "Severity", "How serious a MeshIssue is.")
       .value("ERROR", Severity::kError, "the mesh cannot be used to generate spheres")
       .value("WARNING", Severity::kWarning, "usable, but results may suffer")
@@ -104,6 +125,8 @@ void BindMesh(py::module_& m) {
       .def_readonly("self_intersecting_pairs", &MeshReport::self_intersecting_pairs)
       .def_readonly("welded_vertices", &MeshReport::welded_vertices)
       .def_readonly("weld_collapsed_triangles", &MeshReport::weld_collapsed_triangles)
+      .def_readonly("weld_moved_within", &MeshReport::weld_moved_within,
+                    "the weld tolerance when it was > 0 and merged vertices, else 0 (mesh units)")
       .def_readonly("holes_filled", &MeshReport::holes_filled)
       .def_readonly("hole_triangles_added", &MeshReport::hole_triangles_added)
       .def_readonly("volume", &MeshReport::volume,
@@ -118,6 +141,12 @@ void BindMesh(py::module_& m) {
       .def_property_readonly("closed", &MeshReport::closed)
       .def_property_readonly("usable", &MeshReport::usable,
                              "True when no issue is an error: spheres can be generated")
+      .def_property_readonly("geometry_repaired", &MeshReport::geometry_repaired,
+                             "True when validation changed the surface (a weld within a "
+                             "tolerance, triangles the weld removed, holes filled): results and "
+                             "certificates hold for the repaired mesh only")
+      .def_property_readonly("repairs", &MeshReport::repairs,
+                             "those repairs in one line, or '' when there were none")
       .def_property_readonly("first_error", &MeshReport::first_error,
                              "the first error as one line, or '' when usable")
       .def("__repr__", &ReportRepr);

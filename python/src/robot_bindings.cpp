@@ -95,6 +95,8 @@ void BindRobot(py::module_& m) {
       .def_readonly("budget", &LinkSpherizeResult::budget,
                     "spheres the link was given (budget modes), else 0")
       .def_readonly("error", &LinkSpherizeResult::error, "why a skipped link was skipped")
+      .def_readonly("warnings", &LinkSpherizeResult::warnings,
+                    "every validation warning and fix of the link's meshes, one line each")
       .def_readonly("seconds", &LinkSpherizeResult::seconds)
       .def("__repr__", [](const LinkSpherizeResult& r) {
         return absl::StrCat("LinkSpheres('", r.link, "', ", robot::LinkStatusName(r.status), ", ",

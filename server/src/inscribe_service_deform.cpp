@@ -212,7 +212,7 @@ grpc::ServerUnaryReactor* InscribeService::UpdateDeformation(
                                                            : ContactDirection::kCarriedFrame;
         // As the stored mesh's own oracle, unless the caller asks for ray parity.
         options.oracle.inside_test =
-            request->ray_parity() ? InsideTest::kRayParity : InsideTestFor((*mesh)->solid.report);
+            request->ray_parity() ? InsideTest::kExactWinding : InsideTestFor((*mesh)->solid.report);
         absl::StatusOr<std::shared_ptr<const DeformerEntry>> entry =
             store_->GetDeformer(*mesh_key, request->sphere_set_key(), options);
         if (!entry.ok()) return entry.status();

@@ -53,6 +53,9 @@ absl::StatusOr<CachedValue> DecodeMesh(const std::string& key, std::string bytes
   return MeshValue(key, ValidatedMesh{*std::move(mesh), *std::move(report)}, std::move(bytes));
 }
 
+// A cover's certificate must name the set's spheres and mesh (CheckCoverCertificateBinding):
+// one that does not (an entry written before certificates named them) is a corrupt entry, so
+// a generated cover is generated again and an uploaded one must be uploaded again.
 absl::StatusOr<CachedValue> DecodeSphereSet(std::string bytes) {
   auto entry = std::make_shared<SphereSetEntry>();
   if (!entry->result.ParseFromString(bytes)) {
@@ -61,6 +64,17 @@ absl::StatusOr<CachedValue> DecodeSphereSet(std::string bytes) {
   absl::StatusOr<SphereSet> set = wire::SphereSetFromProto(entry->result.spheres());
   if (!set.ok()) return set.status();
   entry->set = *std::move(set);
+  if (entry->result.has_cover()) {
+    absl::StatusOr<CoverCertificate> certificate =
+        wire::CoverCertificateFromProto(entry->result.cover().certificate());
+    if (!certificate.ok()) return certificate.status();
+    if (absl::Status bound = CheckCoverCertificateBinding(*certificate, entry->set.spheres,
+                                                          entry->result.mesh_sha256());
+        !bound.ok()) {
+      return absl::DataLossError(
+          absl::StrCat("stored cover ", entry->result.sphere_set_key(), ": ", bound.message()));
+    }
+  }
   CachedValue value;
   value.object_bytes = static_cast<std::int64_t>(entry->result.ByteSizeLong()) +
                        static_cast<std::int64_t>(sizeof(Sphere) * entry->set.size());
@@ -69,12 +83,19 @@ absl::StatusOr<CachedValue> DecodeSphereSet(std::string bytes) {
   return value;
 }
 
-absl::StatusOr<CachedValue> DecodeCertificate(std::string bytes) {
+// The certificate of `spheres` against mesh `mesh_key`; one that does not name them
+// (CheckCoverCertificateBinding) is a corrupt entry, proved again.
+absl::StatusOr<CachedValue> DecodeCertificate(std::string bytes, const std::vector<Sphere>& spheres,
+                                              const std::string& mesh_key) {
   v1::CoverCertificate stored;
   if (!stored.ParseFromString(bytes))
     return absl::DataLossError("stored certificate does not parse");
   absl::StatusOr<CoverCertificate> certificate = wire::CoverCertificateFromProto(stored);
   if (!certificate.ok()) return certificate.status();
+  if (absl::Status bound = CheckCoverCertificateBinding(*certificate, spheres, mesh_key);
+      !bound.ok()) {
+    return absl::DataLossError(absl::StrCat("stored certificate: ", bound.message()));
+  }
   CachedValue value;
   value.object_bytes = static_cast<std::int64_t>(sizeof(CoverCertificate));
   value.object = std::shared_ptr<const CoverCertificate>(
@@ -247,11 +268,11 @@ absl::StatusOr<std::shared_ptr<const SphereSetEntry>> ResultStore::PutSphereSet(
         "certificate: it does not certify the set (certified is false); send a certified one, "
         "or none and let CertifyCover prove it against the set's mesh");
   }
-  if (certificate && !certificate->protrusions.empty() &&
-      certificate->protrusions.size() != set.spheres.size()) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "certificate: ", certificate->protrusions.size(), " protrusions for ", set.spheres.size(),
-        " spheres; send one per sphere, in the set's order, or none"));
+  if (certificate) {
+    if (absl::Status bound = CheckCoverCertificateBinding(*certificate, set.spheres, mesh_key);
+        !bound.ok()) {
+      return absl::InvalidArgumentError(absl::StrCat("certificate: ", bound.message()));
+    }
   }
   if (!mesh_key.empty()) {
     absl::StatusOr<std::shared_ptr<const StoredMeshEntry>> mesh = GetMesh(mesh_key);
@@ -305,9 +326,11 @@ absl::StatusOr<std::shared_ptr<const CoverCertificate>> ResultStore::CertifySphe
         if (!certificate.ok()) return certificate.status();
         v1::CoverCertificate stored;
         wire::CoverCertificateToProto(*certificate, &stored);
-        return DecodeCertificate(stored.SerializeAsString());
+        return DecodeCertificate(stored.SerializeAsString(), (*set)->set.spheres, mesh_key);
       },
-      DecodeCertificate);
+      [&](std::string bytes) {
+        return DecodeCertificate(std::move(bytes), (*set)->set.spheres, mesh_key);
+      });
   if (!found.ok()) return found.status();
   return ObjectOf<CoverCertificate>(*found, key);
 }
@@ -363,6 +386,12 @@ absl::StatusOr<std::shared_ptr<const CertifiedObjectEntry>> ResultStore::GetCert
   }
   absl::StatusOr<CoverCertificate> certificate = CoverCertificateOf(cover_key);
   if (!certificate.ok()) return certificate.status();
+  if (!internal_mesh.empty() && certificate->mesh_sha256 != internal_mesh) {
+    return absl::InvalidArgumentError(absl::StrCat("sphere set ", internal_key, " is of mesh ",
+                                                   internal_mesh, " but its cover ", cover_key,
+                                                   " was certified for mesh ",
+                                                   certificate->mesh_sha256));
+  }
   // The internal set with the cover's cores (UpperBoundSpheres), when the certificate gives
   // them; else the internal set's own hierarchy.
   absl::StatusOr<std::shared_ptr<const SphereHierarchy>> internal_h;

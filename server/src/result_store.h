@@ -37,7 +37,8 @@ struct StoredMeshEntry {
 
 // A generated sphere set: the cache object under "spheres/v1/<hex>". `result` is what Generate
 // returns (its `cache` field empty). An uploaded set has its spheres, mesh and key there, and
-// kind cover with the certificate it was uploaded with, if any.
+// kind cover with the certificate it was uploaded with, if any. A cover's certificate names
+// the set's spheres and mesh (CheckCoverCertificateBinding, checked whenever it is decoded).
 struct SphereSetEntry {
   v1::GenerateResult result;
   SphereSet set;
@@ -106,8 +107,9 @@ class ResultStore {
   // numbers; a full SHA-256 when neither names a mesh. `mesh_key` may be empty; when given the
   // mesh must be stored (NOT_FOUND) and contacts must name its triangles (INVALID_ARGUMENT).
   // *already_stored: the key was held before.
-  // With a `certificate` (which must be certified: INVALID_ARGUMENT otherwise) the set is
-  // stored as a cover holding it, under a key that includes it.
+  // With a `certificate` (which must be certified and bound to the set: name its spheres,
+  // and `mesh_key` when given, with one protrusion per sphere; INVALID_ARGUMENT naming the
+  // mismatch otherwise) the set is stored as a cover holding it, under a key that includes it.
   absl::StatusOr<std::shared_ptr<const SphereSetEntry>> PutSphereSet(
       SphereSet set, const std::string& mesh_key, bool* already_stored,
       const std::string& derived_from = "",
@@ -115,7 +117,8 @@ class ResultStore {
 
   // The certificate of cached set `set_key` against stored mesh `mesh_key` with `options`
   // (CertifyCover; the failed cells are not kept), computed once, then cached under
-  // CoverCertificateKey. NOT_FOUND for unknown keys; CertifyCover's errors.
+  // CoverCertificateKey (one read back that does not name the set's spheres and the mesh is
+  // proved again). NOT_FOUND for unknown keys; CertifyCover's errors.
   absl::StatusOr<std::shared_ptr<const CoverCertificate>> CertifySphereSet(
       const std::string& set_key, const std::string& mesh_key, const CoverCertifyOptions& options,
       const GenerationControl& control = {});
@@ -129,7 +132,7 @@ class ResultStore {
   // One solid of a certified query: internal set `internal_key` (refused, FAILED_PRECONDITION,
   // when Generate made it a cover or dilated: it must lie inside the solid) and cover
   // `cover_key` (CoverCertificateOf), their hierarchies of `volume`. INVALID_ARGUMENT when the
-  // two name different meshes.
+  // two name different meshes, or the cover's certificate another mesh than the internal set.
   absl::StatusOr<std::shared_ptr<const CertifiedObjectEntry>> GetCertifiedObject(
       const std::string& internal_key, const std::string& cover_key, HierarchyVolume volume);
 

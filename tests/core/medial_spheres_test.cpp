@@ -132,7 +132,7 @@ TEST(MedialSpheres, RealMeshesGiveInternalTangentSpheres) {
     SCOPED_TRACE(name);
     const Mesh mesh = LoadTestMesh(name);
     // cow self-intersects: the pseudonormal sign is unreliable there (see InsideTest).
-    const BoundaryOracle oracle = MakeOracle(mesh, InsideTest::kRayParity);
+    const BoundaryOracle oracle = MakeOracle(mesh, InsideTest::kExactWinding);
     const MedialSphereResult result =
         Generate(oracle, 0.05 * ComputeBoundingBox(mesh.vertices).diagonal());
     ASSERT_GT(result.set.size(), 10u);

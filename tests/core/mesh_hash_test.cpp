@@ -77,5 +77,57 @@ TEST(MeshSha256, CountsAreHashed) {
   EXPECT_NE(MeshSha256(empty), MeshSha256(testing::UnitCube()));
 }
 
+std::vector<Sphere> SomeSpheres() {
+  return {Sphere{Vector3(0.0, 1.0, 2.0), 0.5}, Sphere{Vector3(-3.0, 0.25, 1e-300), 2.0},
+          Sphere{Vector3(7.0, -8.0, 9.5), 1e-3}};
+}
+
+TEST(SpheresSha256, MatchesOneShotDigestOfCanonicalEncoding) {
+  const std::vector<Sphere> spheres = SomeSpheres();
+  std::vector<unsigned char> bytes;
+  const char magic[] = "inscribe.spheres.v1";
+  bytes.insert(bytes.end(), magic, magic + 19);
+  auto put = [&](std::uint64_t value) {
+    for (int i = 0; i < 8; ++i) bytes.push_back(static_cast<unsigned char>(value >> (8 * i)));
+  };
+  put(spheres.size());
+  for (const Sphere& s : spheres) {
+    for (const double x : {s.center.x(), s.center.y(), s.center.z(), s.radius}) {
+      std::uint64_t bits;
+      std::memcpy(&bits, &x, 8);
+      put(bits);
+    }
+  }
+  Sha256Digest expected{};
+  SHA256(bytes.data(), bytes.size(), expected.data());
+  EXPECT_EQ(SpheresSha256(spheres), expected);
+  // Stable: the same spheres, the same digest, and empty lists hash too.
+  EXPECT_EQ(SpheresSha256(SomeSpheres()), SpheresSha256(spheres));
+  EXPECT_NE(SpheresSha256({}), SpheresSha256(spheres));
+}
+
+TEST(SpheresSha256, AnyCoordinateRadiusOrderOrCountChangesTheDigest) {
+  const std::vector<Sphere> base = SomeSpheres();
+  const Sha256Digest digest = SpheresSha256(base);
+  for (std::size_t i = 0; i < base.size(); ++i) {
+    for (int k = 0; k < 4; ++k) {
+      std::vector<Sphere> changed = base;
+      double& x = k < 3 ? changed[i].center[k] : changed[i].radius;
+      x = std::nextafter(x, 1e9);
+      EXPECT_NE(SpheresSha256(changed), digest) << "sphere " << i << " number " << k;
+    }
+  }
+  std::vector<Sphere> swapped = base;
+  std::swap(swapped[0], swapped[2]);
+  EXPECT_NE(SpheresSha256(swapped), digest);
+  std::vector<Sphere> dropped = base;
+  dropped.pop_back();
+  EXPECT_NE(SpheresSha256(dropped), digest);
+  // -0.0 and +0.0 are the same sphere.
+  std::vector<Sphere> negative_zero = base;
+  negative_zero[0].center.x() = -0.0;
+  EXPECT_EQ(SpheresSha256(negative_zero), digest);
+}
+
 }  // namespace
 }  // namespace inscribe

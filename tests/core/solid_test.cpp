@@ -44,30 +44,59 @@ TEST(Solid, AnUnusableMeshIsRefusedWithTheReportsFirstError) {
 }
 
 // Two cubes overlapping in [0.5, 1]^3: the mesh intersects itself, so the solid takes the
-// ray-parity test, which calls the doubly covered region outside as CGAL's Side_of_triangle_mesh
-// does; a plain cube keeps the pseudonormal.
-TEST(Solid, ASelfIntersectingMeshGetsTheRayParityTest) {
+// exact winding test, and the doubly covered region (winding number 2) is inside: the solid is
+// the union. A plain cube keeps the pseudonormal.
+TEST(Solid, ASelfIntersectingMeshIsTheUnionUnderTheExactTest) {
   const Mesh overlapping = testing::Concatenate(
       testing::UnitCube(), testing::Box(Vector3::Constant(0.5), Vector3::Constant(1.5)));
   absl::StatusOr<Solid> solid = PrepareSolid(overlapping);
   ASSERT_TRUE(solid.ok()) << solid.status();
   EXPECT_GT(solid->report.self_intersecting_pairs, 0);
-  EXPECT_EQ(InsideTestFor(solid->report), InsideTest::kRayParity);
-  absl::StatusOr<BoundaryOracle> parity =
-      BoundaryOracle::Build(solid->mesh(), {InsideTest::kRayParity});
-  ASSERT_TRUE(parity.ok());
+  EXPECT_EQ(InsideTestFor(solid->report), InsideTest::kExactWinding);
   std::mt19937_64 rng(5);
   std::uniform_real_distribution<double> u(-0.2, 1.7);
+  auto in_box = [](const Vector3& p, double lo, double hi) {
+    return (p.array() > lo).all() && (p.array() < hi).all();
+  };
   for (int i = 0; i < 2000; ++i) {
     const Vector3 p(u(rng), u(rng), u(rng));
-    EXPECT_EQ(solid->oracle.Classify(p), parity->Classify(p)) << p.transpose();
+    const Side expected =
+        in_box(p, 0.0, 1.0) || in_box(p, 0.5, 1.5) ? Side::kInside : Side::kOutside;
+    EXPECT_EQ(solid->oracle.Classify(p), expected) << p.transpose();
   }
-  EXPECT_EQ(solid->oracle.Classify(Vector3::Constant(0.75)), Side::kOutside);
+  EXPECT_EQ(solid->oracle.Classify(Vector3::Constant(0.75)), Side::kInside);
   EXPECT_EQ(solid->oracle.Classify(Vector3::Constant(0.25)), Side::kInside);
+  EXPECT_EQ(solid->oracle.Classify(Vector3(1.25, 0.25, 0.25)), Side::kOutside);
 
   absl::StatusOr<Solid> cube = PrepareSolid(testing::UnitCube());
   ASSERT_TRUE(cube.ok());
   EXPECT_EQ(InsideTestFor(cube->report), InsideTest::kPseudonormal);
+}
+
+// The pseudonormal is kept only where validation proved its conditions: a vertex where two
+// bodies touch, or a mesh whose self-intersections were not checked, takes the exact test.
+TEST(Solid, ThePseudonormalNeedsItsConditionsProved) {
+  // The second cube's corner at (1, 1, 1) is the first one's vertex: one vertex, two fans.
+  const Mesh cube_a = testing::UnitCube();
+  Mesh touching = testing::Concatenate(cube_a, testing::Box(Vector3::Ones(), Vector3::Constant(2.0)));
+  Eigen::Index shared = -1, copy = -1;
+  for (Eigen::Index v = 0; v < touching.num_vertices(); ++v) {
+    if (touching.vertices.row(v).transpose() != Vector3::Ones()) continue;
+    (v < cube_a.num_vertices() ? shared : copy) = v;
+  }
+  ASSERT_GE(shared, 0);
+  ASSERT_GE(copy, 0);
+  touching.triangles = (touching.triangles.array() == copy)
+                           .select(static_cast<std::int32_t>(shared), touching.triangles);
+  absl::StatusOr<Solid> pinned = PrepareSolid(touching);
+  ASSERT_TRUE(pinned.ok()) << pinned.status();
+  EXPECT_GT(pinned->report.non_manifold_vertices, 0);
+  EXPECT_EQ(InsideTestFor(pinned->report), InsideTest::kExactWinding);
+  SolidOptions unchecked;
+  unchecked.validate.check_self_intersections = false;
+  absl::StatusOr<Solid> cube = PrepareSolid(testing::UnitCube(), unchecked);
+  ASSERT_TRUE(cube.ok());
+  EXPECT_EQ(InsideTestFor(cube->report), InsideTest::kExactWinding);
 }
 
 TEST(Solid, RealMeshesKeepTheirHash) {
@@ -76,7 +105,7 @@ TEST(Solid, RealMeshesKeepTheirHash) {
   absl::StatusOr<Solid> solid = PrepareSolid(cow);
   ASSERT_TRUE(solid.ok()) << solid.status();
   EXPECT_EQ(InsideTestFor(solid->report), solid->report.self_intersecting_pairs > 0
-                                              ? InsideTest::kRayParity
+                                              ? InsideTest::kExactWinding
                                               : InsideTest::kPseudonormal);
   absl::StatusOr<Solid> again = MakeSolid(ValidateMesh(cow));
   ASSERT_TRUE(again.ok());

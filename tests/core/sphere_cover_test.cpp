@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "inscribe/cover_certificate.h"
+#include "inscribe/mesh_hash.h"
 #include "inscribe/solid.h"
 #include "inscribe/sphere_set_generation.h"
 #include "support/brute_force_closest_point.h"
@@ -396,6 +397,54 @@ TEST(GenerateCover, BadInputIsAClearError) {
             absl::StatusCode::kCancelled);
   EXPECT_EQ(CertifyCover(solid, {Sphere{Vector3::Constant(0.5), 1.0}}, {}, control).status().code(),
             absl::StatusCode::kCancelled);
+}
+
+// A certificate names the solid and the spheres it proved, and is usable only for them.
+TEST(CoverCertificateBinding, NamesWhatItProvedAndRefusesAnythingElse) {
+  const Solid solid = MakeTestSolid(testing::UnitCube());
+  const std::vector<Sphere> spheres = {Sphere{Vector3(0.25, 0.5, 0.5), 0.8},
+                                       Sphere{Vector3(0.75, 0.5, 0.5), 0.8}};
+  absl::StatusOr<CoverCertificate> certificate = CertifyCover(solid, spheres);
+  ASSERT_TRUE(certificate.ok()) << certificate.status();
+  ASSERT_TRUE(certificate->certified);
+  EXPECT_EQ(certificate->mesh_sha256, solid.sha256);
+  EXPECT_EQ(certificate->spheres_sha256, FormatSha256(SpheresSha256(spheres)));
+  EXPECT_TRUE(CheckCoverCertificateBinding(*certificate, spheres, solid.sha256).ok());
+  EXPECT_TRUE(CheckCoverCertificateBinding(*certificate, spheres, "").ok());
+
+  const auto refused = [&](const CoverCertificate& c, const std::vector<Sphere>& s,
+                           const std::string& mesh) {
+    const absl::Status status = CheckCoverCertificateBinding(c, s, mesh);
+    EXPECT_EQ(status.code(), absl::StatusCode::kFailedPrecondition) << status;
+    return std::string(status.message());
+  };
+  // Edited spheres: every radius scaled, one coordinate nudged by an ulp, reordered, dropped.
+  for (const double scale : {1.03, 0.97}) {
+    std::vector<Sphere> scaled = spheres;
+    for (Sphere& s : scaled) s.radius *= scale;
+    EXPECT_THAT(refused(*certificate, scaled, ""), HasSubstr("edited after they were certified"));
+  }
+  std::vector<Sphere> nudged = spheres;
+  nudged[1].center.y() = std::nextafter(nudged[1].center.y(), 1.0);
+  EXPECT_THAT(refused(*certificate, nudged, solid.sha256), HasSubstr("other spheres"));
+  const std::vector<Sphere> reordered = {spheres[1], spheres[0]};
+  EXPECT_THAT(refused(*certificate, reordered, ""), HasSubstr("certify them again"));
+  EXPECT_THAT(refused(*certificate, {spheres[0]}, ""), HasSubstr("other spheres"));
+  // Another mesh, checked only when the caller knows the mesh.
+  const std::string other = FormatSha256(MeshSha256(testing::Box(Vector3::Zero(), Vector3::Constant(2.0))));
+  EXPECT_THAT(refused(*certificate, spheres, other), HasSubstr("proved against mesh"));
+  EXPECT_THAT(refused(*certificate, spheres, other), HasSubstr(other));
+  // Names no spheres or no mesh (as recorded before certificates were bound), or the wrong
+  // number of protrusions.
+  CoverCertificate unnamed = *certificate;
+  unnamed.spheres_sha256.clear();
+  EXPECT_THAT(refused(unnamed, spheres, ""), HasSubstr("names no spheres"));
+  unnamed = *certificate;
+  unnamed.mesh_sha256.clear();
+  EXPECT_THAT(refused(unnamed, spheres, ""), HasSubstr("names no mesh"));
+  CoverCertificate short_protrusions = *certificate;
+  short_protrusions.protrusions.pop_back();
+  EXPECT_THAT(refused(short_protrusions, spheres, ""), HasSubstr("1 protrusions for 2 spheres"));
 }
 
 }  // namespace

@@ -31,15 +31,19 @@ Vector3 Corner(const Mesh& mesh, Eigen::Index t, int k) {
   return mesh.vertices.row(mesh.triangles(t, k)).transpose();
 }
 
-int BruteForceCrossings(const Mesh& mesh, const Vector3& origin, const Vector3& direction) {
-  int crossings = 0;
+// The winding number around p by XRayCrossing over every triangle, and whether one holds p.
+int ScanWinding(const Mesh& mesh, const Vector3& p, bool* on_surface) {
+  int winding = 0;
+  *on_surface = false;
   for (Eigen::Index t = 0; t < mesh.num_triangles(); ++t) {
-    crossings += RayCrossesTriangle(origin, direction, Corner(mesh, t, 0), Corner(mesh, t, 1),
-                                    Corner(mesh, t, 2))
-                     ? 1
-                     : 0;
+    const int crossing = XRayCrossing(p, Corner(mesh, t, 0), Corner(mesh, t, 1), Corner(mesh, t, 2));
+    if (crossing == kOnTriangle) {
+      *on_surface = true;
+    } else {
+      winding += crossing;
+    }
   }
-  return crossings;
+  return winding;
 }
 
 bool Identical(const BoundaryPoint& a, const BoundaryPoint& b) {
@@ -222,14 +226,15 @@ TEST(TriangleBvh, ExactTiesGoToTheLowestTriangle) {
   }
 }
 
-// A flat 40 x 40 grid of unit squares at z = 0, integer coordinates: every box bound is a
-// float exactly, so box boundaries carry no slack from rounding outward.
+// A flat 40 x 40 grid of unit squares in the plane x = 0, integer coordinates (0, i, j): every
+// box bound is a float exactly, so box boundaries carry no slack from rounding outward, and the
+// rays along +x pass exactly through its vertices and edges.
 Mesh Grid() {
   constexpr int kN = 40;
   Mesh mesh;
   mesh.vertices.resize((kN + 1) * (kN + 1), 3);
   for (int i = 0; i <= kN; ++i) {
-    for (int j = 0; j <= kN; ++j) mesh.vertices.row(i * (kN + 1) + j) << i, j, 0;
+    for (int j = 0; j <= kN; ++j) mesh.vertices.row(i * (kN + 1) + j) << 0, i, j;
   }
   mesh.triangles.resize(2 * kN * kN, 3);
   for (int i = 0; i < kN; ++i) {
@@ -242,25 +247,34 @@ Mesh Grid() {
   return mesh;
 }
 
-// Rays through grid vertices and edge points, where crossings lie exactly on box boundaries
-// and the slab test's rounding decides: the BVH must count what the scan counts.
-TEST(TriangleBvh, GrazingRaysCountLikeTheScan) {
+// Rays through grid vertices and edges: the perturbed ray must cross the sheet exactly once
+// (every triangle faces +x: a crossing of +1) wherever its origin's (y, z) lies in
+// [0, 40) x [0, 40), never outside it, the BVH must find what the scan finds, and an origin on
+// the sheet is on it.
+TEST(TriangleBvh, RaysThroughVerticesAndEdgesCrossTheSheetOnce) {
   const Mesh grid = Grid();
   const TriangleBvh bvh = TriangleBvh::Build(grid);
   std::mt19937_64 rng(31);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
-  std::uniform_int_distribution<int> coordinate(0, 40);
+  std::uniform_int_distribution<int> coordinate(-1, 41);
   int failures = 0;
   for (int i = 0; i < 4000; ++i) {
-    const Vector3 origin(40 * unit(rng), 40 * unit(rng), 1 + 10 * unit(rng));
-    Vector3 target(coordinate(rng), coordinate(rng), 0);
-    if (i % 2 == 1) target.x() += unit(rng);  // a point on an edge
-    const Vector3 direction = target - origin;
-    const int expected = BruteForceCrossings(grid, origin, direction);
-    const int got = bvh.CountCrossings(origin, direction);
-    if (got != expected && failures++ < 5) {
-      ADD_FAILURE() << "ray from " << origin.transpose() << " to " << target.transpose() << ": BVH "
-                    << got << " crossings, scan " << expected;
+    Vector3 origin(-1 - 10 * unit(rng), coordinate(rng), coordinate(rng));
+    if (i % 3 == 1) origin.y() += unit(rng);  // a point on an edge
+    if (i % 5 == 0) origin.x() = 0.0;         // on the sheet (or its plane)
+    const bool in_range = origin.y() >= 0 && origin.y() < 40 && origin.z() >= 0 && origin.z() < 40;
+    bool scan_on = false, bvh_on = false;
+    const int scan = ScanWinding(grid, origin, &scan_on);
+    const int got = bvh.XRayWinding(origin, &bvh_on);
+    const bool on_plane = origin.x() == 0.0;
+    const bool holds = origin.y() >= 0 && origin.y() <= 40 && origin.z() >= 0 && origin.z() <= 40;
+    const int expected = on_plane ? 0 : (in_range ? 1 : 0);
+    if ((got != scan || bvh_on != scan_on || (!on_plane && got != expected) ||
+         (on_plane && in_range && !bvh_on) || (bvh_on && !(on_plane && holds))) &&
+        failures++ < 5) {
+      ADD_FAILURE() << "ray from " << origin.transpose() << ": BVH winding " << got << " (on "
+                    << bvh_on << "), scan " << scan << " (on " << scan_on << "), expected "
+                    << expected;
     }
   }
   EXPECT_EQ(failures, 0);
@@ -337,43 +351,39 @@ TEST_P(TriangleBvhOnMesh, BoundedQueryEqualsUnbounded) {
   EXPECT_LT(bounded_work.triangles, 5 * unbounded_work.triangles);
 }
 
-TEST_P(TriangleBvhOnMesh, CountCrossingsEqualsScan) {
+TEST_P(TriangleBvhOnMesh, XRayWindingEqualsScan) {
   INSCRIBE_REQUIRE_MESH(GetParam());
   const Mesh mesh = testing::LoadTestMesh(GetParam());
   const TriangleBvh bvh = TriangleBvh::Build(mesh);
   std::mt19937_64 rng(26);
-  std::uniform_real_distribution<double> unit(-1.0, 1.0);
   // About 10^7 triangle tests for the scan.
-  const std::vector<Vector3> origins = QueryPoints(
-      mesh, static_cast<int>(std::clamp<std::int64_t>(150'000 / mesh.num_triangles(), 2, 12)), 27);
-  // Random directions, the oracle's three fixed ones, and axis directions (zero components).
-  std::vector<Vector3> directions = {Vector3(0.5773503, 0.4082483, 0.7071068),
-                                     Vector3(-0.6154797, 0.7071068, -0.3481553),
-                                     Vector3(0.2672612, -0.8017837, 0.5345225),
-                                     Vector3::UnitX(),
-                                     -Vector3::UnitY(),
-                                     Vector3(0, 1, 1)};
-  for (int i = 0; i < 4; ++i) directions.emplace_back(unit(rng), unit(rng), unit(rng));
-  int failures = 0;
-  const auto check = [&](const Vector3& o, const Vector3& d) {
-    const int expected = BruteForceCrossings(mesh, o, d);
-    const int got = bvh.CountCrossings(o, d);
-    if (got != expected && failures++ < 5) {
-      ADD_FAILURE() << "ray from " << o.transpose() << " along " << d.transpose() << ": BVH " << got
-                    << " crossings, scan " << expected;
-    }
-  };
-  for (const Vector3& o : origins) {
-    for (const Vector3& d : directions) check(o, d);
-  }
-  // Grazing rays, aimed exactly at vertices and edge midpoints, where crossings sit on the
-  // boundary of leaf boxes and rounding decides.
+  std::vector<Vector3> origins = QueryPoints(
+      mesh, static_cast<int>(std::clamp<std::int64_t>(800'000 / mesh.num_triangles(), 6, 60)), 27);
+  // Origins whose ray runs exactly through a vertex or along an edge's (y, z) line, and
+  // origins on a vertex: where the perturbation decides.
   std::uniform_int_distribution<Eigen::Index> pick(0, mesh.num_triangles() - 1);
-  for (std::size_t i = 0; i < origins.size(); ++i) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const std::size_t given = origins.size();
+  for (std::size_t i = 0; i < given; ++i) {
     const Eigen::Index t = pick(rng);
     const Vector3 a = Corner(mesh, t, 0), b = Corner(mesh, t, 1);
-    check(origins[i], a - origins[i]);
-    check(origins[i], 0.5 * (a + b) - origins[i]);
+    origins.emplace_back(origins[i].x(), a.y(), a.z());
+    origins.emplace_back(origins[i].x(), a.y(), 0.5 * (a.z() + b.z()));
+    if (i % 8 == 0) origins.push_back(a);
+  }
+  int failures = 0;
+  for (const Vector3& o : origins) {
+    bool scan_on = false, bvh_on = false;
+    const int expected = ScanWinding(mesh, o, &scan_on);
+    const int got = bvh.XRayWinding(o, &bvh_on);
+    if ((got != expected || bvh_on != scan_on) && failures++ < 5) {
+      ADD_FAILURE() << "ray from " << o.transpose() << ": BVH " << got << " (on " << bvh_on
+                    << "), scan " << expected << " (on " << scan_on << ")";
+    }
+    // A closed surface (as the file orients it): winding +-1 inside, 0 outside.
+    if (!scan_on && std::abs(expected) > 1 && failures++ < 5) {
+      ADD_FAILURE() << "winding " << expected << " at " << o.transpose();
+    }
   }
   EXPECT_EQ(failures, 0);
 }

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <string>
 
+#include "inscribe/mesh_hash.h"
 #include "inscribe/wire/convert.h"
 #include "request_fuzz_server.h"
 
@@ -153,6 +154,10 @@ int main(int argc, char** argv) {
   put_cover.mutable_certificate()->set_certified(true);
   put_cover.mutable_certificate()->set_delta(0.5);
   put_cover.mutable_certificate()->set_resolution(1.0 / 512);
+  put_cover.mutable_certificate()->add_protrusions(0.5);
+  put_cover.mutable_certificate()->set_mesh_sha256(server.mesh_key);
+  put_cover.mutable_certificate()->set_spheres_sha256(
+      FormatSha256(SpheresSha256({Sphere{Vector3::Constant(0.5), 1.0}})));
   Seed(dir, RequestKind::kPutSphereSet, put_cover, "certificate");
 
   v1::DistanceFrame frame;

@@ -9,6 +9,7 @@
 #include "grpcpp/create_channel.h"
 #include "grpcpp/security/credentials.h"
 #include "inscribe/mesh.h"
+#include "inscribe/mesh_hash.h"
 #include "inscribe/wire/convert.h"
 
 namespace inscribe::fuzz {
@@ -149,6 +150,9 @@ FuzzServer* Start() {
   certificate.certified = true;
   certificate.delta = 0.4;
   certificate.resolution = 1.0 / 512;
+  certificate.protrusions = {0.4};
+  certificate.mesh_sha256 = fuzz->mesh_key;
+  certificate.spheres_sha256 = FormatSha256(SpheresSha256(ball.spheres));
   wire::CoverCertificateToProto(certificate, put_cover.mutable_certificate());
   status = fuzz->stub->PutSphereSet(Context().get(), put_cover, &set_reply);
   if (!status.ok()) Die("PutSphereSet of a cover: " + status.error_message());

@@ -129,6 +129,11 @@ def test_certified_intervals_over_the_service_are_the_in_process_ones(server, ei
         # A cover made in-process, uploaded with its certificate, gives the same intervals.
         local_cover = inscribe.generate(eight, max_spheres=80, kind="cover", evaluate=False)
         uploaded = client.put_certified_cover(local_cover, local_cover.certificate)
+        # Spheres edited after they were certified do not take the certificate.
+        for scale in (1.03, 0.97):
+            edited = local_cover.spheres * np.array([1.0, 1.0, 1.0, scale])
+            with pytest.raises(ValueError, match="edited after they were certified"):
+                client.put_certified_cover(edited, local_cover.certificate)
         again = client.distance(internal.sphere_set_key, internal.sphere_set_key, poses,
                                 cover_a=uploaded, cover_b=uploaded, closer_than=0.2)
         assert np.array_equal(again.lower, ours.lower)

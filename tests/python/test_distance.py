@@ -121,6 +121,15 @@ def test_certified_interval_holds_the_internal_distance():
         inscribe.CertifiedObject(internal, cover, protrusions=[0.1])
     with pytest.raises(ValueError, match="delta"):
         inscribe.CertifiedObject(internal, cover.spheres)
+    # The certificate names the spheres and the mesh it proved; a set naming another mesh
+    # does not take it.
+    assert cover.certificate.mesh_sha256 == cover.mesh_sha256 == solid.sha256
+    assert cover.certificate.spheres_sha256.startswith("sha256:")
+    cover.mesh_sha256 = "sha256:" + "0" * 64
+    with pytest.raises(inscribe.Error, match="proved against mesh") as raised:
+        inscribe.CertifiedObject(internal, cover)
+    assert raised.value.code == "FAILED_PRECONDITION"
+    cover.mesh_sha256 = solid.sha256
     assert set(result.closer) <= {"yes", "no", "undecided"}
     with pytest.raises(ValueError):
         inscribe.CertifiedObject(internal, cover, -1.0)

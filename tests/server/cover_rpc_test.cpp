@@ -5,14 +5,19 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <memory>
 #include <random>
 #include <string>
 #include <vector>
 
+#include "cache_entry_format.h"
 #include "inscribe/certified_distance.h"
 #include "inscribe/client/client.h"
 #include "inscribe/cover_certificate.h"
+#include "inscribe/mesh_hash.h"
 #include "inscribe/separation_distance.h"
 #include "inscribe/solid.h"
 #include "spheres_rpc_fixture.h"
@@ -70,6 +75,9 @@ TEST_F(CoverRpcTest, GenerateMakesACertifiedCoverAndCachesItsCertificate) {
   ASSERT_TRUE(core.ok()) << core.status();
   EXPECT_TRUE(core->certified);
   EXPECT_EQ(core->delta, certificate.delta());
+  // It names what it proved: the stored mesh and these spheres.
+  EXPECT_EQ(certificate.mesh_sha256(), mesh);
+  EXPECT_EQ(certificate.spheres_sha256(), FormatSha256(SpheresSha256(spheres->spheres)));
 
   ASSERT_TRUE(Generate(CoverRequest(mesh, 30), &again).ok());
   EXPECT_EQ(again.cache(), "memory");
@@ -302,6 +310,12 @@ TEST_F(CoverRpcTest, ASetIsACoverOnlyWithACertificateTheServerHolds) {
   bad = client->PutCertifiedCover(solids.cover[0].set, short_protrusions);
   EXPECT_EQ(bad.status().code(), absl::StatusCode::kInvalidArgument);
   EXPECT_THAT(bad.status().message(), HasSubstr("protrusions for"));
+  // A certificate of other spheres, of another mesh, or naming none is refused too.
+  SphereSet scaled = solids.cover[0].set;
+  for (Sphere& s : scaled.spheres) s.radius *= 0.97;
+  bad = client->PutCertifiedCover(scaled, solids.cover[0].cover->certificate);
+  EXPECT_EQ(bad.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(bad.status().message(), HasSubstr("edited after they were certified"));
 
   // A cover (or dilated set) as the internal set; covers of another mesh.
   refused = certified(solids.cover[0].sphere_set_key, solids.cover[0].sphere_set_key,
@@ -326,6 +340,103 @@ TEST_F(CoverRpcTest, ASetIsACoverOnlyWithACertificateTheServerHolds) {
   loose_tolerance.brute_force = true;
   EXPECT_EQ(client->Distance(a, b, origin, {apart}, loose_tolerance).status().code(),
             absl::StatusCode::kInvalidArgument);
+}
+
+// PutSphereSet with a certificate that does not name the set it comes with: INVALID_ARGUMENT
+// naming the mismatch, whatever else the request holds.
+TEST_F(CoverRpcTest, PutSphereSetRefusesACertificateOfAnythingElse) {
+  const std::string slab = PutMesh(Slab());
+  const std::string bar = PutMesh(testing::Box(Vector3::Zero(), Vector3(1.0, 0.4, 0.4)));
+  v1::GenerateResult cover;
+  ASSERT_TRUE(Generate(CoverRequest(slab, 20), &cover).ok());
+  const auto put = [&](const v1::SphereSet& spheres, const v1::CoverCertificate& certificate,
+                       const std::string& mesh) {
+    v1::PutSphereSetRequest request;
+    *request.mutable_spheres() = spheres;
+    *request.mutable_certificate() = certificate;
+    request.set_mesh_sha256(mesh);
+    v1::PutSphereSetResponse response;
+    return stub_->PutSphereSet(Context().get(), request, &response);
+  };
+  const v1::CoverCertificate& certificate = cover.cover().certificate();
+  ASSERT_TRUE(put(cover.spheres(), certificate, "").ok());
+  ASSERT_TRUE(put(cover.spheres(), certificate, slab).ok());
+
+  struct Case {
+    const char* what;
+    v1::SphereSet spheres;
+    v1::CoverCertificate certificate;
+    std::string mesh;
+    const char* message;
+  };
+  std::vector<Case> cases;
+  for (const double scale : {1.03, 0.97}) {
+    Case grown{"radii scaled", cover.spheres(), certificate, "", "edited after"};
+    for (double& r : *grown.spheres.mutable_radii()) r *= scale;
+    cases.push_back(grown);
+  }
+  Case nudged{"a centre nudged", cover.spheres(), certificate, slab, "other spheres"};
+  nudged.spheres.set_centers(1, nudged.spheres.centers(1) + 1e-9);
+  cases.push_back(nudged);
+  Case dropped{"a sphere dropped", cover.spheres(), certificate, "", "other spheres"};
+  dropped.spheres.mutable_radii()->RemoveLast();
+  for (int k = 0; k < 3; ++k) dropped.spheres.mutable_centers()->RemoveLast();
+  cases.push_back(dropped);
+  cases.push_back({"another mesh", cover.spheres(), certificate, bar, "proved against mesh"});
+  Case unnamed{"no spheres named", cover.spheres(), certificate, "", "names no spheres"};
+  unnamed.certificate.clear_spheres_sha256();
+  cases.push_back(unnamed);
+  Case meshless{"no mesh named", cover.spheres(), certificate, "", "names no mesh"};
+  meshless.certificate.clear_mesh_sha256();
+  cases.push_back(meshless);
+  Case edited{"its hash edited", cover.spheres(), certificate, "", "other spheres"};
+  edited.certificate.set_spheres_sha256("sha256:" + std::string(64, '0'));
+  cases.push_back(edited);
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.what);
+    const grpc::Status status = put(c.spheres, c.certificate, c.mesh);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_THAT(status.error_message(), HasSubstr("certificate: "));
+    EXPECT_THAT(status.error_message(), HasSubstr(c.message));
+  }
+}
+
+// A cached cover whose certificate names nothing (as written before certificates named their
+// spheres and mesh) is not served: the cover is generated again, certificate and all.
+TEST_F(CoverRpcTest, ACachedCoverWithAnUnboundCertificateIsGeneratedAgain) {
+  const std::string mesh = PutMesh(Slab());
+  v1::GenerateResult cover;
+  ASSERT_TRUE(Generate(CoverRequest(mesh, 20), &cover).ok());
+  const std::string& key = cover.sphere_set_key();
+  server_.reset();
+  const std::string hex = Sha256Hex(key);
+  const std::filesystem::path path = cache_dir_ / hex.substr(0, 2) / hex;
+  std::string entry;
+  {
+    std::ifstream in(path, std::ios::binary);
+    ASSERT_TRUE(in) << path;
+    entry.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  v1::GenerateResult stale;
+  ASSERT_TRUE(stale.ParseFromString(entry.substr(EntryHeaderSize(key.size()))));
+  stale.mutable_cover()->mutable_certificate()->clear_mesh_sha256();
+  stale.mutable_cover()->mutable_certificate()->clear_spheres_sha256();
+  const std::string payload = stale.SerializeAsString();
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << EntryHeader(key, payload) << payload;
+  Restart();
+
+  v1::GetSphereSetRequest get;
+  get.set_sphere_set_key(key);
+  v1::GetSphereSetResponse got;
+  EXPECT_EQ(stub_->GetSphereSet(Context().get(), get, &got).error_code(),
+            grpc::StatusCode::NOT_FOUND);
+  v1::GenerateResult again;
+  ASSERT_TRUE(Generate(CoverRequest(mesh, 20), &again).ok());
+  EXPECT_EQ(again.cache(), "computed");
+  EXPECT_EQ(again.sphere_set_key(), key);
+  EXPECT_EQ(again.cover().certificate().mesh_sha256(), mesh);
+  EXPECT_EQ(again.cover().certificate().spheres_sha256(),
+            cover.cover().certificate().spheres_sha256());
 }
 
 }  // namespace

@@ -74,6 +74,38 @@ Mesh Icosphere(int levels, const Vector3& centre, double radius) {
   return mesh;
 }
 
+Mesh Tetrahedron(const Vector3& a, const Vector3& b, const Vector3& c, const Vector3& d) {
+  Mesh mesh;
+  mesh.vertices.resize(4, 3);
+  mesh.vertices << a.transpose(), b.transpose(), c.transpose(), d.transpose();
+  mesh.triangles.resize(4, 3);
+  mesh.triangles << 0, 2, 1, 0, 1, 3, 1, 2, 3, 0, 3, 2;  // outward when (b-a)x(c-a) . (d-a) > 0
+  if ((b - a).cross(c - a).dot(d - a) < 0.0) return Inverted(std::move(mesh));
+  return mesh;
+}
+
+Mesh Octahedron(const Vector3& centre, double radius) {
+  Mesh mesh;
+  mesh.vertices.resize(6, 3);
+  for (int axis = 0; axis < 3; ++axis) {
+    Vector3 u = Vector3::Zero();
+    u[axis] = radius;
+    mesh.vertices.row(2 * axis) = (centre + u).transpose();
+    mesh.vertices.row(2 * axis + 1) = (centre - u).transpose();
+  }
+  // Vertices: 0 +x, 1 -x, 2 +y, 3 -y, 4 +z, 5 -z; one triangle per octant, counter-clockwise
+  // seen from outside.
+  mesh.triangles.resize(8, 3);
+  mesh.triangles << 0, 2, 4, 2, 1, 4, 1, 3, 4, 3, 0, 4,  // z > 0
+      2, 0, 5, 1, 2, 5, 3, 1, 5, 0, 3, 5;                // z < 0
+  return mesh;
+}
+
+Mesh Translated(Mesh mesh, const Vector3& offset) {
+  mesh.vertices.rowwise() += offset.transpose();
+  return mesh;
+}
+
 Mesh Concatenate(const Mesh& a, const Mesh& b) {
   Mesh out;
   out.vertices.resize(a.num_vertices() + b.num_vertices(), 3);

@@ -255,6 +255,8 @@ TEST(CoverCertificate, RoundTripsWithoutItsCellList) {
   c.uncovered_gap = 0.002;
   c.seconds = 1.5;
   c.protrusions = {0.125, -0.5, 1e-300};
+  c.mesh_sha256 = "sha256:" + std::string(64, 'a');
+  c.spheres_sha256 = "sha256:" + std::string(64, 'b');
   v1::CoverCertificate wire;
   CoverCertificateToProto(c, &wire);
   absl::StatusOr<CoverCertificate> back = CoverCertificateFromProto(wire);
@@ -272,6 +274,8 @@ TEST(CoverCertificate, RoundTripsWithoutItsCellList) {
   EXPECT_EQ(back->uncovered_gap, c.uncovered_gap);
   EXPECT_EQ(back->seconds, c.seconds);
   EXPECT_EQ(back->protrusions, c.protrusions);
+  EXPECT_EQ(back->mesh_sha256, c.mesh_sha256);
+  EXPECT_EQ(back->spheres_sha256, c.spheres_sha256);
   // A protrusion that is not finite is refused, naming it.
   wire.set_protrusions(1, std::numeric_limits<double>::infinity());
   EXPECT_THAT(std::string(CoverCertificateFromProto(wire).status().message()),

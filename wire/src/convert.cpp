@@ -99,6 +99,7 @@ void MeshReportToProto(const MeshReport& report, v1::MeshReport* out) {
   out->set_out_of_range_indices(report.out_of_range_indices);
   out->set_welded_vertices(report.welded_vertices);
   out->set_weld_collapsed_triangles(report.weld_collapsed_triangles);
+  out->set_weld_moved_within(report.weld_moved_within);
   out->set_degenerate_triangles(report.degenerate_triangles);
   out->set_duplicate_triangles(report.duplicate_triangles);
   out->set_unreferenced_vertices(report.unreferenced_vertices);
@@ -140,6 +141,7 @@ absl::StatusOr<MeshReport> MeshReportFromProto(const v1::MeshReport& report) {
   out.out_of_range_indices = report.out_of_range_indices();
   out.welded_vertices = report.welded_vertices();
   out.weld_collapsed_triangles = report.weld_collapsed_triangles();
+  out.weld_moved_within = report.weld_moved_within();
   out.degenerate_triangles = report.degenerate_triangles();
   out.duplicate_triangles = report.duplicate_triangles();
   out.unreferenced_vertices = report.unreferenced_vertices();

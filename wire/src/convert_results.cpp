@@ -374,6 +374,8 @@ void CoverCertificateToProto(const CoverCertificate& c, v1::CoverCertificate* ou
   out->set_uncovered_gap(c.uncovered_gap);
   out->set_seconds(c.seconds);
   out->mutable_protrusions()->Assign(c.protrusions.begin(), c.protrusions.end());
+  out->set_mesh_sha256(c.mesh_sha256);
+  out->set_spheres_sha256(c.spheres_sha256);
 }
 
 absl::StatusOr<CoverCertificate> CoverCertificateFromProto(const v1::CoverCertificate& c) {
@@ -403,6 +405,8 @@ absl::StatusOr<CoverCertificate> CoverCertificateFromProto(const v1::CoverCertif
     }
   }
   out.protrusions.assign(c.protrusions().begin(), c.protrusions().end());
+  out.mesh_sha256 = c.mesh_sha256();
+  out.spheres_sha256 = c.spheres_sha256();
   return out;
 }
 

@@ -10,20 +10,42 @@
 namespace inscribe::cli {
 namespace {
 
-// The value named `name` as a T (an int64 stat also reads as a double), or INVALID_ARGUMENT.
+// The value named `name`, or nullptr.
+const ScalarValue* Find(const NamedValues& stats, const char* name) {
+  for (const auto& [key, value] : stats) {
+    if (key == name) return &value;
+  }
+  return nullptr;
+}
+
+// `value`, stat `name`, as a T (an int64 stat also reads as a double), or INVALID_ARGUMENT.
+template <typename T>
+absl::StatusOr<T> As(const ScalarValue& value, const char* name) {
+  if (const T* held = std::get_if<T>(&value)) return *held;
+  if constexpr (std::is_same_v<T, double>) {
+    if (const std::int64_t* whole = std::get_if<std::int64_t>(&value)) {
+      return static_cast<double>(*whole);
+    }
+  }
+  return absl::InvalidArgumentError(absl::StrCat("stats.", name, " has the wrong type"));
+}
+
+// The value named `name` as a T, or INVALID_ARGUMENT when it is missing or of another type.
 template <typename T>
 absl::StatusOr<T> Stat(const NamedValues& stats, const char* name) {
-  for (const auto& [key, value] : stats) {
-    if (key != name) continue;
-    if (const T* held = std::get_if<T>(&value)) return *held;
-    if constexpr (std::is_same_v<T, double>) {
-      if (const std::int64_t* whole = std::get_if<std::int64_t>(&value)) {
-        return static_cast<double>(*whole);
-      }
-    }
-    return absl::InvalidArgumentError(absl::StrCat("stats.", name, " has the wrong type"));
+  const ScalarValue* value = Find(stats, name);
+  if (value == nullptr) {
+    return absl::InvalidArgumentError(absl::StrCat("a cover file needs stats.", name));
   }
-  return absl::InvalidArgumentError(absl::StrCat("a cover file needs stats.", name));
+  return As<T>(*value, name);
+}
+
+// The string named `name`, "" when the file has none (a certificate that names nothing, which
+// CheckCoverCertificateBinding refuses), or INVALID_ARGUMENT for another type.
+absl::StatusOr<std::string> OptionalString(const NamedValues& stats, const char* name) {
+  const ScalarValue* value = Find(stats, name);
+  if (value == nullptr) return std::string();
+  return As<std::string>(*value, name);
 }
 
 }  // namespace
@@ -36,7 +58,9 @@ NamedValues CoverCertificateStats(const CoverCertificate& c) {
           {"cells_in_sphere", c.cells_in_sphere},
           {"cells_outside", c.cells_outside},
           {"failed_cells", c.failed_cells},
-          {"certify_seconds", c.seconds}};
+          {"certify_seconds", c.seconds},
+          {"certified_mesh_sha256", c.mesh_sha256},
+          {"certified_spheres_sha256", c.spheres_sha256}};
 }
 
 std::string RecordedKind(const SphereFile& file) {
@@ -57,9 +81,11 @@ absl::StatusOr<std::optional<CoverCertificate>> RecordedCoverCertificate(const S
   absl::StatusOr<std::int64_t> in_sphere = Stat<std::int64_t>(file.stats, "cells_in_sphere");
   absl::StatusOr<std::int64_t> outside = Stat<std::int64_t>(file.stats, "cells_outside");
   absl::StatusOr<std::int64_t> failed = Stat<std::int64_t>(file.stats, "failed_cells");
+  absl::StatusOr<std::string> mesh = OptionalString(file.stats, "certified_mesh_sha256");
+  absl::StatusOr<std::string> spheres = OptionalString(file.stats, "certified_spheres_sha256");
   for (const absl::Status& s :
        {certified.status(), delta.status(), resolution.status(), cells.status(), in_sphere.status(),
-        outside.status(), failed.status()}) {
+        outside.status(), failed.status(), mesh.status(), spheres.status()}) {
     if (!s.ok()) return s;
   }
   c.certified = *certified;
@@ -70,7 +96,27 @@ absl::StatusOr<std::optional<CoverCertificate>> RecordedCoverCertificate(const S
   c.cells_outside = *outside;
   c.failed_cells = *failed;
   c.protrusions = file.protrusions;
+  c.mesh_sha256 = *std::move(mesh);
+  c.spheres_sha256 = *std::move(spheres);
   return c;
+}
+
+absl::StatusOr<std::optional<CoverCertificate>> UsableCoverCertificate(
+    const SphereFile& file, const std::string& path, absl::string_view mesh_sha256) {
+  absl::StatusOr<std::optional<CoverCertificate>> recorded = RecordedCoverCertificate(file);
+  if (!recorded.ok()) {
+    return absl::InvalidArgumentError(absl::StrCat(path, ": ", recorded.status().message()));
+  }
+  if (!recorded->has_value()) return std::nullopt;
+  if (absl::Status bound = CheckCoverCertificateBinding(**recorded, file.set.spheres, mesh_sha256);
+      !bound.ok()) {
+    return absl::FailedPreconditionError(absl::StrCat(path, ": ", bound.message()));
+  }
+  if (!(*recorded)->certified) {
+    return absl::FailedPreconditionError(
+        absl::StrCat(path, " records a certificate that does not certify it"));
+  }
+  return recorded;
 }
 
 std::string CoverVerdict(const CoverCertificate& c) {

@@ -134,8 +134,8 @@ absl::StatusOr<DeformInputs> ReadInputs(const DeformCliOptions& options) {
   // The inside-test rule holds for both solids: ray parity if either intersects itself.
   MeshReport deformed_report;
   deformed_report.self_intersecting_pairs = in.deformed_self_intersecting_pairs;
-  in.ray_parity = InsideTestFor(solid->report) == InsideTest::kRayParity ||
-                  InsideTestFor(deformed_report) == InsideTest::kRayParity;
+  in.ray_parity = InsideTestFor(solid->report) == InsideTest::kExactWinding ||
+                  InsideTestFor(deformed_report) == InsideTest::kExactWinding;
   in.file = *std::move(file);
   return in;
 }

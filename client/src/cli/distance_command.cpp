@@ -30,7 +30,7 @@ struct DistanceCliOptions {
   std::string a_path, b_path, poses_path;
   SphereFileReadOptions a_read, b_read;  // .sph level, YAML link
   // A certified query: covers of A's and B's solids, and the meshes that certify a cover whose
-  // file records no certificate.
+  // file records no certificate, or one that does not name its spheres and that mesh.
   std::string cover_paths[2], mesh_paths[2];
   std::string hierarchy = "sphere";
   std::string output_path;
@@ -41,7 +41,8 @@ struct DistanceCliOptions {
   bool certified() const { return !cover_paths[0].empty(); }
 };
 
-// One solid's cover as read: its spheres, and the certificate its file records, if any.
+// One solid's cover as read: its spheres, and without the mesh the certificate its file records
+// (UsableCoverCertificate; with the mesh it is checked against that mesh when stored).
 struct CoverInput {
   SphereFile file;
   std::optional<CoverCertificate> certificate;
@@ -70,7 +71,8 @@ std::string FormatCsv(const std::vector<DistanceResult>& results,
 
 // The cover given for one solid (side 0: A, 1: B), read and checked against its internal set:
 // that set must not be recorded as dilated or a cover, the two must name the same mesh when
-// both name one, and the cover must record a certificate or come with the mesh to prove one.
+// both name one, and without the mesh the cover must record a certificate of its spheres (and
+// of the mesh the files name), which it certifies.
 absl::StatusOr<CoverInput> ReadCover(const DistanceCliOptions& options, int side,
                                      const SphereFile& internal) {
   const char* names[2][3] = {{"A", "--cover-a", "--mesh-a"}, {"B", "--cover-b", "--mesh-b"}};
@@ -88,41 +90,67 @@ absl::StatusOr<CoverInput> ReadCover(const DistanceCliOptions& options, int side
   if (!file.ok()) return BadInputError(file.status().message());
   if (file->set.spheres.empty()) return BadInputError(path + ": no spheres");
   in.file = *std::move(file);
-  absl::StatusOr<std::optional<CoverCertificate>> recorded = RecordedCoverCertificate(in.file);
-  if (!recorded.ok()) return BadInputError(absl::StrCat(path, ": ", recorded.status().message()));
-  in.certificate = *std::move(recorded);
-  if (in.certificate && !in.certificate->certified) {
-    return BadInputError(path + " records a certificate that does not certify it");
-  }
-  if (!in.certificate && options.mesh_paths[side].empty()) {
-    return UsageError(absl::StrFormat(
-        "%s %s records no cover certificate (the files `inscribe generate --cover` writes do); "
-        "give %s MESH to certify it",
-        cover_flag, path, mesh_flag));
-  }
   if (!internal.mesh_sha256.empty() && !in.file.mesh_sha256.empty() &&
       internal.mesh_sha256 != in.file.mesh_sha256) {
     return BadInputError(absl::StrFormat("%s was made for mesh %s, its cover %s for mesh %s",
                                          side == 0 ? options.a_path : options.b_path,
                                          internal.mesh_sha256, path, in.file.mesh_sha256));
   }
+  if (!options.mesh_paths[side].empty()) {
+    // Only malformed stats are refused here; StoreCover checks the certificate against the mesh.
+    if (absl::Status s = RecordedCoverCertificate(in.file).status(); !s.ok()) {
+      return BadInputError(absl::StrCat(path, ": ", s.message()));
+    }
+    return in;
+  }
+  const std::string& named_mesh =
+      in.file.mesh_sha256.empty() ? internal.mesh_sha256 : in.file.mesh_sha256;
+  absl::StatusOr<std::optional<CoverCertificate>> usable =
+      UsableCoverCertificate(in.file, path, named_mesh);
+  if (usable.status().code() == absl::StatusCode::kFailedPrecondition) {
+    return BadInputError(absl::StrFormat("%s %s (%s MESH)", cover_flag, usable.status().message(),
+                                         mesh_flag));
+  }
+  if (!usable.ok()) return BadInputError(usable.status().message());
+  if (!usable->has_value()) {
+    return UsageError(absl::StrFormat(
+        "%s %s records no cover certificate (the files `inscribe generate --cover` writes do); "
+        "give %s MESH to certify it",
+        cover_flag, path, mesh_flag));
+  }
+  in.certificate = *std::move(usable);
   return in;
 }
 
-// The cover stored in the service with its certificate: the one its file records (taken on
-// the file's word), else the service's proof against the mesh (CertifyCover by key, which the
-// service keeps for Distance). Not a cover: exit 1, with the point it misses.
+// The cover stored in the service with its certificate: the one its file records when it
+// names the cover's spheres (and the mesh, when given), else the service's proof against the
+// mesh (CertifyCover by key, which the service keeps for Distance). Not a cover: exit 1, with
+// the point it misses.
 absl::StatusOr<std::string> StoreCover(const client::Client& client,
                                        const DistanceCliOptions& options, int side,
                                        const CoverInput& cover) {
-  if (cover.certificate) {
+  const std::string& path = options.cover_paths[side];
+  std::optional<CoverCertificate> recorded = cover.certificate;
+  std::optional<StoredSolid> solid;
+  if (!options.mesh_paths[side].empty()) {
+    absl::StatusOr<StoredSolid> stored = StoreSolid(client, options.mesh_paths[side]);
+    if (!stored.ok()) return stored.status();
+    solid = *std::move(stored);
+    absl::StatusOr<std::optional<CoverCertificate>> usable =
+        UsableCoverCertificate(cover.file, path, solid->sha256);
+    if (usable.ok()) {
+      recorded = *std::move(usable);
+    } else {
+      std::cerr << "inscribe: " << usable.status().message() << "; certifying it against "
+                << options.mesh_paths[side] << "\n";
+    }
+  }
+  if (recorded) {
     absl::StatusOr<client::PutSphereSetResult> stored =
-        client.PutCertifiedCover(cover.file.set, *cover.certificate);
+        client.PutCertifiedCover(cover.file.set, *recorded);
     if (!stored.ok()) return stored.status();
     return stored->sphere_set_key;
   }
-  absl::StatusOr<StoredSolid> solid = StoreSolid(client, options.mesh_paths[side]);
-  if (!solid.ok()) return solid.status();
   absl::StatusOr<client::PutSphereSetResult> stored =
       client.PutSphereSet(cover.file.set, solid->sha256);
   if (!stored.ok()) return stored.status();
@@ -342,17 +370,19 @@ void AddDistanceCommand(CLI::App& app, CommandOutcome* outcome) {
   CLI::Option* cover_a = cmd->add_option(
       "--cover-a", options->cover_paths[0],
       "A certified query: a cover of A's solid (A then holds its internal spheres); each answer "
-      "gains an interval lower <= exact distance <= upper. The file must record its certificate "
-      "(as `generate --cover` writes it), or --mesh-a proves one");
+      "gains an interval lower <= exact distance <= upper. The file must record the certificate "
+      "of its spheres (as `generate --cover` writes it), or --mesh-a proves one");
   CLI::Option* cover_b =
       cmd->add_option("--cover-b", options->cover_paths[1], "A cover of B's solid (see --cover-a)");
   cover_a->needs(cover_b);
   cover_b->needs(cover_a);
   cmd->add_option("--mesh-a", options->mesh_paths[0],
-                  "The mesh of A, to certify --cover-a when its file records no certificate")
+                  "The mesh of A, to certify --cover-a when its file records no certificate "
+                  "of its spheres and this mesh")
       ->needs(cover_a);
   cmd->add_option("--mesh-b", options->mesh_paths[1],
-                  "The mesh of B, to certify --cover-b when its file records no certificate")
+                  "The mesh of B, to certify --cover-b when its file records no certificate "
+                  "of its spheres and this mesh")
       ->needs(cover_b);
   cmd->add_option("-o,--output", options->output_path,
                   "Write the CSV here: pose,distance,sphere_a,sphere_b,ax,ay,az,bx,by,bz (with "

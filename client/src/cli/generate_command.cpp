@@ -43,7 +43,10 @@ struct Generated {
   GeneratedSphereSet result;  // S_D, S_D+ with --dilate, or a cover with --cover
   std::string mesh_sha256;
   std::int64_t triangles = 0;  // of the validated mesh
-  double load_seconds = 0.0;   // reading, storing and validation
+  // MeshReport::repairs: what validation changed of the surface ("" when nothing); the set and
+  // its certificate are then about the repaired mesh, mesh_sha256, only.
+  std::string mesh_repairs;
+  double load_seconds = 0.0;  // reading, storing and validation
   // Remote mode only: the server's key of the set and where it came from ("computed",
   // "memory", "disk", "joined").
   std::string sphere_set_key, cache;
@@ -103,6 +106,7 @@ SphereFile MakeSphereFile(const GenerateCliOptions& options, const Generated& g)
     if (p.max_protrusion) file.params.emplace_back("max_protrusion", *p.max_protrusion);
     file.params.emplace_back("cover_resolution", p.cover_resolution);
   }
+  if (!g.mesh_repairs.empty()) file.params.emplace_back("mesh_repairs", g.mesh_repairs);
   const QualityReport& quality = *r.quality;
   file.stats = {{"seconds", r.generation_seconds}};
   if (medial_run) file.stats.emplace_back("search_runs", static_cast<std::int64_t>(r.runs));
@@ -171,6 +175,7 @@ absl::StatusOr<Generated> Generate(const client::Client& client,
   g.cache = std::move(result->cache);
   g.result = *std::move(result);  // the GeneratedSphereSet part
   g.triangles = solid->report.triangles;
+  g.mesh_repairs = solid->report.repairs();
   g.load_seconds = solid->seconds;
   return g;
 }
@@ -182,6 +187,7 @@ void PrintSummary(const GenerateCliOptions& options, const Generated& g) {
   summary["mesh"] = options.mesh_path;
   summary["mesh_sha256"] = g.mesh_sha256;
   summary["triangles"] = g.triangles;
+  if (!g.mesh_repairs.empty()) summary["mesh_repairs"] = g.mesh_repairs;
   summary["voxel_size"] = r.voxel_size;
   summary["object_angle"] = p.medial.object_angle;
   summary["samples"] = p.medial.samples;

@@ -74,26 +74,39 @@ class SceneUploads {
     return stored->sphere_set_key;
   }
 
-  // The object's cover: with the certificate its file records (on the file's word), else
-  // with its mesh, against which the service certifies it on first use.
+  // The object's cover: with the certificate its file records when it names the cover's
+  // spheres (and the object's mesh, when given: UsableCoverCertificate), else with its mesh,
+  // against which the service certifies it on first use.
   absl::StatusOr<std::string> Cover(const SceneFileObject& object, const std::string& where) {
     absl::StatusOr<SphereFile> file = ReadSphereFile(object.cover_path);
     if (!file.ok()) return BadInputError(file.status().message());
     if (file->set.spheres.empty()) return BadInputError(object.cover_path + ": no spheres");
-    absl::StatusOr<std::optional<CoverCertificate>> recorded = RecordedCoverCertificate(*file);
-    if (!recorded.ok()) {
-      return BadInputError(absl::StrCat(object.cover_path, ": ", recorded.status().message()));
+    std::string mesh;
+    if (!object.mesh_path.empty()) {
+      absl::StatusOr<std::string> stored = Mesh(object.mesh_path);
+      if (!stored.ok()) return stored.status();
+      mesh = *stored;
+    }
+    absl::StatusOr<std::optional<CoverCertificate>> usable =
+        UsableCoverCertificate(*file, object.cover_path, mesh.empty() ? file->mesh_sha256 : mesh);
+    if (usable.status().code() == absl::StatusCode::kInvalidArgument) {
+      return BadInputError(usable.status().message());
     }
     absl::StatusOr<client::PutSphereSetResult> stored;
-    if (recorded->has_value()) {
-      stored = client_.PutCertifiedCover(file->set, **recorded);
-    } else if (!object.mesh_path.empty()) {
-      absl::StatusOr<std::string> mesh = Mesh(object.mesh_path);
-      if (!mesh.ok()) return mesh.status();
-      stored = client_.PutSphereSet(file->set, *mesh);
+    if (usable.ok() && usable->has_value()) {
+      stored = client_.PutCertifiedCover(file->set, **usable);
+    } else if (!mesh.empty()) {
+      if (!usable.ok()) {
+        std::cerr << "inscribe: " << where << ": " << usable.status().message()
+                  << "; certifying it against " << object.mesh_path << "\n";
+      }
+      stored = client_.PutSphereSet(file->set, mesh);
+    } else if (!usable.ok()) {
+      return BadInputError(
+          absl::StrCat("cover ", usable.status().message(), " (give the object's mesh)"));
     } else {
       return UsageError(absl::StrCat(
-          where, ": cover ", object.cover_path,
+          "cover ", object.cover_path,
           " records no certificate (the files `inscribe generate --cover` writes do); give the "
           "object's mesh to certify it"));
     }

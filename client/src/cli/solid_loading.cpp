@@ -10,13 +10,16 @@
 namespace inscribe::cli {
 namespace {
 
-// The solid is no longer the file's: say so, since hashes and results now differ from it.
-void NoteRepairs(const std::string& path, const MeshReport& report) {
-  for (const MeshIssue& issue : report.issues) {
-    if (issue.code == "holes_filled" ||
-        (issue.code == "welded_vertices" && report.weld_collapsed_triangles > 0)) {
-      std::cerr << "inscribe: " << path << ": " << issue.message << "\n";
-    }
+// Every warning and fix validation made (MeshReport::notices), one line each, and when the
+// geometry was repaired, that what follows holds for the repaired mesh only.
+void NoteRepairs(const std::string& path, const MeshReport& report, const std::string& sha256) {
+  for (const MeshIssue& issue : report.notices()) {
+    std::cerr << "inscribe: " << path << ": " << SeverityName(issue.severity) << ": "
+              << issue.message << "\n";
+  }
+  if (report.geometry_repaired()) {
+    std::cerr << "inscribe: " << path << ": results and certificates hold for the repaired mesh "
+              << sha256 << ", not for the file's triangles as given\n";
   }
 }
 
@@ -44,7 +47,7 @@ absl::StatusOr<LoadedSolid> LoadSolid(const std::string& path, const SolidLoadOp
   solid_options.validate.weld_tolerance = options.weld_tolerance;
   absl::StatusOr<Solid> solid = PrepareSolid(*std::move(mesh), solid_options);
   if (!solid.ok()) return UnusableMeshError(path + ": " + std::string(solid.status().message()));
-  NoteRepairs(path, solid->report);
+  NoteRepairs(path, solid->report, solid->sha256);
   return LoadedSolid{*std::move(solid), SecondsSince(start)};
 }
 
@@ -63,7 +66,7 @@ absl::StatusOr<StoredSolid> StoreSolid(const client::Client& client, const std::
     }
     return stored.status();
   }
-  NoteRepairs(path, stored->report);
+  NoteRepairs(path, stored->report, stored->mesh_sha256);
   return StoredSolid{*std::move(mesh), std::move(stored->report), std::move(stored->mesh_sha256),
                      SecondsSince(start)};
 }

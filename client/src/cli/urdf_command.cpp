@@ -232,6 +232,7 @@ void PrintJson(const UrdfCliOptions& options, const UrdfSpherizeOptions& spheriz
     link["generation_runs"] = link_result.generation_runs;
     link["seconds"] = link_result.seconds;
     if (!link_result.error.empty()) link["error"] = link_result.error;
+    if (!link_result.warnings.empty()) link["warnings"] = link_result.warnings;
     links.push_back(std::move(link));
     spherized += link_result.status == LinkStatus::kSpherized;
     skipped += link_result.status == LinkStatus::kSkipped;
@@ -328,6 +329,9 @@ absl::Status RunUrdf(const UrdfCliOptions& options) {
   if (!spherized.ok()) return UsageError(spherized.status().message());
   const std::vector<LinkSpherizeResult>& results = spherized->links;
   for (const LinkSpherizeResult& link : results) {
+    for (const std::string& warning : link.warnings) {
+      std::cerr << "inscribe: link '" << link.link << "': " << warning << "\n";
+    }
     if (link.status == LinkStatus::kSkipped) {
       std::cerr << "inscribe: link '" << link.link << "' skipped: " << link.error << "\n";
     }

@@ -21,16 +21,23 @@ struct BoundaryPoint {
 
 enum class Side { kInside, kOutside, kOnBoundary };
 
-// How Classify decides inside from outside.
+// How Classify decides inside from outside. The solid is defined once: the points around which
+// the winding number of the (validated, outward-oriented) mesh is not zero. Overlapping bodies
+// are therefore their union, and a cavity (a shell oriented inward inside another) is outside.
+// Both tests answer that rule; InsideTestFor (solid.h) picks the fast one only where its
+// conditions are proved.
 enum class InsideTest {
   // Sign against the angle-weighted pseudonormal of the closest feature (Baerentzen & Aanaes
-  // 2005). Costs nothing beyond the closest-point query. Exact for a closed, outward-oriented
-  // 2-manifold WITHOUT self-intersections; wrong near sheets buried inside the solid.
+  // 2005). Costs nothing beyond the closest-point query. Right only for a closed,
+  // outward-oriented mesh without self-intersections, non-manifold vertices or zero-area
+  // triangles; wrong near sheets buried inside the solid.
   kPseudonormal,
-  // Parity of crossings along three fixed rays (majority vote), each crossing computed in
-  // double precision. Same answer as CGAL's Side_of_triangle_mesh, also for self-intersecting
-  // meshes (where overlapped regions count as outside). About three ray casts per query.
-  kRayParity,
+  // The winding number counted along one ray, exactly: CGAL's filtered orientation predicates
+  // on the mesh's own coordinates, with the ray's origin perturbed symbolically so that rays
+  // through edges and vertices count each sheet once. Right for every closed, consistently
+  // oriented mesh: any number of shells and cavities, overlapping bodies, non-manifold
+  // vertices, zero-area triangles, any finite coordinates. One ray cast per query.
+  kExactWinding,
 };
 
 // The bounding-volume hierarchy that culls triangles. Both give identical answers, bit for bit

@@ -10,13 +10,19 @@
 // tile the cube exactly, and each test carries a relative margin far above the rounding of the
 // few operations it makes. Certified means: every point of the solid (boundary included) lies
 // in some sphere.
+//
+// A certificate names what it proved: the solid (its mesh's hash) and the spheres (theirs), so
+// that one read back from a file or sent by a client is used only for the spheres it was made
+// for (CheckCoverCertificateBinding).
 #pragma once
 
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
 #include "inscribe/medial_spheres.h"
 #include "inscribe/solid.h"
 #include "inscribe/sphere.h"
@@ -49,6 +55,10 @@ struct CoverCell {
 struct CoverCertificate {
   // Every point of the solid lies in some sphere (a proof, see above).
   bool certified = false;
+  // What was proved: Solid::sha256 (the validated mesh, "sha256:<64 hex>") and
+  // FormatSha256(SpheresSha256(spheres)) of the spheres, in their order.
+  std::string mesh_sha256;
+  std::string spheres_sha256;
   // No point of any sphere lies farther than this outside the solid: the maximum over spheres
   // of radius - depth(centre) (depth: distance to the boundary, negative outside), at least 0,
   // rounded up. Holds whether or not the set is certified. Mesh units.
@@ -75,13 +85,25 @@ struct CoverCertificate {
   double seconds = 0.0;
 };
 
+// The one rule for using a certificate that was not just computed (read from a file, sent by a
+// client, read back from a cache): it must name `spheres` (their SpheresSha256) and, when
+// `mesh_sha256` is not empty, that mesh (empty: the caller does not know the mesh, only the
+// spheres are checked), and hold one protrusion per sphere. FAILED_PRECONDITION saying which
+// fails and what to do: a certificate that names no spheres or no mesh, other spheres (edited
+// after they were certified), another mesh, or too few or too many protrusions. Says nothing
+// about `certified`. Cost O(#spheres).
+absl::Status CheckCoverCertificateBinding(const CoverCertificate& certificate,
+                                          const std::vector<Sphere>& spheres,
+                                          absl::string_view mesh_sha256);
+
 // OK, or INVALID_ARGUMENT for a resolution outside (0, 1] or a negative max_failures_kept.
 absl::Status CheckCoverCertifyOptions(const CoverCertifyOptions& options);
 
 // Certifies `spheres` (each passing CheckSphere) as a cover of `solid`. INVALID_ARGUMENT for a
 // bad sphere or resolution (in (0, 1]); CANCELLED when control.cancel is set. Parallel (TBB)
 // and deterministic: the verdict, the counts, the failures and the witness depend only on the
-// input. Progress goes to control.on_progress in [0, 1].
+// input. Progress goes to control.on_progress in [0, 1]. The certificate names solid.sha256
+// and the spheres.
 absl::StatusOr<CoverCertificate> CertifyCover(const Solid& solid,
                                               const std::vector<Sphere>& spheres,
                                               const CoverCertifyOptions& options = {},

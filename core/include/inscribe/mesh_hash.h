@@ -1,10 +1,13 @@
-// Content hash of a mesh: the key under which sphere sets are cached.
+// Content hashes: of a mesh (the key under which sphere sets are cached) and of a list of
+// spheres (what a cover certificate names as the spheres it proved).
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "inscribe/mesh.h"
 #include "inscribe/sha256.h"
+#include "inscribe/sphere.h"
 
 namespace inscribe {
 
@@ -14,6 +17,13 @@ namespace inscribe {
 // Equal arrays give equal digests on every platform; any change of a bit in a coordinate or an
 // index changes it. Cost O(#V + #T).
 Sha256Digest MeshSha256(const Mesh& mesh);
+
+// SHA-256 over a canonical little-endian encoding of the spheres, in order:
+//   "inscribe.spheres.v1" (19 bytes), uint64 #S,
+//   #S x (x, y, z, r) IEEE-754 binary64 (with -0.0 written as +0.0).
+// Any change of a bit in a coordinate or a radius, of the order or of the count changes it;
+// contacts are not hashed. Cost O(#S).
+Sha256Digest SpheresSha256(const std::vector<Sphere>& spheres);
 
 // "sha256:" followed by 64 lowercase hex digits.
 std::string FormatSha256(const Sha256Digest& digest);

@@ -39,6 +39,8 @@ struct MeshReport {
   // a repeated corner (the welded mesh has triangles - weld_collapsed_triangles).
   std::int64_t welded_vertices = 0;
   std::int64_t weld_collapsed_triangles = 0;
+  // The weld's tolerance when it was > 0 and merged vertices (moving them up to it), else 0.
+  double weld_moved_within = 0.0;
   std::int64_t degenerate_triangles = 0;   // repeated corner or zero area (exact predicate)
   std::int64_t duplicate_triangles = 0;    // same three corners as an earlier triangle
   std::int64_t unreferenced_vertices = 0;  // in no triangle (harmless)
@@ -66,6 +68,20 @@ struct MeshReport {
   bool closed() const { return triangles > 0 && (border_edges == 0 || holes_filled > 0); }
   // True when no issue is an error: the mesh bounds a solid the generator can use.
   bool usable() const;
+  // True when the returned mesh's geometry is not the given one's up to exact duplicates:
+  // vertices welded within a tolerance > 0, triangles welding removed, holes filled. Hashes,
+  // spheres and certificates are then about the repaired mesh only (orientation fixes and
+  // welds of identical positions change no point of the surface).
+  bool geometry_repaired() const {
+    return weld_moved_within > 0.0 || weld_collapsed_triangles > 0 || holes_filled > 0;
+  }
+  // Those repairs in one line ("welded 3 vertices within 0.02 ...; filled 1 hole ..."), or ""
+  // when geometry_repaired() is false.
+  std::string repairs() const;
+  // The warnings and fixes to show whoever uses the mesh (every entry point prints or returns
+  // them): every issue that is not an error, except a weld of identical positions that removed
+  // no triangle (lossless, and what every per-face exporter needs).
+  std::vector<MeshIssue> notices() const;
   // The first error as a one-line reason, or "" when usable.
   std::string first_error() const;
 };
@@ -88,10 +104,13 @@ struct ValidateOptions {
   bool weld_vertices = true;
   double weld_tolerance = 0.0;
   // Self-intersection testing costs O(#T log #T) with exact predicates; it is skipped (and
-  // reported as unchecked) for meshes that are not closed 2-manifolds, where it means little.
+  // reported as unchecked) for meshes that are not closed 2-manifolds. A solid whose mesh was
+  // not checked, or intersects itself, gets the exact inside test (InsideTestFor).
   bool check_self_intersections = true;
   // Make orientation consistent within each component and point every normal away from the
-  // solid (outer shells outward, cavities inward).
+  // solid: a shell enclosed by an even number of others outward, by an odd number (a cavity)
+  // inward, for any number of components (exact winding numbers). The solid is then where the
+  // mesh's winding number is not zero (InsideTest).
   bool fix_orientation = true;
   // Close every hole (border loop) with triangles between its own border vertices (no vertex
   // is added; CGAL's triangulate_hole: the constrained Delaunay triangulation of a near-planar

@@ -20,9 +20,11 @@ struct Solid {
   const Mesh& mesh() const { return oracle.mesh(); }
 };
 
-// The inside test a solid with this report needs: ray parity when the mesh intersects itself
-// (the pseudonormal sign is wrong near sheets buried inside the solid), the pseudonormal
-// otherwise. The one place this rule lives.
+// The inside test a solid with this report needs: the pseudonormal only when validation checked
+// the mesh for self-intersections and found none, and found no non-manifold vertex and no
+// zero-area triangle (the conditions under which its sign is proved right); the exact winding
+// number otherwise (self-intersections, checks not made, options that skip them). The one
+// place this rule lives.
 InsideTest InsideTestFor(const MeshReport& report);
 
 struct SolidOptions {

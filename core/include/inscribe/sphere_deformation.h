@@ -43,8 +43,8 @@ struct DeformationOptions {
   // gets inside are dropped (see DeformedSpheres::reference_index).
   bool strict = false;
   ContactDirection direction = ContactDirection::kCarriedFrame;
-  // For the oracle of the deforming boundary. Use InsideTest::kRayParity when the reference or
-  // a deformed frame self-intersects: the pseudonormal sign is wrong near buried sheets.
+  // For the oracle of the deforming boundary. Use InsideTest::kExactWinding unless
+  // InsideTestFor proves the pseudonormal right for the reference and the deformed frame.
   BoundaryOracleOptions oracle;
 };
 

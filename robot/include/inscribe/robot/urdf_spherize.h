@@ -4,9 +4,8 @@
 // spheres or dilated ones on request.
 //
 // Elements are spherized one by one and their spheres concatenated, rather than their meshes
-// merged into one: two overlapping closed meshes merged are one self-intersecting mesh, whose
-// overlap the inside test counts as outside (see InsideTest::kRayParity), so the spheres would
-// miss exactly where the parts meet. A budget is shared out among elements (a whole robot's
+// merged into one: each element's spheres then follow its own shape, and a budget is spent
+// where each element needs it. A budget is shared out among elements (a whole robot's
 // among all its links' elements: RobotSphereBudgets; a link's among its own: LinkSphereBudgets).
 #pragma once
 
@@ -132,6 +131,9 @@ struct LinkSpherizeResult {
   std::int64_t budget = 0;  // spheres the link was given (budget modes; 0 otherwise)
   // kSkipped: one line naming the element (by its line in the URDF) and the problem.
   std::string error;
+  // Every validation warning and fix of the link's meshes (MeshReport::notices), one line each
+  // naming the element, as `error` does.
+  std::vector<std::string> warnings;
   int generation_runs = 0;  // generation runs over all elements (budget searches make several)
   double seconds = 0.0;     // wall time for the link: reading, validation, generation
 };

@@ -168,8 +168,7 @@ int main(int argc, char** argv) {
   }
   const bool defaults = names.empty();
   if (defaults) {
-    names = {"eight.off", "cow.off",  "elephant.off", "knot1.off",
-             "fandisk.off", "pig.off", "bunny00.off"};
+    names = {"eight.off", "cow.off", "elephant.off", "knot1.off", "fandisk.off", "bunny00.off"};
   }
   const char* env = std::getenv("INSCRIBE_DATA_DIR");
   const std::string dir = env != nullptr ? env : std::string(INSCRIBE_SOURCE_DIR) + "/data";

@@ -351,8 +351,8 @@ Side BoundaryOracle::Impl::ClassifyByWinding(const Vector3& p) const {
 }
 
 Side BoundaryOracle::Impl::ClassifyFrom(const Vector3& p, const BoundaryPoint& closest) const {
-  if (closest.distance == 0.0) return Side::kOnBoundary;
   if (options.inside_test == InsideTest::kExactWinding) return ClassifyByWinding(p);
+  if (closest.distance == 0.0) return Side::kOnBoundary;
   const Vector3& w = closest.barycentric;
   const std::int32_t t = closest.triangle;
   Vector3 normal;
@@ -455,6 +455,10 @@ BoundaryPoint BoundaryOracle::ClosestPoint(const Vector3& query, double upper_bo
 }
 
 Side BoundaryOracle::Classify(const Vector3& query) const {
+  // The exact test needs no closest point: one ray decides, boundary included.
+  if (impl_->options.inside_test == InsideTest::kExactWinding) {
+    return impl_->ClassifyByWinding(query);
+  }
   return impl_->ClassifyFrom(query, impl_->Closest(query));
 }
 

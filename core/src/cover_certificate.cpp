@@ -289,16 +289,15 @@ absl::Status CheckCoverCertificateBinding(const CoverCertificate& certificate,
                                           absl::string_view mesh_sha256) {
   if (certificate.spheres_sha256.empty() || certificate.mesh_sha256.empty()) {
     return absl::FailedPreconditionError(absl::StrCat(
-        "the cover certificate names no ",
-        certificate.spheres_sha256.empty() ? "spheres" : "mesh",
+        "the cover certificate names no ", certificate.spheres_sha256.empty() ? "spheres" : "mesh",
         " it was proved for (it was recorded without them, or by an older inscribe): certify "
         "the spheres again against their mesh"));
   }
   const std::string given = FormatSha256(SpheresSha256(spheres));
   if (certificate.spheres_sha256 != given) {
     return absl::FailedPreconditionError(
-        absl::StrCat("the cover certificate was made for other spheres (", certificate.spheres_sha256,
-                     ") than these ", spheres.size(), " (", given,
+        absl::StrCat("the cover certificate was made for other spheres (",
+                     certificate.spheres_sha256, ") than these ", spheres.size(), " (", given,
                      "): the spheres were edited after they were certified; certify them again "
                      "against their mesh"));
   }

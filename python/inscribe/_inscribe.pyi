@@ -41,6 +41,7 @@ class MeshReport:
     self_intersecting_pairs: int
     welded_vertices: int
     weld_collapsed_triangles: int
+    weld_moved_within: float
     holes_filled: int
     hole_triangles_added: int
     volume: float
@@ -49,7 +50,11 @@ class MeshReport:
     issues: list[MeshIssue]
     closed: bool
     usable: bool
+    geometry_repaired: bool
+    repairs: str
     first_error: str
+
+class MeshWarning(UserWarning): ...
 
 class Mesh:
     def __init__(self, vertices: Float64Array, triangles: Int32Array) -> None: ...
@@ -309,6 +314,7 @@ class LinkSpheres:
     def cores(self) -> Float64Array: ...
     budget: int
     error: str
+    warnings: list[str]
     seconds: float
 
 class SelfCollision:

@@ -387,10 +387,9 @@ absl::StatusOr<std::shared_ptr<const CertifiedObjectEntry>> ResultStore::GetCert
   absl::StatusOr<CoverCertificate> certificate = CoverCertificateOf(cover_key);
   if (!certificate.ok()) return certificate.status();
   if (!internal_mesh.empty() && certificate->mesh_sha256 != internal_mesh) {
-    return absl::InvalidArgumentError(absl::StrCat("sphere set ", internal_key, " is of mesh ",
-                                                   internal_mesh, " but its cover ", cover_key,
-                                                   " was certified for mesh ",
-                                                   certificate->mesh_sha256));
+    return absl::InvalidArgumentError(
+        absl::StrCat("sphere set ", internal_key, " is of mesh ", internal_mesh, " but its cover ",
+                     cover_key, " was certified for mesh ", certificate->mesh_sha256));
   }
   // The internal set with the cover's cores (UpperBoundSpheres), when the certificate gives
   // them; else the internal set's own hierarchy.

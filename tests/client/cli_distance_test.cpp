@@ -5,8 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <functional>
 #include <fstream>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
@@ -26,8 +26,7 @@ namespace fs = std::filesystem;
 
 // Rows of a CSV answer, header dropped (and checked: the plain columns, then `extra`), split
 // on commas.
-std::vector<std::vector<std::string>> Rows(const std::string& csv,
-                                                  const std::string& extra = "") {
+std::vector<std::vector<std::string>> Rows(const std::string& csv, const std::string& extra = "") {
   std::vector<std::vector<std::string>> rows;
   std::istringstream in(csv);
   std::string line;
@@ -253,9 +252,9 @@ class CliCoverBinding : public ::testing::Test {
                     .ok());
     internal_ = (dir_ / "internal.json").string();
     cover_ = (dir_ / "cover.json").string();
-    ASSERT_EQ(RunCli("generate " + Quote(mesh_) + " --max-spheres 40 -o " + Quote(internal_))
-                  .exit_code,
-              0);
+    ASSERT_EQ(
+        RunCli("generate " + Quote(mesh_) + " --max-spheres 40 -o " + Quote(internal_)).exit_code,
+        0);
     const CliRun cover =
         RunCli("generate " + Quote(mesh_) + " --cover --max-spheres 30 -o " + Quote(cover_));
     ASSERT_EQ(cover.exit_code, 0) << cover.err;

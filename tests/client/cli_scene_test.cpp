@@ -18,9 +18,11 @@
 #include <vector>
 
 #include "client/cli_run.h"
+#include "inscribe/mesh_io.h"
 #include "inscribe/separation_distance.h"
 #include "inscribe/sphere_io.h"
 #include "support/inscribed_process.h"
+#include "support/synthetic_meshes.h"
 #include "support/test_meshes.h"
 
 namespace inscribe {
@@ -210,6 +212,72 @@ TEST_F(CliScene, BadFilesAreNamedWithTheirLine) {
     EXPECT_THAT(run.err, HasSubstr(c.says));
     EXPECT_TRUE(run.out.empty()) << run.out;
   }
+}
+
+// A scene's cover is used with its file's certificate only while the certificate names the
+// cover's spheres: an edited cover is refused without the object's mesh and certified again
+// with it. Two unit cubes 3 apart along x: the exact distance is 2.
+TEST(CliSceneCovers, EditedCoversAreRefusedOrCertifiedAgain) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("inscribe_cli_scene_covers_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const std::string mesh = (dir / "cube.off").string();
+  ASSERT_TRUE(WriteMesh(mesh, testing::UnitCube()).ok());
+  const std::string internal = (dir / "internal.json").string(),
+                    cover = (dir / "cover.json").string();
+  ASSERT_EQ(RunCli("generate " + Quote(mesh) + " --max-spheres 30 -o " + Quote(internal)).exit_code,
+            0);
+  ASSERT_EQ(
+      RunCli("generate " + Quote(mesh) + " --cover --max-spheres 30 -o " + Quote(cover)).exit_code,
+      0);
+  for (const double scale : {0.97, 1.03}) {
+    absl::StatusOr<SphereFile> file = ReadSphereFile(cover);
+    ASSERT_TRUE(file.ok()) << file.status();
+    for (Sphere& s : file->set.spheres) s.radius *= scale;
+    const std::string name = scale < 1.0 ? "shrunk.json" : "grown.json";
+    ASSERT_TRUE(WriteSphereFile((dir / name).string(), *file).ok());
+  }
+  const std::string poses = (dir / "poses.csv").string();
+  std::ofstream(poses) << "0,2,1,0,0,0,3,0,0\n";
+  // Object 2's cover `cover_2`, with the cube's mesh when `with_mesh`.
+  const auto scene = [&](const std::string& cover_2, bool with_mesh) {
+    nlohmann::json second = {{"id", 2}, {"spheres", "internal.json"}, {"cover", cover_2}};
+    if (with_mesh) second["mesh"] = "cube.off";
+    const nlohmann::json j = {
+        {"format", "inscribe.scene"},
+        {"version", 1},
+        {"threshold", 5.0},
+        {"objects", {{{"id", 1}, {"spheres", "internal.json"}, {"cover", "cover.json"}}, second}}};
+    const std::string path = (dir / "scene.json").string();
+    std::ofstream(path) << j.dump();
+    return RunCli("scene " + Quote(path) + " " + Quote(poses) + " --json");
+  };
+  const auto expect_interval = [](const CliRun& run) {
+    ASSERT_EQ(run.exit_code, 0) << run.err;
+    const nlohmann::json frames = nlohmann::json::parse(run.out);
+    ASSERT_EQ(frames.size(), 1u);
+    ASSERT_EQ(frames[0]["pairs"].size(), 1u);
+    const nlohmann::json& pair = frames[0]["pairs"][0];
+    EXPECT_TRUE(pair["certified"].get<bool>());
+    EXPECT_LE(pair["lower"].get<double>(), 2.0 + 1e-9);
+    EXPECT_GE(pair["upper"].get<double>(), 2.0 - 1e-9);
+  };
+
+  expect_interval(scene("cover.json", false));
+  const CliRun refused = scene("shrunk.json", false);
+  EXPECT_EQ(refused.exit_code, 2) << refused.err;
+  EXPECT_THAT(refused.err, HasSubstr("shrunk.json"));
+  EXPECT_THAT(refused.err, HasSubstr("edited after they were certified"));
+  EXPECT_THAT(refused.err, HasSubstr("give the object's mesh"));
+  // With the mesh: proved again, and 0.97 of every radius no longer holds the cube.
+  const CliRun not_a_cover = scene("shrunk.json", true);
+  EXPECT_EQ(not_a_cover.exit_code, 1) << not_a_cover.err;
+  EXPECT_THAT(not_a_cover.err, HasSubstr("not a cover"));
+  const CliRun grown = scene("grown.json", true);
+  EXPECT_THAT(grown.err, HasSubstr("certifying it against"));
+  expect_interval(grown);
+  std::error_code ec;
+  fs::remove_all(dir, ec);
 }
 
 }  // namespace

@@ -431,7 +431,8 @@ TEST(CoverCertificateBinding, NamesWhatItProvedAndRefusesAnythingElse) {
   EXPECT_THAT(refused(*certificate, reordered, ""), HasSubstr("certify them again"));
   EXPECT_THAT(refused(*certificate, {spheres[0]}, ""), HasSubstr("other spheres"));
   // Another mesh, checked only when the caller knows the mesh.
-  const std::string other = FormatSha256(MeshSha256(testing::Box(Vector3::Zero(), Vector3::Constant(2.0))));
+  const std::string other =
+      FormatSha256(MeshSha256(testing::Box(Vector3::Zero(), Vector3::Constant(2.0))));
   EXPECT_THAT(refused(*certificate, spheres, other), HasSubstr("proved against mesh"));
   EXPECT_THAT(refused(*certificate, spheres, other), HasSubstr(other));
   // Names no spheres or no mesh (as recorded before certificates were bound), or the wrong

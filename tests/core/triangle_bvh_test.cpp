@@ -380,8 +380,10 @@ TEST_P(TriangleBvhOnMesh, XRayWindingEqualsScan) {
       ADD_FAILURE() << "ray from " << o.transpose() << ": BVH " << got << " (on " << bvh_on
                     << "), scan " << expected << " (on " << scan_on << ")";
     }
-    // A closed surface (as the file orients it): winding +-1 inside, 0 outside.
-    if (!scan_on && std::abs(expected) > 1 && failures++ < 5) {
+    // A closed surface (as the file orients it): winding +-1 inside, 0 outside, except where
+    // cow's self-intersecting sheets overlap.
+    if (!scan_on && std::abs(expected) > (GetParam() == std::string("cow.off") ? 2 : 1) &&
+        failures++ < 5) {
       ADD_FAILURE() << "winding " << expected << " at " << o.transpose();
     }
   }

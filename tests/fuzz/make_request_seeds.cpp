@@ -156,8 +156,8 @@ int main(int argc, char** argv) {
   put_cover.mutable_certificate()->set_resolution(1.0 / 512);
   put_cover.mutable_certificate()->add_protrusions(0.5);
   put_cover.mutable_certificate()->set_mesh_sha256(server.mesh_key);
-  put_cover.mutable_certificate()->set_spheres_sha256(
-      FormatSha256(SpheresSha256({Sphere{Vector3::Constant(0.5), 1.0}})));
+  put_cover.mutable_certificate()->set_spheres_sha256(inscribe::FormatSha256(
+      inscribe::SpheresSha256({inscribe::Sphere{inscribe::Vector3::Constant(0.5), 1.0}})));
   Seed(dir, RequestKind::kPutSphereSet, put_cover, "certificate");
 
   v1::DistanceFrame frame;

@@ -138,8 +138,7 @@ struct BadMesh {
   const char* name;
   Mesh mesh;
   bool usable;  // the validator only warns: stored, and Generate answers
-  // Generate finds spheres. Not for a doubled surface: both copies bound the same solid, so
-  // ray parity puts every point outside, and the answer is an empty set (see report).
+  // Generate finds spheres.
   bool has_spheres = true;
 };
 
@@ -169,7 +168,8 @@ TEST(Adversarial, BrokenMeshesGetAReportOrAClearRefusal) {
       {"empty", Mesh{}, false},
       {"collinear", collinear, false},
       {"zero-area", zero_area, true},
-      {"duplicated", duplicated, true, false},
+      // Both copies bound the cube: winding number 2 inside it, so the solid is the cube.
+      {"duplicated", duplicated, true},
       {"open", testing::OpenUnitCube(), false},
       {"out-of-range", out_of_range, false},
       {"negative-index", negative_index, false},
@@ -225,7 +225,7 @@ TEST(Adversarial, BrokenMeshesGetAReportOrAClearRefusal) {
   EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
   EXPECT_THAT(status.error_message(), AllOf(HasSubstr("mesh.vertices"), HasSubstr("25")));
 
-  // Two overlapping closed boxes intersect each other: usable (ray parity decides inside),
+  // Two overlapping closed boxes intersect each other: usable (the exact winding number decides),
   // reported, and spheres can be generated.
   const Mesh overlapping =
       testing::Concatenate(cube, testing::Box(Vector3::Constant(0.5), Vector3::Constant(1.5)));

@@ -76,11 +76,10 @@ Assembly HollowBoxWithDebris(bool cavity_inward) {
       for (int i = 0; i < 10; ++i, ++piece) {
         const Vector3 c(-1.35 + 0.3 * i, -1.35 + 0.3 * j, 1.3 + 0.3 * k);
         const double h = 0.05;
-        const Mesh shell =
-            (i + j + k) % 2 == 0
-                ? Box(c - Vector3::Constant(h), c + Vector3::Constant(h))
-                : Tetrahedron(c + Vector3(-h, -h, -h), c + Vector3(h, -h, -h),
-                              c + Vector3(-h, h, -h), c + Vector3(-h, -h, h));
+        const Mesh shell = (i + j + k) % 2 == 0
+                               ? Box(c - Vector3::Constant(h), c + Vector3::Constant(h))
+                               : Tetrahedron(c + Vector3(-h, -h, -h), c + Vector3(h, -h, -h),
+                                             c + Vector3(-h, h, -h), c + Vector3(-h, -h, h));
         builder.Add(shell, piece % 7 == 3);
       }
     }
@@ -135,8 +134,7 @@ Assembly NestedShells(bool given_inverted) {
     const bool cavity = level % 2 == 1;
     // Given outward: a cavity is given the wrong way; given inside out: the others are.
     builder.Add(cavity ? Inverted(outward) : outward, cavity != given_inverted);
-    FocusFaces(builder, Vector3::Constant(-halves[level]), Vector3::Constant(halves[level]),
-               0.05);
+    FocusFaces(builder, Vector3::Constant(-halves[level]), Vector3::Constant(halves[level]), 0.05);
   }
   return builder.Take();
 }
@@ -213,7 +211,7 @@ Assembly OverlappingIcospheres() {
   AssemblyBuilder builder("overlapping icospheres");
   const Vector3 centres[] = {{0.0, 0.0, 0.0}, {0.8, 0.0, 0.0}, {0.4, 0.6, 0.1}, {0.3, 0.2, 0.7}};
   const double radii[] = {1.0, 0.7, 0.5, 0.45};
-  for (int i = 0; i < 4; ++i) builder.Add(Icosphere(3, centres[i], radii[i]), i == 1);
+  for (int i = 0; i < 4; ++i) builder.Add(Icosphere(2, centres[i], radii[i]), i == 1);
   for (int i = 0; i < 4; ++i) {
     for (int j = i + 1; j < 4; ++j) {
       const Vector3 lo = (centres[i] - Vector3::Constant(radii[i]))

@@ -51,7 +51,7 @@ Assembly ThinPlate();
 // representable point of the edge by a zero-area triangle: closed and edge-manifold, with
 // five collinear triangles.
 Assembly BoxWithCollinearTriangles();
-// (h) Four overlapping icospheres (level 3, 1,280 triangles each), the second given inside out.
+// (h) Four overlapping icospheres (level 2, 320 triangles each), the second given inside out.
 Assembly OverlappingIcospheres();
 
 // Points in the assembly's bounding box, expanded by a tenth of its diagonal: `uniform` spread

@@ -99,7 +99,11 @@ WindingOracle::WindingOracle(const Mesh& mesh) {
             std::max(shell.hi[static_cast<std::size_t>(axis)], corners[k][axis]);
       }
     }
-    shell.triangles.push_back(corners);
+    const long double diameter2 =
+        std::max({Dot(Sub(corners[1], corners[0]), Sub(corners[1], corners[0])),
+                  Dot(Sub(corners[2], corners[1]), Sub(corners[2], corners[1])),
+                  Dot(Sub(corners[0], corners[2]), Sub(corners[0], corners[2]))});
+    shell.triangles.push_back(Triangle{corners, std::sqrt(diameter2)});
   }
   near_distance_ = kWindingNearRelative * largest;
 }
@@ -122,14 +126,20 @@ WindingSample WindingOracle::At(const Vector3& query) const {
   bool near = false;
   for (const Shell& shell : shells_) {
     if (BoxDistanceSquared(shell, p) > near2) continue;  // adds 0, holds no near triangle
-    for (const Corners& t : shell.triangles) {
-      const Point a = Sub(t[0], p), b = Sub(t[1], p), c = Sub(t[2], p);
-      if (!near && PointTriangleDistanceSquared(p, t[0], t[1], t[2]) <= near2) near = true;
+    for (const Triangle& t : shell.triangles) {
+      const Point a = Sub(t.corners[0], p), b = Sub(t.corners[1], p), c = Sub(t.corners[2], p);
       const long double la = Norm(a), lb = Norm(b), lc = Norm(c);
+      // Only a triangle with a corner within its longest side plus near_distance can be near.
+      if (!near) {
+        near = std::min({la, lb, lc}) <= t.diameter + static_cast<long double>(near_distance_) &&
+               PointTriangleDistanceSquared(p, t.corners[0], t.corners[1], t.corners[2]) <= near2;
+      }
+      // Numerator and denominator carry the cancellation, so they are formed in long double;
+      // the angle of the rounded pair is then good to about 1e-16 rad.
       const long double numerator = Dot(a, Cross(b, c));
       const long double denominator =
           la * lb * lc + Dot(a, b) * lc + Dot(b, c) * la + Dot(c, a) * lb;
-      angles += std::atan2(numerator, denominator);
+      angles += std::atan2(static_cast<double>(numerator), static_cast<double>(denominator));
     }
   }
   // Solid angle = 2 * atan2(...); winding = total solid angle / (4 pi).
@@ -157,8 +167,9 @@ double WindingOracle::Distance(const Vector3& query) const {
   long double best2 = std::numeric_limits<long double>::infinity();
   for (const Shell& shell : shells_) {
     if (BoxDistanceSquared(shell, p) >= best2) continue;  // no triangle of it is nearer
-    for (const Corners& t : shell.triangles) {
-      best2 = std::min(best2, PointTriangleDistanceSquared(p, t[0], t[1], t[2]));
+    for (const Triangle& t : shell.triangles) {
+      best2 = std::min(best2,
+                       PointTriangleDistanceSquared(p, t.corners[0], t.corners[1], t.corners[2]));
     }
   }
   return static_cast<double>(std::sqrt(best2));

@@ -59,9 +59,13 @@ class WindingOracle {
  private:
   using Point = std::array<long double, 3>;
   using Corners = std::array<Point, 3>;
+  struct Triangle {
+    Corners corners;
+    long double diameter;  // longest side: every point of it is this close to each corner
+  };
   struct Shell {
-    Point lo, hi;                   // bounding box of its vertices
-    std::vector<Corners> triangles;
+    Point lo, hi;  // bounding box of its vertices
+    std::vector<Triangle> triangles;
   };
   static long double BoxDistanceSquared(const Shell& shell, const Point& p);
 

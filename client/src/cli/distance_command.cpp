@@ -108,8 +108,8 @@ absl::StatusOr<CoverInput> ReadCover(const DistanceCliOptions& options, int side
   absl::StatusOr<std::optional<CoverCertificate>> usable =
       UsableCoverCertificate(in.file, path, named_mesh);
   if (usable.status().code() == absl::StatusCode::kFailedPrecondition) {
-    return BadInputError(absl::StrFormat("%s %s (%s MESH)", cover_flag, usable.status().message(),
-                                         mesh_flag));
+    return BadInputError(
+        absl::StrFormat("%s %s (%s MESH)", cover_flag, usable.status().message(), mesh_flag));
   }
   if (!usable.ok()) return BadInputError(usable.status().message());
   if (!usable->has_value()) {
@@ -141,8 +141,8 @@ absl::StatusOr<std::string> StoreCover(const client::Client& client,
     if (usable.ok()) {
       recorded = *std::move(usable);
     } else {
-      std::cerr << "inscribe: " << usable.status().message() << "; certifying it against "
-                << options.mesh_paths[side] << "\n";
+      std::cerr << "inscribe: " << usable.status().message() << " (certifying it against "
+                << options.mesh_paths[side] << " now)\n";
     }
   }
   if (recorded) {

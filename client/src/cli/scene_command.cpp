@@ -98,7 +98,7 @@ class SceneUploads {
     } else if (!mesh.empty()) {
       if (!usable.ok()) {
         std::cerr << "inscribe: " << where << ": " << usable.status().message()
-                  << "; certifying it against " << object.mesh_path << "\n";
+                  << " (certifying it against " << object.mesh_path << " now)\n";
       }
       stored = client_.PutSphereSet(file->set, mesh);
     } else if (!usable.ok()) {

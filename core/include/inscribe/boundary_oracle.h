@@ -36,7 +36,9 @@ enum class InsideTest {
   // on the mesh's own coordinates, with the ray's origin perturbed symbolically so that rays
   // through edges and vertices count each sheet once. Right for every closed, consistently
   // oriented mesh: any number of shells and cavities, overlapping bodies, non-manifold
-  // vertices, zero-area triangles, any finite coordinates. One ray cast per query.
+  // vertices, zero-area triangles, any finite coordinates. One ray cast per query and no
+  // closest point. A query on the surface is kOnBoundary when the ray finds it on a triangle
+  // it crosses, else classified as a point infinitesimally beside it.
   kExactWinding,
 };
 
@@ -103,8 +105,7 @@ class BoundaryOracle {
   }
   Side Classify(const Vector3& query) const;
   // The same answer as Classify(query), given `closest` = ClosestPoint(query) (with or without
-  // a bound), so the pseudonormal test costs no second query. The ray-parity test casts its
-  // rays as usual.
+  // a bound), so the pseudonormal test costs no second query; the exact test ignores it.
   Side Classify(const Vector3& query, const BoundaryPoint& closest) const;
   // Distance to the boundary, negative inside, 0 on it.
   double SignedDistance(const Vector3& query) const;

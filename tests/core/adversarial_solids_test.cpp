@@ -233,5 +233,33 @@ TEST(AdversarialSolids, OverlappingIcospheres) {
   ExpectClassifiedAsMeant(assembly, *solid, 10'000, 15'000, 5'000, 12);
 }
 
+// The checks above have teeth: a solid whose cavity kept the orientation it was given (as when
+// nesting went unchecked above 256 components) and the pseudonormal test on overlapping bodies
+// (wrong near the buried faces) are both caught.
+TEST(AdversarialSolids, CatchMisorientedCavityAndPseudonormalOnOverlaps) {
+  const Assembly hollow = testing::HollowBoxWithDebris(false);
+  ValidatedMesh as_given = ValidateMesh(hollow.input);
+  as_given.mesh = hollow.input;
+  absl::StatusOr<Solid> unfixed = MakeSolid(std::move(as_given));
+  ASSERT_TRUE(unfixed.ok()) << unfixed.status();
+  const Tally cavity = Classify(hollow, *unfixed, testing::AssemblyPoints(hollow, 0, 5'000, 0, 13));
+  EXPECT_GT(cavity.misclassified, 500);
+  EXPECT_GT(cavity.misoriented, 100);
+
+  for (const Assembly& overlap :
+       {testing::OverlapWithTouchingTetrahedron(), testing::OverlappingIcospheres()}) {
+    absl::StatusOr<Solid> solid = PrepareSolid(overlap.input);
+    ASSERT_TRUE(solid.ok()) << solid.status();
+    BoundaryOracleOptions options;
+    options.inside_test = InsideTest::kPseudonormal;
+    absl::StatusOr<BoundaryOracle> oracle = BoundaryOracle::Build(solid->mesh(), options);
+    ASSERT_TRUE(oracle.ok()) << oracle.status();
+    const Solid fast{solid->report, solid->sha256, *std::move(oracle)};
+    const Tally tally = Classify(overlap, fast, testing::AssemblyPoints(overlap, 0, 5'000, 0, 14));
+    EXPECT_GT(tally.misclassified, 0) << overlap.name;
+    EXPECT_EQ(tally.misoriented, 0) << overlap.name;
+  }
+}
+
 }  // namespace
 }  // namespace inscribe

@@ -90,14 +90,6 @@ Assembly HollowBoxWithDebris(bool cavity_inward) {
   return builder.Take();
 }
 
-Assembly HollowBox() {
-  AssemblyBuilder builder("hollow box");
-  builder.Add(Box(Vector3::Constant(-1.0), Vector3::Constant(1.0)), false);
-  builder.Add(Inverted(Box(Vector3::Constant(-0.6), Vector3::Constant(0.6))), true);
-  builder.Focus(Around(Vector3::Constant(-0.6), Vector3::Constant(0.6), 0.05));
-  return builder.Take();
-}
-
 Assembly OverlapWithTouchingTetrahedron() {
   AssemblyBuilder builder("overlapping boxes with a tetrahedron on a corner");
   const Vector3 b_lo(0.5, 0.3, 0.2), b_hi(1.5, 1.3, 1.2);

@@ -29,8 +29,6 @@ struct Assembly {
 // given facing inward (as meant), else outward (validation must find it enclosed and flip
 // it). Every seventh piece of debris is given inside out either way.
 Assembly HollowBoxWithDebris(bool cavity_inward);
-// The hollow box alone (2 components), same cavity, given facing outward.
-Assembly HollowBox();
 // (b) Boxes [0, 1]^3 and [0.5, 1.5] x [0.3, 1.3] x [0.2, 1.2] overlapping (the second given
 // inside out), and a tetrahedron in the negative octant sharing the first box's corner vertex
 // (0, 0, 0), the same vertex index: a non-manifold vertex and a self-intersection.

@@ -25,8 +25,9 @@ struct SceneFileObject {
   std::string spheres_path;
   std::string mesh_path;
   SphereSetParameters generate;
-  // Optional: a cover of the solid, making the object certified. Its file records its
-  // certificate, or mesh_path names the mesh the service certifies it against.
+  // Optional: a cover of the solid, making the object certified. Its file records the
+  // certificate of its spheres (UsableCoverCertificate), or mesh_path names the mesh the
+  // service certifies it against.
   std::string cover_path;
 };
 

@@ -28,6 +28,11 @@ using internal::RoundUp;
 // the rounding of u = sqrt(d^2) itself (the flat BVH checks the same inside its query).
 constexpr double kBoundRelative = 1e-13;
 
+// Below these the pseudonormal's sign is not trusted (see ClassifyFrom): relative to the
+// distance, and to the mesh's largest coordinate.
+constexpr double kPseudonormalMargin = 1e-7;
+constexpr double kPseudonormalAbsolute = 1e-12;
+
 absl::Status CheckVertices(const Vertices& vertices) {
   for (Eigen::Index v = 0; v < vertices.rows(); ++v) {
     if (!vertices.row(v).allFinite()) {
@@ -58,6 +63,7 @@ struct BoundaryOracle::Impl {
 
   // Backend kEmbree (all null otherwise).
   float pad = 0;  // outward padding of every primitive box (see UpdateBoxAndPad)
+  double magnitude = 0.0;  // largest |coordinate| of the vertices (UpdateBoxAndPad)
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;
   RTCGeometry geometry = nullptr;
@@ -281,7 +287,7 @@ BoundaryPoint BoundaryOracle::Impl::Closest(const Vector3& p, double upper_bound
 // away from it, and queries outside the bbox never cast rays, so |p| is bounded by the mesh.
 void BoundaryOracle::Impl::UpdateBoxAndPad() {
   box = ComputeBoundingBox(mesh.vertices);
-  const double magnitude = std::max(box.min.cwiseAbs().maxCoeff(), box.max.cwiseAbs().maxCoeff());
+  magnitude = std::max(box.min.cwiseAbs().maxCoeff(), box.max.cwiseAbs().maxCoeff());
   pad = RoundUp(1e-6 * magnitude + 1e-30);
 }
 
@@ -367,6 +373,13 @@ Side BoundaryOracle::Impl::ClassifyFrom(const Vector3& p, const BoundaryPoint& c
     normal = face_normals[static_cast<std::size_t>(t)];
   }
   const double s = (p - closest.point).dot(normal);
+  // The sign is trusted only well clear of the rounding of the normals (relative 1e-15 of
+  // their weights, summed over at most a few dozen faces) and of the closest point (1e-15 of
+  // the coordinates): nearly cancelling normals, as at the edges of a flat sliver, or a query
+  // almost in the feature's tangent plane, are decided by the exact winding number instead.
+  const double margin = kPseudonormalMargin * closest.distance * std::max(normal.norm(), 1.0) +
+                        kPseudonormalAbsolute * magnitude * normal.norm();
+  if (!(std::abs(s) > margin)) return ClassifyByWinding(p);
   return s < 0.0 ? Side::kInside : Side::kOutside;
 }
 

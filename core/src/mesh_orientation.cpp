@@ -37,18 +37,19 @@ void FlipTriangle(Mesh& mesh, Eigen::Index t) {
   std::swap(mesh.triangles(t, 1), mesh.triangles(t, 2));
 }
 
-// How many other shells enclose each component: shell o encloses c when up to kSamples of c's
-// vertices, spread over it, all lie strictly inside o (o's winding number around them is not
-// zero, and none lies on o). Shells that merely overlap or touch (a self-intersecting union,
-// bodies meeting at a vertex) do not enclose. Every winding number is exact (XRayCrossing along
-// one ray per sample, the crossings added up per component), so the answer holds for any
-// number of components. Cost: one ray per component that no other one may enclose, up to
-// kSamples for the others; O(#T log #T) for the tree, none for a single component.
+// How many other shells enclose each component: shell o encloses c when every vertex of c lies
+// strictly inside o (o's winding number around it is not zero, and it lies on no triangle of
+// o). Shells that overlap or touch (a self-intersecting union, bodies meeting at a vertex) do
+// not enclose; a shell whose vertices are all inside another but whose triangles pass out of
+// it intersects it, and is taken as enclosed. Every winding number is exact (XRayCrossing
+// along one ray per vertex, crossings added up per component), so the answer holds for any
+// number of components. Cost: one ray for a component that no shell holds its first vertex,
+// one per vertex while some shell holds all so far; O(#T log #T) for the tree, nothing for a
+// single component.
 std::vector<int> NestingDepths(const Mesh& mesh, const std::vector<std::int32_t>& component,
                                const std::vector<std::vector<std::int32_t>>& members) {
   std::vector<int> depth(members.size(), 0);
   if (members.size() < 2) return depth;
-  constexpr std::size_t kSamples = 16;
   const TriangleBvh bvh = TriangleBvh::Build(mesh);
   // Per sample: the components other than `own` whose winding around it is not zero.
   std::vector<std::pair<std::int32_t, int>> crossings;  // (component, crossing)
@@ -83,10 +84,16 @@ std::vector<int> NestingDepths(const Mesh& mesh, const std::vector<std::int32_t>
   };
   for (std::size_t c = 0; c < members.size(); ++c) {
     const auto own = static_cast<std::int32_t>(c);
-    const std::size_t step = std::max<std::size_t>(1, members[c].size() / kSamples);
+    std::vector<std::int32_t> vertices;
+    vertices.reserve(3 * members[c].size());
+    for (const std::int32_t t : members[c]) {
+      for (int k = 0; k < 3; ++k) vertices.push_back(mesh.triangles(t, k));
+    }
+    std::sort(vertices.begin(), vertices.end());
+    vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
     std::vector<std::int32_t> enclosers;
-    for (std::size_t i = 0, n = 0; i < members[c].size() && n < kSamples; i += step, ++n) {
-      const Vector3 p = mesh.vertices.row(mesh.triangles(members[c][i], 0)).transpose();
+    for (std::size_t n = 0; n < vertices.size(); ++n) {
+      const Vector3 p = mesh.vertices.row(vertices[n]).transpose();
       std::vector<std::int32_t> here = enclosing(p, own);
       if (n == 0) {
         enclosers = std::move(here);

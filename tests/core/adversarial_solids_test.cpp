@@ -1,13 +1,14 @@
 // The one inside test of a solid against the winding number by brute force
 // (support/winding_oracle.h), on assemblies built to break it (support/adversarial_assemblies.h):
 // a cavity in either orientation among 300 other shells, overlapping bodies with a shell
-// touching at one vertex, nested shells, shells 1e-9 apart, coordinates near 1e5, a plate
-// 1e-3 thick, collinear triangles, overlapping icospheres. Inside is where the winding number
-// of the shells as meant is nonzero (a cavity subtracts, an overlap stays inside); at every
-// sampled point that the brute force can decide, Solid::oracle must agree (ClassifyAll), and
-// validation must have oriented the shells as meant (the winding number of Solid::mesh() is
-// nonzero at the same points). About 1.1 million points in all. The sphere sets, covers and
-// distance intervals of such solids: adversarial_spheres_test.cpp.
+// touching at one vertex, a shell poking out of another, nested shells, shells 1e-9 apart,
+// coordinates near 1e5, a plate 1e-3 thick, collinear triangles, a shell flat to within
+// rounding, overlapping icospheres. Inside is where the winding number of the shells as meant
+// is nonzero (a cavity subtracts, an overlap stays inside); at every sampled point that the
+// brute force can decide, Solid::oracle must agree (ClassifyAll), and validation must have
+// oriented the shells as meant (the winding number of Solid::mesh() is nonzero at the same
+// points). About 1.2 million points in all. The sphere sets, covers and distance intervals of
+// such solids: adversarial_spheres_test.cpp.
 #include <gtest/gtest.h>
 
 #include <array>
@@ -167,6 +168,16 @@ TEST(AdversarialSolids, OverlappingBoxesWithTetrahedronOnACorner) {
   ExpectClassifiedAsMeant(assembly, *solid, 40'000, 40'000, 20'000, 3);
 }
 
+// The tetrahedron's corners 0 and 1 lie inside the box, 2 and 3 outside: a nesting test that
+// looks at some corners only may take it for a cavity of the box.
+TEST(AdversarialSolids, TetrahedronPokingOutOfABox) {
+  const Assembly assembly = testing::TetrahedronPokingOutOfABox();
+  const absl::StatusOr<Solid> solid = PrepareSolid(assembly.input);
+  ASSERT_TRUE(solid.ok()) << solid.status();
+  EXPECT_GT(solid->report.self_intersecting_pairs, 0);
+  ExpectClassifiedAsMeant(assembly, *solid, 20'000, 30'000, 10'000, 15);
+}
+
 TEST(AdversarialSolids, NestedShellsGivenOutward) {
   const Assembly assembly = testing::NestedShells(false);
   const absl::StatusOr<Solid> solid = PrepareSolid(assembly.input);
@@ -224,6 +235,13 @@ TEST(AdversarialSolids, BoxWithCollinearTriangles) {
   ASSERT_TRUE(solid.ok()) << solid.status();
   EXPECT_EQ(solid->report.degenerate_triangles, 5);
   ExpectClassifiedAsMeant(assembly, *solid, 20'000, 50'000, 10'000, 11);
+}
+
+TEST(AdversarialSolids, SliverTetrahedronBesideABox) {
+  const Assembly assembly = testing::SliverTetrahedronBesideABox();
+  const absl::StatusOr<Solid> solid = PrepareSolid(assembly.input);
+  ASSERT_TRUE(solid.ok()) << solid.status();
+  ExpectClassifiedAsMeant(assembly, *solid, 20'000, 30'000, 10'000, 16);
 }
 
 TEST(AdversarialSolids, OverlappingIcospheres) {

@@ -85,11 +85,13 @@ Mesh MakeShell(int kind, const Vector3& centre, double half, ByteStream& bytes) 
       return inscribe::testing::Box(centre - Vector3::Constant(half),
                                     centre + Vector3::Constant(half));
     case 1: {
-      // Corners at centre + half * (step), steps from the bytes (may be coplanar: a flat shell).
+      // Corners of the cube [-1, 1]^3 (times half, about centre), three of them moved by a step
+      // in {-1, 0, 1}^3 from the bytes: coplanar corners (a flat shell of four zero-area
+      // triangles) and coincident ones occur.
       const Vector3 a = centre + half * Vector3(-1, -1, -1);
-      const Vector3 b = centre + half * (Vector3(1, -1, -1) + 0.5 * bytes.UnitStep());
-      const Vector3 c = centre + half * (Vector3(-1, 1, -1) + 0.5 * bytes.UnitStep());
-      const Vector3 d = centre + half * (Vector3(-1, -1, 1) + 0.5 * bytes.UnitStep());
+      const Vector3 b = centre + half * (Vector3(1, -1, -1) + bytes.UnitStep());
+      const Vector3 c = centre + half * (Vector3(-1, 1, -1) + bytes.UnitStep());
+      const Vector3 d = centre + half * (Vector3(-1, -1, 1) + bytes.UnitStep());
       return inscribe::testing::Tetrahedron(a, b, c, d);
     }
     default:
@@ -264,8 +266,8 @@ std::vector<Vector3> ReadPoints(ByteStream& bytes, const std::vector<Shell>& she
 }
 
 [[noreturn]] void Fail(const char* what, const std::vector<Shell>& shells,
-                       const inscribe::Solid& solid, const Vector3& p, const WindingSample& w,
-                       const char* side) {
+                       const std::vector<bool>& meant_inverted, const inscribe::Solid& solid,
+                       const Vector3& p, const WindingSample& w, const char* side) {
   std::fprintf(stderr,
                "fuzz_assembly: %s\n  at (%.17g, %.17g, %.17g): winding %d (sum %.12g), %s\n", what,
                p.x(), p.y(), p.z(), w.winding, w.raw, side);
@@ -277,10 +279,20 @@ std::vector<Vector3> ReadPoints(ByteStream& bytes, const std::vector<Shell>& she
                solid.report.self_intersections_checked ? 1 : 0,
                static_cast<long long>(solid.report.non_manifold_vertices),
                static_cast<long long>(solid.report.degenerate_triangles));
-  for (const Shell& s : shells) {
-    std::fprintf(stderr, "  shell: %lld vertices, %s%s\n",
-                 static_cast<long long>(s.outward.num_vertices()), s.how,
-                 s.given_inverted ? ", given inside out" : "");
+  for (std::size_t i = 0; i < shells.size(); ++i) {
+    const Shell& s = shells[i];
+    const inscribe::BoundingBox box = inscribe::ComputeBoundingBox(s.outward.vertices);
+    std::fprintf(stderr, "  shell %zu: %lld vertices in [%g, %g] x [%g, %g] x [%g, %g], %s%s%s\n",
+                 i, static_cast<long long>(s.outward.num_vertices()), box.min.x(), box.max.x(),
+                 box.min.y(), box.max.y(), box.min.z(), box.max.z(), s.how,
+                 s.given_inverted ? ", given inside out" : "",
+                 meant_inverted.empty() ? ""
+                 : meant_inverted[i]    ? ", a cavity as meant"
+                                        : ", outward as meant");
+    for (Eigen::Index v = 0; v < s.outward.num_vertices(); ++v) {
+      std::fprintf(stderr, "    vertex %lld: (%.17g, %.17g, %.17g)\n", static_cast<long long>(v),
+                   s.outward.vertices(v, 0), s.outward.vertices(v, 1), s.outward.vertices(v, 2));
+    }
   }
   std::abort();
 }
@@ -313,8 +325,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (w.reliable) {
       const inscribe::Side side = solid->oracle.Classify(p);
       if (side != (w.inside() ? inscribe::Side::kInside : inscribe::Side::kOutside)) {
-        Fail("Classify disagrees with the winding number of the validated mesh", shells, *solid, p,
-             w, SideName(side));
+        Fail("Classify disagrees with the winding number of the validated mesh", shells,
+             meant_inverted, *solid, p, w, SideName(side));
       }
     }
     if (meant) {
@@ -323,7 +335,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         Fail(
             "validation oriented a shell against the nesting rule (winding of the shells as "
             "meant shown)",
-            shells, *solid, p, m,
+            shells, meant_inverted, *solid, p, m,
             w.inside() ? "validated mesh: inside" : "validated mesh: outside");
       }
     }

@@ -117,6 +117,15 @@ Assembly OverlapWithTouchingTetrahedron() {
   return builder.Take();
 }
 
+Assembly TetrahedronPokingOutOfABox() {
+  AssemblyBuilder builder("tetrahedron poking out of a box");
+  const Vector3 a(0.3, 0.5, 0.5), b(0.5, 0.3, 0.5), c(1.4, 0.6, 0.4), d(1.4, 0.5, 0.8);
+  builder.Add(UnitCube(), false);
+  builder.Add(Tetrahedron(a, b, c, d), true);
+  builder.Focus(BoundingBox{Vector3(0.25, 0.25, 0.35), Vector3(1.45, 0.65, 0.85)});
+  return builder.Take();
+}
+
 Assembly NestedShells(bool given_inverted) {
   AssemblyBuilder builder(given_inverted ? "nested shells, given inside out"
                                          : "nested shells, given outward");
@@ -196,6 +205,19 @@ Assembly BoxWithCollinearTriangles() {
     builder.Focus(Around(a.cwiseMin(b), a.cwiseMax(b), 0.02));
   }
   builder.Add(mesh, false);
+  return builder.Take();
+}
+
+Assembly SliverTetrahedronBesideABox() {
+  AssemblyBuilder builder("sliver tetrahedron beside a box");
+  builder.Add(Box(Vector3::Constant(0.5), Vector3::Constant(1.5)), false);
+  const Vector3 a(-0.38950373607782318, 0.040145213590864301, 0.18486536021429584);
+  const Vector3 b(-0.4668687438319471, 0.18867193007190214, -0.3484773720569575);
+  const Vector3 c(-0.34508871926043783, 0.21476908823588653, 0.57860868864675452);
+  const Vector3 d(-0.35655374514108473, -0.28300537753519567, 0.3244647640530906);
+  builder.Add(Tetrahedron(a, b, c, d), true);
+  builder.Focus(BoundingBox{Vector3(-0.6, -0.4, -0.5), Vector3(-0.2, 0.4, 0.7)});
+  builder.Focus(BoundingBox{Vector3(-0.6, -0.4, -0.5), Vector3(1.6, 1.6, 1.6)});
   return builder.Take();
 }
 

@@ -41,6 +41,11 @@ Assembly NestedShells(bool given_inverted);
 Assembly OffsetTwinBoxes();
 // (d) The unit box with the cavity [1e-9, 1 - 1e-9]^3 (walls 1e-9 thick), given outward.
 Assembly HairlineHollowBox();
+// (b) The unit box and a tetrahedron poking out of it through its face x = 1: corners
+// (0.3, 0.5, 0.5) and (0.5, 0.3, 0.5) inside the box, (1.4, 0.6, 0.4) and (1.4, 0.5, 0.8)
+// outside. They overlap, so neither encloses the other: both face outward (their union), the
+// tetrahedron given inside out.
+Assembly TetrahedronPokingOutOfABox();
 // (e) `assembly` with every vertex moved by `offset` (focus regions too).
 Assembly TranslatedAssembly(const Assembly& assembly, const Vector3& offset);
 // (f) The plate [0, 1] x [0, 1] x [0, 1e-3].
@@ -49,6 +54,10 @@ Assembly ThinPlate();
 // representable point of the edge by a zero-area triangle: closed and edge-manifold, with
 // five collinear triangles.
 Assembly BoxWithCollinearTriangles();
+// (g) The box [0.5, 1.5]^3 and a tetrahedron (sides about 0.6) whose corners are coplanar to
+// within rounding (volume -1.8e-17, from fuzz_assembly): exact predicates find no zero-area
+// triangle and no self-intersection, yet its two sheets lie closer than rounding apart.
+Assembly SliverTetrahedronBesideABox();
 // (h) Four overlapping icospheres (level 2, 320 triangles each), the second given inside out.
 Assembly OverlappingIcospheres();
 

@@ -96,6 +96,8 @@ void PrintCertificate(const EvaluateCliOptions& options, const SphereFile& file,
     j["spheres_path"] = options.spheres_path;
     j["spheres"] = file.set.size();
     j["certified"] = c.certified;
+    j["certified_mesh_sha256"] = c.mesh_sha256;
+    j["certified_spheres_sha256"] = c.spheres_sha256;
     j["delta"] = c.delta;
     j["resolution"] = c.resolution;
     j["cells"] = c.cells;
@@ -119,6 +121,7 @@ void PrintCertificate(const EvaluateCliOptions& options, const SphereFile& file,
   line("mesh", options.mesh_path);
   line("spheres", absl::StrFormat("%s (%d)", options.spheres_path, file.set.size()));
   line("cover", CoverVerdict(c));
+  line("proved for", absl::StrFormat("mesh %s, spheres %s", c.mesh_sha256, c.spheres_sha256));
   line("delta (reach outside)", absl::StrFormat("%.6g", c.delta));
   line("proof",
        absl::StrFormat("%d cells: %d in one sphere, %d outside the solid, %d failed; "

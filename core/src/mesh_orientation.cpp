@@ -33,6 +33,22 @@ double ComponentVolume(const Mesh& mesh, const std::vector<std::int32_t>& triang
   return six_volume / 6.0;
 }
 
+// A shell's box.
+BoundingBox ShellBox(const Mesh& mesh, const std::vector<std::int32_t>& triangles) {
+  Vector3 lo = Vector3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (std::int32_t t : triangles) {
+    for (int k = 0; k < 3; ++k) {
+      lo = lo.cwiseMin(mesh.vertices.row(mesh.triangles(t, k)).transpose());
+      hi = hi.cwiseMax(mesh.vertices.row(mesh.triangles(t, k)).transpose());
+    }
+  }
+  return BoundingBox{lo, hi};
+}
+
+// Below this fraction of its box's largest side cubed, a shell is flat: the floating-point
+// sign of its volume, and the pseudonormals of its nearly coincident sheets, are not trusted.
+constexpr double kFlatVolume = 1e-9;
+
 void FlipTriangle(Mesh& mesh, Eigen::Index t) {
   std::swap(mesh.triangles(t, 1), mesh.triangles(t, 2));
 }
@@ -176,18 +192,21 @@ bool MakeOrientationConsistent(Mesh& mesh, const std::vector<EdgeUse>& uses,
   return true;
 }
 
-void OrientComponentsOutward(Mesh& mesh, const std::vector<std::int32_t>& component,
-                             std::int64_t num_components, std::vector<char>& flip) {
+std::int64_t OrientComponentsOutward(Mesh& mesh, const std::vector<std::int32_t>& component,
+                                     std::int64_t num_components, std::vector<char>& flip) {
   std::vector<std::vector<std::int32_t>> members(static_cast<std::size_t>(num_components));
   for (std::size_t t = 0; t < component.size(); ++t) {
     if (component[t] >= 0)
       members[static_cast<std::size_t>(component[t])].push_back(static_cast<std::int32_t>(t));
   }
-  const BoundingBox box = ComputeBoundingBox(mesh.vertices);
-  const Vector3 origin = 0.5 * (box.min + box.max);
   const std::vector<int> depth = NestingDepths(mesh, component, members);
+  std::int64_t flat = 0;
   for (std::size_t c = 0; c < members.size(); ++c) {
-    const double volume = ComponentVolume(mesh, members[c], origin);
+    // About the shell's own centre, so that its rounding is relative to the shell's size.
+    const BoundingBox box = ShellBox(mesh, members[c]);
+    const double volume = ComponentVolume(mesh, members[c], 0.5 * (box.min + box.max));
+    const double side = (box.max - box.min).maxCoeff();
+    if (!(std::abs(volume) > kFlatVolume * side * side * side)) ++flat;
     const bool want_positive = depth[c] % 2 == 0;
     if ((volume > 0) != want_positive && volume != 0.0) {
       for (std::int32_t t : members[c]) {
@@ -196,6 +215,7 @@ void OrientComponentsOutward(Mesh& mesh, const std::vector<std::int32_t>& compon
       }
     }
   }
+  return flat;
 }
 
 }  // namespace inscribe::internal

@@ -25,7 +25,9 @@ bool MakeOrientationConsistent(Mesh& mesh, const std::vector<EdgeUse>& uses,
 // a cavity (negative volume), for any number of components, with exact winding numbers, so
 // that the solid is where the winding number of the result is not zero (InsideTest). Toggles
 // `flip` for the triangles it reverses. Needs consistent orientation within each component.
-void OrientComponentsOutward(Mesh& mesh, const std::vector<std::int32_t>& component,
-                             std::int64_t num_components, std::vector<char>& flip);
+// Returns how many shells are flat: so little volume for their size that their orientation's
+// sign, and the pseudonormal near them, cannot be trusted (the exact test is then needed).
+std::int64_t OrientComponentsOutward(Mesh& mesh, const std::vector<std::int32_t>& component,
+                                     std::int64_t num_components, std::vector<char>& flip);
 
 }  // namespace inscribe::internal

@@ -298,7 +298,7 @@ void CheckOrientation(Mesh& mesh, const std::vector<EdgeUse>& uses, const EdgeGr
              1);
     return;
   }
-  internal::OrientComponentsOutward(mesh, component, report.components, flip);
+  report.flat_shells = internal::OrientComponentsOutward(mesh, component, report.components, flip);
   ReportFlips(flip, component, report);
 }
 
@@ -373,7 +373,8 @@ void FillHolesAndOrient(Mesh& mesh, const std::vector<EdgeUse>& uses, const Edge
       LabelComponents(closed, closed_uses, closed_groups, closed_report);
   flip.resize(static_cast<std::size_t>(closed.num_triangles()), 0);
   if (options.fix_orientation) {
-    internal::OrientComponentsOutward(closed, closed_component, closed_report.components, flip);
+    report.flat_shells =
+        internal::OrientComponentsOutward(closed, closed_component, closed_report.components, flip);
   }
   // Only the triangles as given count as flipped; the patch was made facing its neighbours.
   flip.resize(static_cast<std::size_t>(given));
@@ -549,6 +550,13 @@ ValidatedMesh ValidateMesh(Mesh mesh, const ValidateOptions& options) {
             report.self_intersecting_pairs);
       }
     }
+  }
+  if (report.flat_shells > 0 && report.usable()) {
+    AddIssue(report, Severity::kWarning, "flat_shells",
+             absl::StrCat(Plural(report.flat_shells, "shell encloses", "shells enclose"),
+                          " almost no volume for its size (under 1e-9 of its box's side cubed); "
+                          "the exact inside test is used"),
+             report.flat_shells);
   }
   if (!report.self_intersections_checked && report.usable()) {
     AddIssue(report, Severity::kWarning, "self_intersections_not_checked",

@@ -10,7 +10,7 @@ InsideTest InsideTestFor(const MeshReport& report) {
   const bool pseudonormal_proved = report.self_intersections_checked &&
                                    report.self_intersecting_pairs == 0 &&
                                    report.non_manifold_vertices == 0 &&
-                                   report.degenerate_triangles == 0;
+                                   report.degenerate_triangles == 0 && report.flat_shells == 0;
   return pseudonormal_proved ? InsideTest::kPseudonormal : InsideTest::kExactWinding;
 }
 

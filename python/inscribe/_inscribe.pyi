@@ -37,6 +37,7 @@ class MeshReport:
     inconsistent_edges: int
     components: int
     flipped_triangles: int
+    flat_shells: int
     self_intersections_checked: bool
     self_intersecting_pairs: int
     welded_vertices: int

@@ -121,6 +121,8 @@ void BindMesh(py::module_& m) {
       .def_readonly("inconsistent_edges", &MeshReport::inconsistent_edges)
       .def_readonly("components", &MeshReport::components)
       .def_readonly("flipped_triangles", &MeshReport::flipped_triangles)
+      .def_readonly("flat_shells", &MeshReport::flat_shells,
+                    "closed shells enclosing almost no volume (the exact inside test is used)")
       .def_readonly("self_intersections_checked", &MeshReport::self_intersections_checked)
       .def_readonly("self_intersecting_pairs", &MeshReport::self_intersecting_pairs)
       .def_readonly("welded_vertices", &MeshReport::welded_vertices)

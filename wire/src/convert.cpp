@@ -100,6 +100,7 @@ void MeshReportToProto(const MeshReport& report, v1::MeshReport* out) {
   out->set_welded_vertices(report.welded_vertices);
   out->set_weld_collapsed_triangles(report.weld_collapsed_triangles);
   out->set_weld_moved_within(report.weld_moved_within);
+  out->set_flat_shells(report.flat_shells);
   out->set_degenerate_triangles(report.degenerate_triangles);
   out->set_duplicate_triangles(report.duplicate_triangles);
   out->set_unreferenced_vertices(report.unreferenced_vertices);
@@ -142,6 +143,7 @@ absl::StatusOr<MeshReport> MeshReportFromProto(const v1::MeshReport& report) {
   out.welded_vertices = report.welded_vertices();
   out.weld_collapsed_triangles = report.weld_collapsed_triangles();
   out.weld_moved_within = report.weld_moved_within();
+  out.flat_shells = report.flat_shells();
   out.degenerate_triangles = report.degenerate_triangles();
   out.duplicate_triangles = report.duplicate_triangles();
   out.unreferenced_vertices = report.unreferenced_vertices();

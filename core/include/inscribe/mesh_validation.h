@@ -50,6 +50,9 @@ struct MeshReport {
   std::int64_t inconsistent_edges = 0;     // edges whose two triangles disagree on orientation
   std::int64_t components = 0;             // edge-connected components of triangles
   std::int64_t flipped_triangles = 0;      // triangles whose orientation the fix reversed
+  // Closed shells enclosing almost no volume for their size (the orientation fix's sign and
+  // the pseudonormal are not trusted near them; the solid then gets the exact inside test).
+  std::int64_t flat_shells = 0;
   bool self_intersections_checked = false;
   std::int64_t self_intersecting_pairs = 0;  // pairs of triangles that cross (exact predicates)
   // ValidateOptions::fill_holes: the border loops closed (all of them or none) and the

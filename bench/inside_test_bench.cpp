@@ -57,7 +57,8 @@ bool MollerTrumbore(const Vector3& o, const Vector3& d, const Vector3& a, const 
   return e2.dot(qvec) * inv > 0.0;
 }
 
-int ParityCrossings(const inscribe::internal::TriangleBvh& bvh, const Vector3& o, const Vector3& d) {
+int ParityCrossings(const inscribe::internal::TriangleBvh& bvh, const Vector3& o,
+                    const Vector3& d) {
   const double pad = 1e-10 * std::max(bvh.magnitude(), o.cwiseAbs().maxCoeff());
   const Vector3 inv = d.cwiseInverse();
   inscribe::internal::TriangleBvhRef stack[inscribe::internal::TriangleBvh::kTraversalStackSize];
@@ -110,8 +111,8 @@ Mesh Box(const Vector3& lo, const Vector3& hi) {
         ((i & 4) ? hi.z() : lo.z());
   }
   m.triangles.resize(12, 3);
-  m.triangles << 0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4, 2, 6, 3, 3, 6, 7, 0, 4, 2,
-      2, 4, 6, 1, 3, 5, 3, 7, 5;
+  m.triangles << 0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4, 2, 6, 3, 3, 6, 7, 0, 4, 2, 2,
+      4, 6, 1, 3, 5, 3, 7, 5;
   return m;
 }
 
@@ -174,9 +175,8 @@ int main(int argc, char** argv) {
   const std::string dir = env != nullptr ? env : std::string(INSCRIBE_SOURCE_DIR) + "/data";
   std::vector<std::pair<std::string, Mesh>> meshes;
   for (const std::string& name : names) {
-    absl::StatusOr<Mesh> mesh = inscribe::ReadMesh(name.find('/') == std::string::npos
-                                                       ? dir + "/" + name
-                                                       : name);
+    absl::StatusOr<Mesh> mesh =
+        inscribe::ReadMesh(name.find('/') == std::string::npos ? dir + "/" + name : name);
     if (!mesh.ok()) {
       std::fprintf(stderr, "%s: %s\n", name.c_str(), std::string(mesh.status().message()).c_str());
       return 2;
@@ -199,7 +199,8 @@ int main(int argc, char** argv) {
       return 2;
     }
     const Mesh& mesh = solid->mesh();
-    absl::StatusOr<BoundaryOracle> pseudo = BoundaryOracle::Build(mesh, {InsideTest::kPseudonormal});
+    absl::StatusOr<BoundaryOracle> pseudo =
+        BoundaryOracle::Build(mesh, {InsideTest::kPseudonormal});
     absl::StatusOr<BoundaryOracle> exact = BoundaryOracle::Build(mesh, {InsideTest::kExactWinding});
     const auto bvh = inscribe::internal::TriangleBvh::Build(mesh);
     SurfaceMesh surface;
@@ -209,9 +210,11 @@ int main(int argc, char** argv) {
           Kernel::Point_3(mesh.vertices(v, 0), mesh.vertices(v, 1), mesh.vertices(v, 2))));
     }
     for (Eigen::Index t = 0; t < mesh.triangles.rows(); ++t) {
-      surface.add_face(vs[mesh.triangles(t, 0)], vs[mesh.triangles(t, 1)], vs[mesh.triangles(t, 2)]);
+      surface.add_face(vs[mesh.triangles(t, 0)], vs[mesh.triangles(t, 1)],
+                       vs[mesh.triangles(t, 2)]);
     }
-    const bool cgal_ok = surface.number_of_faces() == static_cast<std::size_t>(mesh.num_triangles());
+    const bool cgal_ok =
+        surface.number_of_faces() == static_cast<std::size_t>(mesh.num_triangles());
     const inscribe::BoundingBox box = inscribe::ComputeBoundingBox(mesh.vertices);
     std::mt19937_64 rng(11);
     std::vector<Vector3> points(static_cast<std::size_t>(queries));
@@ -223,10 +226,12 @@ int main(int argc, char** argv) {
     }
     std::vector<char> a(points.size()), b(points.size()), c(points.size()), d(points.size(), 0);
     auto start = std::chrono::steady_clock::now();
-    for (std::size_t i = 0; i < points.size(); ++i) a[i] = pseudo->Classify(points[i]) == Side::kInside;
+    for (std::size_t i = 0; i < points.size(); ++i)
+      a[i] = pseudo->Classify(points[i]) == Side::kInside;
     const double pseudo_rate = Rate(queries, start);
     start = std::chrono::steady_clock::now();
-    for (std::size_t i = 0; i < points.size(); ++i) b[i] = exact->Classify(points[i]) == Side::kInside;
+    for (std::size_t i = 0; i < points.size(); ++i)
+      b[i] = exact->Classify(points[i]) == Side::kInside;
     const double exact_rate = Rate(queries, start);
     start = std::chrono::steady_clock::now();
     for (std::size_t i = 0; i < points.size(); ++i) c[i] = ParityInside(bvh, box, points[i]);
@@ -241,8 +246,8 @@ int main(int argc, char** argv) {
       }
       cgal_rate = Rate(queries, start);
     }
-    const bool clean = solid->report.self_intersections_checked &&
-                       solid->report.self_intersecting_pairs == 0;
+    const bool clean =
+        solid->report.self_intersections_checked && solid->report.self_intersecting_pairs == 0;
     int disagree = 0;
     for (std::size_t i = 0; i < points.size(); ++i) {
       if (clean && (b[i] != c[i] || (cgal_ok && b[i] != d[i]))) ++disagree;
@@ -252,12 +257,11 @@ int main(int argc, char** argv) {
       ++failures;
       std::fprintf(stderr, "%s: %d queries disagree\n", name.c_str(), disagree);
     }
-    std::printf("%-24s %7lld %12.0f %12.0f %12.0f %12.0f %8.2fx %8.2fx %s\n", name.c_str(),
-                static_cast<long long>(solid->report.self_intersecting_pairs), pseudo_rate,
-                exact_rate, parity_rate, cgal_rate, exact_rate / parity_rate,
-                exact_rate / pseudo_rate,
-                InsideTestFor(solid->report) == InsideTest::kPseudonormal ? "pseudonormal"
-                                                                           : "exact");
+    std::printf(
+        "%-24s %7lld %12.0f %12.0f %12.0f %12.0f %8.2fx %8.2fx %s\n", name.c_str(),
+        static_cast<long long>(solid->report.self_intersecting_pairs), pseudo_rate, exact_rate,
+        parity_rate, cgal_rate, exact_rate / parity_rate, exact_rate / pseudo_rate,
+        InsideTestFor(solid->report) == InsideTest::kPseudonormal ? "pseudonormal" : "exact");
   }
   std::printf(
       "pairs: self-intersecting triangle pairs; ex/par, ex/pseudo: rate ratios (above 1: the "

@@ -62,7 +62,7 @@ struct BoundaryOracle::Impl {
   internal::TriangleBvh bvh;
 
   // Backend kEmbree (all null otherwise).
-  float pad = 0;  // outward padding of every primitive box (see UpdateBoxAndPad)
+  float pad = 0;           // outward padding of every primitive box (see UpdateBoxAndPad)
   double magnitude = 0.0;  // largest |coordinate| of the vertices (UpdateBoxAndPad)
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;
@@ -330,7 +330,8 @@ int BoundaryOracle::Impl::EmbreeWinding(const Vector3& p, bool* on_surface) cons
   rayhit.ray.dir_z = 0.0f;
   // From behind the float origin: float(p_x) may lie past p_x.
   rayhit.ray.tnear = 0.0f;
-  rayhit.ray.org_x = std::nextafter(rayhit.ray.org_x, -std::numeric_limits<float>::infinity()) - pad;
+  rayhit.ray.org_x =
+      std::nextafter(rayhit.ray.org_x, -std::numeric_limits<float>::infinity()) - pad;
   rayhit.ray.tfar = std::numeric_limits<float>::infinity();
   rayhit.ray.time = 0.0f;
   rayhit.ray.mask = 0xFFFFFFFFu;

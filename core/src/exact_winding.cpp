@@ -48,7 +48,8 @@ int XRayCrossing(const Vector3& p, const Vector3& a, const Vector3& b, const Vec
   }
   // The line through p* meets the triangle's plane; ahead of p when p lies on the side the
   // normal's x component points away from: sign((p - a) . n) = -sign(n_x) = -s.
-  const int side = static_cast<int>(CGAL::orientation(AsPoint(a), AsPoint(b), AsPoint(c), AsPoint(p)));
+  const int side =
+      static_cast<int>(CGAL::orientation(AsPoint(a), AsPoint(b), AsPoint(c), AsPoint(p)));
   if (side == 0) return kOnTriangle;
   return side == -s ? s : 0;
 }

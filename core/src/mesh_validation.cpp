@@ -545,7 +545,8 @@ ValidatedMesh ValidateMesh(Mesh mesh, const ValidateOptions& options) {
                 patch_pairs > 0
                     ? absl::StrCat("; ", patch_pairs, " involve triangles that fill holes")
                     : std::string(),
-                "); the solid is the union of what they bound (winding number not zero), classified "
+                "); the solid is the union of what they bound (winding number not zero), "
+                "classified "
                 "with the exact inside test"),
             report.self_intersecting_pairs);
       }
@@ -563,7 +564,8 @@ ValidatedMesh ValidateMesh(Mesh mesh, const ValidateOptions& options) {
              report.non_manifold_vertices > 0
                  ? "self-intersections were not checked (some vertices are not manifold); the "
                    "exact inside test is used"
-                 : "self-intersections were not checked; the exact inside test is used", 0);
+                 : "self-intersections were not checked; the exact inside test is used",
+             0);
   }
   std::stable_sort(report.issues.begin(), report.issues.end(),
                    [](const MeshIssue& a, const MeshIssue& b) {

@@ -75,7 +75,6 @@ inline Eigen::Array2d ChildSquaredDistances(const TriangleBvhNode& n, const Vect
   return d2;
 }
 
-
 // p in the leaf's frame: (axes[k] . p) for k = 0, 1, 2.
 inline Vector3 ToLeafFrame(const TriangleBvhLeaf& leaf, const Vector3& p) {
   Vector3 x;

@@ -393,9 +393,9 @@ absl::StatusOr<RobotSpherizeResult> SpherizeRobot(const UrdfRobot& robot,
       }
       if (prepared.solid) {
         for (const MeshIssue& issue : prepared.solid->report.notices()) {
-          result.warnings.push_back(absl::StrCat(DescribeUrdfElement(link.elements[k], link.from_visual),
-                                                 ": ", SeverityName(issue.severity), ": ",
-                                                 issue.message));
+          result.warnings.push_back(
+              absl::StrCat(DescribeUrdfElement(link.elements[k], link.from_visual), ": ",
+                           SeverityName(issue.severity), ": ", issue.message));
         }
       }
       if (prepared.solid || prepared.sphere) elements.push_back(std::move(prepared));

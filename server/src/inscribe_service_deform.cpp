@@ -210,9 +210,9 @@ grpc::ServerUnaryReactor* InscribeService::UpdateDeformation(
         options.strict = request->strict();
         options.direction = request->interpolated_normal() ? ContactDirection::kInterpolatedNormal
                                                            : ContactDirection::kCarriedFrame;
-        // As the stored mesh's own oracle, unless the caller asks for ray parity.
-        options.oracle.inside_test =
-            request->ray_parity() ? InsideTest::kExactWinding : InsideTestFor((*mesh)->solid.report);
+        // As the stored mesh's own oracle, unless the caller asks for the exact test.
+        options.oracle.inside_test = request->ray_parity() ? InsideTest::kExactWinding
+                                                           : InsideTestFor((*mesh)->solid.report);
         absl::StatusOr<std::shared_ptr<const DeformerEntry>> entry =
             store_->GetDeformer(*mesh_key, request->sphere_set_key(), options);
         if (!entry.ok()) return entry.status();

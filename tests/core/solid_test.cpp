@@ -78,7 +78,8 @@ TEST(Solid, ASelfIntersectingMeshIsTheUnionUnderTheExactTest) {
 TEST(Solid, ThePseudonormalNeedsItsConditionsProved) {
   // The second cube's corner at (1, 1, 1) is the first one's vertex: one vertex, two fans.
   const Mesh cube_a = testing::UnitCube();
-  Mesh touching = testing::Concatenate(cube_a, testing::Box(Vector3::Ones(), Vector3::Constant(2.0)));
+  Mesh touching =
+      testing::Concatenate(cube_a, testing::Box(Vector3::Ones(), Vector3::Constant(2.0)));
   Eigen::Index shared = -1, copy = -1;
   for (Eigen::Index v = 0; v < touching.num_vertices(); ++v) {
     if (touching.vertices.row(v).transpose() != Vector3::Ones()) continue;

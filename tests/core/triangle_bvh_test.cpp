@@ -36,7 +36,8 @@ int ScanWinding(const Mesh& mesh, const Vector3& p, bool* on_surface) {
   int winding = 0;
   *on_surface = false;
   for (Eigen::Index t = 0; t < mesh.num_triangles(); ++t) {
-    const int crossing = XRayCrossing(p, Corner(mesh, t, 0), Corner(mesh, t, 1), Corner(mesh, t, 2));
+    const int crossing =
+        XRayCrossing(p, Corner(mesh, t, 0), Corner(mesh, t, 1), Corner(mesh, t, 2));
     if (crossing == kOnTriangle) {
       *on_surface = true;
     } else {

@@ -131,7 +131,7 @@ absl::StatusOr<DeformInputs> ReadInputs(const DeformCliOptions& options) {
   in.deformed_self_intersecting_pairs =
       ValidateMesh(in.deformed, check).report.self_intersecting_pairs;
   in.deformed_sha256 = FormatSha256(MeshSha256(in.deformed));
-  // The inside-test rule holds for both solids: ray parity if either intersects itself.
+  // The inside-test rule holds for both solids: the exact test if either needs it.
   MeshReport deformed_report;
   deformed_report.self_intersecting_pairs = in.deformed_self_intersecting_pairs;
   in.ray_parity = InsideTestFor(solid->report) == InsideTest::kExactWinding ||

@@ -22,9 +22,9 @@ struct Solid {
 
 // The inside test a solid with this report needs: the pseudonormal only when validation checked
 // the mesh for self-intersections and found none, and found no non-manifold vertex, no
-// zero-area triangle and no flat shell (the conditions under which its sign is proved right); the exact winding
-// number otherwise (self-intersections, checks not made, options that skip them). The one
-// place this rule lives.
+// zero-area triangle and no flat shell (the conditions under which its sign is proved right); the
+// exact winding number otherwise (self-intersections, checks not made, options that skip them). The
+// one place this rule lives.
 InsideTest InsideTestFor(const MeshReport& report);
 
 struct SolidOptions {

@@ -126,7 +126,8 @@ struct DeformationSettings {
   double xi = 0.0;  // mesh units; 0 = 0.25% of the largest bounding-box extent
   bool strict = false;
   bool interpolated_normal = false;
-  bool ray_parity = false;  // the exact winding inside test (the wire field's old name)
+  // The exact winding inside test (the wire field's old name).
+  bool ray_parity = false;
   bool bounds = false;  // also compute nerr bounds (exact union volumes)
   bool store = false;   // also cache the moved set and return its key
 };

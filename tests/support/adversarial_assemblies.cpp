@@ -238,6 +238,24 @@ Assembly OverlappingIcospheres() {
   return builder.Take();
 }
 
+namespace {
+
+// Triangle t's entry: the area of triangles 0..t (for drawing triangles by area).
+std::vector<double> CumulativeAreas(const Mesh& mesh) {
+  std::vector<double> cumulative(static_cast<std::size_t>(mesh.num_triangles()));
+  double total = 0.0;
+  for (Eigen::Index t = 0; t < mesh.num_triangles(); ++t) {
+    const Vector3 a = mesh.vertices.row(mesh.triangles(t, 0)).transpose();
+    const Vector3 b = mesh.vertices.row(mesh.triangles(t, 1)).transpose();
+    const Vector3 c = mesh.vertices.row(mesh.triangles(t, 2)).transpose();
+    total += 0.5 * (b - a).cross(c - a).norm();
+    cumulative[static_cast<std::size_t>(t)] = total;
+  }
+  return cumulative;
+}
+
+}  // namespace
+
 Vertices AssemblyPoints(const Assembly& assembly, int uniform, int focused, int near_wall,
                         std::uint64_t seed) {
   std::mt19937_64 rng(seed);
@@ -259,15 +277,8 @@ Vertices AssemblyPoints(const Assembly& assembly, int uniform, int focused, int 
   }
   // Triangles by area (zero-area ones never chosen).
   const Mesh& mesh = assembly.intended;
-  std::vector<double> cumulative(static_cast<std::size_t>(mesh.num_triangles()));
-  double total = 0.0;
-  for (Eigen::Index t = 0; t < mesh.num_triangles(); ++t) {
-    const Vector3 a = mesh.vertices.row(mesh.triangles(t, 0)).transpose();
-    const Vector3 b = mesh.vertices.row(mesh.triangles(t, 1)).transpose();
-    const Vector3 c = mesh.vertices.row(mesh.triangles(t, 2)).transpose();
-    total += 0.5 * (b - a).cross(c - a).norm();
-    cumulative[static_cast<std::size_t>(t)] = total;
-  }
+  const std::vector<double> cumulative = CumulativeAreas(mesh);
+  const double total = cumulative.empty() ? 0.0 : cumulative.back();
   for (int i = 0; i < near_wall; ++i) {
     const auto t = static_cast<Eigen::Index>(
         std::upper_bound(cumulative.begin(), cumulative.end(), unit(rng) * total) -
@@ -308,15 +319,8 @@ Vertices PointsInBalls(const std::vector<Vector3>& centres, const std::vector<do
 Vertices BoundaryPoints(const Mesh& mesh, int samples, std::uint64_t seed) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
-  std::vector<double> cumulative(static_cast<std::size_t>(mesh.num_triangles()));
-  double total = 0.0;
-  for (Eigen::Index t = 0; t < mesh.num_triangles(); ++t) {
-    const Vector3 a = mesh.vertices.row(mesh.triangles(t, 0)).transpose();
-    const Vector3 b = mesh.vertices.row(mesh.triangles(t, 1)).transpose();
-    const Vector3 c = mesh.vertices.row(mesh.triangles(t, 2)).transpose();
-    total += 0.5 * (b - a).cross(c - a).norm();
-    cumulative[static_cast<std::size_t>(t)] = total;
-  }
+  const std::vector<double> cumulative = CumulativeAreas(mesh);
+  const double total = cumulative.empty() ? 0.0 : cumulative.back();
   Vertices points(samples + mesh.num_vertices(), 3);
   for (int i = 0; i < samples; ++i) {
     const auto t = std::min<Eigen::Index>(

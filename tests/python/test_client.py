@@ -1,6 +1,7 @@
 """inscribe.Client against real inscribed servers: the same spheres and distances as in-process,
 errors, a DistanceSession, failover and routing as the C++ client, bearer tokens and mTLS."""
 
+import itertools
 import json
 import socket
 import subprocess
@@ -20,15 +21,21 @@ def free_dead_endpoint():
         return f"127.0.0.1:{s.getsockname()[1]}"
 
 
-def held_dead_endpoints(count):
-    # `count` ports held bound without listening (connections are refused) until the returned
-    # sockets are closed: distinct addresses, which a freed port asked for again is not.
-    sockets = []
-    for _ in range(count):
-        s = socket.socket()
-        s.bind(("127.0.0.1", 0))
-        sockets.append(s)
-    return sockets, [f"127.0.0.1:{s.getsockname()[1]}" for s in sockets]
+def dead_endpoint_routed_first(route, live, tries=1_000_000):
+    # A refusing endpoint that rendezvous routing ranks above `live` for `route`, and the socket
+    # that keeps it refusing until closed. The port is held bound on every address without
+    # listening, and the name varies over loopback hosts 127.x.y.z: each name has a fresh score,
+    # so one beats `live` unless live's score is in the top 1/`tries` of all.
+    held = socket.socket()
+    held.bind(("0.0.0.0", 0))
+    port = held.getsockname()[1]
+    hosts = (f"127.{a}.{b}.{c}" for a in range(256) for b in range(256) for c in range(1, 255))
+    for host in itertools.islice(hosts, tries):
+        dead = f"{host}:{port}"
+        if inscribe._inscribe._rendezvous_order(route, [dead, live])[0] == 0:
+            return held, dead
+    held.close()
+    pytest.fail(f"none of {tries} dead endpoints routed before {live}")
 
 
 @pytest.fixture(scope="module")
@@ -205,12 +212,7 @@ def test_routing_picks_the_cpp_clients_replica_and_fails_over(tmp_path, eight):
         # Failover: a dead replica that the mesh routes to first; the call moves on to the
         # live one at once (no backoff), as the C++ client's does.
         route = inscribe._inscribe._route_key(result.mesh_sha256)
-        held, candidates = held_dead_endpoints(64)
-        for dead in candidates:
-            if inscribe._inscribe._rendezvous_order(route, [dead, owner.address])[0] == 0:
-                break
-        else:
-            pytest.fail("none of 64 dead endpoints routed first")
+        held, dead = dead_endpoint_routed_first(route, owner.address)
         retry = inscribe.RetryPolicy(max_attempts=2, initial_backoff=30.0)
         with inscribe.Client([dead, owner.address], retry=retry, timeout=20.0) as client:
             start = time.monotonic()
@@ -227,8 +229,8 @@ def test_routing_picks_the_cpp_clients_replica_and_fails_over(tmp_path, eight):
                 local = inscribe.generate(eight, max_spheres=40, evaluate=False)
                 assert reply.distance[0] == inscribe.distance(local, local, shifted).distance
     finally:
-        for sock in held:
-            sock.close()
+        if held is not None:
+            held.close()
         a.stop()
         b.stop()
 

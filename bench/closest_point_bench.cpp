@@ -31,10 +31,10 @@
 
 #include "absl/status/statusor.h"
 #include "absl/strings/str_cat.h"
-#include "inscribe/boundary_oracle.h"
-#include "inscribe/mesh.h"
-#include "inscribe/mesh_io.h"
-#include "inscribe/mesh_validation.h"
+#include "inscribe/geometry/mesh.h"
+#include "inscribe/mesh/mesh_io.h"
+#include "inscribe/solid/boundary_oracle.h"
+#include "inscribe/solid/mesh_validation.h"
 
 namespace inscribe {
 namespace {

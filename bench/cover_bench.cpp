@@ -35,13 +35,13 @@
 #include <vector>
 
 #include "absl/strings/str_format.h"
-#include "inscribe/certified_distance.h"
-#include "inscribe/cover_certificate.h"
-#include "inscribe/mesh_io.h"
-#include "inscribe/solid.h"
-#include "inscribe/sphere_cover.h"
-#include "inscribe/sphere_io.h"
-#include "inscribe/sphere_set_generation.h"
+#include "inscribe/balls/sphere_io.h"
+#include "inscribe/cover/cover_certificate.h"
+#include "inscribe/cover/sphere_cover.h"
+#include "inscribe/distance/certified_distance.h"
+#include "inscribe/generation/sphere_set_generation.h"
+#include "inscribe/mesh/mesh_io.h"
+#include "inscribe/solid/solid.h"
 #include "support/fcl_solid_distance.h"
 #include "table2_poses.h"
 

@@ -25,13 +25,13 @@
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_split.h"
 #include "deformation_sequences.h"
-#include "inscribe/boundary_oracle.h"
-#include "inscribe/medial_spheres.h"
-#include "inscribe/mesh_io.h"
-#include "inscribe/mesh_validation.h"
-#include "inscribe/solid.h"
-#include "inscribe/sphere_deformation.h"
-#include "inscribe/sphere_quality.h"
+#include "inscribe/balls/sphere_quality.h"
+#include "inscribe/medial/medial_spheres.h"
+#include "inscribe/medial/sphere_deformation.h"
+#include "inscribe/mesh/mesh_io.h"
+#include "inscribe/solid/boundary_oracle.h"
+#include "inscribe/solid/mesh_validation.h"
+#include "inscribe/solid/solid.h"
 
 namespace {
 

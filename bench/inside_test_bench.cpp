@@ -25,10 +25,10 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
-#include "inscribe/boundary_oracle.h"
-#include "inscribe/mesh_io.h"
-#include "inscribe/solid.h"
-#include "triangle_bvh.h"
+#include "inscribe/mesh/mesh_io.h"
+#include "inscribe/solid/boundary_oracle.h"
+#include "inscribe/solid/solid.h"
+#include "solid/triangle_bvh.h"
 
 namespace {
 

@@ -22,9 +22,9 @@
 #include <vector>
 
 #include "absl/strings/str_format.h"
-#include "inscribe/mesh_io.h"
-#include "inscribe/solid.h"
-#include "inscribe/sphere_set_generation.h"
+#include "inscribe/generation/sphere_set_generation.h"
+#include "inscribe/mesh/mesh_io.h"
+#include "inscribe/solid/solid.h"
 
 namespace {
 

@@ -15,12 +15,12 @@
 #include <string>
 #include <vector>
 
-#include "inscribe/mesh_io.h"
-#include "inscribe/rigid_pose.h"
-#include "inscribe/separation_distance.h"
-#include "inscribe/solid.h"
-#include "inscribe/sphere_hierarchy.h"
-#include "inscribe/sphere_set_generation.h"
+#include "inscribe/distance/separation_distance.h"
+#include "inscribe/distance/sphere_hierarchy.h"
+#include "inscribe/generation/sphere_set_generation.h"
+#include "inscribe/geometry/rigid_pose.h"
+#include "inscribe/mesh/mesh_io.h"
+#include "inscribe/solid/solid.h"
 
 namespace {
 

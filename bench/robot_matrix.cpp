@@ -23,10 +23,10 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
-#include "inscribe/mesh_io.h"
-#include "inscribe/mesh_validation.h"
+#include "inscribe/mesh/mesh_io.h"
 #include "inscribe/robot/self_collision.h"
 #include "inscribe/robot/urdf_spherize.h"
+#include "inscribe/solid/mesh_validation.h"
 #include "support/fcl_solid_distance.h"
 #include "support/mesh_arm.h"
 

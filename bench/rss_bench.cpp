@@ -27,8 +27,8 @@
 #include <random>
 #include <vector>
 
-#include "inscribe/rss.h"
-#include "inscribe/sphere.h"
+#include "inscribe/distance/rss.h"
+#include "inscribe/geometry/sphere.h"
 
 namespace inscribe {
 namespace {

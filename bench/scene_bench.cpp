@@ -43,15 +43,15 @@
 
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
-#include "inscribe/certified_distance.h"
 #include "inscribe/client/client.h"
 #include "inscribe/client/connection.h"
-#include "inscribe/mesh_io.h"
-#include "inscribe/scene.h"
+#include "inscribe/cover/sphere_cover.h"
+#include "inscribe/distance/certified_distance.h"
+#include "inscribe/generation/sphere_set_generation.h"
+#include "inscribe/mesh/mesh_io.h"
+#include "inscribe/scene/scene.h"
 #include "inscribe/server/inscribe_server.h"
-#include "inscribe/solid.h"
-#include "inscribe/sphere_cover.h"
-#include "inscribe/sphere_set_generation.h"
+#include "inscribe/solid/solid.h"
 #include "support/fcl_solid_distance.h"
 
 namespace inscribe::scene_bench {

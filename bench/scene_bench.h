@@ -9,11 +9,11 @@
 #include <vector>
 
 #include "inscribe/client/client.h"
-#include "inscribe/cover_certificate.h"
-#include "inscribe/rigid_pose.h"
-#include "inscribe/scene.h"
-#include "inscribe/sphere.h"
-#include "inscribe/sphere_hierarchy.h"
+#include "inscribe/cover/cover_certificate.h"
+#include "inscribe/distance/sphere_hierarchy.h"
+#include "inscribe/geometry/rigid_pose.h"
+#include "inscribe/geometry/sphere.h"
+#include "inscribe/scene/scene.h"
 #include "support/fcl_solid_distance.h"
 
 namespace inscribe::scene_bench {

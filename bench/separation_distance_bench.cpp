@@ -24,14 +24,14 @@
 #include <string>
 #include <vector>
 
-#include "inscribe/boundary_oracle.h"
-#include "inscribe/medial_spheres.h"
-#include "inscribe/mesh_io.h"
-#include "inscribe/mesh_validation.h"
-#include "inscribe/rigid_pose.h"
-#include "inscribe/separation_distance.h"
-#include "inscribe/sphere_dilation.h"
-#include "inscribe/sphere_hierarchy.h"
+#include "inscribe/distance/separation_distance.h"
+#include "inscribe/distance/sphere_hierarchy.h"
+#include "inscribe/geometry/rigid_pose.h"
+#include "inscribe/medial/medial_spheres.h"
+#include "inscribe/medial/sphere_dilation.h"
+#include "inscribe/mesh/mesh_io.h"
+#include "inscribe/solid/boundary_oracle.h"
+#include "inscribe/solid/mesh_validation.h"
 
 namespace inscribe {
 namespace {

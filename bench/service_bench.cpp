@@ -36,10 +36,10 @@
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
 #include "inscribe/client/client.h"
-#include "inscribe/mesh_io.h"
-#include "inscribe/mesh_validation.h"
-#include "inscribe/separation_distance.h"
+#include "inscribe/distance/separation_distance.h"
+#include "inscribe/mesh/mesh_io.h"
 #include "inscribe/server/inscribe_server.h"
+#include "inscribe/solid/mesh_validation.h"
 #include "machine_probes.h"
 
 namespace inscribe {

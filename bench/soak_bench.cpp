@@ -32,8 +32,8 @@
 #include "absl/strings/str_format.h"
 #include "deformation_sequences.h"
 #include "inscribe/client/client.h"
-#include "inscribe/mesh_io.h"
-#include "inscribe/mesh_validation.h"
+#include "inscribe/mesh/mesh_io.h"
+#include "inscribe/solid/mesh_validation.h"
 #include "support/inscribed_process.h"
 
 namespace inscribe {

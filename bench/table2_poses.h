@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "inscribe/rigid_pose.h"
+#include "inscribe/geometry/rigid_pose.h"
 
 namespace inscribe::bench {
 

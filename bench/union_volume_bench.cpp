@@ -20,8 +20,8 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "inscribe/sphere.h"
-#include "inscribe/union_of_balls.h"
+#include "inscribe/balls/union_of_balls.h"
+#include "inscribe/geometry/sphere.h"
 
 namespace inscribe {
 namespace {

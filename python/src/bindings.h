@@ -6,8 +6,8 @@
 
 #include <memory>
 
-#include "inscribe/mesh.h"
-#include "inscribe/solid.h"
+#include "inscribe/geometry/mesh.h"
+#include "inscribe/solid/solid.h"
 
 namespace inscribe::python {
 

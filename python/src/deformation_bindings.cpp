@@ -9,7 +9,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "bindings.h"
-#include "inscribe/sphere_deformation.h"
+#include "inscribe/medial/sphere_deformation.h"
 #include "sphere_set.h"
 #include "status_errors.h"
 

@@ -7,9 +7,9 @@
 #include <memory>
 #include <vector>
 
-#include "inscribe/certified_distance.h"
-#include "inscribe/rigid_pose.h"
-#include "inscribe/sphere_hierarchy.h"
+#include "inscribe/distance/certified_distance.h"
+#include "inscribe/distance/sphere_hierarchy.h"
+#include "inscribe/geometry/rigid_pose.h"
 
 namespace inscribe::python {
 

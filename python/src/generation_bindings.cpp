@@ -8,9 +8,9 @@
 
 #include "absl/strings/str_cat.h"
 #include "bindings.h"
-#include "inscribe/cover_certificate.h"
-#include "inscribe/sphere_quality.h"
-#include "inscribe/sphere_set_generation.h"
+#include "inscribe/balls/sphere_quality.h"
+#include "inscribe/cover/cover_certificate.h"
+#include "inscribe/generation/sphere_set_generation.h"
 #include "interruptible.h"
 #include "sphere_set.h"
 #include "status_errors.h"

@@ -7,7 +7,7 @@
 #include <functional>
 
 #include "absl/status/status.h"
-#include "inscribe/medial_spheres.h"
+#include "inscribe/medial/medial_spheres.h"
 
 namespace inscribe::python {
 

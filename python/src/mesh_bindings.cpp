@@ -7,11 +7,11 @@
 
 #include "absl/strings/str_cat.h"
 #include "bindings.h"
-#include "inscribe/mesh.h"
-#include "inscribe/mesh_hash.h"
-#include "inscribe/mesh_io.h"
-#include "inscribe/mesh_validation.h"
-#include "inscribe/solid.h"
+#include "inscribe/geometry/mesh.h"
+#include "inscribe/geometry/mesh_hash.h"
+#include "inscribe/mesh/mesh_io.h"
+#include "inscribe/solid/mesh_validation.h"
+#include "inscribe/solid/solid.h"
 #include "status_errors.h"
 
 namespace inscribe::python {

@@ -12,7 +12,7 @@
 #include "absl/strings/str_cat.h"
 #include "bindings.h"
 #include "distance_types.h"
-#include "inscribe/scene.h"
+#include "inscribe/scene/scene.h"
 #include "interruptible.h"
 #include "status_errors.h"
 

@@ -11,7 +11,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "bindings.h"
-#include "inscribe/sphere_io.h"
+#include "inscribe/balls/sphere_io.h"
 #include "sphere_set.h"
 #include "status_errors.h"
 

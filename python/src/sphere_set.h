@@ -7,10 +7,10 @@
 #include <string>
 #include <vector>
 
-#include "inscribe/cover_certificate.h"
-#include "inscribe/sphere.h"
-#include "inscribe/sphere_io.h"
-#include "inscribe/sphere_quality.h"
+#include "inscribe/balls/sphere_io.h"
+#include "inscribe/balls/sphere_quality.h"
+#include "inscribe/cover/cover_certificate.h"
+#include "inscribe/geometry/sphere.h"
 
 namespace inscribe::python {
 

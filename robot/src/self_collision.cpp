@@ -11,8 +11,8 @@
 
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
-#include "inscribe/certified_distance.h"
-#include "parallel.h"  // core's loops (core/src)
+#include "base/parallel.h"  // core's loops (core/src)
+#include "inscribe/distance/certified_distance.h"
 
 namespace inscribe::robot {
 namespace {

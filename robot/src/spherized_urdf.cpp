@@ -13,7 +13,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_replace.h"
-#include "inscribe/sphere_io.h"
+#include "inscribe/balls/sphere_io.h"
 
 namespace inscribe::robot {
 namespace {

@@ -13,13 +13,13 @@
 
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
-#include "inscribe/certified_distance.h"
-#include "inscribe/mesh_clip.h"
-#include "inscribe/mesh_io.h"
+#include "inscribe/cover/sphere_cover.h"
+#include "inscribe/distance/certified_distance.h"
+#include "inscribe/generation/sphere_set_generation.h"
+#include "inscribe/mesh/mesh_clip.h"
+#include "inscribe/mesh/mesh_io.h"
 #include "inscribe/robot/primitive_meshes.h"
-#include "inscribe/solid.h"
-#include "inscribe/sphere_cover.h"
-#include "inscribe/sphere_set_generation.h"
+#include "inscribe/solid/solid.h"
 
 namespace inscribe::robot {
 namespace {

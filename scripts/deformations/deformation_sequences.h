@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "inscribe/mesh.h"
+#include "inscribe/geometry/mesh.h"
 
 namespace inscribe::sequences {
 

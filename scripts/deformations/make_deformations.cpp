@@ -10,7 +10,7 @@
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_split.h"
 #include "deformation_sequences.h"
-#include "inscribe/mesh_io.h"
+#include "inscribe/mesh/mesh_io.h"
 
 namespace {
 

@@ -13,7 +13,7 @@
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
-#include "inscribe/sha256.h"
+#include "inscribe/base/sha256.h"
 
 namespace grpc {
 class ServerContextBase;

@@ -17,7 +17,7 @@
 #include <string>
 
 #include "absl/strings/string_view.h"
-#include "inscribe/sha256.h"
+#include "inscribe/base/sha256.h"
 
 namespace inscribe::server {
 

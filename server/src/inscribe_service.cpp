@@ -8,8 +8,8 @@
 
 #include "absl/strings/str_cat.h"
 #include "frame_dispatch.h"
-#include "inscribe/mesh_hash.h"
-#include "inscribe/mesh_validation.h"
+#include "inscribe/geometry/mesh_hash.h"
+#include "inscribe/solid/mesh_validation.h"
 #include "inscribe/wire/convert.h"
 #include "memory_budget.h"
 #include "mesh_sizes.h"

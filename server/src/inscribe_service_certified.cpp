@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
-#include "inscribe/certified_distance.h"
+#include "inscribe/distance/certified_distance.h"
 #include "inscribe/server/inscribe_service.h"
 #include "inscribe/wire/convert.h"
 #include "oneapi/tbb/task_arena.h"

@@ -14,8 +14,8 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
-#include "inscribe/medial_spheres.h"
-#include "inscribe/separation_distance.h"
+#include "inscribe/distance/separation_distance.h"
+#include "inscribe/medial/medial_spheres.h"
 #include "inscribe/server/inscribe_service.h"
 #include "inscribe/wire/convert.h"
 #include "memory_budget.h"

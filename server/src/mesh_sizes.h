@@ -11,7 +11,7 @@
 #include <string>
 #include <unordered_map>
 
-#include "inscribe/mesh.h"
+#include "inscribe/geometry/mesh.h"
 
 namespace inscribe::server {
 

@@ -3,7 +3,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
-#include "inscribe/mesh_hash.h"
+#include "inscribe/geometry/mesh_hash.h"
 #include "inscribe/wire/convert.h"
 #include "inscribe/wire/keys.h"
 

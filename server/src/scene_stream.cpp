@@ -14,7 +14,7 @@
 #include "absl/strings/str_cat.h"
 #include "frame_dispatch.h"
 #include "frame_stream_reactor.h"
-#include "inscribe/scene.h"
+#include "inscribe/scene/scene.h"
 #include "inscribe/server/inscribe_service.h"
 #include "inscribe/wire/convert.h"
 #include "memory_budget.h"

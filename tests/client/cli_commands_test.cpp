@@ -9,9 +9,9 @@
 #include <string>
 
 #include "command_outcome.h"
-#include "inscribe/cover_certificate.h"
-#include "inscribe/solid.h"
-#include "inscribe/sphere_set_generation.h"
+#include "inscribe/cover/cover_certificate.h"
+#include "inscribe/generation/sphere_set_generation.h"
+#include "inscribe/solid/solid.h"
 #include "service_session.h"
 #include "support/synthetic_meshes.h"
 #include "support/test_meshes.h"

@@ -13,8 +13,8 @@
 #include <vector>
 
 #include "client/cli_run.h"
-#include "inscribe/mesh_io.h"
-#include "inscribe/sphere_io.h"
+#include "inscribe/balls/sphere_io.h"
+#include "inscribe/mesh/mesh_io.h"
 #include "support/synthetic_meshes.h"
 #include "support/test_meshes.h"
 

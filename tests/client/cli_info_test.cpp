@@ -13,7 +13,7 @@
 #include <string>
 
 #include "client/cli_run.h"
-#include "inscribe/mesh_io.h"
+#include "inscribe/mesh/mesh_io.h"
 #include "support/assimp_scenes.h"
 #include "support/cgal_mesh_writer.h"
 #include "support/synthetic_meshes.h"

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "client/cli_run.h"
-#include "inscribe/sphere_io.h"
+#include "inscribe/balls/sphere_io.h"
 #include "support/test_meshes.h"
 
 namespace inscribe {

@@ -20,8 +20,8 @@
 
 #include "client/cli_run.h"
 #include "deformation_sequences.h"
-#include "inscribe/mesh_io.h"
-#include "inscribe/sphere_io.h"
+#include "inscribe/balls/sphere_io.h"
+#include "inscribe/mesh/mesh_io.h"
 #include "support/inscribed_process.h"
 #include "support/test_meshes.h"
 

@@ -18,9 +18,9 @@
 #include <vector>
 
 #include "client/cli_run.h"
-#include "inscribe/mesh_io.h"
-#include "inscribe/separation_distance.h"
-#include "inscribe/sphere_io.h"
+#include "inscribe/balls/sphere_io.h"
+#include "inscribe/distance/separation_distance.h"
+#include "inscribe/mesh/mesh_io.h"
 #include "support/inscribed_process.h"
 #include "support/synthetic_meshes.h"
 #include "support/test_meshes.h"

@@ -19,7 +19,7 @@
 #include <string>
 #include <vector>
 
-#include "inscribe/solid.h"
+#include "inscribe/solid/solid.h"
 #include "support/adversarial_assemblies.h"
 #include "support/synthetic_meshes.h"
 #include "support/winding_oracle.h"

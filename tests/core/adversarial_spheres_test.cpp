@@ -22,11 +22,11 @@
 #include <string>
 #include <vector>
 
-#include "inscribe/certified_distance.h"
-#include "inscribe/cover_certificate.h"
-#include "inscribe/solid.h"
-#include "inscribe/sphere_hierarchy.h"
-#include "inscribe/sphere_set_generation.h"
+#include "inscribe/cover/cover_certificate.h"
+#include "inscribe/distance/certified_distance.h"
+#include "inscribe/distance/sphere_hierarchy.h"
+#include "inscribe/generation/sphere_set_generation.h"
+#include "inscribe/solid/solid.h"
 #include "support/adversarial_assemblies.h"
 #include "support/fcl_solid_distance.h"
 #include "support/synthetic_meshes.h"

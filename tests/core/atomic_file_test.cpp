@@ -1,4 +1,4 @@
-#include "inscribe/atomic_file.h"
+#include "inscribe/base/atomic_file.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>

@@ -1,4 +1,4 @@
-#include "inscribe/boundary_oracle.h"
+#include "inscribe/solid/boundary_oracle.h"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Side_of_triangle_mesh.h>

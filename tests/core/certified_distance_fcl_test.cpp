@@ -15,10 +15,10 @@
 #include <string>
 #include <vector>
 
-#include "inscribe/certified_distance.h"
-#include "inscribe/cover_certificate.h"
-#include "inscribe/sphere_cover.h"
-#include "inscribe/sphere_set_generation.h"
+#include "inscribe/cover/cover_certificate.h"
+#include "inscribe/cover/sphere_cover.h"
+#include "inscribe/distance/certified_distance.h"
+#include "inscribe/generation/sphere_set_generation.h"
 #include "support/fcl_solid_distance.h"
 #include "support/synthetic_meshes.h"
 #include "support/test_meshes.h"

@@ -5,7 +5,7 @@
 // poses test the margins themselves: touching balls at every scale, far from the origin,
 // rotated by quaternions a little off unit length, and coordinates where squares underflow or
 // overflow. Also: the closer-than rule at its boundaries, and bad input.
-#include "inscribe/certified_distance.h"
+#include "inscribe/distance/certified_distance.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

@@ -2,7 +2,7 @@
 // row-by-row count (SampleGrid::ForEachRun and BitField::Count) on random and adversarial balls
 // and fields, its block totals against a full recount, its parallel fill against ball-by-ball
 // sets, and the cleared points of a choice against what each ball's count loses.
-#include "coverage_grid.h"
+#include "medial/coverage_grid.h"
 
 #include <gtest/gtest.h>
 

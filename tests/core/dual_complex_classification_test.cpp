@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "inscribe/union_of_balls.h"
+#include "inscribe/balls/union_of_balls.h"
 #include "support/fixed_alpha_shape_dual_complex.h"
 #include "support/sphere_sets.h"
 

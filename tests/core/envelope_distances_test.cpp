@@ -1,4 +1,4 @@
-#include "inscribe/envelope_distances.h"
+#include "inscribe/distance/envelope_distances.h"
 
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
@@ -7,9 +7,9 @@
 #include <limits>
 #include <vector>
 
-#include "inscribe/medial_spheres.h"
-#include "inscribe/sphere_dilation.h"
-#include "inscribe/sphere_quality.h"
+#include "inscribe/balls/sphere_quality.h"
+#include "inscribe/medial/medial_spheres.h"
+#include "inscribe/medial/sphere_dilation.h"
 #include "support/sphere_sets.h"
 #include "support/synthetic_meshes.h"
 #include "support/test_meshes.h"

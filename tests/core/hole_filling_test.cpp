@@ -1,5 +1,5 @@
 // ValidateOptions::fill_holes: closing the border loops of open meshes.
-#include "hole_filling.h"  // private: core/src
+#include "mesh/hole_filling.h"  // private: core/src
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -14,10 +14,10 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
-#include "inscribe/mesh_io.h"
-#include "inscribe/mesh_validation.h"
-#include "mesh_topology.h"       // private: core/src
-#include "self_intersections.h"  // private: core/src
+#include "inscribe/mesh/mesh_io.h"
+#include "inscribe/solid/mesh_validation.h"
+#include "mesh/mesh_topology.h"        // private: core/src
+#include "solid/self_intersections.h"  // private: core/src
 #include "support/mesh_issues.h"
 #include "support/synthetic_meshes.h"
 #include "support/test_meshes.h"

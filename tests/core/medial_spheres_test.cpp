@@ -1,4 +1,4 @@
-#include "inscribe/medial_spheres.h"
+#include "inscribe/medial/medial_spheres.h"
 
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
@@ -11,7 +11,7 @@
 #include <string>
 #include <tuple>
 
-#include "inscribe/union_of_balls.h"
+#include "inscribe/balls/union_of_balls.h"
 #include "support/medial_checks.h"
 #include "support/synthetic_meshes.h"
 #include "support/test_meshes.h"

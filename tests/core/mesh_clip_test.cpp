@@ -1,11 +1,11 @@
 // ClipMeshByPlane: the kept part of a solid is a closed solid with the volume it should have.
-#include "inscribe/mesh_clip.h"
+#include "inscribe/mesh/mesh_clip.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include "inscribe/mesh_io.h"
-#include "inscribe/mesh_validation.h"
+#include "inscribe/mesh/mesh_io.h"
+#include "inscribe/solid/mesh_validation.h"
 #include "support/synthetic_meshes.h"
 #include "support/test_meshes.h"
 

@@ -1,4 +1,4 @@
-#include "inscribe/mesh_hash.h"
+#include "inscribe/geometry/mesh_hash.h"
 
 #include <gtest/gtest.h>
 #include <openssl/sha.h>

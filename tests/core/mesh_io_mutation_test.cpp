@@ -13,10 +13,10 @@
 #include <string>
 #include <vector>
 
-#include "inscribe/mesh_hash.h"
-#include "inscribe/mesh_io.h"
-#include "inscribe/mesh_validation.h"
-#include "mesh_file_diagnosis.h"
+#include "inscribe/geometry/mesh_hash.h"
+#include "inscribe/mesh/mesh_io.h"
+#include "inscribe/solid/mesh_validation.h"
+#include "mesh/mesh_file_diagnosis.h"
 #include "support/cgal_mesh_writer.h"
 #include "support/synthetic_meshes.h"
 

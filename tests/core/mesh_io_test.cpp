@@ -1,4 +1,4 @@
-#include "inscribe/mesh_io.h"
+#include "inscribe/mesh/mesh_io.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -8,7 +8,7 @@
 #include <fstream>
 #include <random>
 
-#include "inscribe/mesh_validation.h"
+#include "inscribe/solid/mesh_validation.h"
 #include "support/cgal_mesh_writer.h"
 #include "support/synthetic_meshes.h"
 #include "support/test_meshes.h"

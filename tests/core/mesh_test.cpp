@@ -1,4 +1,4 @@
-#include "inscribe/mesh.h"
+#include "inscribe/geometry/mesh.h"
 
 #include <gtest/gtest.h>
 

@@ -1,5 +1,5 @@
 // The edge-use order of mesh_topology.h against a plain comparison sort.
-#include "mesh_topology.h"  // private: core/src
+#include "mesh/mesh_topology.h"  // private: core/src
 
 #include <gtest/gtest.h>
 
@@ -10,7 +10,7 @@
 #include <utility>
 #include <vector>
 
-#include "inscribe/mesh.h"
+#include "inscribe/geometry/mesh.h"
 #include "support/test_meshes.h"
 
 namespace inscribe {

@@ -1,4 +1,4 @@
-#include "inscribe/mesh_validation.h"
+#include "inscribe/solid/mesh_validation.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
-#include "inscribe/mesh_io.h"
-#include "mesh_topology.h"  // private: core/src
+#include "inscribe/mesh/mesh_io.h"
+#include "mesh/mesh_topology.h"  // private: core/src
 #include "support/mesh_issues.h"
 #include "support/synthetic_meshes.h"
 #include "support/test_meshes.h"

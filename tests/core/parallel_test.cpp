@@ -1,7 +1,7 @@
-// core's parallel loops (core/src/parallel.h): every index once, folds in index order whatever
+// core's parallel loops (core/src/base/parallel.h): every index once, folds in index order whatever
 // the schedule, exceptions reach the caller; and, in ThreadSanitizer builds, that a loop is
 // ordered with the code around it while its bodies stay unordered with one another.
-#include "parallel.h"
+#include "base/parallel.h"
 
 #include <gtest/gtest.h>
 #include <tbb/combinable.h>

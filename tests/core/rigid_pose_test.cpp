@@ -1,4 +1,4 @@
-#include "inscribe/rigid_pose.h"
+#include "inscribe/geometry/rigid_pose.h"
 
 #include <gtest/gtest.h>
 

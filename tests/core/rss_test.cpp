@@ -1,4 +1,4 @@
-#include "inscribe/rss.h"
+#include "inscribe/distance/rss.h"
 
 #include <gtest/gtest.h>
 
@@ -13,8 +13,8 @@
 #include <string>
 #include <vector>
 
-#include "inscribe/boundary_oracle.h"
-#include "inscribe/medial_spheres.h"
+#include "inscribe/medial/medial_spheres.h"
+#include "inscribe/solid/boundary_oracle.h"
 #include "support/test_meshes.h"
 
 namespace inscribe {

@@ -1,4 +1,4 @@
-#include "inscribe/scene.h"
+#include "inscribe/scene/scene.h"
 
 #include <gtest/gtest.h>
 
@@ -13,7 +13,7 @@
 #include <utility>
 #include <vector>
 
-#include "sphere_pair_search.h"
+#include "distance/sphere_pair_search.h"
 #include "support/sphere_sets.h"
 #include "support/test_meshes.h"
 

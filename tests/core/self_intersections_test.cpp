@@ -1,6 +1,6 @@
 // The self-intersection search (self_intersections.h) against CGAL's own: slabs, the shadow
 // screen and the surface linked from edge groups find exactly CGAL's pairs.
-#include "self_intersections.h"  // private: core/src
+#include "solid/self_intersections.h"  // private: core/src
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
@@ -17,8 +17,8 @@
 #include <utility>
 #include <vector>
 
-#include "inscribe/mesh.h"
-#include "mesh_topology.h"  // private: core/src
+#include "inscribe/geometry/mesh.h"
+#include "mesh/mesh_topology.h"  // private: core/src
 #include "support/synthetic_meshes.h"
 #include "support/test_meshes.h"
 

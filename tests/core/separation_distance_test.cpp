@@ -1,4 +1,4 @@
-#include "inscribe/separation_distance.h"
+#include "inscribe/distance/separation_distance.h"
 
 #include <gtest/gtest.h>
 
@@ -8,7 +8,7 @@
 #include <tuple>
 #include <vector>
 
-#include "sphere_pair_search.h"
+#include "distance/sphere_pair_search.h"
 #include "support/sphere_sets.h"
 #include "support/test_meshes.h"
 

@@ -1,5 +1,5 @@
 // PrepareSolid and its one inside-test rule, the one SHA-256 and the one sphere check.
-#include "inscribe/solid.h"
+#include "inscribe/solid/solid.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -7,9 +7,9 @@
 #include <cmath>
 #include <random>
 
-#include "inscribe/mesh_hash.h"
-#include "inscribe/sha256.h"
-#include "inscribe/sphere.h"
+#include "inscribe/base/sha256.h"
+#include "inscribe/geometry/mesh_hash.h"
+#include "inscribe/geometry/sphere.h"
 #include "support/synthetic_meshes.h"
 #include "support/test_meshes.h"
 

@@ -2,7 +2,7 @@
 // each solid must all lie in a sphere of a certified cover, no point of a sphere may lie
 // farther outside than delta, a cover with a needed sphere removed or shrunk must be refused,
 // and the witness of a refusal must be a real uncovered point of the solid.
-#include "inscribe/sphere_cover.h"
+#include "inscribe/cover/sphere_cover.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -15,14 +15,14 @@
 #include <tuple>
 #include <vector>
 
-#include "inscribe/cover_certificate.h"
-#include "inscribe/mesh_hash.h"
-#include "inscribe/solid.h"
-#include "inscribe/sphere_set_generation.h"
+#include "inscribe/cover/cover_certificate.h"
+#include "inscribe/generation/sphere_set_generation.h"
+#include "inscribe/geometry/mesh_hash.h"
+#include "inscribe/solid/solid.h"
+#include "mesh/surface_sampling.h"
 #include "support/brute_force_closest_point.h"
 #include "support/synthetic_meshes.h"
 #include "support/test_meshes.h"
-#include "surface_sampling.h"
 
 namespace inscribe {
 namespace {

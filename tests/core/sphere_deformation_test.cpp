@@ -1,4 +1,4 @@
-#include "inscribe/sphere_deformation.h"
+#include "inscribe/medial/sphere_deformation.h"
 
 #include <gtest/gtest.h>
 
@@ -9,10 +9,10 @@
 #include <string>
 #include <tuple>
 
+#include "base/parallel.h"
 #include "deformation_sequences.h"
-#include "inscribe/medial_spheres.h"
-#include "inscribe/union_of_balls.h"
-#include "parallel.h"
+#include "inscribe/balls/union_of_balls.h"
+#include "inscribe/medial/medial_spheres.h"
 #include "support/brute_force_closest_point.h"
 #include "support/synthetic_meshes.h"
 #include "support/test_meshes.h"

@@ -1,4 +1,4 @@
-#include "inscribe/sphere_dilation.h"
+#include "inscribe/medial/sphere_dilation.h"
 
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
@@ -15,9 +15,9 @@
 #include <utility>
 #include <vector>
 
-#include "inscribe/medial_spheres.h"
-#include "inscribe/sphere_quality.h"
-#include "inscribe/union_of_balls.h"
+#include "inscribe/balls/sphere_quality.h"
+#include "inscribe/balls/union_of_balls.h"
+#include "inscribe/medial/medial_spheres.h"
 #include "support/brute_force_closest_point.h"
 #include "support/sphere_sets.h"
 #include "support/synthetic_meshes.h"

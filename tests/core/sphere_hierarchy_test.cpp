@@ -1,4 +1,4 @@
-#include "inscribe/sphere_hierarchy.h"
+#include "inscribe/distance/sphere_hierarchy.h"
 
 #include <gtest/gtest.h>
 
@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "inscribe/separation_distance.h"
+#include "inscribe/distance/separation_distance.h"
 #include "support/sphere_sets.h"
 #include "support/test_meshes.h"
 

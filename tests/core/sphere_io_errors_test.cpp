@@ -13,7 +13,7 @@
 #include <limits>
 #include <random>
 
-#include "inscribe/sphere_io.h"
+#include "inscribe/balls/sphere_io.h"
 
 namespace inscribe {
 namespace {

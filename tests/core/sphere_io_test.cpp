@@ -1,7 +1,7 @@
 // Sphere-set files: bit-exact round trips, hand-written golden files in every format, the
 // .sph root sphere and the OBJ icospheres against independent computations, and the file
 // system side (extensions, sniffing, atomic replacement). Bad input: sphere_io_errors_test.cpp.
-#include "inscribe/sphere_io.h"
+#include "inscribe/balls/sphere_io.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -14,7 +14,7 @@
 #include <random>
 #include <sstream>
 
-#include "inscribe/mesh_io.h"
+#include "inscribe/mesh/mesh_io.h"
 #include "support/synthetic_meshes.h"
 
 namespace inscribe {

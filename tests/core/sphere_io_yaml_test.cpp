@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "inscribe/sphere_io.h"
+#include "inscribe/balls/sphere_io.h"
 
 namespace inscribe {
 namespace {

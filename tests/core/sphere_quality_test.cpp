@@ -1,12 +1,12 @@
-#include "inscribe/sphere_quality.h"
+#include "inscribe/balls/sphere_quality.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <random>
 
-#include "inscribe/medial_spheres.h"
-#include "parallel.h"
+#include "base/parallel.h"
+#include "inscribe/medial/medial_spheres.h"
 #include "support/synthetic_meshes.h"
 #include "support/test_meshes.h"
 

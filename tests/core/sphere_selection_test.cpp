@@ -2,7 +2,7 @@
 // samples and against exact union volumes; GenerateOptimisedSpheres keeps the paper's
 // guarantees (internal, tangent, contacts), never loses to the paper's set at the same budget
 // on the demo meshes, is deterministic, reports progress and cancels.
-#include "inscribe/sphere_selection.h"
+#include "inscribe/medial/sphere_selection.h"
 
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
@@ -15,15 +15,15 @@
 #include <random>
 #include <vector>
 
-#include "coverage_grid.h"
-#include "inscribe/medial_spheres.h"
-#include "inscribe/solid.h"
-#include "inscribe/sphere_set_generation.h"
-#include "inscribe/union_of_balls.h"
+#include "inscribe/balls/union_of_balls.h"
+#include "inscribe/generation/sphere_set_generation.h"
+#include "inscribe/medial/medial_spheres.h"
+#include "inscribe/solid/solid.h"
+#include "medial/coverage_grid.h"
+#include "medial/voxel_grid.h"
 #include "support/medial_checks.h"
 #include "support/sphere_sets.h"
 #include "support/test_meshes.h"
-#include "voxel_grid.h"
 
 namespace inscribe {
 namespace {

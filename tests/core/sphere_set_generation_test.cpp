@@ -1,6 +1,6 @@
 // GenerateSphereSet, the one pipeline: the same set and figures, bit for bit, as its stages
 // called by hand (the slow obvious path); defaults and checks in one place; cancellation.
-#include "inscribe/sphere_set_generation.h"
+#include "inscribe/generation/sphere_set_generation.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

@@ -1,7 +1,7 @@
-// TriangleBvh (core/src/triangle_bvh.h, private) against the slow obvious answers: a scan of
+// TriangleBvh (core/src/solid/triangle_bvh.h, private) against the slow obvious answers: a scan of
 // every triangle with the same double-precision routines. The BVH promises the scan's answer
 // bit for bit (ties to the lowest triangle index), so every comparison here is exact.
-#include "triangle_bvh.h"
+#include "solid/triangle_bvh.h"
 
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>

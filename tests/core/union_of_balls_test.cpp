@@ -1,4 +1,4 @@
-#include "inscribe/union_of_balls.h"
+#include "inscribe/balls/union_of_balls.h"
 
 #include <gtest/gtest.h>
 

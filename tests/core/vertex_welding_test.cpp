@@ -1,7 +1,7 @@
 // Welding coincident vertices in ValidateMesh: files that repeat each vertex per face (MeshLab's
 // OBJ), near-coincident copies, what welding collapses, shells that touch, and the kd-tree
 // search against a brute-force one.
-#include "vertex_welding.h"  // private: core/src
+#include "mesh/vertex_welding.h"  // private: core/src
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -13,9 +13,9 @@
 #include <string>
 #include <vector>
 
-#include "inscribe/mesh_hash.h"
-#include "inscribe/mesh_io.h"
-#include "inscribe/mesh_validation.h"
+#include "inscribe/geometry/mesh_hash.h"
+#include "inscribe/mesh/mesh_io.h"
+#include "inscribe/solid/mesh_validation.h"
 #include "support/cgal_mesh_writer.h"
 #include "support/mesh_issues.h"
 #include "support/synthetic_meshes.h"

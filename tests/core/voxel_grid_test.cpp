@@ -1,6 +1,6 @@
 // The corner screen's sheet estimate (voxel_grid.h): exact between planes, on a tube's axis,
 // and on real meshes it drops voxels without dropping the plain method's spheres.
-#include "voxel_grid.h"
+#include "medial/voxel_grid.h"
 
 #include <gtest/gtest.h>
 
@@ -15,8 +15,8 @@
 #include <tuple>
 #include <vector>
 
-#include "inscribe/boundary_oracle.h"
-#include "inscribe/medial_spheres.h"
+#include "inscribe/medial/medial_spheres.h"
+#include "inscribe/solid/boundary_oracle.h"
 #include "support/test_meshes.h"
 
 namespace inscribe::internal {

@@ -21,7 +21,7 @@
 #include <utility>
 #include <vector>
 
-#include "inscribe/solid.h"
+#include "inscribe/solid/solid.h"
 #include "support/synthetic_meshes.h"
 #include "support/winding_oracle.h"
 

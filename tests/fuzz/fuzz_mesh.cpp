@@ -11,8 +11,8 @@
 #include <cstdlib>
 #include <string>
 
-#include "inscribe/mesh_io.h"
-#include "inscribe/mesh_validation.h"
+#include "inscribe/mesh/mesh_io.h"
+#include "inscribe/solid/mesh_validation.h"
 
 namespace {
 

@@ -13,7 +13,7 @@
 #include <string>
 
 #include "absl/strings/string_view.h"
-#include "inscribe/sphere_io.h"
+#include "inscribe/balls/sphere_io.h"
 
 namespace {
 

@@ -23,10 +23,10 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/string_view.h"
+#include "inscribe/balls/sphere_io.h"
 #include "inscribe/robot/kinematics.h"
 #include "inscribe/robot/spherized_urdf.h"
 #include "inscribe/robot/urdf_robot.h"
-#include "inscribe/sphere_io.h"
 
 namespace {
 

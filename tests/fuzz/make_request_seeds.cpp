@@ -9,7 +9,7 @@
 #include <fstream>
 #include <string>
 
-#include "inscribe/mesh_hash.h"
+#include "inscribe/geometry/mesh_hash.h"
 #include "inscribe/wire/convert.h"
 #include "request_fuzz_server.h"
 

@@ -8,8 +8,8 @@
 #include "google/protobuf/stubs/logging.h"
 #include "grpcpp/create_channel.h"
 #include "grpcpp/security/credentials.h"
-#include "inscribe/mesh.h"
-#include "inscribe/mesh_hash.h"
+#include "inscribe/geometry/mesh.h"
+#include "inscribe/geometry/mesh_hash.h"
 #include "inscribe/wire/convert.h"
 
 namespace inscribe::fuzz {

@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "inscribe/certified_distance.h"
+#include "inscribe/distance/certified_distance.h"
 #include "inscribe/robot/self_collision.h"
 #include "support/fcl_solid_distance.h"
 #include "support/mesh_arm.h"

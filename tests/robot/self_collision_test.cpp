@@ -17,9 +17,9 @@
 #include <tuple>
 #include <vector>
 
+#include "inscribe/balls/sphere_io.h"
 #include "inscribe/robot/self_collision_srdf.h"
 #include "inscribe/robot/spherized_urdf.h"
-#include "inscribe/sphere_io.h"
 
 namespace inscribe::robot {
 namespace {

@@ -12,8 +12,8 @@
 #include <fstream>
 #include <string>
 
-#include "inscribe/mesh_validation.h"
 #include "inscribe/robot/primitive_meshes.h"
+#include "inscribe/solid/mesh_validation.h"
 
 namespace inscribe::robot {
 namespace {

@@ -15,9 +15,9 @@
 #include <sstream>
 #include <string>
 
-#include "inscribe/mesh_validation.h"
 #include "inscribe/robot/primitive_meshes.h"
 #include "inscribe/robot/spherized_urdf.h"
+#include "inscribe/solid/mesh_validation.h"
 #include "support/assimp_scenes.h"
 #include "support/synthetic_meshes.h"
 

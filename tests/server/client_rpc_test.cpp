@@ -13,14 +13,14 @@
 #include <thread>
 #include <vector>
 
-#include "inscribe/boundary_oracle.h"
+#include "inscribe/balls/sphere_quality.h"
 #include "inscribe/client/client.h"
-#include "inscribe/medial_spheres.h"
-#include "inscribe/mesh_hash.h"
-#include "inscribe/mesh_validation.h"
-#include "inscribe/separation_distance.h"
+#include "inscribe/distance/separation_distance.h"
+#include "inscribe/geometry/mesh_hash.h"
+#include "inscribe/medial/medial_spheres.h"
 #include "inscribe/server/inscribe_server.h"
-#include "inscribe/sphere_quality.h"
+#include "inscribe/solid/boundary_oracle.h"
+#include "inscribe/solid/mesh_validation.h"
 #include "support/sphere_sets.h"
 #include "support/synthetic_meshes.h"
 #include "support/test_meshes.h"

@@ -10,8 +10,8 @@
 
 #include "inscribe/client/client.h"
 #include "inscribe/client/connection.h"
-#include "inscribe/mesh_validation.h"
-#include "inscribe/sphere_hierarchy.h"
+#include "inscribe/distance/sphere_hierarchy.h"
+#include "inscribe/solid/mesh_validation.h"
 #include "inscribe/wire/convert.h"
 #include "support/synthetic_meshes.h"
 

@@ -14,12 +14,12 @@
 #include <vector>
 
 #include "cache_entry_format.h"
-#include "inscribe/certified_distance.h"
 #include "inscribe/client/client.h"
-#include "inscribe/cover_certificate.h"
-#include "inscribe/mesh_hash.h"
-#include "inscribe/separation_distance.h"
-#include "inscribe/solid.h"
+#include "inscribe/cover/cover_certificate.h"
+#include "inscribe/distance/certified_distance.h"
+#include "inscribe/distance/separation_distance.h"
+#include "inscribe/geometry/mesh_hash.h"
+#include "inscribe/solid/solid.h"
 #include "spheres_rpc_fixture.h"
 #include "support/sphere_sets.h"
 #include "support/synthetic_meshes.h"

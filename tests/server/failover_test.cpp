@@ -17,7 +17,7 @@
 
 #include "inscribe/client/client.h"
 #include "inscribe/client/routing.h"
-#include "inscribe/mesh_hash.h"
+#include "inscribe/geometry/mesh_hash.h"
 #include "inscribe/wire/keys.h"
 #include "support/inscribed_process.h"
 #include "support/test_meshes.h"

@@ -37,7 +37,7 @@
 #include "fault_injection_support.h"
 #include "grpcpp/grpcpp.h"
 #include "inscribe/client/client.h"
-#include "inscribe/mesh_hash.h"
+#include "inscribe/geometry/mesh_hash.h"
 #include "inscribe/v1/service.grpc.pb.h"
 #include "support/sphere_sets.h"
 #include "support/test_meshes.h"

@@ -17,7 +17,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "client_test_support.h"
-#include "inscribe/mesh_hash.h"
+#include "inscribe/geometry/mesh_hash.h"
 #include "inscribe/wire/keys.h"
 
 namespace inscribe::client {

@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "inscribe/client/client.h"
-#include "inscribe/mesh.h"
+#include "inscribe/geometry/mesh.h"
 #include "support/inscribed_process.h"
 #include "support/redis_process.h"
 #include "support/synthetic_meshes.h"

@@ -16,9 +16,9 @@
 #include <vector>
 
 #include "inscribe/client/client.h"
-#include "inscribe/scene.h"
-#include "inscribe/separation_distance.h"
-#include "inscribe/sphere_hierarchy.h"
+#include "inscribe/distance/separation_distance.h"
+#include "inscribe/distance/sphere_hierarchy.h"
+#include "inscribe/scene/scene.h"
 #include "spheres_rpc_fixture.h"
 #include "support/sphere_sets.h"
 #include "support/synthetic_meshes.h"

@@ -14,7 +14,7 @@
 #include <thread>
 #include <vector>
 
-#include "inscribe/separation_distance.h"
+#include "inscribe/distance/separation_distance.h"
 #include "spheres_rpc_fixture.h"
 #include "support/sphere_sets.h"
 

@@ -12,11 +12,11 @@
 #include <thread>
 #include <vector>
 
-#include "inscribe/boundary_oracle.h"
-#include "inscribe/mesh_hash.h"
-#include "inscribe/separation_distance.h"
-#include "inscribe/sphere_deformation.h"
-#include "inscribe/sphere_quality.h"
+#include "inscribe/balls/sphere_quality.h"
+#include "inscribe/distance/separation_distance.h"
+#include "inscribe/geometry/mesh_hash.h"
+#include "inscribe/medial/sphere_deformation.h"
+#include "inscribe/solid/boundary_oracle.h"
 #include "spheres_rpc_fixture.h"
 #include "support/sphere_sets.h"
 #include "support/synthetic_meshes.h"

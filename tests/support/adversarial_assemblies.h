@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "inscribe/mesh.h"
+#include "inscribe/geometry/mesh.h"
 
 namespace inscribe::testing {
 

@@ -7,7 +7,7 @@
 #include <memory>
 #include <vector>
 
-#include "inscribe/mesh.h"
+#include "inscribe/geometry/mesh.h"
 
 namespace inscribe::testing {
 

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <limits>
 
-#include "closest_point_triangle.h"
+#include "solid/closest_point_triangle.h"
 
 namespace inscribe::testing {
 

@@ -2,8 +2,8 @@
 // paths (the BVH, the oracle, generation, deformation updates).
 #pragma once
 
-#include "inscribe/boundary_oracle.h"
-#include "inscribe/mesh.h"
+#include "inscribe/geometry/mesh.h"
+#include "inscribe/solid/boundary_oracle.h"
 
 namespace inscribe::testing {
 

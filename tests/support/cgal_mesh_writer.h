@@ -3,7 +3,7 @@
 
 #include <string>
 
-#include "inscribe/mesh.h"
+#include "inscribe/geometry/mesh.h"
 
 namespace inscribe::testing {
 

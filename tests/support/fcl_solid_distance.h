@@ -10,8 +10,8 @@
 #include <memory>
 #include <vector>
 
-#include "inscribe/rigid_pose.h"
-#include "inscribe/solid.h"
+#include "inscribe/geometry/rigid_pose.h"
+#include "inscribe/solid/solid.h"
 
 namespace inscribe::testing {
 

@@ -5,8 +5,8 @@
 
 #include <vector>
 
-#include "inscribe/sphere.h"
-#include "inscribe/union_of_balls.h"
+#include "inscribe/balls/union_of_balls.h"
+#include "inscribe/geometry/sphere.h"
 
 namespace inscribe::testing {
 

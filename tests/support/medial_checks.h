@@ -2,8 +2,8 @@
 // obvious distance scan.
 #pragma once
 
-#include "inscribe/boundary_oracle.h"
-#include "inscribe/sphere.h"
+#include "inscribe/geometry/sphere.h"
+#include "inscribe/solid/boundary_oracle.h"
 
 namespace inscribe::testing {
 

@@ -5,8 +5,8 @@
 
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
-#include "inscribe/cover_certificate.h"
-#include "inscribe/sphere_cover.h"
+#include "inscribe/cover/cover_certificate.h"
+#include "inscribe/cover/sphere_cover.h"
 
 namespace inscribe::testing {
 namespace {

@@ -10,7 +10,7 @@
 #include "absl/status/statusor.h"
 #include "inscribe/robot/self_collision.h"
 #include "inscribe/robot/urdf_robot.h"
-#include "inscribe/solid.h"
+#include "inscribe/solid/solid.h"
 
 namespace inscribe::testing {
 

@@ -3,7 +3,7 @@
 
 #include <string>
 
-#include "inscribe/mesh_validation.h"
+#include "inscribe/solid/mesh_validation.h"
 
 namespace inscribe::testing {
 

@@ -6,8 +6,8 @@
 #include <map>
 #include <mutex>
 
-#include "inscribe/boundary_oracle.h"
-#include "inscribe/medial_spheres.h"
+#include "inscribe/medial/medial_spheres.h"
+#include "inscribe/solid/boundary_oracle.h"
 #include "support/test_meshes.h"
 
 namespace inscribe::testing {

@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
-#include "inscribe/rigid_pose.h"
-#include "inscribe/sphere.h"
+#include "inscribe/geometry/rigid_pose.h"
+#include "inscribe/geometry/sphere.h"
 
 namespace inscribe::testing {
 

@@ -1,7 +1,7 @@
 // Small meshes built in code, with known volumes, for tests.
 #pragma once
 
-#include "inscribe/mesh.h"
+#include "inscribe/geometry/mesh.h"
 
 namespace inscribe::testing {
 

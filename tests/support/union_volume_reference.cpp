@@ -9,7 +9,7 @@
 #include <utility>
 #include <vector>
 
-#include "parallel.h"
+#include "base/parallel.h"
 
 namespace inscribe::testing {
 namespace {

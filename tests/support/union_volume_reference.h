@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "inscribe/sphere.h"
+#include "inscribe/geometry/sphere.h"
 
 namespace inscribe::testing {
 

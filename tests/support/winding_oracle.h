@@ -8,7 +8,7 @@
 #include <array>
 #include <vector>
 
-#include "inscribe/mesh.h"
+#include "inscribe/geometry/mesh.h"
 
 namespace inscribe::testing {
 

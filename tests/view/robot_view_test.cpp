@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "inscribe/mesh_io.h"
+#include "inscribe/mesh/mesh_io.h"
 #include "inscribe/view/robot_view_link.h"
 #include "inscribe/view/robot_view_spheres.h"
 #include "support/synthetic_meshes.h"

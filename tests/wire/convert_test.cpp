@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "inscribe/mesh_validation.h"
+#include "inscribe/solid/mesh_validation.h"
 #include "support/synthetic_meshes.h"
 
 namespace inscribe::wire {

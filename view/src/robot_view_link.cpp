@@ -7,8 +7,8 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
-#include "inscribe/solid.h"
-#include "inscribe/sphere_quality.h"
+#include "inscribe/balls/sphere_quality.h"
+#include "inscribe/solid/solid.h"
 
 namespace inscribe::view {
 namespace {

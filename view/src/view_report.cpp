@@ -4,8 +4,8 @@
 #include <chrono>
 #include <utility>
 
-#include "inscribe/envelope_distances.h"
-#include "inscribe/sphere_quality.h"
+#include "inscribe/balls/sphere_quality.h"
+#include "inscribe/distance/envelope_distances.h"
 #include "inscribe/view/signed_histogram.h"
 #include "inscribe/view/view_report_html.h"
 

@@ -8,7 +8,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/strip.h"
-#include "inscribe/sha256.h"
+#include "inscribe/base/sha256.h"
 
 namespace inscribe::wire {
 namespace {

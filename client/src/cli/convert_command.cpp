@@ -8,7 +8,7 @@
 
 #include "absl/strings/str_join.h"
 #include "command_outcome.h"
-#include "inscribe/sphere_io.h"
+#include "inscribe/balls/sphere_io.h"
 #include "sphere_output.h"
 
 namespace inscribe::cli {

@@ -8,9 +8,9 @@
 
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
-#include "inscribe/cover_certificate.h"
-#include "inscribe/sphere_io.h"
-#include "inscribe/sphere_set_generation.h"
+#include "inscribe/balls/sphere_io.h"
+#include "inscribe/cover/cover_certificate.h"
+#include "inscribe/generation/sphere_set_generation.h"
 
 namespace inscribe::cli {
 

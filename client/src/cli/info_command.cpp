@@ -8,8 +8,8 @@
 
 #include "absl/strings/str_format.h"
 #include "command_outcome.h"
-#include "inscribe/mesh_io.h"
-#include "inscribe/mesh_validation.h"
+#include "inscribe/mesh/mesh_io.h"
+#include "inscribe/solid/mesh_validation.h"
 #include "inscribe/view/report_json.h"
 #include "remote_options.h"
 #include "service_session.h"

@@ -8,7 +8,7 @@
 
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
-#include "inscribe/rigid_pose.h"
+#include "inscribe/geometry/rigid_pose.h"
 
 namespace inscribe::cli {
 

@@ -10,9 +10,9 @@
 #include "absl/container/flat_hash_set.h"
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
-#include "inscribe/scene.h"
-#include "inscribe/sphere_hierarchy.h"
-#include "inscribe/sphere_set_generation.h"
+#include "inscribe/distance/sphere_hierarchy.h"
+#include "inscribe/generation/sphere_set_generation.h"
+#include "inscribe/scene/scene.h"
 
 namespace inscribe::cli {
 

@@ -5,7 +5,7 @@
 #include <utility>
 
 #include "command_outcome.h"
-#include "inscribe/mesh_io.h"
+#include "inscribe/mesh/mesh_io.h"
 
 namespace inscribe::cli {
 namespace {

@@ -8,8 +8,8 @@
 
 #include "absl/status/statusor.h"
 #include "inscribe/client/client.h"
-#include "inscribe/mesh_validation.h"
-#include "inscribe/solid.h"
+#include "inscribe/solid/mesh_validation.h"
+#include "inscribe/solid/solid.h"
 
 namespace inscribe::cli {
 

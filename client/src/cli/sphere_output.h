@@ -4,7 +4,7 @@
 #include <string>
 
 #include "absl/status/status.h"
-#include "inscribe/sphere_io.h"
+#include "inscribe/balls/sphere_io.h"
 
 namespace inscribe::cli {
 

@@ -17,14 +17,14 @@
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_split.h"
 #include "command_outcome.h"
-#include "inscribe/atomic_file.h"
+#include "inscribe/base/atomic_file.h"
+#include "inscribe/generation/sphere_set_generation.h"
 #include "inscribe/robot/kinematics.h"
 #include "inscribe/robot/self_collision.h"
 #include "inscribe/robot/self_collision_srdf.h"
 #include "inscribe/robot/spherized_urdf.h"
 #include "inscribe/robot/urdf_robot.h"
 #include "inscribe/robot/urdf_spherize.h"
-#include "inscribe/sphere_set_generation.h"
 #include "nlohmann/json.hpp"
 
 namespace inscribe::cli {

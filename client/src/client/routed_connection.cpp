@@ -20,9 +20,9 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_join.h"
 #include "absl/strings/strip.h"
+#include "inscribe/base/sha256.h"
 #include "inscribe/client/routing.h"
-#include "inscribe/mesh_hash.h"
-#include "inscribe/sha256.h"
+#include "inscribe/geometry/mesh_hash.h"
 #include "inscribe/wire/convert.h"
 #include "inscribe/wire/keys.h"
 

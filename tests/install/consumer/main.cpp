@@ -5,8 +5,8 @@
 #include <cstdio>
 
 #include "inscribe/client/client.h"
-#include "inscribe/solid.h"
-#include "inscribe/sphere_set_generation.h"
+#include "inscribe/generation/sphere_set_generation.h"
+#include "inscribe/solid/solid.h"
 
 int main() {
   inscribe::Mesh box;

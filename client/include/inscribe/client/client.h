@@ -11,19 +11,19 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "inscribe/certified_distance.h"
+#include "inscribe/balls/sphere_quality.h"
 #include "inscribe/client/connection.h"
-#include "inscribe/cover_certificate.h"
-#include "inscribe/mesh.h"
-#include "inscribe/mesh_validation.h"
-#include "inscribe/rigid_pose.h"
-#include "inscribe/scene.h"
-#include "inscribe/separation_distance.h"
-#include "inscribe/sphere.h"
-#include "inscribe/sphere_deformation.h"
-#include "inscribe/sphere_hierarchy.h"
-#include "inscribe/sphere_quality.h"
-#include "inscribe/sphere_set_generation.h"
+#include "inscribe/cover/cover_certificate.h"
+#include "inscribe/distance/certified_distance.h"
+#include "inscribe/distance/separation_distance.h"
+#include "inscribe/distance/sphere_hierarchy.h"
+#include "inscribe/generation/sphere_set_generation.h"
+#include "inscribe/geometry/mesh.h"
+#include "inscribe/geometry/rigid_pose.h"
+#include "inscribe/geometry/sphere.h"
+#include "inscribe/medial/sphere_deformation.h"
+#include "inscribe/scene/scene.h"
+#include "inscribe/solid/mesh_validation.h"
 
 namespace inscribe::client {
 

@@ -3,7 +3,7 @@
 // outward oriented (counter-clockwise seen from outside) and pass ValidateMesh unchanged.
 #pragma once
 
-#include "inscribe/mesh.h"
+#include "inscribe/geometry/mesh.h"
 
 namespace inscribe::robot {
 

@@ -31,10 +31,10 @@
 
 #include "absl/status/statusor.h"
 #include "absl/types/span.h"
-#include "inscribe/medial_spheres.h"
+#include "inscribe/geometry/sphere.h"
+#include "inscribe/medial/medial_spheres.h"
 #include "inscribe/robot/kinematics.h"
 #include "inscribe/robot/urdf_spherize.h"
-#include "inscribe/sphere.h"
 
 namespace inscribe::robot {
 

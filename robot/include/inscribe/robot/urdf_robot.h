@@ -12,7 +12,7 @@
 
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
-#include "inscribe/mesh.h"
+#include "inscribe/geometry/mesh.h"
 
 namespace inscribe::robot {
 

@@ -16,13 +16,13 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "inscribe/cover_certificate.h"
-#include "inscribe/medial_spheres.h"
-#include "inscribe/mesh.h"
+#include "inscribe/cover/cover_certificate.h"
+#include "inscribe/generation/sphere_set_generation.h"
+#include "inscribe/geometry/mesh.h"
+#include "inscribe/geometry/sphere.h"
+#include "inscribe/medial/medial_spheres.h"
+#include "inscribe/medial/sphere_dilation.h"
 #include "inscribe/robot/urdf_robot.h"
-#include "inscribe/sphere.h"
-#include "inscribe/sphere_dilation.h"
-#include "inscribe/sphere_set_generation.h"
 
 namespace inscribe::robot {
 

@@ -15,11 +15,11 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
-#include "inscribe/rigid_pose.h"
-#include "inscribe/separation_distance.h"
+#include "inscribe/distance/separation_distance.h"
+#include "inscribe/generation/sphere_set_generation.h"
+#include "inscribe/geometry/rigid_pose.h"
 #include "inscribe/server/job_pool.h"
 #include "inscribe/server/result_cache.h"
-#include "inscribe/sphere_set_generation.h"
 #include "inscribe/v1/service.grpc.pb.h"
 
 namespace inscribe::server {

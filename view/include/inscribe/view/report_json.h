@@ -4,8 +4,8 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "inscribe/mesh_validation.h"
-#include "inscribe/sphere_quality.h"
+#include "inscribe/balls/sphere_quality.h"
+#include "inscribe/solid/mesh_validation.h"
 
 namespace inscribe::view {
 

@@ -6,10 +6,10 @@
 #include <string>
 #include <vector>
 
-#include "inscribe/mesh.h"
+#include "inscribe/geometry/mesh.h"
+#include "inscribe/geometry/sphere.h"
 #include "inscribe/robot/urdf_robot.h"
 #include "inscribe/robot/urdf_spherize.h"
-#include "inscribe/sphere.h"
 
 namespace inscribe::view {
 

@@ -10,8 +10,8 @@
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
+#include "inscribe/balls/sphere_io.h"
 #include "inscribe/robot/urdf_robot.h"
-#include "inscribe/sphere_io.h"
 
 namespace inscribe::view {
 

@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "inscribe/solid.h"
-#include "inscribe/sphere.h"
+#include "inscribe/geometry/sphere.h"
+#include "inscribe/solid/solid.h"
 
 namespace inscribe::view {
 

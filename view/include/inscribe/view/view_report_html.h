@@ -9,9 +9,9 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "inscribe/mesh.h"
-#include "inscribe/sphere.h"
-#include "inscribe/sphere_quality.h"
+#include "inscribe/balls/sphere_quality.h"
+#include "inscribe/geometry/mesh.h"
+#include "inscribe/geometry/sphere.h"
 #include "inscribe/view/signed_histogram.h"
 
 namespace inscribe::view {

@@ -8,10 +8,10 @@
 #include <vector>
 
 #include "absl/strings/string_view.h"
-#include "inscribe/cover_certificate.h"
-#include "inscribe/sphere_deformation.h"
-#include "inscribe/sphere_hierarchy.h"
-#include "inscribe/sphere_set_generation.h"
+#include "inscribe/cover/cover_certificate.h"
+#include "inscribe/distance/sphere_hierarchy.h"
+#include "inscribe/generation/sphere_set_generation.h"
+#include "inscribe/medial/sphere_deformation.h"
 
 namespace inscribe::wire {
 

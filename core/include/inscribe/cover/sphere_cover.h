@@ -1,0 +1,104 @@
+// Cover sets: spheres that provably contain the whole solid (cover_certificate.h), with a
+// certified bound delta on how far they reach outside it.
+//
+// GenerateCover chooses internal balls and grows them. The candidates: from each of many
+// boundary points (every vertex and area samples), balls centred on the inward normal at a
+// ladder of depths up to the deepest, each with radius = the depth of its centre (so a ball
+// grown to R protrudes at most R - depth). The choice: the fewest candidates that reach every
+// boundary sample (and interior stand-ins) by growing at most a threshold t: a greedy set
+// cover, with t searched down to the least that fits the budget (for max_protrusion: the
+// fewest spheres whose certified delta fits, a search over budgets). Then every boundary
+// triangle goes whole, or cut into pieces while that saves growth, to the chosen ball that
+// needs the least growth to hold its corners, plus a margin of one finest certificate cell's
+// diagonal; a ball is convex, so it then holds
+// the piece and its margin, and every certificate cell meeting the boundary lies in one ball.
+// The certificate then passes (failed cells, if any, grow the ball needing the least growth
+// and it certifies again): the result is always certified. delta is about t plus the margin
+// plus the growth the boundary between samples needs.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "inscribe/cover/cover_certificate.h"
+#include "inscribe/geometry/sphere.h"
+#include "inscribe/medial/medial_spheres.h"
+#include "inscribe/solid/solid.h"
+
+namespace inscribe {
+
+struct CoverParameters {
+  // The two modes, at most one set: at most N spheres with the smallest delta reached (> 0),
+  // or delta at most D mesh units with the fewest spheres (finite, > 0). Neither: at most
+  // kDefaultMaxSpheres spheres.
+  std::optional<std::int64_t> max_spheres;
+  std::optional<double> max_protrusion;
+  // Boundary points drawn (uniformly by area, fixed seed) that the choice must reach; every
+  // mesh vertex is used too. 0..100,000,000; more: a tighter choice, slower.
+  std::int64_t growth_samples = 20'000;
+  // The certificate's settings. Every sphere reaches one finest cell's diagonal past the
+  // boundary (so the certificate settles the cells there), which delta includes: a finer
+  // resolution allows a smaller delta and costs more cells.
+  CoverCertifyOptions certify;
+};
+
+// OK, or INVALID_ARGUMENT naming the first bad field. O(1).
+absl::Status CheckCoverParameters(const CoverParameters& parameters);
+
+struct GeneratedCover {
+  SphereSet set;                   // the cover (no contacts: its spheres touch nothing)
+  CoverCertificate certificate;    // certified; delta is the cover's protrusion bound
+  std::int64_t candidates = 0;     // balls the choice was made from
+  std::int64_t grown_spheres = 0;  // spheres the repairs grew (after the first certificate)
+  int repair_rounds = 0;           // certificates that failed before the one that passed
+  double seconds = 0.0;            // all of it, the internal set included
+};
+
+// What GenerateCover chooses from, made once and asked for several budgets: the boundary
+// samples, the candidate balls and their grid. For sharing one budget among many solids (a
+// robot's links): estimate each solid's delta for every count, share, then generate each.
+// Immutable and cheap to copy; `solid` must outlive it.
+class PreparedCover {
+ public:
+  // `parameters` as GenerateCover takes them (max_protrusion ignored); max_spheres (default
+  // kDefaultMaxSpheres) is the largest budget Generate will be asked for: it sets how many
+  // candidates are made (8 ladder bases per sphere) and the boundary samples (40 per sphere,
+  // 2,000 at least, CoverParameters::growth_samples at most). Errors as GenerateCover's.
+  // Cost: the candidates' ladders, O(budget * log #T) closest-point queries, plus sampling.
+  static absl::StatusOr<PreparedCover> Prepare(const Solid& solid,
+                                               const CoverParameters& parameters,
+                                               const GenerationControl& control = {});
+
+  // Entry k-1: an estimate of the delta Generate(k) reaches, for k = 1..max_spheres: the
+  // growth threshold of the farthest-first choice of k candidates plus the certificate's
+  // margin. Non-increasing, and usually above what Generate certifies (its threshold search
+  // ends near half the farthest-first one). O(max_spheres * (#samples + #candidates)).
+  std::vector<double> EstimatedDeltas(std::int64_t max_spheres) const;
+
+  // The budget mode: at most max_spheres (> 0) spheres, certified. INVALID_ARGUMENT for a
+  // budget <= 0, CANCELLED. Deterministic.
+  absl::StatusOr<GeneratedCover> Generate(std::int64_t max_spheres,
+                                          const GenerationControl& control = {}) const;
+
+  const Solid& solid() const;
+  double margin() const;           // the certificate's cell diagonal every sphere reaches past
+  double prepare_seconds() const;  // what Prepare took
+
+ private:
+  struct State;
+  explicit PreparedCover(std::shared_ptr<const State> state);
+  absl::StatusOr<GeneratedCover> Finish(const std::vector<std::size_t>& chosen,
+                                        const GenerationControl& control) const;
+  std::shared_ptr<const State> state_;
+};
+
+// A certified cover of `solid` (see above). INVALID_ARGUMENT for bad parameters, CANCELLED
+// when control.cancel is set, FAILED_PRECONDITION when the solid has no volume to cover.
+// Deterministic and parallel (TBB); progress goes to control.on_progress in [0, 1].
+absl::StatusOr<GeneratedCover> GenerateCover(const Solid& solid, const CoverParameters& parameters,
+                                             const GenerationControl& control = {});
+
+}  // namespace inscribe

@@ -1,0 +1,265 @@
+// ReadMesh and ParseMesh on COLLADA and glTF files written by assimp's exporter from CGAL's demo
+// meshes: node transforms, instancing, units, up axes, and files that are not meshes.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <assimp/Exporter.hpp>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "inscribe/mesh/mesh_io.h"
+#include "inscribe/solid/mesh_validation.h"
+#include "support/assimp_scenes.h"
+#include "support/synthetic_meshes.h"
+#include "support/test_meshes.h"
+
+namespace inscribe {
+namespace {
+
+using ::testing::AllOf;
+using ::testing::HasSubstr;
+namespace fs = std::filesystem;
+using testing::MakeScene;
+using testing::Placement;
+
+// Every placed vertex, by the transforms composed independently of the reader.
+std::vector<Vector3> PlacedVertices(const std::vector<Mesh>& meshes,
+                                    const std::vector<Placement>& placements, double scale) {
+  std::vector<Vector3> out;
+  std::vector<Eigen::Matrix4d> world(placements.size());
+  for (std::size_t i = 0; i < placements.size(); ++i) {
+    world[i] = placements[i].parent < 0 ? placements[i].transform
+                                        : world[static_cast<std::size_t>(placements[i].parent)] *
+                                              placements[i].transform;
+    const Mesh& mesh = meshes[static_cast<std::size_t>(placements[i].mesh)];
+    for (Eigen::Index v = 0; v < mesh.num_vertices(); ++v) {
+      const Eigen::Vector4d p = world[i] * mesh.vertices.row(v).transpose().homogeneous();
+      out.push_back(scale * p.head<3>());
+    }
+  }
+  return out;
+}
+
+// The largest distance from a point of either set to the other set (brute force).
+double HausdorffDistance(const std::vector<Vector3>& a, const Mesh& mesh) {
+  auto nearest = [](const Vector3& p, auto&& points, Eigen::Index n) {
+    double best = INFINITY;
+    for (Eigen::Index i = 0; i < n; ++i) best = std::min(best, (points(i) - p).norm());
+    return best;
+  };
+  double worst = 0.0;
+  for (const Vector3& p : a) {
+    worst = std::max(
+        worst, nearest(
+                   p, [&](Eigen::Index i) -> Vector3 { return mesh.vertices.row(i).transpose(); },
+                   mesh.num_vertices()));
+  }
+  for (Eigen::Index v = 0; v < mesh.num_vertices(); ++v) {
+    const Vector3 p = mesh.vertices.row(v).transpose();
+    worst = std::max(
+        worst, nearest(
+                   p, [&](Eigen::Index i) -> Vector3 { return a[static_cast<std::size_t>(i)]; },
+                   static_cast<Eigen::Index>(a.size())));
+  }
+  return worst;
+}
+
+Eigen::Matrix4d Pose(double angle_z, const Vector3& translation, double scale = 1.0) {
+  Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+  m.topLeftCorner<3, 3>() = scale * Eigen::AngleAxisd(angle_z, Vector3::UnitZ()).toRotationMatrix();
+  m.topRightCorner<3, 1>() = translation;
+  return m;
+}
+
+class AssimpImportTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("inscribe_scene_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  std::string Export(const aiScene& scene, const char* format_id, const std::string& name) {
+    const std::string path = (dir_ / name).string();
+    Assimp::Exporter exporter;
+    EXPECT_EQ(exporter.Export(&scene, format_id, path), AI_SUCCESS) << exporter.GetErrorString();
+    return path;
+  }
+  std::string Write(const std::string& name, const std::string& bytes) {
+    const std::string path = (dir_ / name).string();
+    std::ofstream(path, std::ios::binary) << bytes;
+    return path;
+  }
+  static std::string Contents(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::ostringstream out;
+    out << in.rdbuf();
+    return out.str();
+  }
+
+  fs::path dir_;
+};
+
+// Two demo meshes, one of them placed twice, under nested nodes with rotations, translations
+// and a scale: the same mesh from .dae, .gltf and .glb, and .glb from bytes.
+TEST_F(AssimpImportTest, MultiMeshScenesWithNodeTransforms) {
+  INSCRIBE_REQUIRE_MESH("eight.off");
+  INSCRIBE_REQUIRE_MESH("knot1.off");
+  const std::vector<Mesh> meshes = {testing::LoadTestMesh("eight.off"),
+                                    testing::LoadTestMesh("knot1.off")};
+  const std::vector<Placement> placements = {
+      {0, Pose(0.0, Vector3(0, 0, 0))},
+      {1, Pose(M_PI / 2, Vector3(3, 0, 0), 0.5)},
+      {0, Pose(M_PI / 3, Vector3(0, 2, 1)), 1},  // under the knot's node
+  };
+  const std::unique_ptr<aiScene> scene = MakeScene(meshes, placements);
+  const std::vector<Vector3> expected = PlacedVertices(meshes, placements, 1.0);
+  const Eigen::Index triangles = 2 * meshes[0].num_triangles() + meshes[1].num_triangles();
+  // The second eight is under the knot's node, so scaled by 0.5 too.
+  const double volume =
+      1.125 * ValidateMesh(meshes[0]).report.volume + 0.125 * ValidateMesh(meshes[1]).report.volume;
+
+  for (const auto& [format_id, name] :
+       {std::pair{"collada", "scene.dae"}, std::pair{"gltf2", "scene.gltf"},
+        std::pair{"glb2", "scene.glb"}}) {
+    const std::string path = Export(*scene, format_id, name);
+    ReadMeshInfo info;
+    absl::StatusOr<Mesh> read = ReadMesh(path, &info);
+    ASSERT_TRUE(read.ok()) << name << ": " << read.status();
+    EXPECT_EQ(read->num_triangles(), triangles) << name;
+    // Faces as the file stores them: the instanced mesh once.
+    EXPECT_EQ(info.polygons, meshes[0].num_triangles() + meshes[1].num_triangles()) << name;
+    EXPECT_EQ(info.polygons_triangulated, 0) << name;
+    EXPECT_LT(HausdorffDistance(expected, *read), 1e-5) << name;
+    // Closed once welded (the importers give each face corner its own vertex), with the
+    // instances' volumes.
+    const ValidatedMesh v = ValidateMesh(*read);
+    EXPECT_EQ(v.mesh.num_vertices(), 2 * meshes[0].num_vertices() + meshes[1].num_vertices())
+        << name;
+    EXPECT_TRUE(v.report.closed()) << name << ": " << v.report.first_error();
+    EXPECT_NEAR(v.report.volume, volume, 1e-5 * volume) << name;
+  }
+  const std::string glb = Contents((dir_ / "scene.glb").string());
+  absl::StatusOr<Mesh> parsed = ParseMesh(glb, "GLB");
+  ASSERT_TRUE(parsed.ok()) << parsed.status();
+  EXPECT_LT(HausdorffDistance(expected, *parsed), 1e-5);
+  // A .gltf whose buffer is a sibling file cannot be read from bytes.
+  absl::StatusOr<Mesh> gltf = ParseMesh(Contents((dir_ / "scene.gltf").string()), "gltf");
+  EXPECT_EQ(gltf.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(gltf.status().message(), AllOf(HasSubstr("separate file"), HasSubstr(".glb")));
+}
+
+// COLLADA's <unit meter> scales to metres; <up_axis> is not applied (the file's own axes, as
+// ROS's loaders take them).
+TEST_F(AssimpImportTest, ColladaUnitsAndUpAxis) {
+  INSCRIBE_REQUIRE_MESH("eight.off");
+  const std::vector<Mesh> meshes = {testing::LoadTestMesh("eight.off")};
+  const std::vector<Placement> placements = {{0, Pose(0.3, Vector3(1, 2, 3))}};
+  const std::unique_ptr<aiScene> scene = MakeScene(meshes, placements);
+  const std::string dae = Contents(Export(*scene, "collada", "metres.dae"));
+  const std::size_t unit = dae.find("<unit ");
+  ASSERT_NE(unit, std::string::npos);
+  const std::size_t unit_end = dae.find("/>", unit) + 2;
+  const std::size_t up = dae.find("<up_axis>Y_UP</up_axis>");
+  ASSERT_NE(up, std::string::npos);
+
+  for (const char* axis : {"Y_UP", "Z_UP", "X_UP"}) {
+    for (const auto& [element, scale] :
+         {std::pair{"<unit name=\"centimeter\" meter=\"0.01\"/>", 0.01},
+          std::pair{"<unit name=\"inch\" meter=\"0.0254\"/>", 0.0254},
+          std::pair{"<unit meter=\"1\"/>", 1.0}}) {
+      std::string edited = dae;
+      edited.replace(up, std::string("<up_axis>Y_UP</up_axis>").size(),
+                     std::string("<up_axis>") + axis + "</up_axis>");
+      edited.replace(unit, unit_end - unit, element);
+      const std::string path = Write("edited.dae", edited);
+      absl::StatusOr<Mesh> read = ReadMesh(path);
+      ASSERT_TRUE(read.ok()) << read.status();
+      const std::vector<Vector3> expected = PlacedVertices(meshes, placements, scale);
+      EXPECT_LT(HausdorffDistance(expected, *read), 1e-5 * scale) << axis << " " << element;
+      absl::StatusOr<Mesh> parsed = ParseMesh(edited, "dae");
+      ASSERT_TRUE(parsed.ok()) << parsed.status();
+      EXPECT_EQ(parsed->vertices, read->vertices);
+    }
+  }
+}
+
+TEST_F(AssimpImportTest, PolygonsAreTriangulatedAndLinesIgnored) {
+  // A unit cube of six quads, and a mesh of lines only under another node.
+  const Mesh cube = testing::UnitCube();
+  auto scene = MakeScene({cube}, {{0, Eigen::Matrix4d::Identity()}});
+  aiMesh* quads = scene->mMeshes[0];
+  quads->mPrimitiveTypes = aiPrimitiveType_POLYGON;
+  // The cube's faces as quads, walked as its triangle pairs are (outward).
+  const std::vector<std::array<unsigned, 4>> faces = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                                                      {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  ASSERT_EQ(faces.size(), 6u);
+  delete[] quads->mFaces;  // each aiFace frees its indices
+  quads->mNumFaces = 6;
+  quads->mFaces = new aiFace[6];
+  for (unsigned f = 0; f < 6; ++f) {
+    quads->mFaces[f].mNumIndices = 4;
+    quads->mFaces[f].mIndices = new unsigned[4]{faces[f][0], faces[f][1], faces[f][2], faces[f][3]};
+  }
+  const std::string path = Export(*scene, "glb2", "quads.glb");
+  ReadMeshInfo info;
+  absl::StatusOr<Mesh> read = ReadMesh(path, &info);
+  ASSERT_TRUE(read.ok()) << read.status();
+  EXPECT_EQ(read->num_triangles(), 12);
+  const ValidatedMesh v = ValidateMesh(*read);
+  EXPECT_TRUE(v.report.usable()) << v.report.first_error();
+  EXPECT_NEAR(v.report.volume, 1.0, 1e-6);
+
+  // Lines only: no triangles, said so.
+  aiMesh* lines = scene->mMeshes[0];
+  lines->mPrimitiveTypes = aiPrimitiveType_LINE;
+  for (unsigned f = 0; f < 6; ++f) lines->mFaces[f].mNumIndices = 2;
+  absl::StatusOr<Mesh> none = ReadMesh(Export(*scene, "glb2", "lines.glb"));
+  EXPECT_EQ(none.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(none.status().message(), HasSubstr("no triangles"));
+}
+
+TEST_F(AssimpImportTest, FilesThatAreNotScenesAreClearErrors) {
+  std::mt19937 random(5);
+  std::string garbage(4096, '\0');
+  for (char& c : garbage) c = static_cast<char>(random());
+  for (const char* name : {"garbage.dae", "garbage.glb", "garbage.gltf", "GARBAGE.DAE"}) {
+    const std::string path = Write(name, garbage);
+    absl::StatusOr<Mesh> read = ReadMesh(path);
+    EXPECT_EQ(read.status().code(), absl::StatusCode::kInvalidArgument) << name;
+    EXPECT_THAT(read.status().message(), AllOf(HasSubstr(path), HasSubstr("assimp")));
+  }
+  for (const char* format : {"dae", "glb", "gltf"}) {
+    absl::StatusOr<Mesh> parsed = ParseMesh(garbage, format);
+    EXPECT_EQ(parsed.status().code(), absl::StatusCode::kInvalidArgument) << format;
+  }
+  absl::StatusOr<Mesh> empty = ReadMesh(Write("empty.dae", ""));
+  EXPECT_THAT(empty.status().message(), HasSubstr("file is empty"));
+  absl::StatusOr<Mesh> xml = ReadMesh(Write("not.dae", "<?xml version=\"1.0\"?><html/>"));
+  EXPECT_EQ(xml.status().code(), absl::StatusCode::kInvalidArgument);
+}
+
+TEST_F(AssimpImportTest, NonFiniteCoordinatesAreRefused) {
+  const std::unique_ptr<aiScene> scene =
+      MakeScene({testing::UnitCube()}, {{0, Eigen::Matrix4d::Identity()}});
+  std::string dae = Contents(Export(*scene, "collada", "cube.dae"));
+  // The first position of the cube's float array, made NaN.
+  const std::size_t array = dae.find("<float_array");
+  ASSERT_NE(array, std::string::npos);
+  const std::size_t first = dae.find('>', array) + 1;
+  const std::size_t end = dae.find(' ', first);
+  dae.replace(first, end - first, "nan");
+  absl::StatusOr<Mesh> read = ReadMesh(Write("nan.dae", dae));
+  EXPECT_EQ(read.status().code(), absl::StatusCode::kInvalidArgument);
+}
+
+}  // namespace
+}  // namespace inscribe

@@ -1,4 +1,4 @@
-// Latency isolation under abuse (issue 8): one inscribed process, a light client doing small
+// Latency isolation under abuse: one inscribed process, a light client doing small
 // Distance calls (10 pose pairs) on a cached sphere set back to back, measured alone for T
 // seconds and then again while abusive clients send attacks in loops: broken meshes, a
 // billion-voxel Generate, 10^6-pose Distance calls, garbage bytes and oversized messages.

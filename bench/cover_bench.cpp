@@ -1,4 +1,4 @@
-// Certified covers and certified distance intervals (issue 22) against their peers, in one run:
+// Certified covers and certified distance intervals against their peers, in one run:
 //
 // 1. Covers: for each model, GenerateCover at AMAA's sphere count (where known) and at 500:
 //    generation seconds, CertifyCover seconds on the result, delta as % of the bounding box's

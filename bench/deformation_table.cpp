@@ -1,4 +1,4 @@
-// The deformation-update table (paper Section V, issue 4): for each deformation sequence of a
+// The deformation-update table (paper Section V): for each deformation sequence of a
 // demo mesh, how long SphereDeformer::Update takes against generating the spheres again from
 // scratch at the same voxel size, and how good each result is (exact nerr, or Lemma 1/2 bounds
 // when updated spheres protrude). Prints Markdown tables: the reference sets, one row per frame,
@@ -39,7 +39,7 @@ using namespace inscribe;
 using sequences::DeformationKind;
 using Clock = std::chrono::steady_clock;
 
-// The update must cost at most this fraction of a regeneration (issue 4's target).
+// The update must cost at most this fraction of a regeneration.
 constexpr double kTargetRatio = 0.02;
 
 double SecondsSince(Clock::time_point start) {
@@ -70,7 +70,7 @@ struct Options {
 struct ReferenceRow {
   std::string sequence;
   std::int64_t triangles = 0;
-  bool ray_parity = false;  // the reference self-intersects: ray-parity inside test
+  bool exact_winding = false;  // the reference's generation used the exact inside test
   std::size_t spheres = 0;
   double sigma = 0.0;    // voxel size found by the budget search, mesh units
   double epsilon = 0.0;  // resolved search tolerance, mesh units
@@ -155,7 +155,6 @@ absl::Status RunSequence(const SequenceSpec& spec, const Options& options, Resul
   if (!quality.ok()) return quality.status();
 
   DeformationOptions carried;  // defaults: carried frame, xi = 0.25% of the largest extent
-  carried.oracle = oracle_options;
   DeformationOptions interpolated = carried;
   interpolated.direction = ContactDirection::kInterpolatedNormal;
   absl::StatusOr<SphereDeformer> deformer =
@@ -168,7 +167,7 @@ absl::Status RunSequence(const SequenceSpec& spec, const Options& options, Resul
   ReferenceRow ref;
   ref.sequence = name;
   ref.triangles = reference.num_triangles();
-  ref.ray_parity = oracle_options.inside_test == InsideTest::kExactWinding;
+  ref.exact_winding = oracle_options.inside_test == InsideTest::kExactWinding;
   ref.spheres = generated->best.set.size();
   ref.sigma = generated->best.voxel_size;
   ref.epsilon = generated->best.epsilon;
@@ -270,8 +269,8 @@ void PrintReferences(const Options& options, const Results& results) {
   absl::PrintF("|---|---:|---|---:|---:|---:|---:|---:|---:|\n");
   for (const ReferenceRow& r : results.references) {
     absl::PrintF("| %s | %d | %s | %d | %.5g | %d | %.2f | %.4f | %.4g |\n", r.sequence,
-                 r.triangles, r.ray_parity ? "ray parity" : "pseudonormal", r.spheres, r.sigma,
-                 r.runs, r.seconds, r.nerr, r.xi);
+                 r.triangles, r.exact_winding ? "exact winding" : "pseudonormal", r.spheres,
+                 r.sigma, r.runs, r.seconds, r.nerr, r.xi);
   }
 }
 

@@ -1,9 +1,9 @@
 // The paper's Table I protocol (Section IV-C) on CGAL's demo meshes, with both ways of spending
-// a sphere budget side by side (issue 26): the paper's finest voxel grid within the budget, and
+// a sphere budget side by side: the paper's finest voxel grid within the budget, and
 // the optimised choice from a finer grid's pool (sphere_selection.h). For each model and
 // selection: the sphere count, sigma, the exact nerr and the seconds of the whole generation
 // (every run of the sigma search, or every pool run and the selection). Then the same at
-// AMAA's sphere counts, next to AMAA's figures measured on this kind of machine (issue 3).
+// AMAA's sphere counts, next to AMAA's figures measured on this kind of machine.
 // Open models get their holes filled first (ValidateOptions::fill_holes) and are labelled so;
 // the triangle count is then the repaired mesh's. Every set goes through GenerateSphereSet,
 // the pipeline the CLI and the service use.
@@ -37,8 +37,8 @@ struct Peer {
   double seconds;  // 0 = not measured
 };
 
-// AMAA (spheretree makeTreeMedial, 8-ary, <= 512 spheres), measured by Monte Carlo (+-0.001);
-// figures from issue 3.
+// AMAA (spheretree makeTreeMedial, 8-ary, <= 512 spheres), measured by Monte Carlo (+-0.001) on
+// this kind of machine (spheretree is not packaged, so the figures are quoted).
 const std::map<std::string, Peer>& AmaaFigures() {
   static const std::map<std::string, Peer> figures = {
       {"eight.off", {504, 0.058, 1.0, 0.0}},

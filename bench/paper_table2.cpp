@@ -1,4 +1,4 @@
-// The paper's Table II protocol (Section VI-D, issue 5): approximate separation distance between
+// The paper's Table II protocol (Section VI-D): approximate separation distance between
 // two copies of a model, each a union of grown medial spheres S_D+, against the exact
 // mesh-mesh distance of FCL, on random poses. For each model: S_D from GenerateWithSphereBudget
 // with boundary voxels split in 8 (subdivide_boundary), S_D+ = DilateSpheres(S_D), an RSS

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Python bindings against C++ on the same work, in one run (issue 24's targets: at most 5%
+"""Python bindings against C++ on the same work, in one run (the targets: at most 5%
 overhead for generation, 10% for distance batches).
 
     /usr/bin/python3 bench/python_overhead.py [--mesh data/bunny00.off] [--max-spheres 500]

@@ -1,4 +1,4 @@
-// Scale-out on loopback (issue 7): inscribed replicas as separate processes, the client library
+// Scale-out on loopback: inscribed replicas as separate processes, the client library
 // routing over them.
 //   1. Generate throughput with 1 vs 3 replicas: distinct requests (every one computes), from
 //      several client threads, routed by mesh hash.

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Generation at scale (issue 26): meshes of about a million triangles at 2,000 spheres, and
+"""Generation at scale: meshes of about a million triangles at 2,000 spheres, and
 budgets of 10,000 spheres, with both selections. Each row runs `inscribe generate ... --json` in
 its own process and reports its wall time and peak resident memory (os.wait4), next to the
 generation's own seconds and the exact nerr from the JSON summary. Prints a Markdown table.

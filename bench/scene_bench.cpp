@@ -1,4 +1,4 @@
-// Simulator scenes (issue 25): N objects drawn from the CGAL demo meshes move randomly inside a
+// Simulator scenes: N objects drawn from the CGAL demo meshes move randomly inside a
 // box; every frame sets all their poses and asks for every pair closer than a threshold, with
 // its distance. Timed in-process (core's Scene on TBB's threads, and on one thread) next to
 // FCL's broad-phase manager on the same poses and the same meshes: DynamicAABBTreeCollisionManager

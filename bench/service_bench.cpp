@@ -1,4 +1,4 @@
-// The service over loopback (issue 6): what a simulator pays for calling inscribed instead of
+// The service over loopback: what a simulator pays for calling inscribed instead of
 // linking the core.
 //   1. Distance RPC with batches of 1, 100 and 10,000 pose pairs against the same queries
 //      in-process (SeparationDistances on the same hierarchies): throughput ratio.

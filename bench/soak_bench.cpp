@@ -1,4 +1,4 @@
-// Soak (issue 8): one inscribed process on loopback, N concurrent clients mixing Generate,
+// Soak: one inscribed process on loopback, N concurrent clients mixing Generate,
 // UpdateDeformation, Distance and DistanceStream for a fixed time, every loop bounded by a
 // deadline and an iteration cap so the run always ends by itself. Reports calls, errors (any
 // failed call, or an answer of the wrong size), p50/p99/max latency per RPC, the server's

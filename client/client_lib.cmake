@@ -12,6 +12,6 @@ add_library(inscribe::client ALIAS inscribe_client)
 target_include_directories(inscribe_client
   PUBLIC $<BUILD_INTERFACE:${CMAKE_CURRENT_LIST_DIR}/include> $<INSTALL_INTERFACE:include>)
 target_link_libraries(inscribe_client
-  PUBLIC inscribe::core inscribe::proto absl::status absl::statusor
-  PRIVATE inscribe::wire gRPC::grpc++ OpenSSL::Crypto inscribe_build_flags)
+  PUBLIC inscribe::core inscribe::proto inscribe::wire absl::status absl::statusor
+  PRIVATE gRPC::grpc++ OpenSSL::Crypto inscribe_build_flags)
 set_target_properties(inscribe_client PROPERTIES POSITION_INDEPENDENT_CODE ON)

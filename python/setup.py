@@ -1,7 +1,7 @@
 """Packages what CMake builds into build/python (the _inscribe extension, the package's .py and
-.pyi files, the grpcio stubs of proto/): builds the `inscribe_python` target first, configuring
-the build directory when it is not yet. INSCRIBE_BUILD_DIR overrides the build directory
-(default: build/ at the top of the source tree). For Debian's /usr/bin/python3 only."""
+.pyi files): builds the `inscribe_python` target first, configuring the build directory when
+it is not yet. INSCRIBE_BUILD_DIR overrides the build directory (default: build/ at the top of
+the source tree). For Debian's /usr/bin/python3 only."""
 
 import os
 import pathlib
@@ -37,7 +37,7 @@ setup(
     description="Unions of spheres approximating closed triangle meshes: the core in-process "
                 "and the inscribed service",
     python_requires=">=3.11",
-    packages=["inscribe", "inscribe.v1"],
+    packages=["inscribe"],
     package_dir={"": os.path.relpath(BUILD / "python", HERE)},
     package_data={"inscribe": ["_inscribe*.so", "*.pyi", "py.typed"]},
     cmdclass={"build_py": BuildWithCMake},

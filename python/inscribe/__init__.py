@@ -46,11 +46,19 @@ from ._inscribe import (
     write_mesh,
     write_spheres,
 )
-from ._client import Client, DistanceReply, DistanceSession, GenerateResult, RetryPolicy
+from ._client import (
+    Client,
+    DeformationResult,
+    DistanceReply,
+    DistanceSession,
+    GenerateResult,
+    InspectMeshResult,
+    RetryPolicy,
+)
 
 __all__ = [
     "DEFAULT_MAX_SPHERES_PER_LINK", "CertifiedDistances", "CertifiedObject", "Client",
-    "DistanceReply", "GenerateResult",
+    "DeformationResult", "DistanceReply", "GenerateResult", "InspectMeshResult",
     "CoverCertificate", "DeformationErrorBounds", "Deformer", "DistanceBatch", "DistanceResult",
     "DistanceSession", "Error", "Hierarchy", "LinkSpheres", "Mesh", "MeshIssue", "MeshReport",
     "MeshWarning",

@@ -1,11 +1,15 @@
-"""inscribe.Client: the inscribed service over gRPC (grpcio and the stubs generated from proto/).
+"""inscribe.Client: the inscribed service over gRPC (grpcio).
 
-It behaves as the C++ client (client/include/inscribe/client/client.h, routing.h): each call
-goes to the replica that owns its mesh (rendezvous hashing on the mesh hash, computed by the
-same C++ function, wire::RendezvousOrder, bound in _inscribe); an UNAVAILABLE replica is marked
-down for `down_for` seconds and the next attempt goes to the next replica at once; idempotent
-calls (all unary ones) are retried on UNAVAILABLE with exponential, jittered backoff within
-the call's deadline; TLS, mutual TLS and bearer tokens as inscribed's flags expect them.
+Transport only. Every request is built and every answer read by the extension (_inscribe,
+python/src/client_requests.cpp and client_replies.cpp) with wire/'s conversions, the ones the
+C++ client and the server use; grpcio carries the serialised bytes. What is here behaves as the
+C++ client (client/include/inscribe/client/client.h, routing.h): each call goes to the replica
+that owns its mesh (rendezvous hashing on the mesh hash, computed by the same C++ function,
+wire::RendezvousOrder, bound in _inscribe); an UNAVAILABLE replica is marked down for
+`down_for` seconds and the next attempt goes to the next replica at once; idempotent calls (all
+unary ones) are retried on UNAVAILABLE with exponential, jittered backoff within the call's
+deadline; a mesh the server lost between its upload and Generate is uploaded once more; TLS,
+mutual TLS and bearer tokens as inscribed's flags expect them.
 """
 
 from __future__ import annotations
@@ -22,7 +26,6 @@ import numpy as np
 
 from . import _inscribe
 from ._errors import Error
-from .v1 import mesh_pb2, service_pb2, service_pb2_grpc, spheres_pb2
 
 
 @dataclasses.dataclass(frozen=True)
@@ -50,83 +53,40 @@ def _raise_rpc_error(error: grpc.RpcError, note: str = "") -> None:
     raise Error(message, code.name) from None
 
 
-def _pose_array(poses, name: str) -> spheres_pb2.PoseArray:
-    array = np.asarray(poses, dtype=np.float64) if not isinstance(poses, np.ndarray) else poses
-    if array.dtype != np.float64:
-        raise TypeError(f"{name} must be a float64 array, got {array.dtype}")
-    if array.ndim == 1:
-        array = array.reshape(1, -1)
-    if array.ndim != 2 or array.shape[1] != 7:
-        raise ValueError(f"{name} must have shape (7,) or (N, 7), got {array.shape}")
-    return spheres_pb2.PoseArray(values=array.ravel())
+@dataclasses.dataclass
+class InspectMeshResult:
+    """The server's validation of a mesh (nothing stored)."""
 
-
-def _pose(pose, name: str) -> spheres_pb2.Pose:
-    values = _pose_array(pose, name).values
-    if len(values) != 7:
-        raise ValueError(f"{name} must be one pose of 7 numbers")
-    qw, qx, qy, qz, tx, ty, tz = values
-    return spheres_pb2.Pose(qw=qw, qx=qx, qy=qy, qz=qz, tx=tx, ty=ty, tz=tz)
-
-
-def _sphere_set_to_proto(spheres) -> spheres_pb2.SphereSet:
-    if not isinstance(spheres, _inscribe.SphereSet):
-        spheres = _inscribe.SphereSet(spheres)
-    array = spheres.spheres
-    message = spheres_pb2.SphereSet(centers=array[:, :3].ravel(), radii=array[:, 3])
-    if spheres.contact_triangles is not None:
-        message.contact_triangles.extend(spheres.contact_triangles)
-        message.contact_barycentrics.extend(spheres.contact_barycentrics.ravel())
-    return message
-
-
-_KINDS = {spheres_pb2.SPHERE_SET_KIND_INTERNAL: "internal",
-          spheres_pb2.SPHERE_SET_KIND_DILATED: "dilated",
-          spheres_pb2.SPHERE_SET_KIND_COVER: "cover"}
-
-
-def _sphere_set_from_proto(message, kind: str = "", mesh_sha256: str = ""):
-    n = len(message.radii)
-    array = np.empty((n, 4), dtype=np.float64)
-    array[:, :3] = np.asarray(message.centers, dtype=np.float64).reshape(n, 3)
-    array[:, 3] = message.radii
-    triangles = barycentrics = None
-    if len(message.contact_triangles):
-        triangles = np.asarray(message.contact_triangles, dtype=np.int32)
-        barycentrics = np.asarray(message.contact_barycentrics, dtype=np.float64).reshape(n, 3)
-    return _inscribe.SphereSet(array, triangles, barycentrics, kind=kind, mesh_sha256=mesh_sha256)
-
-
-def _fields(message) -> dict:
-    """Every field of a response message by name, zeros included (proto3 leaves them out of
-    ListFields); unset sub-messages and optional scalars are left out, repeated ones listed."""
-    out = {}
-    for field in message.DESCRIPTOR.fields:
-        value = getattr(message, field.name)
-        if field.label == field.LABEL_REPEATED:
-            out[field.name] = [_fields(v) if field.message_type else v for v in value]
-        elif field.message_type is not None or field.has_presence:
-            if message.HasField(field.name):
-                out[field.name] = _fields(value) if field.message_type else value
-        else:
-            out[field.name] = value
-    return out
+    mesh_sha256: str         # "sha256:<64 hex>" of the mesh after the server's fixes
+    report: _inscribe.MeshReport
 
 
 @dataclasses.dataclass
 class GenerateResult:
     """A generated set and what the server says about it (mesh units)."""
 
-    spheres: _inscribe.SphereSet
+    spheres: _inscribe.SphereSet  # with .kind, .mesh_sha256, .quality and .certificate
     sphere_set_key: str      # "spheres/v1/<64 hex>"
     mesh_sha256: str
     cache: str               # "memory", "disk", "redis", "computed" or "joined"
     voxel_size: float        # sigma used; 0 for a cover
     seconds: float           # the original run's, when cached
-    quality: dict            # QualityReport fields ({} when not evaluated)
-    certificate: dict        # a cover's CoverCertificate fields ({} otherwise)
+    quality: Optional[_inscribe.QualityReport]          # None when not evaluated
+    certificate: Optional[_inscribe.CoverCertificate]   # a cover's; None otherwise
     selection: str           # how the budget was spent: "paper" or "optimised"
     pool_size: int           # optimised: the medial spheres chosen from; 0 otherwise
+
+
+@dataclasses.dataclass
+class DeformationResult:
+    """The cached set moved onto new vertices, as inscribe.Deformer.update makes it, and what
+    the server adds."""
+
+    spheres: _inscribe.SphereSet  # with contacts, .reference_index and .stats (shrunk, ...)
+    bounds: Optional[_inscribe.DeformationErrorBounds]  # when asked (bounds=True)
+    reference_spheres: int
+    deformed_mesh_sha256: str
+    sphere_set_key: str      # the moved set's key when stored (store=True), else ""
 
 
 @dataclasses.dataclass
@@ -142,32 +102,23 @@ class DistanceReply:
     closer: np.ndarray       # (N,) bool
     lower: np.ndarray        # (N,) float64, certified only
     upper: np.ndarray        # (N,) float64, certified only
-    answers: list            # "yes" / "no" / "undecided", certified with closer_than only
+    answers: list            # "yes" / "no" / "undecided" ("undecided" without closer_than)
     server_seconds: float
 
 
-def _distance_reply(results, seconds: float = 0.0) -> DistanceReply:
-    n = len(results.distances)
-    names = {spheres_pb2.CLOSER_YES: "yes", spheres_pb2.CLOSER_NO: "no",
-             spheres_pb2.CLOSER_UNDECIDED: "undecided"}
-    return DistanceReply(
-        distance=np.asarray(results.distances, dtype=np.float64),
-        sphere_a=np.asarray(results.spheres_a, dtype=np.int32),
-        sphere_b=np.asarray(results.spheres_b, dtype=np.int32),
-        point_a=np.asarray(results.points_a, dtype=np.float64).reshape(n, 3),
-        point_b=np.asarray(results.points_b, dtype=np.float64).reshape(n, 3),
-        closer=np.asarray(results.closer, dtype=bool),
-        lower=np.asarray(results.lower, dtype=np.float64),
-        upper=np.asarray(results.upper, dtype=np.float64),
-        answers=[names.get(a, "undecided") for a in results.answers],
-        server_seconds=seconds)
-
-
 class _Replica:
+    """One endpoint: its channel and one callable per RPC, carrying serialised messages."""
+
+    _KINDS = {(False, False): "unary_unary", (False, True): "unary_stream",
+              (True, False): "stream_unary", (True, True): "stream_stream"}
+
     def __init__(self, name: str, channel: grpc.Channel):
         self.name = name
         self.channel = channel
-        self.stub = service_pb2_grpc.InscribeStub(channel)
+        self.rpc = {}
+        for method, path, client_streaming, server_streaming in _inscribe._rpc_methods():
+            kind = self._KINDS[(client_streaming, server_streaming)]
+            self.rpc[method] = getattr(channel, kind)(path)
         self.down_until = 0.0
 
 
@@ -186,9 +137,11 @@ class Client:
     tls / ca_file: TLS, the server's certificate checked against ca_file (PEM; None = the
     system's roots); cert_file and key_file: a client certificate for mutual TLS.
 
-    Errors: ValueError for INVALID_ARGUMENT, inscribe.Error with .code otherwise (UNAVAILABLE
-    after the last attempt says "(gave up after N attempts)"), messages as the server's.
-    Thread-safe.
+    Results are the in-process API's types (SphereSet, QualityReport, CoverCertificate,
+    MeshReport, Hierarchy, DeformationErrorBounds) and numpy arrays.
+    Errors: ValueError for INVALID_ARGUMENT (bad settings are refused before anything is
+    sent), inscribe.Error with .code otherwise (UNAVAILABLE after the last attempt says
+    "(gave up after N attempts)"), messages as the server's. Thread-safe.
     """
 
     def __init__(self, endpoints, *, timeout: float = 30.0, retry: RetryPolicy = RetryPolicy(),
@@ -254,15 +207,16 @@ class Client:
             replica.down_until = time.monotonic() + self._down_for if down else 0.0
 
     def _call(self, route_key: Optional[str], attempt: Callable, timeout: Optional[float]):
-        """Runs attempt(stub, seconds_left) on the routed replica until it succeeds, fails with
-        another code than UNAVAILABLE, the attempts run out or the deadline would pass."""
+        """Runs attempt(rpc, seconds_left) on the routed replica's callables until it succeeds,
+        fails with another code than UNAVAILABLE, the attempts run out or the deadline would
+        pass."""
         deadline = time.monotonic() + (self._timeout if timeout is None else timeout)
         attempts = max(1, self._retry.max_attempts)
         for n in range(1, attempts + 1):
             order = self._order(route_key)
             replica = self._replicas[order[0]]
             try:
-                result = attempt(replica.stub, max(0.0, deadline - time.monotonic()))
+                result = attempt(replica.rpc, max(0.0, deadline - time.monotonic()))
                 self._mark(replica, False)
                 return result
             except grpc.RpcError as error:
@@ -280,21 +234,23 @@ class Client:
                                                     f" (gave up after {n} attempts)"))
                 time.sleep(wait)
 
-    def _unary(self, route_key, method: str, request, timeout):
-        return self._call(route_key, lambda stub, left: getattr(stub, method)(
+    def _unary(self, route_key, method: str, request: bytes, timeout) -> bytes:
+        return self._call(route_key, lambda rpc, left: rpc[method](
             request, timeout=left, metadata=self._metadata), timeout)
 
-    def _put(self, route_key: str, method: str, request, key_of: Callable, timeout):
-        """A put routed by `route_key`; when the key the server answers with routes to another
-        replica (a repaired mesh, a set without a mesh), put there too and return that answer,
-        as the C++ routed connection does."""
-        response = self._unary(route_key, method, request, timeout)
-        stored_route = _inscribe._route_key(key_of(response))
+    def _put(self, route_key: str, method: str, request: bytes,
+             stored_key: Callable[[bytes], str], timeout) -> str:
+        """A put routed by `route_key`, returning the key the server stored it under
+        (stored_key reads it from the answer); when that key routes to another replica (a
+        repaired mesh, a set without a mesh), put there too and return that answer's, as the
+        C++ routed connection does."""
+        key = stored_key(self._unary(route_key, method, request, timeout))
+        stored_route = _inscribe._route_key(key)
         if stored_route == route_key or len(self._replicas) == 1:
-            return response
+            return key
         if self._order(stored_route)[0] == self._order(route_key)[0]:
-            return response
-        return self._unary(stored_route, method, request, timeout)
+            return key
+        return stored_key(self._unary(stored_route, method, request, timeout))
 
     # ---- calls ---------------------------------------------------------------------------
 
@@ -303,96 +259,78 @@ class Client:
         """Validates and stores `mesh` on its replica; returns its key "sha256:<hex>" (of the
         mesh as the server fixed it: coincident vertices welded, also those within
         weld_tolerance). inscribe.Error FAILED_PRECONDITION for an unusable mesh."""
-        request = service_pb2.PutMeshRequest(
-            mesh=mesh_pb2.Mesh(vertices=mesh.vertices.ravel(), triangles=mesh.triangles.ravel()),
-            fill_holes=fill_holes, weld_tolerance=weld_tolerance)
-        response = self._put(_inscribe._route_key(mesh.sha256), "PutMesh", request,
-                             lambda r: r.mesh_sha256, timeout)
-        return response.mesh_sha256
+        request = _inscribe._put_mesh_request(mesh, fill_holes=fill_holes,
+                                              weld_tolerance=weld_tolerance)
+        return self._put(_inscribe._route_key(mesh.sha256), "PutMesh", request,
+                         _inscribe._put_mesh_reply, timeout)
 
     def generate(self, mesh, *, max_spheres: Optional[int] = None,
                  voxel_size: Optional[float] = None, kind: str = "internal",
                  object_angle: Optional[float] = None, epsilon: Optional[float] = None,
-                 samples: Optional[int] = None, subdivide_boundary: bool = False,
+                 samples: Optional[int] = None, subdivide_boundary: Optional[bool] = None,
+                 max_voxels: Optional[int] = None, dilation_growth: Optional[float] = None,
                  max_protrusion: Optional[float] = None,
                  cover_resolution: Optional[float] = None, evaluate: bool = True,
-                 fill_holes: bool = False, selection: Optional[str] = None, progress: Optional[Callable[[float], None]] = None,
+                 quality_samples: Optional[int] = None, fill_holes: bool = False,
+                 selection: Optional[str] = None,
+                 progress: Optional[Callable[[float], None]] = None,
                  progress_interval: float = 0.0,
                  timeout: Optional[float] = None) -> GenerateResult:
         """Spheres for `mesh` (an inscribe.Mesh, uploaded first, or the key of a stored one),
-        with the settings of inscribe.generate (None: the server's defaults, which are core's).
-        progress(fraction) is called on this thread as the server reports it, at most every
-        progress_interval seconds (0: the server's 0.5 s). The result is cached on the server
-        by content."""
-        if kind not in ("internal", "dilated", "cover"):
-            raise ValueError(f"kind must be 'internal', 'dilated' or 'cover', got {kind!r}")
-        parameters = spheres_pb2.GenerateParameters(
-            voxel_size=voxel_size or 0.0, max_spheres=max_spheres or 0,
-            object_angle=object_angle or 0.0, epsilon=epsilon or 0.0, samples=samples or 0,
-            subdivide_boundary=subdivide_boundary, dilate=kind == "dilated",
-            cover=kind == "cover", fill_holes=fill_holes)
-        if max_protrusion is not None:
-            parameters.max_protrusion = max_protrusion
-        if cover_resolution is not None:
-            parameters.cover_resolution = cover_resolution
-        if selection is not None:
-            parameters.selection = selection  # the server names a bad one
+        with the settings of inscribe.generate (None: core's defaults), checked before anything
+        is sent (ValueError naming the field). progress(fraction) is called on this thread as
+        the server reports it, at most every progress_interval seconds (0: the server's 0.5 s).
+        The result is cached on the server by content. A mesh uploaded here that the server
+        lost before Generate (evicted) is uploaded once more."""
+        call = _inscribe._GenerateCall(
+            max_spheres=max_spheres, voxel_size=voxel_size, kind=kind, object_angle=object_angle,
+            epsilon=epsilon, samples=samples, subdivide_boundary=subdivide_boundary,
+            max_voxels=max_voxels, dilation_growth=dilation_growth,
+            max_protrusion=max_protrusion, cover_resolution=cover_resolution, evaluate=evaluate,
+            quality_samples=quality_samples, selection=selection, fill_holes=fill_holes,
+            progress_interval=progress_interval)
         uploaded = isinstance(mesh, _inscribe.Mesh)
         key = self.put_mesh(mesh, fill_holes=fill_holes, timeout=timeout) if uploaded else mesh
-        request = service_pb2.GenerateRequest(mesh_sha256=key, parameters=parameters,
-                                              skip_quality=not evaluate,
-                                              progress_interval=progress_interval)
 
-        def attempt(stub, left):
+        def attempt(rpc, left):
             result = None
-            for response in stub.Generate(request, timeout=left, metadata=self._metadata):
-                if response.HasField("progress"):
-                    if progress is not None:
-                        progress(response.progress.fraction)
-                elif response.HasField("result"):
-                    result = response.result
+            for message in rpc["Generate"](call.request(key), timeout=left,
+                                           metadata=self._metadata):
+                fraction, answer = call.read(message)
+                if fraction is not None and progress is not None:
+                    progress(fraction)
+                if answer is not None:
+                    result = answer
             if result is None:
                 raise Error("malformed Generate response: the stream ended without a result",
                             "INTERNAL")
             return result
 
         try:
-            result = self._call(_inscribe._route_key(key), attempt, timeout)
+            fields = self._call(_inscribe._route_key(key), attempt, timeout)
         except Error as error:
             if not (uploaded and error.code == "NOT_FOUND"):
                 raise
             # The server lost the mesh in between (evicted): upload it once more.
-            self.put_mesh(mesh, fill_holes=fill_holes, timeout=timeout)
-            result = self._call(_inscribe._route_key(key), attempt, timeout)
-        kind_name = _KINDS.get(result.kind, "")
-        return GenerateResult(
-            spheres=_sphere_set_from_proto(result.spheres, kind_name, result.mesh_sha256),
-            sphere_set_key=result.sphere_set_key, mesh_sha256=result.mesh_sha256,
-            cache=result.cache, voxel_size=result.voxel_size, seconds=result.seconds,
-            quality=_fields(result.quality) if result.HasField("quality") else {},
-            certificate=(_fields(result.cover.certificate)
-                         if result.HasField("cover") and result.cover.HasField("certificate")
-                         else {}),
-            selection=result.selection, pool_size=result.pool_size)
+            key = self.put_mesh(mesh, fill_holes=fill_holes, timeout=timeout)
+            fields = self._call(_inscribe._route_key(key), attempt, timeout)
+        return GenerateResult(**fields)
 
     def get_sphere_set(self, sphere_set_key: str, *, timeout: Optional[float] = None):
         """The cached set `sphere_set_key` (SphereSet with contacts when it has them).
         inscribe.Error NOT_FOUND for an unknown key."""
-        response = self._unary(_inscribe._route_key(sphere_set_key), "GetSphereSet",
-                               service_pb2.GetSphereSetRequest(sphere_set_key=sphere_set_key),
-                               timeout)
-        return _sphere_set_from_proto(response.spheres, mesh_sha256=response.mesh_sha256)
+        reply = self._unary(_inscribe._route_key(sphere_set_key), "GetSphereSet",
+                            _inscribe._get_sphere_set_request(sphere_set_key), timeout)
+        return _inscribe._sphere_set_reply(reply)
 
     def put_sphere_set(self, spheres, *, mesh_sha256: str = "",
                        timeout: Optional[float] = None) -> str:
         """Uploads `spheres` (SphereSet or (N, 4) float64), optionally naming the stored mesh
         they approximate; returns the set's key."""
-        message = _sphere_set_to_proto(spheres)
-        route = (_inscribe._route_key(mesh_sha256) if mesh_sha256
-                 else _inscribe._content_route_key(message.SerializeToString()))
-        request = service_pb2.PutSphereSetRequest(spheres=message, mesh_sha256=mesh_sha256)
-        return self._put(route, "PutSphereSet", request, lambda r: r.sphere_set_key,
-                         timeout).sphere_set_key
+        request, content_route = _inscribe._put_sphere_set_request(spheres,
+                                                                   mesh_sha256=mesh_sha256)
+        route = _inscribe._route_key(mesh_sha256) if mesh_sha256 else content_route
+        return self._put(route, "PutSphereSet", request, _inscribe._put_sphere_set_reply, timeout)
 
     def put_certified_cover(self, spheres, certificate: _inscribe.CoverCertificate, *,
                             timeout: Optional[float] = None) -> str:
@@ -401,22 +339,8 @@ class Client:
         caller's word; returns its key. ValueError when the certificate does not certify, or
         does not name these spheres (its spheres_sha256: they were edited after it was made)
         with one protrusion each."""
-        message = _sphere_set_to_proto(spheres)
-        proof = spheres_pb2.CoverCertificate(
-            certified=certificate.certified, delta=certificate.delta,
-            resolution=certificate.resolution, cells=certificate.cells,
-            cells_in_sphere=certificate.cells_in_sphere,
-            cells_outside=certificate.cells_outside, failed_cells=certificate.failed_cells,
-            uncovered_depth=certificate.uncovered_depth,
-            uncovered_gap=certificate.uncovered_gap, seconds=certificate.seconds,
-            protrusions=list(certificate.protrusions), mesh_sha256=certificate.mesh_sha256,
-            spheres_sha256=certificate.spheres_sha256)
-        if certificate.uncovered_point is not None:
-            proof.uncovered_point.extend(certificate.uncovered_point)
-        request = service_pb2.PutSphereSetRequest(spheres=message, certificate=proof)
-        route = _inscribe._content_route_key(message.SerializeToString())
-        return self._put(route, "PutSphereSet", request, lambda r: r.sphere_set_key,
-                         timeout).sphere_set_key
+        request, route = _inscribe._put_sphere_set_request(spheres, certificate=certificate)
+        return self._put(route, "PutSphereSet", request, _inscribe._put_sphere_set_reply, timeout)
 
     def distance(self, sphere_set_a: str, sphere_set_b: str, poses_b, *, poses_a=None,
                  volume: str = "sphere", abs_err: float = 0.0, rel_err: float = 0.0,
@@ -427,92 +351,69 @@ class Client:
         [qw, qx, qy, qz, tx, ty, tz]; poses_a one pose for all or one per row (default
         identity). With cover_a and cover_b (cover keys of the same solids) each answer also
         holds a certified interval [lower, upper] of the exact distance."""
-        volumes = {"sphere": service_pb2.SPHERE, "rss": service_pb2.RSS}
-        if volume not in volumes:
-            raise ValueError(f"volume must be 'sphere' or 'rss', got {volume!r}")
-        tolerance = spheres_pb2.DistanceTolerance(abs_err=abs_err, rel_err=rel_err)
-        if closer_than is not None:
-            tolerance.closer_than = closer_than
-        request = service_pb2.DistanceRequest(
-            sphere_set_a=sphere_set_a, sphere_set_b=sphere_set_b, volume=volumes[volume],
-            poses_a=_pose_array(np.array([1.0, 0, 0, 0, 0, 0, 0]) if poses_a is None else poses_a,
-                                "poses_a"),
-            poses_b=_pose_array(poses_b, "poses_b"), tolerance=tolerance,
-            brute_force=brute_force, cover_a=cover_a, cover_b=cover_b)
-        response = self._unary(_inscribe._route_key(sphere_set_a), "Distance", request, timeout)
-        return _distance_reply(response.results, response.seconds)
+        request = _inscribe._distance_request(
+            sphere_set_a, sphere_set_b, poses_b, poses_a=poses_a, volume=volume,
+            abs_err=abs_err, rel_err=rel_err, closer_than=closer_than, brute_force=brute_force,
+            cover_a=cover_a, cover_b=cover_b)
+        reply = self._unary(_inscribe._route_key(sphere_set_a), "Distance", request, timeout)
+        return DistanceReply(**_inscribe._distance_reply(reply, certified=bool(cover_a)))
 
     def update_deformation(self, sphere_set_key: str, vertices, *, mesh_sha256: str = "",
-                           xi: float = 0.0, strict: bool = False, bounds: bool = False,
-                           store: bool = False, timeout: Optional[float] = None):
+                           xi: Optional[float] = None, strict: bool = False,
+                           interpolated_normal: bool = False, bounds: bool = False,
+                           store: bool = False,
+                           timeout: Optional[float] = None) -> DeformationResult:
         """Moves the cached internal set onto `vertices` ((V, 3) float64, the stored mesh's
-        vertex order); returns (SphereSet, response fields as a dict)."""
-        vertices = np.asarray(vertices)
-        if vertices.dtype != np.float64:
-            raise TypeError(f"vertices must be a float64 array, got {vertices.dtype}")
-        if vertices.ndim != 2 or vertices.shape[1] != 3:
-            raise ValueError(f"vertices must have shape (V, 3), got {vertices.shape}")
-        request = service_pb2.UpdateDeformationRequest(
-            mesh_sha256=mesh_sha256, sphere_set_key=sphere_set_key, vertices=vertices.ravel(),
-            xi=xi, strict=strict, bounds=bounds, store=store)
-        response = self._unary(_inscribe._route_key(sphere_set_key), "UpdateDeformation",
-                               request, timeout)
-        figures = _fields(response)
-        figures.pop("spheres", None)
-        return _sphere_set_from_proto(response.spheres, "internal"), figures
+        vertex order), with inscribe.Deformer's settings (xi None: core's default); with
+        bounds, also nerr's bounds; with store, the moved set is cached too."""
+        request = _inscribe._update_deformation_request(
+            sphere_set_key, vertices, mesh_sha256=mesh_sha256, xi=xi, strict=strict,
+            interpolated_normal=interpolated_normal, bounds=bounds, store=store)
+        reply = self._unary(_inscribe._route_key(sphere_set_key), "UpdateDeformation",
+                            request, timeout)
+        return DeformationResult(**_inscribe._update_deformation_reply(reply, bounds=bounds))
 
     def inspect_mesh(self, mesh: _inscribe.Mesh, *, skip_self_intersections: bool = False,
                      fill_holes: bool = False, weld_tolerance: float = 0.0,
-                     timeout: Optional[float] = None) -> dict:
-        """The server's validation of `mesh` (nothing stored): {"mesh_sha256": ..., "report":
-        the MeshReport's fields as a dict, its "issues" a list of dicts}."""
-        request = service_pb2.InspectMeshRequest(
-            mesh=mesh_pb2.Mesh(vertices=mesh.vertices.ravel(), triangles=mesh.triangles.ravel()),
-            skip_self_intersections=skip_self_intersections, fill_holes=fill_holes,
+                     timeout: Optional[float] = None) -> InspectMeshResult:
+        """The server's validation of `mesh` (nothing stored): its key after the server's
+        fixes and its MeshReport."""
+        request = _inscribe._inspect_mesh_request(
+            mesh, skip_self_intersections=skip_self_intersections, fill_holes=fill_holes,
             weld_tolerance=weld_tolerance)
-        response = self._unary(_inscribe._route_key(mesh.sha256), "InspectMesh", request, timeout)
-        return _fields(response)
+        reply = self._unary(_inscribe._route_key(mesh.sha256), "InspectMesh", request, timeout)
+        return InspectMeshResult(**_inscribe._inspect_mesh_reply(reply))
 
     def get_hierarchy(self, sphere_set_key: str, *, volume: str = "sphere",
                       timeout: Optional[float] = None) -> _inscribe.Hierarchy:
         """The server's hierarchy of a cached set, checked as it is read
         (Hierarchy.deserialize): usable with inscribe.distance in-process."""
-        volumes = {"sphere": service_pb2.SPHERE, "rss": service_pb2.RSS}
-        if volume not in volumes:
-            raise ValueError(f"volume must be 'sphere' or 'rss', got {volume!r}")
-        request = service_pb2.GetHierarchyRequest(sphere_set_key=sphere_set_key,
-                                                  volume=volumes[volume])
-        response = self._unary(_inscribe._route_key(sphere_set_key), "GetHierarchy", request,
-                               timeout)
-        return _inscribe.Hierarchy.deserialize(response.hierarchy)
+        request = _inscribe._get_hierarchy_request(sphere_set_key, volume=volume)
+        reply = self._unary(_inscribe._route_key(sphere_set_key), "GetHierarchy", request,
+                            timeout)
+        return _inscribe._hierarchy_reply(reply, volume=volume)
 
     def certify_cover(self, mesh_sha256: str, spheres, *, resolution: Optional[float] = None,
-                      timeout: Optional[float] = None) -> dict:
+                      timeout: Optional[float] = None) -> _inscribe.CoverCertificate:
         """Whether a cached set (its key) or `spheres` (SphereSet or (N, 4) float64) provably
-        hold the whole solid of a stored mesh: the CoverCertificate's fields as a dict."""
-        request = service_pb2.CertifyCoverRequest(mesh_sha256=mesh_sha256)
-        if isinstance(spheres, str):
-            request.sphere_set_key = spheres
-        else:
-            request.sphere_set.CopyFrom(_sphere_set_to_proto(spheres))
-        if resolution is not None:
-            request.resolution = resolution
-        response = self._unary(_inscribe._route_key(mesh_sha256), "CertifyCover", request,
-                               timeout)
-        return _fields(response.certificate) if response.HasField("certificate") else {}
+        hold the whole solid of a stored mesh: its CoverCertificate (the failed cells are
+        counted, not sent). resolution as inscribe.certify's (None: core's default)."""
+        request = _inscribe._certify_cover_request(mesh_sha256, spheres, resolution=resolution)
+        reply = self._unary(_inscribe._route_key(mesh_sha256), "CertifyCover", request,
+                            timeout)
+        return _inscribe._certify_cover_reply(reply)
 
     def evaluate(self, mesh_sha256: str, sphere_set_key: str, *,
-                 timeout: Optional[float] = None) -> dict:
-        """The QualityReport of a cached set against a stored mesh, as a dict."""
-        request = service_pb2.EvaluateRequest(mesh_sha256=mesh_sha256,
-                                              sphere_set_key=sphere_set_key)
-        response = self._unary(_inscribe._route_key(mesh_sha256), "Evaluate", request, timeout)
-        return _fields(response.quality)
+                 timeout: Optional[float] = None) -> _inscribe.QualityReport:
+        """The QualityReport of a cached set against a stored mesh (core's default options)."""
+        request = _inscribe._evaluate_request(mesh_sha256, sphere_set_key)
+        reply = self._unary(_inscribe._route_key(mesh_sha256), "Evaluate", request, timeout)
+        return _inscribe._evaluate_reply(reply)
 
     def cache_stats(self, *, timeout: Optional[float] = None) -> dict:
         """The first listed replica's cache counters (the next when it is down), as a dict."""
-        response = self._unary(None, "CacheStats", service_pb2.CacheStatsRequest(), timeout)
-        return _fields(response)
+        reply = self._unary(None, "CacheStats", _inscribe._cache_stats_request(), timeout)
+        return _inscribe._cache_stats_reply(reply)
 
     def open_distance_session(self, *, volume: str = "sphere", abs_err: float = 0.0,
                               rel_err: float = 0.0, frame_timeout: float = 10.0,
@@ -529,12 +430,8 @@ class DistanceSession:
 
     def __init__(self, client: Client, volume: str, abs_err: float, rel_err: float,
                  frame_timeout: float, session_timeout: Optional[float]):
-        volumes = {"sphere": service_pb2.SPHERE, "rss": service_pb2.RSS}
-        if volume not in volumes:
-            raise ValueError(f"volume must be 'sphere' or 'rss', got {volume!r}")
         self._client = client
-        self._volume = volumes[volume]
-        self._tolerance = spheres_pb2.DistanceTolerance(abs_err=abs_err, rel_err=rel_err)
+        self._frames = _inscribe._DistanceFrames(volume, abs_err, rel_err)
         self._frame_timeout = frame_timeout
         self._session_timeout = session_timeout
         self._next_frame = 0
@@ -546,9 +443,9 @@ class DistanceSession:
         replica = next(r for r in (self._client._replicas[i]
                                    for i in self._client._order(route_key)) if r not in tried)
         requests: queue.Queue = queue.Queue()
-        call = replica.stub.DistanceStream(iter(requests.get, None),
-                                           timeout=self._session_timeout,
-                                           metadata=self._client._metadata)
+        call = replica.rpc["DistanceStream"](iter(requests.get, None),
+                                             timeout=self._session_timeout,
+                                             metadata=self._client._metadata)
         replies: queue.Queue = queue.Queue()
 
         def read():
@@ -570,29 +467,20 @@ class DistanceSession:
         answers pairs[i]; lower and upper filled when certified)."""
         if self._broken is not None:
             raise self._broken
-        frame = service_pb2.DistanceFrame(frame=self._next_frame, volume=self._volume,
-                                          tolerance=self._tolerance)
-        for i, pair in enumerate(pairs):
-            if len(pair) not in (4, 6):
-                raise ValueError(f"pairs[{i}] must be (key_a, key_b, pose_a, pose_b[, cover_a, "
-                                 f"cover_b]), got {len(pair)} items")
-            key_a, key_b, pose_a, pose_b = pair[:4]
-            cover_a, cover_b = pair[4:] if len(pair) == 6 else ("", "")
-            frame.pairs.append(service_pb2.DistancePair(
-                sphere_set_a=key_a, sphere_set_b=key_b, pose_a=_pose(pose_a, f"pairs[{i}] pose_a"),
-                pose_b=_pose(pose_b, f"pairs[{i}] pose_b"), cover_a=cover_a, cover_b=cover_b))
+        frame, certified = self._frames.frame(self._next_frame, pairs)
+        route = _inscribe._route_key(pairs[0][0] if pairs else "")
         try:
             if self._stream is None:
-                self._open(_inscribe._route_key(frame.pairs[0].sphere_set_a if frame.pairs else ""))
-            reply = self._round_trip(frame)
+                self._open(route)
+            reply = self._round_trip(frame, route, certified)
         except BaseException as error:
             self._broken = error
             self.close()
             raise
         self._next_frame += 1
-        return _distance_reply(reply.results)
+        return reply
 
-    def _round_trip(self, frame):
+    def _round_trip(self, frame: bytes, route: str, certified: bool) -> DistanceReply:
         tried = []
         for _ in range(len(self._client._replicas)):
             replica, requests, call, replies = self._stream
@@ -602,7 +490,7 @@ class DistanceSession:
                 reply = replies.get(timeout=self._frame_timeout)
             except queue.Empty:
                 call.cancel()
-                raise Error(f"frame {frame.frame} took longer than {self._frame_timeout} s",
+                raise Error(f"frame {self._next_frame} took longer than {self._frame_timeout} s",
                             "DEADLINE_EXCEEDED") from None
             if isinstance(reply, grpc.RpcError):
                 last = len(tried) == len(self._client._replicas)
@@ -611,13 +499,14 @@ class DistanceSession:
                 # A broken routed stream is reopened on the next replica, the frame resent.
                 self._client._mark(replica, True)
                 requests.put(None)
-                self._open(_inscribe._route_key(frame.pairs[0].sphere_set_a), tried)
+                self._open(route, tried)
                 continue
             if reply is None:
                 raise Error("the server ended the stream", "INTERNAL")
-            if reply.frame != frame.frame:
-                raise Error(f"reply for frame {reply.frame}, expected {frame.frame}", "INTERNAL")
-            return reply
+            number, fields = _inscribe._distance_frame_reply(reply, certified=certified)
+            if number != self._next_frame:
+                raise Error(f"reply for frame {number}, expected {self._next_frame}", "INTERNAL")
+            return DistanceReply(**fields)
         raise Error("no replica took the stream", "UNAVAILABLE")
 
     def close(self) -> None:

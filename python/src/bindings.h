@@ -21,6 +21,8 @@ void BindDeformation(py::module_& m);
 void BindRobot(py::module_& m);
 void BindRouting(py::module_& m);
 void BindScene(py::module_& m);
+void BindClientRequests(py::module_& m);
+void BindClientReplies(py::module_& m);
 
 // warnings.warn(inscribe.MeshWarning) for each of report.notices(), and once more when the
 // geometry was repaired (results hold for the mesh `sha256` only). Needs the GIL.

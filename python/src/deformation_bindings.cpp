@@ -9,6 +9,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "bindings.h"
+#include "deformation_results.h"
 #include "inscribe/medial/sphere_deformation.h"
 #include "sphere_set.h"
 #include "status_errors.h"
@@ -25,6 +26,30 @@ struct LockedDeformer {
 };
 
 }  // namespace
+
+DeformationOptions DeformationOptionsOf(std::optional<double> xi, bool strict,
+                                        bool interpolated_normal) {
+  DeformationOptions options;
+  if (xi) options.xi = *xi;
+  options.strict = strict;
+  if (interpolated_normal) options.direction = ContactDirection::kInterpolatedNormal;
+  return options;
+}
+
+std::shared_ptr<PySphereSet> DeformedSphereSet(DeformedSpheres moved) {
+  auto set = std::make_shared<PySphereSet>();
+  set->kind = "internal";
+  set->set = std::move(moved.set);
+  set->reference_index = std::move(moved.reference_index);
+  set->stats = {{"xi", moved.xi},
+                {"max_protrusion", moved.max_protrusion},
+                {"shrunk", moved.shrunk},
+                {"dropped", moved.dropped},
+                {"closest_point_queries", moved.closest_point_queries},
+                {"max_shrink_steps", std::int64_t{moved.max_shrink_steps}},
+                {"seconds", moved.seconds}};
+  return set;
+}
 
 void BindDeformation(py::module_& m) {
   py::class_<DeformationErrorBounds>(m, "DeformationErrorBounds",
@@ -49,13 +74,9 @@ void BindDeformation(py::module_& m) {
       "positions of the same mesh; every update starts from the reference. Not thread-safe.")
       .def(py::init([](py::handle reference, const PySphereSet& spheres, std::optional<double> xi,
                        bool strict, bool interpolated_normal) {
-             DeformationOptions options;
-             if (xi) options.xi = *xi;
-             options.strict = strict;
-             if (interpolated_normal) options.direction = ContactDirection::kInterpolatedNormal;
+             const DeformationOptions options =
+                 DeformationOptionsOf(xi, strict, interpolated_normal);
              const std::shared_ptr<Solid> solid = SolidOf(reference);
-             // Ray parity where the reference intersects itself: the solid's own rule.
-             options.oracle.inside_test = InsideTestFor(solid->report);
              absl::StatusOr<SphereDeformer> deformer;
              {
                py::gil_scoped_release release;
@@ -84,19 +105,7 @@ void BindDeformation(py::module_& m) {
               std::lock_guard<std::mutex> lock(locked.mutex);
               moved = locked.deformer.Update(deformed);
             }
-            DeformedSpheres result = ValueOrRaise(std::move(moved));
-            auto set = std::make_shared<PySphereSet>();
-            set->kind = "internal";
-            set->set = std::move(result.set);
-            set->reference_index = std::move(result.reference_index);
-            set->stats = {{"xi", result.xi},
-                          {"max_protrusion", result.max_protrusion},
-                          {"shrunk", result.shrunk},
-                          {"dropped", result.dropped},
-                          {"closest_point_queries", result.closest_point_queries},
-                          {"max_shrink_steps", std::int64_t{result.max_shrink_steps}},
-                          {"seconds", result.seconds}};
-            return set;
+            return DeformedSphereSet(ValueOrRaise(std::move(moved)));
           },
           py::arg("vertices"),
           "The spheres on `vertices` ((V, 3) float64, the reference's vertex order and count; "

@@ -23,7 +23,6 @@
 #include "status_errors.h"
 
 namespace inscribe::python {
-namespace {
 
 HierarchyVolume VolumeOf(const std::string& name) {
   for (HierarchyVolume volume : {HierarchyVolume::kSphere, HierarchyVolume::kRss}) {
@@ -31,6 +30,8 @@ HierarchyVolume VolumeOf(const std::string& name) {
   }
   throw py::value_error("volume must be 'sphere' or 'rss', got '" + name + "'");
 }
+
+namespace {
 
 HierarchyPtr BuildHierarchy(py::handle spheres, const std::string& volume) {
   const HierarchyVolume kind = VolumeOf(volume);

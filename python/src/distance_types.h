@@ -5,6 +5,7 @@
 #include <pybind11/pybind11.h>
 
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "inscribe/distance/certified_distance.h"
@@ -16,6 +17,9 @@ namespace inscribe::python {
 namespace py = pybind11;
 
 using HierarchyPtr = std::shared_ptr<const SphereHierarchy>;
+
+// The volume named "sphere" or "rss" (HierarchyVolumeName); ValueError otherwise.
+HierarchyVolume VolumeOf(const std::string& name);
 
 // A Hierarchy as given, or one built (sphere volumes, the service's default) from a SphereSet
 // or an (N, 4) array.

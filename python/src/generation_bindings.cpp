@@ -8,8 +8,10 @@
 
 #include "absl/strings/str_cat.h"
 #include "bindings.h"
+#include "generation_arguments.h"
 #include "inscribe/balls/sphere_quality.h"
 #include "inscribe/cover/cover_certificate.h"
+#include "inscribe/generation/sphere_file_record.h"
 #include "inscribe/generation/sphere_set_generation.h"
 #include "interruptible.h"
 #include "sphere_set.h"
@@ -17,13 +19,6 @@
 
 namespace inscribe::python {
 namespace {
-
-// Only what the caller gave overrides core's defaults (SphereSetParameters and the option
-// structs it holds); CheckSphereSetParameters judges the result.
-template <typename T>
-void Override(T& field, const std::optional<T>& value) {
-  if (value) field = *value;
-}
 
 std::shared_ptr<PySphereSet> Generate(
     py::handle mesh_or_solid, std::optional<std::int64_t> max_spheres,
@@ -34,22 +29,10 @@ std::shared_ptr<PySphereSet> Generate(
     std::optional<double> cover_resolution, bool evaluate,
     std::optional<std::int64_t> quality_samples, const std::optional<std::string>& selection,
     const py::object& progress) {
-  SphereSetParameters parameters;
-  parameters.kind = ValueOrRaise(ParseSphereSetKind(kind));
-  if (selection) parameters.selection = ValueOrRaise(ParseSphereSelection(*selection));
-  parameters.max_spheres = max_spheres;
-  parameters.voxel_size = voxel_size;
-  Override(parameters.medial.object_angle, object_angle);
-  Override(parameters.medial.epsilon, epsilon);
-  Override(parameters.medial.samples, samples);
-  Override(parameters.medial.subdivide_boundary, subdivide_boundary);
-  Override(parameters.medial.max_voxels, max_voxels);
-  Override(parameters.dilation.growth, dilation_growth);
-  parameters.max_protrusion = max_protrusion;
-  Override(parameters.cover_resolution, cover_resolution);
-  parameters.evaluate = evaluate;
-  Override(parameters.quality.surface_samples, quality_samples);
-  OkOrRaise(CheckSphereSetParameters(parameters));
+  const SphereSetParameters parameters =
+      SphereSetParametersOf({max_spheres, voxel_size, kind, object_angle, epsilon, samples,
+                             subdivide_boundary, max_voxels, dilation_growth, max_protrusion,
+                             cover_resolution, evaluate, quality_samples, selection});
 
   const std::shared_ptr<Solid> solid = SolidOf(mesh_or_solid);
   absl::StatusOr<GeneratedSphereSet> generated;
@@ -58,37 +41,18 @@ std::shared_ptr<PySphereSet> Generate(
     return generated.status();
   }));
 
+  // The params and stats a sphere file records of a generation: the same as `inscribe
+  // generate` writes.
+  SphereFile file =
+      GenerationSphereFile(parameters, *generated, solid->sha256, solid->report.repairs());
   auto result = std::make_shared<PySphereSet>();
   result->kind = SphereSetKindName(generated->kind);
-  result->mesh_sha256 = solid->sha256;
+  result->mesh_sha256 = std::move(file.mesh_sha256);
   result->set = std::move(generated->set);
-  result->params = {{"kind", result->kind}};
-  if (const std::optional<std::int64_t> budget = EffectiveMaxSpheres(parameters)) {
-    result->params.emplace_back("max_spheres", *budget);
-    if (parameters.kind != SphereSetKind::kCover) {
-      result->params.emplace_back("selection",
-                                  std::string(SphereSelectionName(generated->selection)));
-    }
-  }
-  if (parameters.voxel_size) result->params.emplace_back("voxel_size", *parameters.voxel_size);
-  if (parameters.max_protrusion) {
-    result->params.emplace_back("max_protrusion", *parameters.max_protrusion);
-  }
-  result->stats = {{"voxel_size", generated->voxel_size},
-                   {"epsilon", generated->epsilon},
-                   {"runs", std::int64_t{generated->runs}},
-                   {"generation_seconds", generated->generation_seconds},
-                   {"seconds", generated->seconds}};
-  if (generated->selection == SphereSelection::kOptimised) {
-    result->stats.emplace_back("pool_size", generated->pool_size);
-    result->stats.emplace_back("covered_fraction", generated->covered_fraction);
-  }
+  result->params = std::move(file.params);
+  result->stats = std::move(file.stats);
   result->quality = generated->quality;
-  if (generated->quality) result->stats.emplace_back("nerr", generated->quality->nerr);
-  if (generated->cover) {
-    result->certificate = generated->cover->certificate;
-    result->stats.emplace_back("delta", generated->cover->certificate.delta);
-  }
+  if (generated->cover) result->certificate = generated->cover->certificate;
   return result;
 }
 

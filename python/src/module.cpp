@@ -1,4 +1,5 @@
-// The _inscribe extension module: core and robot bound for Python. The package `inscribe`
+// The _inscribe extension module: core and robot bound for Python, and the service's messages
+// for inscribe.Client, built and read by wire/. The package `inscribe`
 // (python/inscribe/__init__.py) re-exports it with the service client.
 #include <pybind11/pybind11.h>
 
@@ -14,4 +15,6 @@ PYBIND11_MODULE(_inscribe, m) {
   inscribe::python::BindRobot(m);
   inscribe::python::BindRouting(m);
   inscribe::python::BindScene(m);
+  inscribe::python::BindClientRequests(m);
+  inscribe::python::BindClientReplies(m);
 }

@@ -14,13 +14,6 @@ void BindRouting(py::module_& m) {
       "_route_key", [](const std::string& key) { return wire::RouteKey(key); }, py::arg("key"),
       "What routes a mesh or sphere-set key between replicas (wire::RouteKey).");
   m.def(
-      "_content_route_key",
-      [](const py::bytes& spheres_bytes) {
-        return wire::ContentRouteKey(std::string(spheres_bytes));
-      },
-      py::arg("spheres_bytes"),
-      "What routes a set uploaded without a mesh: from its serialised SphereSet message.");
-  m.def(
       "_rendezvous_order",
       [](const std::string& route_key, const std::vector<std::string>& names) {
         return wire::RendezvousOrder(route_key, names);

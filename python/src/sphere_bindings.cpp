@@ -12,6 +12,7 @@
 #include "absl/strings/str_cat.h"
 #include "bindings.h"
 #include "inscribe/balls/sphere_io.h"
+#include "inscribe/generation/sphere_file_record.h"
 #include "sphere_set.h"
 #include "status_errors.h"
 
@@ -224,6 +225,13 @@ void BindSpheres(py::module_& m) {
         auto result = std::make_shared<PySphereSet>();
         result->set = std::move(read.set);
         result->mesh_sha256 = std::move(read.mesh_sha256);
+        // The kind and a cover's certificate as the file records them; the certificate only
+        // when it names these spheres and certifies them (UsableCoverCertificate), as the CLI
+        // takes a cover file.
+        result->kind = RecordedKind(read);
+        absl::StatusOr<std::optional<CoverCertificate>> certificate =
+            UsableCoverCertificate(read, path, "");
+        if (certificate.ok()) result->certificate = *std::move(certificate);
         result->params = std::move(read.params);
         result->stats = std::move(read.stats);
         return result;

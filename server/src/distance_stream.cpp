@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
-#include "drainable_stream.h"
+#include "admission.h"
 #include "frame_dispatch.h"
 #include "frame_stream_reactor.h"
 #include "inscribe/distance/certified_distance.h"
@@ -23,6 +23,7 @@
 #include "memory_budget.h"
 #include "result_store.h"
 #include "service_checks.h"
+#include "service_parts.h"
 
 namespace inscribe::server {
 namespace {
@@ -31,32 +32,29 @@ namespace {
 // the cache has evicted it, so a stream cannot pin an unbounded amount.
 constexpr std::size_t kMaxStreamSets = 1024;
 
-}  // namespace
-
 // FrameStreamReactor runs the stream; a frame here is a batch of distance queries, admitted
 // against --max-poses and --memory-budget (its reservation held until its reply is written).
 class DistanceStreamReactor final
     : public FrameStreamReactor<v1::DistanceFrame, v1::DistanceFrameResult> {
  public:
-  DistanceStreamReactor(InscribeService* service, grpc::CallbackServerContext* context)
-      : FrameStreamReactor(service, context, "DistanceStream") {}
+  DistanceStreamReactor(const ServiceParts& parts, grpc::CallbackServerContext* context)
+      : FrameStreamReactor(parts, context, "DistanceStream") {}
 
  private:
   absl::Status Admit() override {
     const v1::DistanceFrame& frame = request();
-    if (frame.pairs_size() > service()->limits_.max_poses) {
-      return absl::ResourceExhaustedError(
-          absl::StrCat("frame ", frame.frame(), " has ", frame.pairs_size(),
-                       " pairs; this server's limit (--max-poses) is ",
-                       service()->limits_.max_poses, " per frame"));
+    if (frame.pairs_size() > parts().limits.max_poses) {
+      return absl::ResourceExhaustedError(absl::StrCat(
+          "frame ", frame.frame(), " has ", frame.pairs_size(),
+          " pairs; this server's limit (--max-poses) is ", parts().limits.max_poses, " per frame"));
     }
     // Held from here until the frame's reply has been written (or the stream ends).
-    absl::StatusOr<MemoryBudget::Reservation> reserved = service()->memory_->Reserve(
+    absl::StatusOr<MemoryBudget::Reservation> reserved = parts().admission.Reserve(
         frame.pairs_size() * MemoryCosts::kPerFramePair,
-        absl::StrCat("DistanceStream frame ", frame.frame(), " of ", frame.pairs_size(), " pairs"));
+        absl::StrCat("DistanceStream frame ", frame.frame(), " of ", frame.pairs_size(), " pairs"),
+        &record());
     if (!reserved.ok()) return reserved.status();
     frame_reservation_ = *std::move(reserved);
-    record().memory_bytes = std::max(record().memory_bytes, frame_reservation_.bytes());
     return absl::OkStatus();
   }
 
@@ -262,7 +260,7 @@ class DistanceStreamReactor final
                        " distinct sphere sets (per hierarchy volume); open another stream"));
     }
     absl::StatusOr<std::shared_ptr<const CertifiedObjectEntry>> entry =
-        service()->store_->GetCertifiedObject(internal_key, cover_key, volume);
+        parts().store.GetCertifiedObject(internal_key, cover_key, volume);
     if (!entry.ok()) {
       return absl::Status(entry.status().code(),
                           absl::StrCat(field, ": ", entry.status().message()));
@@ -283,7 +281,7 @@ class DistanceStreamReactor final
                        " distinct sphere sets (per hierarchy volume); open another stream"));
     }
     absl::StatusOr<std::shared_ptr<const SphereHierarchy>> h =
-        service()->store_->GetHierarchy(key, volume);
+        parts().store.GetHierarchy(key, volume);
     if (!h.ok()) {
       return absl::Status(h.status().code(), absl::StrCat(field, ": ", h.status().message()));
     }
@@ -303,27 +301,13 @@ class DistanceStreamReactor final
   std::unordered_map<std::string, std::shared_ptr<const CertifiedObjectEntry>> certified_;
 };
 
+}  // namespace
+
 grpc::ServerBidiReactor<v1::DistanceFrame, v1::DistanceFrameResult>*
 InscribeService::DistanceStream(grpc::CallbackServerContext* context) {
-  auto* reactor = new DistanceStreamReactor(this, context);
-  reactor->Start(Authenticate(*context));
+  auto* reactor = new DistanceStreamReactor(Parts(), context);
+  reactor->Start();
   return reactor;
-}
-
-void InscribeService::StartDraining() {
-  draining_.store(true);
-  std::vector<DrainableStream*> streams;
-  {
-    std::lock_guard<std::mutex> lock(calls_mutex_);
-    for (DrainableStream* stream : streams_) {
-      stream->Ref();
-      streams.push_back(stream);
-    }
-  }
-  for (DrainableStream* stream : streams) {
-    stream->Drain();
-    stream->Unref();
-  }
 }
 
 }  // namespace inscribe::server

@@ -52,9 +52,8 @@ bool FrameDispatcher::Run(const FrameWork& frame, double estimated_seconds,
       }
     }
   }
-  const JobSize size =
-      frame.memory_bytes <= MemoryCosts::kSmallJob ? JobSize::kSmall : JobSize::kLarge;
-  if (!pool_->TrySubmit([work = std::move(work)] { work(FramePlace::kPool); }, size)) {
+  if (!pool_->TrySubmit([work = std::move(work)] { work(FramePlace::kPool); },
+                        LaneFor(frame.memory_bytes))) {
     return false;
   }
   pooled_frames_.fetch_add(1, std::memory_order_relaxed);

@@ -32,7 +32,7 @@ struct FrameWork {
   // pool's arena): DistanceStream frames of at most kSerialFramePairs pairs.
   bool serial = false;
   // The frame's memory reservation (--memory-budget); picks the pool's lane when the frame
-  // goes there (small lane up to MemoryCosts::kSmallJob, as for every call).
+  // goes there (LaneFor in memory_budget.h, as for every call).
   std::int64_t memory_bytes = 0;
 };
 

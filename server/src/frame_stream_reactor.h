@@ -13,18 +13,20 @@
 
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
+#include "admission.h"
 #include "drainable_stream.h"
 #include "frame_dispatch.h"
 #include "inscribe/server/inscribe_service.h"
 #include "inscribe/wire/convert.h"
 #include "service_checks.h"
+#include "service_parts.h"
 
 namespace inscribe::server {
 
 // The state machine, the service's bookkeeping (active calls, the drainable streams, the
-// call record and its observer), drain and cancellation, timing and the cost model. A stream
-// derives from it and supplies its hooks: Admit, Work and Answer, and where it needs them
-// InFrame, Timed, FrameEnded and Closed.
+// call record and its observer: Admission), drain and cancellation, timing and the cost model.
+// A stream derives from it and supplies its hooks: Admit, Work and Answer, and where it needs
+// them InFrame, Timed, FrameEnded and Closed.
 //
 // States: kStarting (before the first read), kReading (a read is pending; nothing else),
 // kBusy (a frame is being computed or its reply written), kFinished (Finish was called).
@@ -33,20 +35,14 @@ namespace inscribe::server {
 template <typename Request, typename Reply>
 class FrameStreamReactor : public grpc::ServerBidiReactor<Request, Reply>, public DrainableStream {
  public:
-  // `admitted`: the service's Authenticate verdict; a refused stream ends before any read.
-  void Start(const absl::Status& admitted) {
-    service_->CallStarted();
-    {
-      std::lock_guard<std::mutex> lock(service_->calls_mutex_);
-      service_->streams_.insert(this);
-    }
+  // Admission::Enter under the stream's lock (a drain that starts meanwhile is either seen
+  // there or finds the stream reading); a refused stream ends before any read.
+  void Start() {
+    parts_.admission.CallStarted();
+    parts_.admission.AddStream(this);
     std::lock_guard<std::mutex> lock(mutex_);
-    if (!admitted.ok()) {
-      FinishLocked(admitted);
-      return;
-    }
-    if (service_->draining_.load()) {
-      FinishLocked(absl::UnavailableError("server is shutting down; retry"));
+    if (absl::Status entered = parts_.admission.Enter(*context_); !entered.ok()) {
+      FinishLocked(entered);
       return;
     }
     state_ = State::kReading;
@@ -84,12 +80,12 @@ class FrameStreamReactor : public grpc::ServerBidiReactor<Request, Reply>, publi
     const FrameWork work = Work();
     // After a true return the reply may be written and the next frame running: no member may
     // be touched here.
-    if (!service_->frames_->Run(work, cost_.Estimate(work.items),
-                                [this, arrived, items = work.items](FramePlace place) {
-                                  RunFrame(arrived, place, items);
-                                })) {
+    if (!parts_.frames.Run(work, cost_.Estimate(work.items),
+                           [this, arrived, items = work.items](FramePlace place) {
+                             RunFrame(arrived, place, items);
+                           })) {
       std::lock_guard<std::mutex> lock(mutex_);
-      FinishLocked(service_->QueueFullError());
+      FinishLocked(parts_.admission.QueueFullError());
     }
   }
 
@@ -112,22 +108,19 @@ class FrameStreamReactor : public grpc::ServerBidiReactor<Request, Reply>, publi
   void OnCancel() final { cancelled_.store(true); }
 
   void OnDone() final {
-    {
-      std::lock_guard<std::mutex> lock(service_->calls_mutex_);
-      service_->streams_.erase(this);
-    }
+    parts_.admission.RemoveStream(this);
     record_.status = final_status_;
-    service_->Observe(record_);
+    parts_.admission.Observe(record_);
     Closed();
-    service_->CallEnded();
+    parts_.admission.CallEnded();
     Unref();
   }
 
  protected:
   // `method`: the RPC's name, for the call record and messages.
-  FrameStreamReactor(InscribeService* service, grpc::CallbackServerContext* context,
+  FrameStreamReactor(const ServiceParts& parts, grpc::CallbackServerContext* context,
                      const char* method)
-      : service_(service) {
+      : parts_(parts), context_(context) {
     record_.method = method;
     record_.peer = context->peer();
   }
@@ -156,7 +149,7 @@ class FrameStreamReactor : public grpc::ServerBidiReactor<Request, Reply>, publi
   // The call is done and observed: release what the stream held for its life.
   virtual void Closed() {}
 
-  InscribeService* service() const { return service_; }
+  const ServiceParts& parts() const { return parts_; }
   Request& request() { return request_; }
   const Request& request() const { return request_; }
   Reply& reply() { return reply_; }
@@ -211,7 +204,8 @@ class FrameStreamReactor : public grpc::ServerBidiReactor<Request, Reply>, publi
     this->Unref();
   }
 
-  InscribeService* const service_;
+  const ServiceParts parts_;
+  grpc::CallbackServerContext* const context_;
   std::atomic<bool> cancelled_{false};
 
   std::mutex mutex_;

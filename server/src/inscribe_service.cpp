@@ -1,95 +1,55 @@
+// The service's shape: its parts, the unary call's life (RunUnary), and drain. The RPCs are in
+// the service_*.cpp files named after them, the streams in distance_stream.cpp and
+// scene_stream.cpp.
 #include "inscribe/server/inscribe_service.h"
 
 #include <chrono>
 #include <exception>
 #include <functional>
+#include <memory>
 #include <new>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "admission.h"
 #include "frame_dispatch.h"
-#include "inscribe/geometry/mesh_hash.h"
-#include "inscribe/solid/mesh_validation.h"
 #include "inscribe/wire/convert.h"
 #include "memory_budget.h"
 #include "mesh_sizes.h"
 #include "result_store.h"
 #include "service_checks.h"
+#include "service_parts.h"
 
 namespace inscribe::server {
-namespace {
-
-// The body of InspectMesh, run on the pool. Only expected failures are returned; the mesh's
-// own problems are issues in the report, not errors.
-absl::Status RunInspectMesh(const v1::InspectMeshRequest& request,
-                            v1::InspectMeshResponse* response) {
-  absl::StatusOr<Mesh> mesh = wire::MeshFromProto(request.mesh());
-  if (!mesh.ok()) return mesh.status();
-  ValidateOptions options;
-  options.check_self_intersections = !request.skip_self_intersections();
-  options.fill_holes = request.fill_holes();
-  options.weld_tolerance = request.weld_tolerance();
-  const ValidatedMesh validated = ValidateMesh(*std::move(mesh), options);
-  const MeshReport& report = validated.report;
-  // As the CLI does: a hash over NaNs or dangling indices would key nothing usable.
-  if (report.non_finite_vertices == 0 && report.out_of_range_indices == 0) {
-    response->set_mesh_sha256(FormatSha256(MeshSha256(validated.mesh)));
-  }
-  wire::MeshReportToProto(report, response->mutable_report());
-  return absl::OkStatus();
-}
-
-}  // namespace
 
 InscribeService::InscribeService(JobPool* pool, ResultCache* cache, const ServiceLimits& limits,
                                  CallObserver observer, CallAuthenticator authenticate)
-    : pool_(pool),
+    : admission_(std::make_unique<Admission>(pool, limits.memory_budget_bytes,
+                                             std::move(authenticate), std::move(observer))),
       frames_(std::make_unique<FrameDispatcher>(pool)),
       store_(
           std::make_unique<ResultStore>(cache, StoreLimits{limits.max_voxels, limits.max_spheres})),
-      memory_(std::make_unique<MemoryBudget>(limits.memory_budget_bytes)),
       mesh_sizes_(std::make_unique<MeshSizes>()),
-      limits_(limits),
-      observer_(std::move(observer)),
-      authenticate_(std::move(authenticate)) {}
+      limits_(limits) {}
 
 InscribeService::~InscribeService() = default;
 
-void InscribeService::CallStarted() {
-  std::lock_guard<std::mutex> lock(calls_mutex_);
-  ++active_calls_;
+ServiceParts InscribeService::Parts() {
+  return ServiceParts{*admission_, *store_, *frames_, *mesh_sizes_, limits_, open_scenes_};
 }
 
-void InscribeService::CallEnded() {
-  std::lock_guard<std::mutex> lock(calls_mutex_);
-  if (--active_calls_ == 0) calls_answered_.notify_all();
-}
+void InscribeService::StartDraining() { admission_->StartDraining(); }
 
-void InscribeService::Observe(const CallRecord& record) const {
-  if (observer_) observer_(record);
-}
-
-absl::Status InscribeService::Authenticate(const grpc::CallbackServerContext& context) const {
-  return authenticate_ ? authenticate_(context) : absl::OkStatus();
+bool InscribeService::WaitForCalls(std::chrono::system_clock::time_point deadline) {
+  return admission_->WaitForCalls(deadline);
 }
 
 void InscribeService::Finish(grpc::ServerUnaryReactor* reactor, CallRecord& record,
                              const absl::Status& status) {
   record.status = status;
-  Observe(record);
+  admission_->Observe(record);
   reactor->Finish(wire::ToGrpcStatus(status));
-  CallEnded();
-}
-
-absl::Status InscribeService::QueueFullError() const {
-  return absl::ResourceExhaustedError(
-      absl::StrCat("server is busy: the job queue is full; this server's limit (--max-queue) is ",
-                   pool_->options().max_jobs, " queued or running jobs; retry later"));
-}
-
-bool InscribeService::WaitForCalls(std::chrono::system_clock::time_point deadline) {
-  std::unique_lock<std::mutex> lock(calls_mutex_);
-  return calls_answered_.wait_until(lock, deadline, [this] { return active_calls_ == 0; });
+  admission_->CallEnded();
 }
 
 grpc::ServerUnaryReactor* InscribeService::RunUnary(grpc::CallbackServerContext* context,
@@ -103,45 +63,23 @@ grpc::ServerUnaryReactor* InscribeService::RunUnary(grpc::CallbackServerContext*
   record.method = method;
   record.peer = context->peer();
   record.triangles = triangles;
-  CallStarted();
-  // Refused callers learn nothing else: not whether the server drains, nor what their
-  // request's problems are.
-  if (absl::Status admitted = Authenticate(*context); !admitted.ok()) {
-    Finish(reactor, record, admitted);
-    return reactor;
-  }
-  if (draining_.load()) {
-    Finish(reactor, record, absl::UnavailableError("server is shutting down; retry"));
-    return reactor;
-  }
-  // O(1) checks stay on the gRPC thread, so bad or oversized requests never occupy the queue.
-  if (!precheck.ok()) {
-    Finish(reactor, record, precheck);
+  admission_->CallStarted();
+  absl::StatusOr<MemoryBudget::Reservation> reserved =
+      admission_->Admit(*context, precheck, memory_bytes, what, record);
+  if (!reserved.ok()) {
+    Finish(reactor, record, reserved.status());
     return reactor;
   }
   // Reserved before queueing, so that queued calls count too; held by the job (shared: a
   // std::function must be copyable) and given back when the job ends, whichever way it ends,
   // or at once when the pool refuses it.
-  absl::StatusOr<MemoryBudget::Reservation> reserved = memory_->Reserve(memory_bytes, what);
-  if (!reserved.ok()) {
-    Finish(reactor, record, reserved.status());
-    return reactor;
-  }
-  record.memory_bytes = reserved->bytes();
   auto reservation = std::make_shared<MemoryBudget::Reservation>(*std::move(reserved));
-  const JobSize size = memory_bytes <= MemoryCosts::kSmallJob ? JobSize::kSmall : JobSize::kLarge;
-  const bool queued = pool_->TrySubmit(
+  const absl::Status queued = admission_->Queue(
       [this, context, reactor, arrived, record, reservation, body = std::move(body)]() mutable {
         record.queued_seconds = SecondsSince(arrived);
-        // The caller may have given up (cancel, disconnect) while the job waited; a passed
-        // deadline counts too, even before gRPC has noticed it and cancelled the call.
-        if (context->IsCancelled()) {
-          Finish(reactor, record, absl::CancelledError("call was cancelled before work started"));
-          return;
-        }
-        if (std::chrono::system_clock::now() >= context->deadline()) {
-          Finish(reactor, record,
-                 absl::DeadlineExceededError("deadline passed before work started"));
+        // The caller may have given up (cancel, disconnect) while the job waited.
+        if (absl::Status wanted = Admission::StillWanted(*context); !wanted.ok()) {
+          Finish(reactor, record, wanted);
           return;
         }
         const ServiceClock::time_point started = ServiceClock::now();
@@ -161,8 +99,8 @@ grpc::ServerUnaryReactor* InscribeService::RunUnary(grpc::CallbackServerContext*
         reservation->Release();
         Finish(reactor, record, status);
       },
-      size);
-  if (!queued) Finish(reactor, record, QueueFullError());
+      LaneFor(memory_bytes));
+  if (!queued.ok()) Finish(reactor, record, queued);
   return reactor;
 }
 
@@ -174,16 +112,6 @@ absl::Status InscribeService::CheckMesh(const v1::Mesh& mesh) const {
         " triangles; this server's limit (--max-triangles) is ", limits_.max_triangles));
   }
   return absl::OkStatus();
-}
-
-grpc::ServerUnaryReactor* InscribeService::InspectMesh(grpc::CallbackServerContext* context,
-                                                       const v1::InspectMeshRequest* request,
-                                                       v1::InspectMeshResponse* response) {
-  return RunUnary(
-      context, "InspectMesh", wire::TriangleCount(request->mesh()), CheckMesh(request->mesh()),
-      MeshWorkBytes(request->mesh()),
-      absl::StrCat("InspectMesh of ", wire::TriangleCount(request->mesh()), " triangles"),
-      [request, response] { return RunInspectMesh(*request, response); });
 }
 
 }  // namespace inscribe::server

@@ -14,6 +14,7 @@
 #include "absl/status/statusor.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "inscribe/server/job_pool.h"
 
 namespace inscribe::server {
 
@@ -65,6 +66,12 @@ struct MemoryCosts {
   // mesh of up to ~8,000 triangles, a stream frame of up to 16,000 pairs; milliseconds of work.
   static constexpr std::int64_t kSmallJob = 8 << 20;
 };
+
+// The pool lane of a job estimated at `memory_bytes`: the small-job lane up to kSmallJob. The
+// one rule for unary calls and stream frames.
+inline JobSize LaneFor(std::int64_t memory_bytes) {
+  return memory_bytes <= MemoryCosts::kSmallJob ? JobSize::kSmall : JobSize::kLarge;
+}
 
 // "1.50 GiB", "512.00 MiB", "900 B": for messages.
 inline std::string FormatBytes(std::int64_t bytes) {

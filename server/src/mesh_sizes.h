@@ -3,8 +3,6 @@
 // disk or Redis to answer). Private to the server.
 #pragma once
 
-#include <algorithm>
-#include <cmath>
 #include <cstdint>
 #include <mutex>
 #include <optional>
@@ -12,6 +10,7 @@
 #include <unordered_map>
 
 #include "inscribe/geometry/mesh.h"
+#include "inscribe/medial/voxel_grid_cells.h"
 
 namespace inscribe::server {
 
@@ -20,15 +19,15 @@ struct MeshSize {
   std::int64_t triangles = 0;
   Vector3 extent = Vector3::Zero();  // bounding-box extent, mesh units
 
-  // Voxels of the generation grid of side `voxel_size` over the bounding box, as core's
-  // MakeGrid counts them (at least one cell per axis), in double so that a tiny voxel size
-  // cannot overflow. O(1).
-  double GridVoxels(double voxel_size) const {
-    double total = 1.0;
-    for (int axis = 0; axis < 3; ++axis)
-      total *= std::max(1.0, std::ceil(extent[axis] / voxel_size));
-    return total;
+  // The size of `mesh`. O(#V).
+  static MeshSize Of(const Mesh& mesh) {
+    return MeshSize{mesh.num_vertices(), mesh.num_triangles(),
+                    ComputeBoundingBox(mesh.vertices).extent()};
   }
+
+  // Voxels of the generation grid of side `voxel_size` over the bounding box (core's
+  // VoxelGridCells), in double so that a tiny voxel size cannot overflow. O(1).
+  double GridVoxels(double voxel_size) const { return VoxelGridCells(extent, voxel_size).prod(); }
 };
 
 // Thread-safe; lookups are one hash of the key under a lock. At most kMaxEntries meshes are

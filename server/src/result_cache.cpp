@@ -391,6 +391,7 @@ ResultCacheStats ResultCache::stats() const {
     std::lock_guard<std::mutex> lock(impl_->mutex);
     stats = impl_->counters;
   }
+  stats.hits = stats.memory_hits + stats.disk_hits;
   if (impl_->disk != nullptr) {
     const DiskTier::Counts disk = impl_->disk->counts();
     stats.disk_entries = disk.entries;

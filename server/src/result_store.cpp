@@ -6,6 +6,7 @@
 #include "inscribe/geometry/mesh_hash.h"
 #include "inscribe/wire/convert.h"
 #include "inscribe/wire/keys.h"
+#include "service_checks.h"
 
 namespace inscribe::server {
 namespace {
@@ -138,10 +139,9 @@ ResultStore::ResultStore(ResultCache* cache, const StoreLimits& limits)
 absl::StatusOr<std::shared_ptr<const StoredMeshEntry>> ResultStore::PutMesh(
     Mesh mesh, const ValidateOptions& options, bool* already_stored) {
   ValidatedMesh validated = ValidateMesh(std::move(mesh), options);
-  if (validated.report.non_finite_vertices > 0 || validated.report.out_of_range_indices > 0) {
-    // Not hashable; refused before hashing, with the error MakeSolid would give.
-    return absl::FailedPreconditionError(validated.report.first_error());
-  }
+  // Refused before hashing (a mesh with NaNs or dangling indices has no usable hash) and before
+  // the cache is asked.
+  if (!validated.report.usable()) return UnusableMeshError(validated.report.first_error());
   const std::string key = FormatSha256(MeshSha256(validated.mesh));
   absl::StatusOr<CacheLookup> found = cache_->GetOrCompute(
       key,

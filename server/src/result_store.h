@@ -84,8 +84,8 @@ class ResultStore {
   ResultStore(ResultCache* cache, const StoreLimits& limits);
 
   // Validates `mesh` with `options` (its repairs: welding, hole filling) and stores it under
-  // the hash of the validated mesh. FAILED_PRECONDITION when it is unusable (naming the first
-  // error). *already_stored: the key was held before.
+  // the hash of the validated mesh. UnusableMeshError (the report's first error) when it is
+  // unusable, before any hashing or cache lookup. *already_stored: the key was held before.
   absl::StatusOr<std::shared_ptr<const StoredMeshEntry>> PutMesh(Mesh mesh,
                                                                  const ValidateOptions& options,
                                                                  bool* already_stored);

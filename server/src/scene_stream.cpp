@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "admission.h"
 #include "frame_dispatch.h"
 #include "frame_stream_reactor.h"
 #include "inscribe/scene/scene.h"
@@ -20,23 +21,25 @@
 #include "memory_budget.h"
 #include "result_store.h"
 #include "service_checks.h"
+#include "service_parts.h"
 
 namespace inscribe::server {
+namespace {
 
 // FrameStreamReactor runs the stream; a frame here is a message that changes the scene and
 // asks its close pairs. Errors of a message name its frame.
 class SceneStreamReactor final : public FrameStreamReactor<v1::SceneMessage, v1::SceneReply> {
  public:
-  SceneStreamReactor(InscribeService* service, grpc::CallbackServerContext* context)
-      : FrameStreamReactor(service, context, "SceneStream") {
-    service->open_scenes_.fetch_add(1);  // until Closed
+  SceneStreamReactor(const ServiceParts& parts, grpc::CallbackServerContext* context)
+      : FrameStreamReactor(parts, context, "SceneStream") {
+    parts.open_scenes.fetch_add(1);  // until Closed
   }
 
  private:
   // The O(1) checks of the message on the gRPC thread: first message or not, the limits, its
   // query, and the memory of the scene it would make (reserved here, held for the stream).
   absl::Status Admit() override {
-    const ServiceLimits& limits = service()->limits_;
+    const ServiceLimits& limits = parts().limits;
     if (!created_ && !request().has_query()) {
       return absl::InvalidArgumentError(
           "query: the first message creates the scene and must carry its query");
@@ -78,12 +81,13 @@ class SceneStreamReactor final : public FrameStreamReactor<v1::SceneMessage, v1:
         objects * MemoryCosts::kPerSceneObject + ignored * MemoryCosts::kPerIgnoredPair +
         static_cast<std::int64_t>(pending_query_.max_pairs) * MemoryCosts::kPerScenePair;
     if (bytes > scene_reservation_.bytes()) {
-      absl::StatusOr<MemoryBudget::Reservation> reserved = service()->memory_->Reserve(
-          bytes, absl::StrCat("SceneStream of ", objects, " objects and max_pairs ",
-                              pending_query_.max_pairs));
+      absl::StatusOr<MemoryBudget::Reservation> reserved = parts().admission.Reserve(
+          bytes,
+          absl::StrCat("SceneStream of ", objects, " objects and max_pairs ",
+                       pending_query_.max_pairs),
+          &record());
       if (!reserved.ok()) return reserved.status();
       scene_reservation_ = *std::move(reserved);
-      record().memory_bytes = std::max(record().memory_bytes, scene_reservation_.bytes());
     }
     ignored_sent_ = ignored;
     return absl::OkStatus();
@@ -119,7 +123,7 @@ class SceneStreamReactor final : public FrameStreamReactor<v1::SceneMessage, v1:
   void Closed() override {
     scene_ = Scene();
     scene_reservation_.Release();
-    service()->open_scenes_.fetch_sub(1);
+    parts().open_scenes.fetch_sub(1);
   }
 
   // Applies the message to the scene and answers it into reply() (`place`: where it runs).
@@ -180,14 +184,13 @@ class SceneStreamReactor final : public FrameStreamReactor<v1::SceneMessage, v1:
       return Named(named, s);
     }
     absl::StatusOr<std::shared_ptr<const SphereHierarchy>> spheres =
-        service()->store_->GetHierarchy(wire_object.sphere_set(), volume_);
+        parts().store.GetHierarchy(wire_object.sphere_set(), volume_);
     if (!spheres.ok()) return Named(absl::StrCat(named, ".sphere_set"), spheres.status());
     object->spheres = *std::move(spheres);
     if (!wire_object.cover().empty()) {
       if (absl::Status s = CheckKey(wire_object.cover(), "cover"); !s.ok()) return Named(named, s);
       absl::StatusOr<std::shared_ptr<const CertifiedObjectEntry>> certified =
-          service()->store_->GetCertifiedObject(wire_object.sphere_set(), wire_object.cover(),
-                                                volume_);
+          parts().store.GetCertifiedObject(wire_object.sphere_set(), wire_object.cover(), volume_);
       if (!certified.ok()) return Named(absl::StrCat(named, ".cover"), certified.status());
       object->internal = (*certified)->internal;
       object->cover = (*certified)->cover;
@@ -213,10 +216,12 @@ class SceneStreamReactor final : public FrameStreamReactor<v1::SceneMessage, v1:
   MemoryBudget::Reservation scene_reservation_;  // the scene's estimate, for its life
 };
 
+}  // namespace
+
 grpc::ServerBidiReactor<v1::SceneMessage, v1::SceneReply>* InscribeService::SceneStream(
     grpc::CallbackServerContext* context) {
-  auto* reactor = new SceneStreamReactor(this, context);
-  reactor->Start(Authenticate(*context));
+  auto* reactor = new SceneStreamReactor(Parts(), context);
+  reactor->Start();
   return reactor;
 }
 

@@ -9,6 +9,7 @@
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/string_view.h"
 #include "inscribe/distance/separation_distance.h"
 #include "inscribe/distance/sphere_hierarchy.h"
 #include "inscribe/server/result_cache.h"
@@ -22,6 +23,14 @@ using ServiceClock = std::chrono::steady_clock;
 
 inline double SecondsSince(ServiceClock::time_point start) {
   return std::chrono::duration<double>(ServiceClock::now() - start).count();
+}
+
+// The one status of a mesh the service cannot use, whichever call brought it (PutMesh, and
+// Generate's upload through it; a frame of UpdateDeformation): FAILED_PRECONDITION with
+// `problem` as the message, which names what is wrong (the mesh report's first error, or the
+// frame's bad vertex).
+inline absl::Status UnusableMeshError(absl::string_view problem) {
+  return absl::FailedPreconditionError(problem);
 }
 
 // A required cache key: INVALID_ARGUMENT naming `field` when empty or malformed. O(length).

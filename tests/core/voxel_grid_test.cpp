@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "inscribe/medial/medial_spheres.h"
+#include "inscribe/medial/voxel_grid_cells.h"
 #include "inscribe/solid/boundary_oracle.h"
 #include "support/test_meshes.h"
 
@@ -246,6 +247,38 @@ TEST(CornerScreen, SheetEstimatesDropVoxelsButNotThePlainMethodsSpheres) {
     EXPECT_GE(kept_by_estimates, kept_by_directions - static_cast<int>(all->set.size()) / 100)
         << kept_by_estimates << " and " << kept_by_directions << " of " << all->set.size();
   }
+}
+
+// The public count (VoxelGridCells, which the service's estimates use) is the grid MakeGrid
+// builds, and both are the smallest whole number of cells (at least one) whose sides reach the
+// extent, counted here by stepping. Extents and sizes are multiples of 1/64 and 1/16, so that
+// every product and quotient is exact or far from a whole number. A grid over max_voxels is
+// refused, one at it is not.
+TEST(VoxelGridCells, AreTheCellsMakeGridLaysAndCountedByStepping) {
+  std::mt19937 random(11);
+  std::uniform_int_distribution<int> sixty_fourths(0, 192);
+  std::uniform_int_distribution<int> sixteenths(1, 16);
+  auto extent_of = [&] { return sixty_fourths(random) / 64.0; };
+  for (int trial = 0; trial < 500; ++trial) {
+    BoundingBox box;
+    box.min = Vector3(extent_of(), extent_of(), extent_of()) - Vector3::Ones();
+    box.max = box.min + Vector3(extent_of(), trial % 7 == 0 ? 0.0 : extent_of(), extent_of());
+    const double size = sixteenths(random) / 16.0;
+    const Vector3 cells = VoxelGridCells(box.extent(), size);
+    for (int axis = 0; axis < 3; ++axis) {
+      std::int64_t stepped = 1;
+      while (static_cast<double>(stepped) * size < box.extent()[axis]) ++stepped;
+      EXPECT_EQ(cells[axis], static_cast<double>(stepped)) << "trial " << trial << " axis " << axis;
+    }
+    const auto voxels = static_cast<std::int64_t>(cells.prod());
+    const absl::StatusOr<Grid> grid = MakeGrid(box, size, voxels);
+    ASSERT_TRUE(grid.ok()) << grid.status();
+    EXPECT_EQ(grid->count(), voxels);
+    for (int axis = 0; axis < 3; ++axis) EXPECT_EQ(grid->dims[axis], cells[axis]);
+    if (voxels > 1) EXPECT_FALSE(MakeGrid(box, size, voxels - 1).ok());
+  }
+  // A voxel size far below the extent: a huge count or +infinity, never an overflow.
+  EXPECT_GT(VoxelGridCells(Vector3::Ones(), 1e-300).prod(), 1e18);
 }
 
 }  // namespace

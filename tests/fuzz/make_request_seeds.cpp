@@ -120,7 +120,6 @@ int main(int argc, char** argv) {
   deform.set_store(true);
   Seed(dir, RequestKind::kUpdateDeformation, deform, "stretch");
   deform.set_strict(true);
-  deform.set_ray_parity(true);
   deform.set_interpolated_normal(true);
   deform.set_xi(0.01);
   Seed(dir, RequestKind::kUpdateDeformation, deform, "strict");

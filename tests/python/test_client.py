@@ -7,6 +7,7 @@ import socket
 import subprocess
 import time
 
+import grpc
 import numpy as np
 import pytest
 
@@ -51,7 +52,7 @@ def test_generate_on_the_server_is_in_process_generation_bit_for_bit(server, eig
         assert np.array_equal(result.spheres.spheres, local.spheres)
         assert np.array_equal(result.spheres.contact_triangles, local.contact_triangles)
         assert result.mesh_sha256 == local.mesh_sha256 and result.spheres.kind == "internal"
-        assert result.quality["nerr"] == local.quality.nerr
+        assert result.quality.nerr == local.quality.nerr
         again = client.generate(eight, max_spheres=60)
         assert again.cache == "memory" and again.sphere_set_key == result.sphere_set_key
         stored = client.get_sphere_set(result.sphere_set_key)
@@ -88,13 +89,13 @@ def test_every_other_call_agrees_with_in_process(server, eight):
     with inscribe.Client(server.address) as client:
         solid = inscribe.prepare(eight)
         inspected = client.inspect_mesh(eight)
-        assert inspected["mesh_sha256"] == solid.sha256
-        assert inspected["report"]["volume"] == solid.report.volume
+        assert inspected.mesh_sha256 == solid.sha256
+        assert inspected.report.volume == solid.report.volume
         generated = client.generate(eight, max_spheres=60)
         key, mesh_key = generated.sphere_set_key, generated.mesh_sha256
         local = inscribe.generate(solid, max_spheres=60)
         # Evaluation with the same settings as in-process.
-        assert client.evaluate(mesh_key, key)["nerr"] == local.quality.nerr
+        assert client.evaluate(mesh_key, key).nerr == local.quality.nerr
         # The server's hierarchy answers as one built here.
         pose = np.array([1.0, 0, 0, 0, 0.7, 0.1, 0])
         remote_h = client.get_hierarchy(key)
@@ -102,26 +103,116 @@ def test_every_other_call_agrees_with_in_process(server, eight):
             inscribe.distance(local, local, pose).distance
         # Deformation frames as inscribe.Deformer makes them.
         vertices = np.ascontiguousarray(solid.mesh.vertices * np.array([1.03, 1.0, 0.98]))
-        moved, figures = client.update_deformation(key, vertices, bounds=True)
-        ours = inscribe.Deformer(solid, local).update(vertices)
-        assert np.array_equal(moved.spheres, ours.spheres)
-        assert figures["shrunk"] == ours.stats["shrunk"] and "nerr_upper" in figures
+        moved = client.update_deformation(key, vertices, bounds=True)
+        deformer = inscribe.Deformer(solid, local)
+        ours = deformer.update(vertices)
+        assert np.array_equal(moved.spheres.spheres, ours.spheres)
+        assert np.array_equal(moved.spheres.reference_index, ours.reference_index)
+        assert moved.spheres.stats == {**ours.stats, "seconds": moved.spheres.stats["seconds"]}
+        assert moved.bounds.nerr_upper == deformer.bounds(ours).nerr_upper
         # Uploads and certificates.
         uploaded = client.put_sphere_set(local, mesh_sha256=mesh_key)
         assert np.array_equal(client.get_sphere_set(uploaded).spheres, local.spheres)
-        assert client.certify_cover(mesh_key, uploaded)["certified"] is False
+        assert client.certify_cover(mesh_key, uploaded).certified is False
         cover = inscribe.generate(solid, max_spheres=80, kind="cover", evaluate=False)
-        assert client.certify_cover(mesh_key, cover)["certified"] is True
+        assert client.certify_cover(mesh_key, cover).certified is True
+
+
+def test_answers_are_the_in_process_types(server, eight):
+    with inscribe.Client(server.address) as client:
+        internal = client.generate(eight, max_spheres=60)
+        assert isinstance(internal.quality, inscribe.QualityReport)
+        assert internal.spheres.quality.nerr == internal.quality.nerr
+        assert internal.certificate is None and internal.spheres.certificate is None
+        assert isinstance(client.inspect_mesh(eight).report, inscribe.MeshReport)
+        assert isinstance(client.evaluate(internal.mesh_sha256, internal.sphere_set_key),
+                          inscribe.QualityReport)
+        cover = client.generate(eight, max_spheres=80, kind="cover", evaluate=False)
+        assert cover.quality is None and isinstance(cover.certificate, inscribe.CoverCertificate)
+        # The cover's SphereSet carries its certificate, which names its spheres and mesh:
+        # CertifiedObject takes delta and the cores from it, as from an in-process cover.
+        assert cover.spheres.certificate.delta == cover.certificate.delta
+        inscribe.CertifiedObject(internal.spheres, cover.spheres)
+        certificate = client.certify_cover(cover.mesh_sha256, cover.sphere_set_key)
+        assert isinstance(certificate, inscribe.CoverCertificate) and certificate.certified
+
+
+class Lost(grpc.RpcError):
+    """NOT_FOUND as the server answers for a mesh it no longer holds."""
+
+    def code(self):
+        return grpc.StatusCode.NOT_FOUND
+
+    def details(self):
+        return "unknown mesh"
+
+
+def test_generate_uploads_a_mesh_the_server_lost_once_more(server, eight):
+    with inscribe.Client(server.address) as client:
+        replica = client._replicas[0]
+        generate, put = replica.rpc["Generate"], replica.rpc["PutMesh"]
+        calls = []
+
+        def put_counted(request, **kwargs):
+            calls.append("PutMesh")
+            return put(request, **kwargs)
+
+        def lost_once(request, **kwargs):
+            calls.append("Generate")
+            if calls.count("Generate") == 1:
+                raise Lost()
+            return generate(request, **kwargs)
+
+        replica.rpc["PutMesh"], replica.rpc["Generate"] = put_counted, lost_once
+        result = client.generate(eight, max_spheres=40)
+        assert calls == ["PutMesh", "Generate", "PutMesh", "Generate"]
+        assert len(result.spheres) > 0
+
+        # Lost again after the second upload: that NOT_FOUND is the answer.
+        def lost(request, **kwargs):
+            calls.append("Generate")
+            raise Lost()
+
+        replica.rpc["Generate"] = lost
+        calls.clear()
+        with pytest.raises(inscribe.Error) as raised:
+            client.generate(eight, max_spheres=40)
+        assert raised.value.code == "NOT_FOUND"
+        assert calls == ["PutMesh", "Generate", "PutMesh", "Generate"]
+        # A stored mesh named by its key is not the client's to upload.
+        calls.clear()
+        with pytest.raises(inscribe.Error):
+            client.generate(result.mesh_sha256, max_spheres=40)
+        assert calls == ["Generate"]
+
+
+def test_bad_settings_are_refused_before_anything_is_sent(eight):
+    with inscribe.Client(free_dead_endpoint(), timeout=5.0,
+                         retry=inscribe.RetryPolicy(max_attempts=1)) as client:
+        with pytest.raises(ValueError, match="not both"):
+            client.generate(eight, max_spheres=5, voxel_size=0.1)
+        with pytest.raises(ValueError, match="unknown sphere selection 'greedy'"):
+            client.generate(eight, max_spheres=60, selection="greedy")
+        with pytest.raises(ValueError, match="kind must be"):
+            client.generate(eight, kind="outer")
+        with pytest.raises(ValueError, match="unit quaternion"):
+            client.distance("a", "b", np.array([2.0, 0, 0, 0, 0, 0, 0]))
+        with pytest.raises(ValueError, match="volume must be 'sphere' or 'rss'"):
+            client.open_distance_session(volume="obb")
+        with client.open_distance_session() as session:
+            identity = np.array([1.0, 0, 0, 0, 0, 0, 0])
+            with pytest.raises(ValueError, match=r"pairs\[0\] must be"):
+                session.query([("a", "b", identity)])
 
 
 def test_certified_intervals_over_the_service_are_the_in_process_ones(server, eight):
     with inscribe.Client(server.address) as client:
         internal = client.generate(eight, max_spheres=60, evaluate=False)
         cover = client.generate(eight, max_spheres=80, kind="cover", evaluate=False)
-        assert cover.spheres.kind == "cover" and cover.certificate["certified"]
+        assert cover.spheres.kind == "cover" and cover.certificate.certified
         local = inscribe.CertifiedObject(internal.spheres, cover.spheres,
-                                         cover.certificate["delta"],
-                                         protrusions=cover.certificate["protrusions"])
+                                         cover.certificate.delta,
+                                         protrusions=cover.certificate.protrusions)
         rng = np.random.default_rng(5)
         q = rng.normal(size=(50, 4))
         poses = np.hstack([q / np.linalg.norm(q, axis=1, keepdims=True),
@@ -144,6 +235,10 @@ def test_certified_intervals_over_the_service_are_the_in_process_ones(server, ei
         again = client.distance(internal.sphere_set_key, internal.sphere_set_key, poses,
                                 cover_a=uploaded, cover_b=uploaded, closer_than=0.2)
         assert np.array_equal(again.lower, ours.lower)
+        # Without a threshold every answer is undecided, as in-process.
+        unasked = client.distance(internal.sphere_set_key, internal.sphere_set_key, poses,
+                                  cover_a=uploaded, cover_b=uploaded)
+        assert unasked.answers == inscribe.certified_distance(local, local, poses).closer
         identity = np.array([1.0, 0, 0, 0, 0, 0, 0])
         with client.open_distance_session() as session:
             reply = session.query([(internal.sphere_set_key, internal.sphere_set_key, identity,

@@ -77,3 +77,71 @@ def test_a_set_without_contacts_cannot_deform(reference):
     solid, _ = reference
     with pytest.raises(ValueError):
         inscribe.Deformer(solid, inscribe.SphereSet(np.array([[0.0, 0.0, 0.0, 0.1]])))
+
+
+def coiled_bar(segments=48, turns=1.15, radius=1.0, half=0.18):
+    # A square bar along x, of `segments` slices, and the same bar wound around the z axis
+    # through `turns` turns: its two ends pass through each other, so the wound frame
+    # intersects itself while the straight reference does not.
+    length = 2 * np.pi * radius * turns
+    xs = np.linspace(0.0, length, segments + 1)
+    ring = np.array([[-half, -half], [half, -half], [half, half], [-half, half]])
+    vertices = np.array([[x, y, z] for x in xs for (y, z) in ring])
+    triangles = []
+    for i in range(segments):
+        a, b = 4 * i, 4 * (i + 1)
+        for k in range(4):
+            k1 = (k + 1) % 4
+            triangles += [[a + k, b + k, b + k1], [a + k, b + k1, a + k1]]
+    triangles += [[0, 2, 1], [0, 3, 2]]
+    e = 4 * segments
+    triangles += [[e, e + 1, e + 2], [e, e + 2, e + 3]]
+    triangles = np.array(triangles, dtype=np.int32)
+    straight = inscribe.Mesh(vertices, triangles)
+    if inscribe.prepare(straight).mesh.vertices.shape != vertices.shape:
+        raise AssertionError("the bar should need no welding")
+    theta = vertices[:, 0] / radius
+    wound = np.stack([(radius - vertices[:, 1]) * np.cos(theta),
+                      (radius - vertices[:, 1]) * np.sin(theta),
+                      vertices[:, 2] + 0.05 * theta], axis=1)
+    return straight, np.ascontiguousarray(wound)
+
+
+def test_a_self_intersecting_frame_moves_the_same_from_the_cli_the_service_and_python(tmp_path):
+    # The inside-test rule of a deforming boundary is core's alone: the CLI, the service (for
+    # a client that asks nothing of it) and Python give one answer bit for bit, also on a frame
+    # whose ends pass through each other, where the pseudonormal sign and the winding number
+    # disagree near the buried faces.
+    from conftest import Server
+
+    straight, wound = coiled_bar()
+    solid = inscribe.prepare(straight)
+    # The reference (validated as is) needs no exact test; the frame intersects itself.
+    assert solid.report.self_intersecting_pairs == 0
+    frame = inscribe.prepare(inscribe.Mesh(wound, solid.mesh.triangles))
+    assert frame.report.self_intersecting_pairs > 0
+    spheres = inscribe.generate(solid, max_spheres=120, evaluate=False)
+
+    ours = inscribe.Deformer(solid, spheres).update(wound)
+
+    reference_file, spheres_file = tmp_path / "bar.off", tmp_path / "bar.json"
+    deformed_file, out = tmp_path / "wound.off", tmp_path / "moved.json"
+    inscribe.write_mesh(solid.mesh, str(reference_file))
+    inscribe.write_spheres(spheres, str(spheres_file))
+    inscribe.write_mesh(inscribe.Mesh(wound, solid.mesh.triangles), str(deformed_file))
+    run_cli("deform", reference_file, spheres_file, deformed_file, "-o", out)
+    cli = inscribe.read_spheres(str(out))
+
+    server = Server("--jobs", "1")
+    try:
+        with inscribe.Client(server.address) as client:
+            mesh_key = client.put_mesh(solid.mesh)
+            set_key = client.put_sphere_set(spheres, mesh_sha256=mesh_key)
+            served = client.update_deformation(set_key, wound, mesh_sha256=mesh_key).spheres
+    finally:
+        server.stop()
+
+    assert np.array_equal(ours.spheres, cli.spheres)
+    assert np.array_equal(served.spheres, cli.spheres)
+    # The frame's buried ends matter: some spheres were shrunk there.
+    assert ours.stats["shrunk"] > 0

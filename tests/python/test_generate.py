@@ -43,6 +43,37 @@ def test_spheres_are_bit_identical_to_the_cli(tmp_path, mesh, cli_args, kwargs):
     if ours.kind == "cover":
         assert ours.certificate.certified
         assert ours.certificate.delta == cli.stats["delta"]
+    # What a sphere file records of a generation is one rule (core's GenerationSphereFile):
+    # the same params, and the same stats but for the timings.
+    assert ours.params == cli.params
+    assert set(ours.stats) == set(cli.stats)
+    untimed = lambda stats: {k: v for k, v in stats.items() if not k.endswith("seconds")}
+    assert untimed(ours.stats) == untimed(cli.stats)
+
+
+def test_a_cover_saved_from_python_is_a_cover_to_the_cli(tmp_path, eight):
+    internal = inscribe.generate(eight, max_spheres=40, evaluate=False)
+    cover = inscribe.generate(eight, max_spheres=80, kind="cover", evaluate=False)
+    internal_file, cover_file = tmp_path / "internal.json", tmp_path / "cover.json"
+    inscribe.write_spheres(internal, str(internal_file))
+    inscribe.write_spheres(cover, str(cover_file))
+    read = inscribe.read_spheres(str(cover_file))
+    assert read.kind == "cover" and read.certificate.certified
+    assert read.certificate.delta == cover.certificate.delta
+    poses = tmp_path / "poses.txt"
+    poses.write_text("1 0 0 0 3 0 0\n1 0 0 0 0.5 0 0\n")
+    summary = json.loads(run_cli("distance", internal_file, internal_file, "--poses", poses,
+                                 "--cover-a", cover_file, "--cover-b", cover_file,
+                                 "--json").stdout)
+    assert summary["queries"] == 2
+    # Edited spheres lose the certificate on reading, as the CLI refuses them.
+    edited = np.array(cover.spheres)
+    edited[0, 3] *= 0.5
+    edited_file = tmp_path / "edited.json"
+    forged = inscribe.SphereSet(edited, kind="cover", mesh_sha256=cover.mesh_sha256)
+    forged.params, forged.stats = cover.params, cover.stats  # the old certificate's figures
+    inscribe.write_spheres(forged, str(edited_file))
+    assert inscribe.read_spheres(str(edited_file)).certificate is None
 
 
 def test_quality_is_the_cli_evaluation(tmp_path, eight):

@@ -408,8 +408,8 @@ TEST(Adversarial, DeformationsWithWrongVertexCountsOrNaNsAreRefused) {
   EXPECT_THAT(status.error_message(), AllOf(HasSubstr("21 numbers"), HasSubstr("8 vertices")));
   std::vector<double> with_nan = moved;
   with_nan[3 * 6 + 2] = kNaN;
-  status = update(with_nan);
-  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  status = update(with_nan);  // an unusable mesh, as PutMesh's
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::FAILED_PRECONDITION);
   EXPECT_THAT(status.error_message(), HasSubstr("vertex 6 has a non-finite coordinate"));
   status = update(moved);  // the same call with good positions works
   EXPECT_TRUE(status.ok()) << status.error_message();

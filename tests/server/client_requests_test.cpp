@@ -135,6 +135,49 @@ TEST(Client, GenerateFromAMeshDoesNotUploadAgainForOtherErrors) {
             absl::StatusCode::kFailedPrecondition);
 }
 
+TEST(Client, GenerateForAStoredMeshUploadsItOnlyWhenTheServerLostIt) {
+  auto connection = std::make_shared<MockConnection>();
+  {
+    InSequence order;
+    EXPECT_CALL(*connection, Generate(_, _, _))
+        .WillOnce(Return(absl::NotFoundError("unknown mesh sha256:cube")));
+    EXPECT_CALL(*connection, PutMesh(Truly([](const v1::PutMeshRequest& request) {
+                                       return request.fill_holes() &&
+                                              request.weld_tolerance() == 0.5 &&
+                                              request.mesh().triangles_size() == 36;
+                                     }),
+                                     _))
+        .WillOnce(Return(PutMeshOk()));
+    EXPECT_CALL(*connection, Generate(Truly([](const v1::GenerateRequest& request) {
+                                        return request.mesh_sha256() == "sha256:cube";
+                                      }),
+                                      _, _))
+        .WillOnce(Return(GenerateOk()));
+  }
+  GenerateSettings settings;
+  settings.fill_holes = true;
+  settings.weld_tolerance = 0.5;
+  absl::StatusOr<GenerateResult> result =
+      Client(connection).Generate("sha256:cube", testing::UnitCube(), settings);
+  ASSERT_TRUE(result.ok()) << result.status();
+  EXPECT_EQ(result->sphere_set_key, "spheres/v1/two");
+
+  // Found at once: nothing is uploaded.
+  auto found = std::make_shared<MockConnection>();
+  EXPECT_CALL(*found, PutMesh(_, _)).Times(0);
+  EXPECT_CALL(*found, Generate(_, _, _)).WillOnce(Return(GenerateOk()));
+  EXPECT_TRUE(Client(found).Generate("sha256:cube", testing::UnitCube(), {}).ok());
+
+  // Lost again after the second upload: the server's answer.
+  auto losing = std::make_shared<MockConnection>();
+  EXPECT_CALL(*losing, PutMesh(_, _)).WillOnce(Return(PutMeshOk()));
+  EXPECT_CALL(*losing, Generate(_, _, _))
+      .Times(2)
+      .WillRepeatedly(Return(absl::NotFoundError("unknown mesh")));
+  EXPECT_EQ(Client(losing).Generate("sha256:cube", testing::UnitCube(), {}).status(),
+            absl::NotFoundError("unknown mesh"));
+}
+
 TEST(Client, DistanceSendsPosesVolumeAndToleranceAndConvertsResults) {
   RigidPose a;
   a.translation = Vector3(1, 2, 3);
@@ -195,7 +238,7 @@ TEST(Client, UpdateDeformationSendsVerticesRowByRowAndReadsTheBounds) {
         EXPECT_THAT(request.vertices(), ElementsAre(1, 2, 3, 4, 5, 6));
         EXPECT_EQ(request.xi(), 0.01);
         EXPECT_TRUE(request.strict() && request.bounds() && request.store() &&
-                    request.ray_parity() && request.interpolated_normal());
+                    request.interpolated_normal());
         v1::UpdateDeformationResponse response = DeformationOk();
         response.set_nerr_lower(0.1);
         response.set_nerr_upper(0.2);
@@ -209,9 +252,9 @@ TEST(Client, UpdateDeformationSendsVerticesRowByRowAndReadsTheBounds) {
       .WillOnce(Return(DeformationOk()));
   Client client(connection);
   DeformationSettings settings;
-  settings.xi = 0.01;
-  settings.strict = settings.bounds = settings.store = true;
-  settings.ray_parity = settings.interpolated_normal = true;
+  settings.options.xi = 0.01;
+  settings.options.strict = settings.bounds = settings.store = true;
+  settings.options.direction = ContactDirection::kInterpolatedNormal;
   absl::StatusOr<DeformationResult> moved =
       client.UpdateDeformation("sha256:cube", "spheres/v1/two", vertices, settings);
   ASSERT_TRUE(moved.ok()) << moved.status();

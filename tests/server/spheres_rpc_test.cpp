@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <mutex>
 #include <random>
 #include <string>
 #include <thread>
@@ -243,6 +244,42 @@ TEST_F(SpheresRpcTest, SphereSetHierarchyAndDistanceMatchTheLibrary) {
   const grpc::Status too_many = stub_->Distance(Context().get(), huge, &answer);
   EXPECT_EQ(too_many.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
   EXPECT_THAT(too_many.error_message(), HasSubstr("--max-poses"));
+}
+
+// poses_a holds one pose or one per pose of poses_b; any other count is refused on the gRPC
+// thread, before the sets are looked up (unknown keys here: a call that passes the rule is
+// NOT_FOUND, one that breaks it INVALID_ARGUMENT, never queued).
+TEST_F(SpheresRpcTest, DistanceTakesOnePoseAOrOnePerPoseB) {
+  std::vector<CallRecord> calls;
+  std::mutex calls_mutex;
+  observer_ = [&](const CallRecord& call) {
+    std::lock_guard<std::mutex> lock(calls_mutex);
+    calls.push_back(call);
+  };
+  Restart();
+  auto request = [](int count_a, int count_b) {
+    v1::DistanceRequest distance;
+    distance.set_sphere_set_a("spheres/v1/" + std::string(64, 'a'));
+    distance.set_sphere_set_b("spheres/v1/" + std::string(64, 'b'));
+    wire::PosesToProto(std::vector<RigidPose>(count_a), distance.mutable_poses_a());
+    wire::PosesToProto(std::vector<RigidPose>(count_b), distance.mutable_poses_b());
+    return distance;
+  };
+  v1::DistanceResponse answer;
+  const grpc::Status two_for_three = stub_->Distance(Context().get(), request(2, 3), &answer);
+  EXPECT_EQ(two_for_three.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(two_for_three.error_message(),
+              HasSubstr("poses_a has 2 poses and poses_b 3; poses_a must have one pose or as "
+                        "many as poses_b"));
+  EXPECT_EQ(stub_->Distance(Context().get(), request(1, 3), &answer).error_code(),
+            grpc::StatusCode::NOT_FOUND);
+  EXPECT_EQ(stub_->Distance(Context().get(), request(3, 3), &answer).error_code(),
+            grpc::StatusCode::NOT_FOUND);
+  std::lock_guard<std::mutex> lock(calls_mutex);
+  ASSERT_EQ(calls.size(), 3u);
+  EXPECT_EQ(calls[0].run_seconds, 0.0);  // refused before it was queued
+  EXPECT_EQ(calls[0].memory_bytes, 0);
+  EXPECT_GT(calls[1].memory_bytes, 0);
 }
 
 TEST_F(SpheresRpcTest, CorruptDiskEntryIsRecomputed) {

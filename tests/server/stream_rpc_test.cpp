@@ -218,8 +218,8 @@ TEST_F(StreamRpcTest, UpdateDeformationErrorsHaveTheirCodes) {
 
   Vertices nan = ball.vertices;
   nan(3, 1) = std::nan("");
-  s = Deform(key, nan, &response);
-  EXPECT_EQ(s.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  s = Deform(key, nan, &response);  // an unusable mesh, as PutMesh's
+  EXPECT_EQ(s.error_code(), grpc::StatusCode::FAILED_PRECONDITION);
   EXPECT_THAT(s.error_message(), HasSubstr("vertex 3"));
 
   Vertices mirrored = ball.vertices;  // a mirror image encloses negative volume

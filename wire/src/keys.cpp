@@ -135,10 +135,10 @@ std::string CoverCertificateKey(const std::string& set_key, const std::string& m
 
 std::string DeformerKey(const std::string& mesh_key, const std::string& set_key,
                         const DeformationOptions& options) {
-  const std::string canonical = absl::StrFormat(
-      "%s\n%s\n%s\nxi=%.17g\nstrict=%d\ndirection=%d\ninside=%d\n", kDeformerVersion, mesh_key,
-      set_key, options.xi, options.strict, static_cast<int>(options.direction),
-      static_cast<int>(options.oracle.inside_test));
+  const std::string canonical =
+      absl::StrFormat("%s\n%s\n%s\nxi=%.17g\nstrict=%d\ndirection=%d\nbackend=%d\n",
+                      kDeformerVersion, mesh_key, set_key, options.xi, options.strict,
+                      static_cast<int>(options.direction), static_cast<int>(options.backend));
   return "deformer/v1/" + DerivedKeyHex(RoutePrefix(mesh_key), canonical);
 }
 

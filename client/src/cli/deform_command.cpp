@@ -69,10 +69,7 @@ struct DeformInputs {
   std::string reference_sha256;
   Mesh deformed;  // the validated reference's triangles on the moved vertices
   std::string deformed_sha256;
-  std::int64_t deformed_self_intersecting_pairs = 0;
-  // Ray parity when either pose self-intersects: the pseudonormal sign fails near buried
-  // sheets.
-  bool ray_parity = false;
+  std::int64_t deformed_self_intersecting_pairs = 0;  // reported, not acted on
 };
 
 absl::StatusOr<DeformInputs> ReadInputs(const DeformCliOptions& options) {
@@ -131,11 +128,6 @@ absl::StatusOr<DeformInputs> ReadInputs(const DeformCliOptions& options) {
   in.deformed_self_intersecting_pairs =
       ValidateMesh(in.deformed, check).report.self_intersecting_pairs;
   in.deformed_sha256 = FormatSha256(MeshSha256(in.deformed));
-  // The inside-test rule holds for both solids: the exact test if either needs it.
-  MeshReport deformed_report;
-  deformed_report.self_intersecting_pairs = in.deformed_self_intersecting_pairs;
-  in.ray_parity = InsideTestFor(solid->report) == InsideTest::kExactWinding ||
-                  InsideTestFor(deformed_report) == InsideTest::kExactWinding;
   in.file = *std::move(file);
   return in;
 }
@@ -157,10 +149,10 @@ absl::StatusOr<client::DeformationResult> Deform(const client::Client& client,
       client.PutSphereSet(in.file.set, mesh->mesh_sha256);
   if (!set.ok()) return set.status();
   client::DeformationSettings settings;
-  settings.xi = options.xi;
-  settings.strict = options.strict;
-  settings.interpolated_normal = options.interpolated_normal;
-  settings.ray_parity = in.ray_parity;
+  settings.options.xi = options.xi;
+  settings.options.strict = options.strict;
+  settings.options.direction = options.interpolated_normal ? ContactDirection::kInterpolatedNormal
+                                                           : ContactDirection::kCarriedFrame;
   settings.bounds = true;
   absl::StatusOr<client::DeformationResult> result = client.UpdateDeformation(
       mesh->mesh_sha256, set->sphere_set_key, in.deformed.vertices, settings);

@@ -13,10 +13,11 @@
 
 #include "absl/strings/str_format.h"
 #include "command_outcome.h"
-#include "cover_file_fields.h"
+#include "cover_verdict.h"
 #include "inscribe/balls/sphere_io.h"
 #include "inscribe/distance/certified_distance.h"
 #include "inscribe/distance/separation_distance.h"
+#include "inscribe/generation/sphere_file_record.h"
 #include "nlohmann/json.hpp"
 #include "pose_file.h"
 #include "remote_options.h"

@@ -9,10 +9,11 @@
 
 #include "absl/strings/str_format.h"
 #include "command_outcome.h"
-#include "cover_file_fields.h"
+#include "cover_verdict.h"
 #include "inscribe/balls/sphere_io.h"
 #include "inscribe/balls/sphere_quality.h"
 #include "inscribe/cover/cover_certificate.h"
+#include "inscribe/generation/sphere_file_record.h"
 #include "inscribe/view/report_json.h"
 #include "remote_options.h"
 #include "service_session.h"

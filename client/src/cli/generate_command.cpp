@@ -11,8 +11,8 @@
 
 #include "absl/strings/str_format.h"
 #include "command_outcome.h"
-#include "cover_file_fields.h"
 #include "inscribe/balls/sphere_io.h"
+#include "inscribe/generation/sphere_file_record.h"
 #include "inscribe/generation/sphere_set_generation.h"
 #include "inscribe/view/report_json.h"
 #include "progress_bar.h"
@@ -52,94 +52,6 @@ struct Generated {
   std::string sphere_set_key, cache;
 };
 
-// What --dilate adds to the file's stats and the JSON summary (mesh units, seconds).
-NamedValues DilationStats(const DilationResult& dilation) {
-  return {{"v_points", dilation.v_points},
-          {"edge_points", dilation.edge_points},
-          {"grown", dilation.grown},
-          {"max_growth", dilation.max_growth},
-          {"dilation_seconds", dilation.seconds}};
-}
-
-// What --cover adds to the file's stats and the JSON summary: the certificate's figures
-// (cover_file_fields.h) and the growth's.
-NamedValues CoverStats(const GeneratedCover& cover) {
-  NamedValues stats = CoverCertificateStats(cover.certificate);
-  stats.emplace_back("grown_spheres", cover.grown_spheres);
-  stats.emplace_back("cover_candidates", cover.candidates);
-  stats.emplace_back("repair_rounds", static_cast<std::int64_t>(cover.repair_rounds));
-  return stats;
-}
-
-// Params and stats of the sphere file (DESIGN.md section 3), in mesh units and radians. A
-// cover's internal set is the cover generator's own: no epsilon, runs or voxel counts.
-SphereFile MakeSphereFile(const GenerateCliOptions& options, const Generated& g) {
-  const SphereSetParameters& p = options.parameters;
-  const GeneratedSphereSet& r = g.result;
-  const bool medial_run = r.kind != SphereSetKind::kCover;
-  SphereFile file;
-  file.set = r.set;
-  file.mesh_sha256 = g.mesh_sha256;
-  file.params = {
-      {kKindParam, std::string(SphereSetKindName(r.kind))},
-      {"voxel_size", r.voxel_size},
-      {"object_angle", p.medial.object_angle},
-  };
-  if (medial_run) file.params.emplace_back("epsilon", r.epsilon);
-  NamedValues medial = {
-      {"samples", static_cast<std::int64_t>(p.medial.samples)},
-      {"screen_samples", static_cast<std::int64_t>(p.medial.screen_samples)},
-      {"pair_angle_margin", p.medial.pair_angle_margin},
-      {"corner_screen", p.medial.corner_screen},
-      {"subdivide_boundary", p.medial.subdivide_boundary},
-  };
-  for (auto& param : medial) file.params.push_back(std::move(param));
-  if (const std::optional<std::int64_t> budget = EffectiveMaxSpheres(p)) {
-    file.params.emplace_back("max_spheres", *budget);
-    if (medial_run)
-      file.params.emplace_back("selection", std::string(SphereSelectionName(r.selection)));
-  }
-  if (r.kind == SphereSetKind::kDilated) {
-    file.params.emplace_back("dilation_growth", p.dilation.growth);
-  }
-  if (r.kind == SphereSetKind::kCover) {
-    if (p.max_protrusion) file.params.emplace_back("max_protrusion", *p.max_protrusion);
-    file.params.emplace_back("cover_resolution", p.cover_resolution);
-  }
-  if (!g.mesh_repairs.empty()) file.params.emplace_back("mesh_repairs", g.mesh_repairs);
-  const QualityReport& quality = *r.quality;
-  file.stats = {{"seconds", r.generation_seconds}};
-  if (medial_run) file.stats.emplace_back("search_runs", static_cast<std::int64_t>(r.runs));
-  if (r.selection == SphereSelection::kOptimised) {
-    file.stats.emplace_back("pool_size", r.pool_size);
-    file.stats.emplace_back("covered_fraction", r.covered_fraction);
-  }
-  NamedValues figures = {
-      {"volume_mesh", quality.volume_mesh},
-      {"volume_union", quality.volume_union},
-      {"nerr", quality.nerr},
-      {"nerr_is_exact", quality.nerr_is_exact},
-      {"protrusion_max", quality.protrusion_max},
-      {"coverage", quality.coverage},
-      {"boundary_to_union_hausdorff", quality.boundary_to_union_hausdorff},
-      {"surface_samples", quality.surface_samples},
-      {"fat", quality.fat},
-  };
-  if (medial_run) {
-    figures.emplace_back("visited_voxels", r.stats.visited_voxels);
-    figures.emplace_back("closest_point_queries", r.stats.closest_point_queries);
-  }
-  if (r.dilation) {
-    for (auto& stat : DilationStats(*r.dilation)) figures.push_back(std::move(stat));
-  }
-  if (r.cover) {
-    file.protrusions = r.cover->certificate.protrusions;
-    for (auto& stat : CoverStats(*r.cover)) figures.push_back(std::move(stat));
-  }
-  for (auto& figure : figures) file.stats.push_back(std::move(figure));
-  return file;
-}
-
 // PutMesh, then Generate with the progress bar fed by the service's messages.
 absl::StatusOr<Generated> Generate(const client::Client& client,
                                    const GenerateCliOptions& options) {
@@ -154,11 +66,9 @@ absl::StatusOr<Generated> Generate(const client::Client& client,
   ProgressBar progress("generating");
   client::GenerateOptions call;
   call.on_progress = [&progress](double fraction) { progress.Update(fraction); };
-  absl::StatusOr<client::GenerateResult> result = client.Generate(solid->sha256, settings, call);
-  // Evicted between the two calls (a busy server with a small cache): upload and ask again.
-  if (result.status().code() == absl::StatusCode::kNotFound) {
-    result = client.Generate(solid->mesh, settings, call);
-  }
+  // The client uploads the mesh again if the service evicted it after StoreSolid.
+  absl::StatusOr<client::GenerateResult> result =
+      client.Generate(solid->sha256, solid->mesh, settings, call);
   if (!result.ok()) {
     // Parameters the service refuses are a bad command line.
     if (result.status().code() == absl::StatusCode::kInvalidArgument) {
@@ -198,7 +108,7 @@ void PrintSummary(const GenerateCliOptions& options, const Generated& g) {
   if (p.max_protrusion) summary["max_protrusion"] = *p.max_protrusion;
   summary["seconds"] = r.generation_seconds;
   summary["load_seconds"] = g.load_seconds;
-  if (r.kind != SphereSetKind::kCover) {  // figures of the medial run (see MakeSphereFile)
+  if (r.kind != SphereSetKind::kCover) {  // figures of the medial run (as GenerationSphereFile)
     summary["epsilon"] = r.epsilon;
     summary["search_runs"] = r.runs;
     summary["selection"] = SphereSelectionName(r.selection);
@@ -211,8 +121,8 @@ void PrintSummary(const GenerateCliOptions& options, const Generated& g) {
     summary["closest_point_queries"] = r.stats.closest_point_queries;
   }
   summary[kKindParam] = SphereSetKindName(r.kind);
-  NamedValues figures = r.dilation ? DilationStats(*r.dilation) : NamedValues();
-  if (r.cover) figures = CoverStats(*r.cover);
+  NamedValues figures = r.dilation ? DilationFigures(*r.dilation) : NamedValues();
+  if (r.cover) figures = CoverFigures(*r.cover);
   for (const auto& [name, value] : figures) {
     std::visit([&summary, &name = name](const auto& v) { summary[name] = v; }, value);
   }
@@ -233,7 +143,8 @@ absl::Status RunGenerate(const GenerateCliOptions& options) {
 
   // The sphere file goes to -o, else to stdout unless --json claims stdout for the summary
   // (as with deform).
-  const SphereFile file = MakeSphereFile(options, *generated);
+  const SphereFile file = GenerationSphereFile(options.parameters, generated->result,
+                                               generated->mesh_sha256, generated->mesh_repairs);
   if (absl::Status written =
           EmitSphereFile(file, options.output_path, options.format, options.json, options.link);
       !written.ok()) {

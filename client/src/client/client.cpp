@@ -120,6 +120,31 @@ absl::StatusOr<GenerateResult> GenerateUntil(Connection& connection, const Retry
   return result;
 }
 
+v1::PutMeshRequest PutMeshRequestFor(const Mesh& mesh, bool fill_holes, double weld_tolerance) {
+  v1::PutMeshRequest request;
+  wire::MeshToProto(mesh, request.mutable_mesh());
+  request.set_fill_holes(fill_holes);
+  request.set_weld_tolerance(weld_tolerance);
+  return request;
+}
+
+// Generate for the mesh that `put` stored as `mesh_sha256`. When the server has dropped it
+// since (NOT_FOUND: evicted, or restarted without its disk tier), `put` uploads it again, once,
+// and Generate asks again; a second NOT_FOUND is the server's answer.
+absl::StatusOr<GenerateResult> GenerateUploadingAgain(
+    Connection& connection, const RetryPolicy& retry, const v1::PutMeshRequest& put,
+    const std::string& mesh_sha256, const GenerateSettings& settings,
+    const GenerateOptions& options, Deadline deadline) {
+  v1::GenerateRequest request = GenerateRequestFor(mesh_sha256, settings, options);
+  absl::StatusOr<GenerateResult> generated =
+      GenerateUntil(connection, retry, request, options.on_progress, deadline);
+  if (generated.status().code() != absl::StatusCode::kNotFound) return generated;
+  absl::StatusOr<PutMeshResult> stored = PutMeshUntil(connection, retry, put, deadline);
+  if (!stored.ok()) return stored.status();
+  request.set_mesh_sha256(stored->mesh_sha256);
+  return GenerateUntil(connection, retry, request, options.on_progress, deadline);
+}
+
 absl::StatusOr<QualityReport> EvaluateUntil(Connection& connection, const RetryPolicy& retry,
                                             v1::EvaluateRequest& request,
                                             const EvaluateSettings& settings, Deadline deadline) {
@@ -169,11 +194,8 @@ absl::StatusOr<InspectMeshResult> Client::InspectMesh(const Mesh& mesh,
 
 absl::StatusOr<PutMeshResult> Client::PutMesh(const Mesh& mesh,
                                               const PutMeshOptions& options) const {
-  v1::PutMeshRequest request;
-  wire::MeshToProto(mesh, request.mutable_mesh());
-  request.set_fill_holes(options.fill_holes);
-  request.set_weld_tolerance(options.weld_tolerance);
-  return PutMeshUntil(*connection_, options_.retry, request,
+  return PutMeshUntil(*connection_, options_.retry,
+                      PutMeshRequestFor(mesh, options.fill_holes, options.weld_tolerance),
                       DeadlineAfter(options.timeout, options_));
 }
 
@@ -197,22 +219,24 @@ absl::StatusOr<GenerateResult> Client::Generate(const Mesh& mesh, const Generate
   }
   // One deadline for the uploads and generations together; the mesh is converted once.
   const Deadline deadline = DeadlineAfter(options.timeout, options_);
-  v1::PutMeshRequest put;
-  wire::MeshToProto(mesh, put.mutable_mesh());
-  put.set_fill_holes(settings.fill_holes);
-  put.set_weld_tolerance(settings.weld_tolerance);
+  const v1::PutMeshRequest put =
+      PutMeshRequestFor(mesh, settings.fill_holes, settings.weld_tolerance);
   absl::StatusOr<PutMeshResult> stored = PutMeshUntil(*connection_, options_.retry, put, deadline);
   if (!stored.ok()) return stored.status();
-  v1::GenerateRequest request = GenerateRequestFor(stored->mesh_sha256, settings, options);
-  absl::StatusOr<GenerateResult> generated =
-      GenerateUntil(*connection_, options_.retry, request, options.on_progress, deadline);
-  if (generated.status().code() != absl::StatusCode::kNotFound) return generated;
-  // The server dropped the mesh between the calls (evicted, or restarted without its disk
-  // tier): upload it again, once; a second NOT_FOUND is the server's answer.
-  stored = PutMeshUntil(*connection_, options_.retry, put, deadline);
-  if (!stored.ok()) return stored.status();
-  request.set_mesh_sha256(stored->mesh_sha256);
-  return GenerateUntil(*connection_, options_.retry, request, options.on_progress, deadline);
+  return GenerateUploadingAgain(*connection_, options_.retry, put, stored->mesh_sha256, settings,
+                                options, deadline);
+}
+
+absl::StatusOr<GenerateResult> Client::Generate(const std::string& mesh_sha256, const Mesh& mesh,
+                                                const GenerateSettings& settings,
+                                                const GenerateOptions& options) const {
+  if (absl::Status checked = CheckSphereSetParameters(settings.parameters); !checked.ok()) {
+    return checked;
+  }
+  return GenerateUploadingAgain(
+      *connection_, options_.retry,
+      PutMeshRequestFor(mesh, settings.fill_holes, settings.weld_tolerance), mesh_sha256, settings,
+      options, DeadlineAfter(options.timeout, options_));
 }
 
 absl::StatusOr<PutSphereSetResult> Client::PutSphereSet(const SphereSet& spheres,
@@ -281,12 +305,7 @@ absl::StatusOr<DeformationResult> Client::UpdateDeformation(const std::string& m
   // Row-major #V x 3: the storage is already the wire's x0, y0, z0, x1, ...
   request.mutable_vertices()->Add(deformed_vertices.data(),
                                   deformed_vertices.data() + deformed_vertices.size());
-  request.set_xi(settings.xi);
-  request.set_strict(settings.strict);
-  request.set_interpolated_normal(settings.interpolated_normal);
-  request.set_ray_parity(settings.ray_parity);
-  request.set_bounds(settings.bounds);
-  request.set_store(settings.store);
+  wire::DeformationSettingsToProto(settings, &request);
   absl::StatusOr<v1::UpdateDeformationResponse> response =
       Retried(options_.retry, DeadlineAfter(options.timeout, options_),
               [&](Deadline d) { return connection_->UpdateDeformation(request, d); });
@@ -396,35 +415,7 @@ absl::StatusOr<ServerCacheStats> Client::CacheStats(const CallOptions& options) 
       Retried(options_.retry, DeadlineAfter(options.timeout, options_),
               [&](Deadline d) { return connection_->CacheStats(request, d); });
   if (!response.ok()) return response.status();
-  ServerCacheStats stats;
-  stats.entries = response->entries();
-  stats.bytes = response->bytes();
-  stats.memory_hits = response->memory_hits();
-  stats.disk_hits = response->disk_hits();
-  stats.hits = response->hits();
-  stats.misses = response->misses();
-  stats.computations = response->computations();
-  stats.joined = response->joined();
-  stats.evictions = response->evictions();
-  stats.disk_entries = response->disk_entries();
-  stats.disk_bytes = response->disk_bytes();
-  stats.disk_errors = response->disk_errors();
-  stats.shared_hits = response->shared_hits();
-  stats.shared_misses = response->shared_misses();
-  stats.shared_errors = response->shared_errors();
-  stats.shared_writes = response->shared_writes();
-  stats.shared_write_errors = response->shared_write_errors();
-  stats.shared_skipped = response->shared_skipped();
-  stats.shared_corrupt = response->shared_corrupt();
-  stats.shared_available = response->shared_available();
-  stats.disk_write_errors = response->disk_write_errors();
-  stats.disk_writes_skipped = response->disk_writes_skipped();
-  stats.disk_available = response->disk_available();
-  stats.disk_bytes_limit = response->disk_bytes_limit();
-  stats.disk_evictions = response->disk_evictions();
-  stats.disk_evicted_bytes = response->disk_evicted_bytes();
-  stats.disk_writes_too_large = response->disk_writes_too_large();
-  return stats;
+  return wire::CacheStatsFromProto(*response);
 }
 
 absl::StatusOr<DistanceSession> Client::OpenDistanceSession(

@@ -33,9 +33,8 @@ using Quad = SphereHierarchy::Quad;
 
 // Node pairs with at most this many sphere pairs below them are compared pair by pair: the
 // filter first drops the rows out of reach of the other node's sphere (most of them), then
-// rejects four or eight pairs in a few instructions, much less than a step of the tree. On the
-// Table II poses (eight, pig) 768-2048 were equally fast; with kSplitBothRatio, 1.3x faster
-// than 128 pairs and one side split per step.
+// rejects four or eight pairs in a few instructions, much less than a step of the tree (the
+// value was chosen on the Table II poses: docs/benchmarks/distance.md).
 constexpr std::int64_t kAllPairs = 1024;
 static_assert(kAllPairs <= 64 * 64, "the shorter side of a compared pair fits a 64-bit mask");
 

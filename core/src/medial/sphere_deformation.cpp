@@ -158,12 +158,17 @@ struct SphereDeformer::Impl {
         oracle(std::move(built)) {}
 };
 
-absl::StatusOr<SphereDeformer> SphereDeformer::Create(Mesh reference, SphereSet spheres,
-                                                      const DeformationOptions& options) {
+absl::Status CheckDeformationOptions(const DeformationOptions& options) {
   if (!std::isfinite(options.xi) || options.xi < 0.0) {
     return absl::InvalidArgumentError(
         absl::StrCat("xi must be finite and >= 0 (0 = the default), got ", options.xi));
   }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<SphereDeformer> SphereDeformer::Create(Mesh reference, SphereSet spheres,
+                                                      const DeformationOptions& options) {
+  if (absl::Status s = CheckDeformationOptions(options); !s.ok()) return s;
   if (spheres.contacts.size() != spheres.spheres.size()) {
     return absl::InvalidArgumentError(absl::StrCat(
         "the reference spheres need one contact each to be moved (", spheres.spheres.size(),
@@ -179,7 +184,10 @@ absl::StatusOr<SphereDeformer> SphereDeformer::Create(Mesh reference, SphereSet 
     return absl::InvalidArgumentError(
         "the reference mesh encloses no positive volume (open, inverted or flat)");
   }
-  absl::StatusOr<BoundaryOracle> oracle = BoundaryOracle::Build(reference, options.oracle);
+  BoundaryOracleOptions oracle_options;
+  oracle_options.inside_test = InsideTest::kExactWinding;
+  oracle_options.backend = options.backend;
+  absl::StatusOr<BoundaryOracle> oracle = BoundaryOracle::Build(reference, oracle_options);
   if (!oracle.ok()) return oracle.status();
 
   DeformationOptions resolved = options;

@@ -8,6 +8,7 @@
 
 #include "absl/strings/str_format.h"
 #include "base/parallel.h"
+#include "inscribe/medial/voxel_grid_cells.h"
 
 namespace inscribe::internal {
 namespace {
@@ -34,24 +35,20 @@ Vector3 InwardDirectionAtFoot(const Mesh& mesh, const Vector3& x, const Boundary
 }  // namespace
 
 absl::StatusOr<Grid> MakeGrid(const BoundingBox& box, double size, std::int64_t max_voxels) {
+  const Vector3 extent = box.extent();
+  const Vector3 cells = VoxelGridCells(extent, size);
+  // Every axis has at least one cell, so the product only grows: checking it once is checking
+  // every partial product, and it is finite or +infinity, never an overflowed integer.
+  if (!(cells.prod() <= static_cast<double>(max_voxels))) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "voxel size %g gives a grid of more than %d voxels over the bounding box (%g x %g x "
+        "%g); use a larger voxel size or raise the voxel limit",
+        size, max_voxels, extent.x(), extent.y(), extent.z()));
+  }
   Grid grid;
   grid.size = size;
-  double total = 1.0;
-  Vector3 padding;
-  for (int axis = 0; axis < 3; ++axis) {
-    const double extent = box.max[axis] - box.min[axis];
-    const double cells = std::max(1.0, std::ceil(extent / size));
-    total *= cells;
-    if (!(total <= static_cast<double>(max_voxels))) {
-      return absl::InvalidArgumentError(absl::StrFormat(
-          "voxel size %g gives a grid of more than %d voxels over the bounding box (%g x %g x "
-          "%g); use a larger voxel size or raise the voxel limit",
-          size, max_voxels, box.extent().x(), box.extent().y(), box.extent().z()));
-    }
-    grid.dims[axis] = static_cast<std::int64_t>(cells);
-    padding[axis] = 0.5 * (cells * size - extent);
-  }
-  grid.origin = box.min - padding;
+  for (int axis = 0; axis < 3; ++axis) grid.dims[axis] = static_cast<std::int64_t>(cells[axis]);
+  grid.origin = box.min - 0.5 * (cells * size - extent);
   return grid;
 }
 
@@ -272,3 +269,15 @@ std::vector<char> ScreenByCorners(const BoundaryOracle& oracle, const Grid& grid
 }
 
 }  // namespace inscribe::internal
+
+namespace inscribe {
+
+Vector3 VoxelGridCells(const Vector3& extent, double voxel_size) {
+  Vector3 cells;
+  for (int axis = 0; axis < 3; ++axis) {
+    cells[axis] = std::max(1.0, std::ceil(extent[axis] / voxel_size));
+  }
+  return cells;
+}
+
+}  // namespace inscribe

@@ -95,8 +95,7 @@ class TriangleBvh {
   TriangleBvh() = default;
 
   // `mesh` must have at least one triangle, in-range indices and finite coordinates (the
-  // caller checks). Cost O(#T log #T) time (about 30 ms for 75k triangles), about 120 bytes per
-  // triangle.
+  // caller checks). Cost O(#T log #T) time, about 120 bytes per triangle.
   static TriangleBvh Build(const Mesh& mesh);
 
   // New positions of the same mesh (same #V and triangles as at Build): copies the corners

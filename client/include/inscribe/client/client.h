@@ -24,6 +24,8 @@
 #include "inscribe/medial/sphere_deformation.h"
 #include "inscribe/scene/scene.h"
 #include "inscribe/solid/mesh_validation.h"
+#include "inscribe/wire/cache_stats.h"
+#include "inscribe/wire/deformation_settings.h"
 
 namespace inscribe::client {
 
@@ -122,15 +124,8 @@ struct StoredSphereSet {
   std::string mesh_sha256;  // empty when uploaded without a mesh
 };
 
-struct DeformationSettings {
-  double xi = 0.0;  // mesh units; 0 = 0.25% of the largest bounding-box extent
-  bool strict = false;
-  bool interpolated_normal = false;
-  // The exact winding inside test (the wire field's old name).
-  bool ray_parity = false;
-  bool bounds = false;  // also compute nerr bounds (exact union volumes)
-  bool store = false;   // also cache the moved set and return its key
-};
+// core's DeformationOptions (xi, strict, direction), bounds and store: wire/'s.
+using DeformationSettings = wire::DeformationSettings;
 
 // The moved spheres with the update's figures (DeformedSpheres; the set has contacts, so it can
 // serve as a later reference), and what the server adds.
@@ -170,37 +165,9 @@ struct DistanceBatchResult {
 // wire; the seed and protrusion tolerance are the server's defaults).
 using EvaluateSettings = QualityOptions;
 
-// CacheStats as the server reports it (see CacheStatsResponse in service.proto).
-struct ServerCacheStats {
-  std::int64_t entries = 0;
-  std::int64_t bytes = 0;
-  std::int64_t memory_hits = 0;
-  std::int64_t disk_hits = 0;
-  std::int64_t hits = 0;
-  std::int64_t misses = 0;
-  std::int64_t computations = 0;
-  std::int64_t joined = 0;
-  std::int64_t evictions = 0;
-  std::int64_t disk_entries = 0;
-  std::int64_t disk_bytes = 0;
-  std::int64_t disk_errors = 0;
-  // The replicas' shared Redis tier (all 0 without one); see CacheStatsResponse.
-  std::int64_t shared_hits = 0;
-  std::int64_t shared_misses = 0;
-  std::int64_t shared_errors = 0;
-  std::int64_t shared_writes = 0;
-  std::int64_t shared_write_errors = 0;
-  std::int64_t shared_skipped = 0;
-  std::int64_t shared_corrupt = 0;
-  std::int64_t shared_available = 0;  // 1 while the server's Redis is up
-  std::int64_t disk_write_errors = 0;
-  std::int64_t disk_writes_skipped = 0;  // while the server's disk writes were stopped
-  std::int64_t disk_available = 0;       // 1 while the server's disk tier is writing
-  std::int64_t disk_bytes_limit = 0;     // the server's --cache-disk-bytes; 0 = unbounded
-  std::int64_t disk_evictions = 0;       // entries deleted from disk for that bound
-  std::int64_t disk_evicted_bytes = 0;
-  std::int64_t disk_writes_too_large = 0;  // results larger than the whole bound, not written
-};
+// CacheStats as the server reports it: wire's counters (see CacheStatsResponse in
+// service.proto).
+using ServerCacheStats = wire::CacheStats;
 
 // One object pair of a simulator frame: two cached sets and their world poses.
 struct PosePair {
@@ -367,6 +334,12 @@ class Client {
   // Uploads `mesh` (PutMesh, with settings.fill_holes and weld_tolerance) and generates; if the
   // server lost the mesh in between (NOT_FOUND: evicted), uploads it once more.
   absl::StatusOr<GenerateResult> Generate(const Mesh& mesh, const GenerateSettings& settings,
+                                          const GenerateOptions& options = {}) const;
+  // Spheres for `mesh`, which the caller stored as `mesh_sha256` (PutMesh with
+  // settings.fill_holes and weld_tolerance); if the server lost it since (NOT_FOUND: evicted),
+  // uploads it once more and asks again, as the overload above does. One deadline for all.
+  absl::StatusOr<GenerateResult> Generate(const std::string& mesh_sha256, const Mesh& mesh,
+                                          const GenerateSettings& settings,
                                           const GenerateOptions& options = {}) const;
 
   absl::StatusOr<PutSphereSetResult> PutSphereSet(const SphereSet& spheres,

@@ -44,10 +44,10 @@ inline constexpr double kCertifiedDistanceMaxScale = 1e100;
 
 // The spheres for CertifiedObject::internal: the cover's cores (CoverCores) when its
 // certificate gives its per-sphere protrusions (CoverCertificate::protrusions) and some core
-// is left, else the solid's internal set. The cores sit right under the cover's spheres: on
-// the Table II poses they give an upper bound within 3-6% of the internal set's and the
-// cores' together, with half the spheres (so 1.5-1.7x faster queries), and much tighter
-// than the internal set's alone. INVALID_ARGUMENT for protrusions neither empty nor one
+// is left, else the solid's internal set. The cores sit right under the cover's spheres, so
+// they give an upper bound close to that of the internal set and the cores together, with
+// half the spheres, and much tighter than the internal set's alone
+// (docs/benchmarks/covers.md). INVALID_ARGUMENT for protrusions neither empty nor one
 // finite value per cover sphere. O(N).
 absl::StatusOr<std::vector<Sphere>> UpperBoundSpheres(const std::vector<Sphere>& internal,
                                                       const std::vector<Sphere>& cover,

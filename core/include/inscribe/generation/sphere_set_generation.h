@@ -21,8 +21,6 @@
 
 namespace inscribe {
 
-// The sphere budget used when neither a voxel size nor a budget is given.
-inline constexpr std::int64_t kDefaultMaxSpheres = 500;
 // How a budget is spent when the caller does not say.
 inline constexpr SphereSelection kDefaultSphereSelection = SphereSelection::kOptimised;
 

@@ -16,6 +16,11 @@ using Triangles = Eigen::Matrix<std::int32_t, Eigen::Dynamic, 3, Eigen::RowMajor
 
 using Vector3 = Eigen::Vector3d;
 
+// Largest coordinate magnitude ValidateMesh accepts (mesh units); beyond it the mesh has the
+// error "coordinates_too_large". Volumes (cubes of differences) and CGAL's constructions
+// (products of differences) stay finite below it.
+inline constexpr double kMaxMeshCoordinate = 1e100;
+
 struct Mesh {
   Vertices vertices;
   Triangles triangles;

@@ -106,6 +106,10 @@ absl::StatusOr<MedialSphereResult> GenerateMedialSpheres(const BoundaryOracle& o
                                                          const MedialSphereOptions& options,
                                                          const GenerationControl& control = {});
 
+// The sphere budget of a generation (GenerateSphereSet, GenerateCover) when neither a voxel
+// size nor a budget is given.
+inline constexpr std::int64_t kDefaultMaxSpheres = 500;
+
 struct SphereBudgetOptions {
   // N: at most this many spheres, > 0.
   std::int64_t max_spheres = 0;

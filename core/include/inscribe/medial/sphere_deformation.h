@@ -43,10 +43,16 @@ struct DeformationOptions {
   // gets inside are dropped (see DeformedSpheres::reference_index).
   bool strict = false;
   ContactDirection direction = ContactDirection::kCarriedFrame;
-  // For the oracle of the deforming boundary. Use InsideTest::kExactWinding unless
-  // InsideTestFor proves the pseudonormal right for the reference and the deformed frame.
-  BoundaryOracleOptions oracle;
+  // The BVH of the deforming boundary's oracle. Its inside test is always the exact winding
+  // number (InsideTest::kExactWinding), whatever the reference's validation allowed: a deformed
+  // frame may intersect itself where the reference did not, the pseudonormal test is wrong
+  // there, and proving a frame free of self-intersections costs more than the exact test.
+  BoundaryOracleBackend backend = BoundaryOracleBackend::kFlatBvh;
 };
+
+// INVALID_ARGUMENT naming the field for options SphereDeformer::Create refuses (xi not finite
+// or negative).
+absl::Status CheckDeformationOptions(const DeformationOptions& options);
 
 struct DeformedSpheres {
   // The moved spheres, in the reference's order (less any dropped in strict mode). Contacts,

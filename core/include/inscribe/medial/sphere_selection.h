@@ -1,4 +1,4 @@
-// Optimised sphere selection (issue 26). The paper keeps one medial sphere per voxel of the
+// Optimised sphere selection. The paper keeps one medial sphere per voxel of the
 // finest grid within the budget, which spreads the budget evenly over the medial surface; the
 // paper itself notes that this is not the distribution that minimises the volume error, where
 // a good set has more large spheres and fewer small ones. GenerateOptimisedSpheres makes a pool

@@ -89,11 +89,6 @@ struct MeshReport {
   std::string first_error() const;
 };
 
-// Largest coordinate magnitude ValidateMesh accepts (mesh units); beyond it the mesh has the
-// error "coordinates_too_large". Volumes (cubes of differences) and CGAL's constructions
-// (products of differences) stay finite below it.
-inline constexpr double kMaxMeshCoordinate = 1e100;
-
 struct ValidateOptions {
   // Merge coincident vertices first: exporters (MeshLab's OBJ, STL by its nature) repeat each
   // vertex once per face, which leaves every edge a border. With weld_tolerance 0 only

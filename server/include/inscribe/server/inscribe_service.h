@@ -3,13 +3,10 @@
 
 #include <atomic>
 #include <chrono>
-#include <condition_variable>
 #include <cstdint>
 #include <functional>
 #include <limits>
 #include <memory>
-#include <mutex>
-#include <set>
 #include <string>
 #include <vector>
 
@@ -24,16 +21,11 @@
 
 namespace inscribe::server {
 
-class ResultStore;
-class DistanceStreamReactor;
-class DrainableStream;
+class Admission;
 class FrameDispatcher;
-template <typename Request, typename Reply>
-class FrameStreamReactor;
-class SceneStreamReactor;
-class MemoryBudget;
 class MeshSizes;
-struct StoredMeshEntry;
+class ResultStore;
+struct ServiceParts;
 
 // Per-request limits. Each is a flag of `inscribed` with the same name; a breach is
 // RESOURCE_EXHAUSTED with a message naming the flag.
@@ -169,13 +161,13 @@ class InscribeService final : public v1::Inscribe::CallbackService {
   // as active.
   void Finish(grpc::ServerUnaryReactor* reactor, CallRecord& record, const absl::Status& status);
 
-  // The shape of every unary call: counts it as active, refuses it while draining or when
-  // `precheck` (O(1) checks done on the gRPC thread) failed, else runs `body` on the pool
-  // (after checking the caller is still waiting and within its deadline) and replies with its
-  // status. `body` may throw std::bad_alloc (RESOURCE_EXHAUSTED) but nothing else escapes.
-  // `memory_bytes` is the call's estimated working memory, reserved from --memory-budget
-  // before it is queued and given back when `body` returns (or the call is refused or
-  // cancelled); `what` names the call in a refusal, e.g. "Distance of 1000 pose pairs".
+  // The shape of every unary call: counts it as active, admits it (Admission::Admit: the
+  // caller, draining, `precheck` (O(1) checks done on the gRPC thread), `memory_bytes` of
+  // --memory-budget for `what`, e.g. "Distance of 1000 pose pairs") or finishes it with the
+  // refusal, else queues `body` on the pool and, once the caller is still waiting and within its
+  // deadline, runs it and replies with its status. `body` may throw std::bad_alloc
+  // (RESOURCE_EXHAUSTED) but nothing else escapes. The reservation is given back when `body`
+  // returns (or the call is refused or cancelled).
   grpc::ServerUnaryReactor* RunUnary(grpc::CallbackServerContext* context, const char* method,
                                      std::int64_t triangles, const absl::Status& precheck,
                                      std::int64_t memory_bytes, std::string what,
@@ -195,48 +187,17 @@ class InscribeService final : public v1::Inscribe::CallbackService {
                                   const std::vector<RigidPose>& poses_b,
                                   const DistanceRequest& tolerance, v1::DistanceResponse* response);
 
-  // Remembers a stored mesh's size, for GenerateWorkBytes.
-  void RecordMeshSize(const StoredMeshEntry& entry);
-  // Estimated working memory of a Generate on `mesh_key` with `parameters`, from
-  // the mesh's size when this process stored it (O(1)); INVALID_ARGUMENT naming --max-voxels
-  // when its grid would be too fine.
-  absl::StatusOr<std::int64_t> GenerateWorkBytes(const std::string& mesh_key,
-                                                 const SphereSetParameters& parameters) const;
-
-  // RESOURCE_EXHAUSTED naming --max-queue: the pool refused a job.
-  absl::Status QueueFullError() const;
-
   // Shape and --max-triangles of a request's mesh: INVALID_ARGUMENT or RESOURCE_EXHAUSTED.
   absl::Status CheckMesh(const v1::Mesh& mesh) const;
 
-  // Active-call bookkeeping shared by unary and streaming calls.
-  void CallStarted();
-  void CallEnded();
-  // Tells the observer; for streaming calls, which finish through their own reactor.
-  void Observe(const CallRecord& record) const;
-  // authenticate_'s verdict on the call; OK when there is none.
-  absl::Status Authenticate(const grpc::CallbackServerContext& context) const;
-  friend class GenerateReactor;
-  template <typename Request, typename Reply>
-  friend class FrameStreamReactor;
-  friend class DistanceStreamReactor;
-  friend class SceneStreamReactor;
+  // What the reactors of Generate and the streams may use (server/src/service_parts.h).
+  ServiceParts Parts();
 
-  JobPool* const pool_;
+  std::unique_ptr<Admission> admission_;     // the checks before work; calls in flight; drain
   std::unique_ptr<FrameDispatcher> frames_;  // inline or pool, for every stream's frames
   std::unique_ptr<ResultStore> store_;
-  std::unique_ptr<MemoryBudget> memory_;   // --memory-budget
   std::unique_ptr<MeshSizes> mesh_sizes_;  // of meshes stored here, for Generate's estimate
   const ServiceLimits limits_;
-  const CallObserver observer_;
-  const CallAuthenticator authenticate_;
-
-  std::atomic<bool> draining_{false};
-  std::mutex calls_mutex_;
-  std::condition_variable calls_answered_;
-  std::int64_t active_calls_ = 0;  // guarded by calls_mutex_
-  // Open DistanceStreams and SceneStreams, told when draining starts; guarded by calls_mutex_.
-  std::set<DrainableStream*> streams_;
   // Open SceneStreams (each holds one scene until its call is done).
   std::atomic<std::int64_t> open_scenes_{0};
 };

@@ -14,6 +14,7 @@
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
+#include "inscribe/wire/cache_stats.h"
 
 namespace inscribe {
 class SphereHierarchy;
@@ -144,45 +145,9 @@ struct CacheLookup {
   CacheSource source = CacheSource::kMemory;
 };
 
-// Counters since the cache was opened (disk_entries / disk_bytes: what the directory holds
-// now, counted at open and kept up to date by this process). Each lookup (GetOrCompute or Get
-// with a well-formed key) counts in exactly one of memory_hits, disk_hits, shared_hits, misses
-// and joined.
-struct ResultCacheStats {
-  std::int64_t entries = 0;  // in memory
-  std::int64_t bytes = 0;    // in memory (key length + bytes + object_bytes, summed)
-  std::int64_t memory_hits = 0;
-  std::int64_t disk_hits = 0;
-  std::int64_t misses = 0;        // lookups found in no tier (GetOrCompute or Get)
-  std::int64_t computations = 0;  // compute functions run (failed ones included)
-  std::int64_t joined = 0;        // lookups that waited for an identical computation
-  std::int64_t evictions = 0;     // entries dropped from memory for the byte budget
-  std::int64_t disk_entries = 0;
-  std::int64_t disk_bytes = 0;
-  std::int64_t disk_errors = 0;        // disk files dropped (bad checksum, truncated, wrong key)
-  std::int64_t disk_write_errors = 0;  // results that could not be written (disk full, ...)
-  // The shared Redis tier; all 0 without one.
-  std::int64_t shared_hits = 0;    // lookups served from Redis
-  std::int64_t shared_misses = 0;  // Redis reads that found nothing
-  std::int64_t shared_errors =
-      0;  // Redis reads that failed (went on as a miss), or the check at Open
-  std::int64_t shared_writes = 0;  // entries written through to Redis
-  std::int64_t shared_write_errors = 0;
-  std::int64_t shared_skipped = 0;    // reads and writes not tried while Redis was marked down
-  std::int64_t shared_corrupt = 0;    // Redis values that failed their checks (deleted)
-  std::int64_t shared_available = 0;  // 1 while Redis is configured and not marked down
-  // 1 while the disk tier is configured and writing; 0 without one, when it was off at Open,
-  // or while its writes are stopped after a failure (see DiskTierEvent).
-  std::int64_t disk_available = 0;
-  std::int64_t disk_writes_skipped = 0;  // results not written while disk writes were stopped
-  // The disk tier's bound (ResultCacheOptions::disk_bytes; 0 = unbounded or no disk tier), the
-  // entries deleted for it since Open (at Open included) and their bytes, and the results not
-  // written because they alone exceed it.
-  std::int64_t disk_bytes_limit = 0;
-  std::int64_t disk_evictions = 0;
-  std::int64_t disk_evicted_bytes = 0;
-  std::int64_t disk_writes_too_large = 0;
-};
+// The cache's counters: wire's plain value, so that CacheStats, the client and the CLI read the
+// very struct the cache fills (wire/include/inscribe/wire/cache_stats.h documents each).
+using ResultCacheStats = wire::CacheStats;
 
 // Thread-safe. Keys are printable: 1-200 characters from [A-Za-z0-9._:/-], e.g.
 // "spheres/v1/<64 hex>"; callers derive them from content hashes, so equal keys mean equal
@@ -231,6 +196,7 @@ class ResultCache {
   // existing disk file is not rewritten (the Redis value is). INVALID_ARGUMENT for a malformed key.
   absl::StatusOr<std::shared_ptr<const CachedValue>> Put(absl::string_view key, CachedValue value);
 
+  // A snapshot of every tier's counters; hits is memory_hits + disk_hits.
   ResultCacheStats stats() const;
 
  private:

@@ -28,6 +28,8 @@
 #include "inscribe/v1/mesh.pb.h"
 #include "inscribe/v1/service.pb.h"
 #include "inscribe/v1/spheres.pb.h"
+#include "inscribe/wire/cache_stats.h"
+#include "inscribe/wire/deformation_settings.h"
 
 namespace inscribe::wire {
 
@@ -183,6 +185,13 @@ void QualityOptionsToProto(const QualityOptions& options, v1::EvaluateRequest* o
 // CheckQualityOptions and a finite coverage tolerance: INVALID_ARGUMENT otherwise.
 absl::StatusOr<QualityOptions> QualityOptionsFromProto(const v1::EvaluateRequest& request);
 
+// An UpdateDeformation request's settings (deformation_settings.h).
+void DeformationSettingsToProto(const DeformationSettings& settings,
+                                v1::UpdateDeformationRequest* out);
+// CheckDeformationOptions' INVALID_ARGUMENT for settings core refuses.
+absl::StatusOr<DeformationSettings> DeformationSettingsFromProto(
+    const v1::UpdateDeformationRequest& request);
+
 // A deformation update's spheres and figures, and its error bounds.
 void DeformedSpheresToProto(const DeformedSpheres& moved, v1::UpdateDeformationResponse* out);
 // INVALID_ARGUMENT for bad spheres or a reference_index of another length than the spheres.
@@ -193,6 +202,11 @@ void DeformationBoundsToProto(const DeformationErrorBounds& bounds,
 // The bounds the wire carries (volume_union_shrunk and volume_union_inner are not sent;
 // nerr_upper_uniform_xi is +infinity and uniform_xi_holds false when absent).
 DeformationErrorBounds DeformationBoundsFromProto(const v1::UpdateDeformationResponse& response);
+
+// The result cache's counters (cache_stats.h), every one in kCacheStatsCounters to and from
+// the CacheStatsResponse field of its name; a field the sender left unset reads as 0.
+void CacheStatsToProto(const CacheStats& stats, v1::CacheStatsResponse* out);
+CacheStats CacheStatsFromProto(const v1::CacheStatsResponse& response);
 
 // absl and gRPC share the canonical status codes (same numbers, same meaning), so these map
 // code and message unchanged; error details are not carried.

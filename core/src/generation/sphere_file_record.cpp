@@ -1,13 +1,13 @@
-#include "cover_file_fields.h"
+#include "inscribe/generation/sphere_file_record.h"
 
 #include <cstdint>
 #include <type_traits>
+#include <utility>
 #include <variant>
 
 #include "absl/strings/str_cat.h"
-#include "absl/strings/str_format.h"
 
-namespace inscribe::cli {
+namespace inscribe {
 namespace {
 
 // The value named `name`, or nullptr.
@@ -119,19 +119,92 @@ absl::StatusOr<std::optional<CoverCertificate>> UsableCoverCertificate(
   return recorded;
 }
 
-std::string CoverVerdict(const CoverCertificate& c) {
-  if (c.certified) return "certified: every point of the solid is in a sphere";
-  if (c.uncovered_point) {
-    const Vector3& p = *c.uncovered_point;
-    return absl::StrFormat(
-        "NOT certified: the point (%.10g %.10g %.10g), %.6g deep in the solid, is %.6g from the "
-        "nearest sphere",
-        p.x(), p.y(), p.z(), c.uncovered_depth, c.uncovered_gap);
-  }
-  return absl::StrFormat(
-      "NOT certified: %d cells of side %.6g near the boundary are in no single sphere (no "
-      "uncovered point found; a finer resolution may settle them)",
-      c.failed_cells, c.resolution);
+NamedValues QualityFigures(const QualityReport& quality) {
+  return {
+      {"volume_mesh", quality.volume_mesh},
+      {"volume_union", quality.volume_union},
+      {"nerr", quality.nerr},
+      {"nerr_is_exact", quality.nerr_is_exact},
+      {"protrusion_max", quality.protrusion_max},
+      {"coverage", quality.coverage},
+      {"boundary_to_union_hausdorff", quality.boundary_to_union_hausdorff},
+      {"surface_samples", quality.surface_samples},
+      {"fat", quality.fat},
+  };
 }
 
-}  // namespace inscribe::cli
+NamedValues DilationFigures(const DilationResult& dilation) {
+  return {{"v_points", dilation.v_points},
+          {"edge_points", dilation.edge_points},
+          {"grown", dilation.grown},
+          {"max_growth", dilation.max_growth},
+          {"dilation_seconds", dilation.seconds}};
+}
+
+NamedValues CoverFigures(const GeneratedCover& cover) {
+  NamedValues stats = CoverCertificateStats(cover.certificate);
+  stats.emplace_back("grown_spheres", cover.grown_spheres);
+  stats.emplace_back("cover_candidates", cover.candidates);
+  stats.emplace_back("repair_rounds", static_cast<std::int64_t>(cover.repair_rounds));
+  return stats;
+}
+
+SphereFile GenerationSphereFile(const SphereSetParameters& p, const GeneratedSphereSet& r,
+                                const std::string& mesh_sha256, const std::string& mesh_repairs) {
+  // A cover's internal set is the cover generator's own: no epsilon, runs or voxel counts.
+  const bool medial_run = r.kind != SphereSetKind::kCover;
+  SphereFile file;
+  file.set = r.set;
+  file.mesh_sha256 = mesh_sha256;
+  file.params = {
+      {kKindParam, std::string(SphereSetKindName(r.kind))},
+      {"voxel_size", r.voxel_size},
+      {"object_angle", p.medial.object_angle},
+  };
+  if (medial_run) file.params.emplace_back("epsilon", r.epsilon);
+  NamedValues medial = {
+      {"samples", static_cast<std::int64_t>(p.medial.samples)},
+      {"screen_samples", static_cast<std::int64_t>(p.medial.screen_samples)},
+      {"pair_angle_margin", p.medial.pair_angle_margin},
+      {"corner_screen", p.medial.corner_screen},
+      {"subdivide_boundary", p.medial.subdivide_boundary},
+  };
+  for (auto& param : medial) file.params.push_back(std::move(param));
+  if (const std::optional<std::int64_t> budget = EffectiveMaxSpheres(p)) {
+    file.params.emplace_back("max_spheres", *budget);
+    if (medial_run) {
+      file.params.emplace_back("selection", std::string(SphereSelectionName(r.selection)));
+    }
+  }
+  if (r.kind == SphereSetKind::kDilated) {
+    file.params.emplace_back("dilation_growth", p.dilation.growth);
+  }
+  if (r.kind == SphereSetKind::kCover) {
+    if (p.max_protrusion) file.params.emplace_back("max_protrusion", *p.max_protrusion);
+    file.params.emplace_back("cover_resolution", p.cover_resolution);
+  }
+  if (!mesh_repairs.empty()) file.params.emplace_back("mesh_repairs", mesh_repairs);
+
+  file.stats = {{"seconds", r.generation_seconds}};
+  if (medial_run) file.stats.emplace_back("search_runs", static_cast<std::int64_t>(r.runs));
+  if (r.selection == SphereSelection::kOptimised) {
+    file.stats.emplace_back("pool_size", r.pool_size);
+    file.stats.emplace_back("covered_fraction", r.covered_fraction);
+  }
+  NamedValues figures = r.quality ? QualityFigures(*r.quality) : NamedValues();
+  if (medial_run) {
+    figures.emplace_back("visited_voxels", r.stats.visited_voxels);
+    figures.emplace_back("closest_point_queries", r.stats.closest_point_queries);
+  }
+  if (r.dilation) {
+    for (auto& figure : DilationFigures(*r.dilation)) figures.push_back(std::move(figure));
+  }
+  if (r.cover) {
+    file.protrusions = r.cover->certificate.protrusions;
+    for (auto& figure : CoverFigures(*r.cover)) figures.push_back(std::move(figure));
+  }
+  for (auto& figure : figures) file.stats.push_back(std::move(figure));
+  return file;
+}
+
+}  // namespace inscribe

@@ -223,8 +223,6 @@ void BindSpheres(py::module_& m) {
         }
         SphereFile read = ValueOrRaise(std::move(file));
         auto result = std::make_shared<PySphereSet>();
-        result->set = std::move(read.set);
-        result->mesh_sha256 = std::move(read.mesh_sha256);
         // The kind and a cover's certificate as the file records them; the certificate only
         // when it names these spheres and certifies them (UsableCoverCertificate), as the CLI
         // takes a cover file.
@@ -232,6 +230,8 @@ void BindSpheres(py::module_& m) {
         absl::StatusOr<std::optional<CoverCertificate>> certificate =
             UsableCoverCertificate(read, path, "");
         if (certificate.ok()) result->certificate = *std::move(certificate);
+        result->set = std::move(read.set);
+        result->mesh_sha256 = std::move(read.mesh_sha256);
         result->params = std::move(read.params);
         result->stats = std::move(read.stats);
         return result;

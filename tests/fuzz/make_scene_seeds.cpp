@@ -105,10 +105,10 @@ void ColladaSeeds(const std::string& dir) {
   Seed(dir, "file-dae-cube", kDae | kFromFile, dae);
 
   // A tetrahedron and a cube placed twice, the second under the tetrahedron's node.
-  const std::unique_ptr<aiScene> nested = inscribe::testing::MakeScene(
-      {cube, tetra}, {{0, Pose(0.0, Vector3(0, 0, 0))},
-                      {1, Pose(M_PI / 2, Vector3(3, 0, 0), 0.5)},
-                      {0, Pose(M_PI / 3, Vector3(0, 2, 1)), 1}});
+  const std::unique_ptr<aiScene> nested =
+      inscribe::testing::MakeScene({cube, tetra}, {{0, Pose(0.0, Vector3(0, 0, 0))},
+                                                   {1, Pose(M_PI / 2, Vector3(3, 0, 0), 0.5)},
+                                                   {0, Pose(M_PI / 3, Vector3(0, 2, 1)), 1}});
   Seed(dir, "dae-nested-instanced", kDae, Exported(*nested, "collada"));
 
   Seed(dir, "dae-centimetre-z-up", kDae,
@@ -123,8 +123,7 @@ void ColladaSeeds(const std::string& dir) {
        Edited(Edited(dae, ">" + first + " ", ">3e38 "), "meter=\"1\"", "meter=\"1e30\""));
   // A triangle's corner past the positions.
   const std::size_t p = dae.find("<p>");
-  Seed(dir, "dae-index-out-of-range", kDae,
-       std::string(dae).replace(p, 4, "<p>4000000 "));
+  Seed(dir, "dae-index-out-of-range", kDae, std::string(dae).replace(p, 4, "<p>4000000 "));
   Seed(dir, "dae-mismatched-tag", kDae, Edited(dae, "<instance_geometry", "<instance_nothing"));
 
   const std::unique_ptr<aiScene> quads =
@@ -162,10 +161,8 @@ class Gltf {
   }
   int Accessor(int view, int component_type, std::size_t count, const char* type,
                std::size_t offset = 0) {
-    json accessor = {{"bufferView", view},
-                     {"componentType", component_type},
-                     {"count", count},
-                     {"type", type}};
+    json accessor = {
+        {"bufferView", view}, {"componentType", component_type}, {"count", count}, {"type", type}};
     if (offset > 0) accessor["byteOffset"] = offset;
     return Append("accessors", accessor);
   }
@@ -212,9 +209,8 @@ class Gltf {
     json out = json_;
     out["buffers"] = json::array(
         {{{"byteLength", bin_.size()},
-          {"uri", uri.empty()
-                      ? "data:application/octet-stream;base64," + absl::Base64Escape(bin_)
-                      : uri}}});
+          {"uri", uri.empty() ? "data:application/octet-stream;base64," + absl::Base64Escape(bin_)
+                              : uri}}});
     return out.dump(1);
   }
   // The .glb: header, JSON chunk (padded with spaces), BIN chunk (padded with zeros).
@@ -291,7 +287,8 @@ void GltfSeeds(const std::string& dir) {
     const int octahedron_mesh = g.MeshOf({Gltf::Primitive(op, oi)});
     const int root = g.Node(cube_mesh, {{"translation", {2, 0, 0}}});
     g.Node(octahedron_mesh,
-           {{"translation", {0, 3, 0}}, {"rotation", {0, 0, 0.38268343, 0.92387953}},
+           {{"translation", {0, 3, 0}},
+            {"rotation", {0, 0, 0.38268343, 0.92387953}},
             {"scale", {0.5, 0.5, 0.5}}},
            root);
     g.Node(octahedron_mesh, {{"translation", {-3, 0, 0}}});
@@ -304,7 +301,8 @@ void GltfSeeds(const std::string& dir) {
     for (Eigen::Index t = 0; t < octahedron.num_triangles(); ++t) {
       for (int k = 0; k < 3; ++k) {
         for (int c = 0; c < 3; ++c) {
-          Gltf::Put(corners, static_cast<float>(octahedron.vertices(octahedron.triangles(t, k), c)));
+          Gltf::Put(corners,
+                    static_cast<float>(octahedron.vertices(octahedron.triangles(t, k), c)));
         }
       }
     }

@@ -431,7 +431,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "cover_bench: %s\n", model.c_str());
     absl::StatusOr<Mesh> mesh = ReadMesh(options.data_dir + "/" + model + ".off");
     SolidOptions solid_options;
-    solid_options.validate.fill_holes = true;  // closed meshes come back unchanged
+    solid_options.validate.repair.level = MeshRepair::kFill;  // closed meshes come back unchanged
     absl::StatusOr<Solid> solid =
         mesh.ok() ? PrepareSolid(*std::move(mesh), solid_options) : mesh.status();
     if (!solid.ok()) {

@@ -4,7 +4,7 @@
 // selection: the sphere count, sigma, the exact nerr and the seconds of the whole generation
 // (every run of the sigma search, or every pool run and the selection). Then the same at
 // AMAA's sphere counts, next to AMAA's figures measured on this kind of machine.
-// Open models get their holes filled first (ValidateOptions::fill_holes) and are labelled so;
+// Open models get their holes filled first (MeshRepair::kFill) and are labelled so;
 // the triangle count is then the repaired mesh's. Every set goes through GenerateSphereSet,
 // the pipeline the CLI and the service use.
 //
@@ -109,7 +109,7 @@ int main(int argc, char** argv) {
     absl::StatusOr<Mesh> mesh = ReadMesh(data_dir + "/" + model, nullptr);
     // Open models (CGAL's pig.off) are closed first; closed ones come back unchanged.
     SolidOptions solid_options;
-    solid_options.validate.fill_holes = true;
+    solid_options.validate.repair.level = MeshRepair::kFill;
     absl::StatusOr<Solid> solid = mesh.ok() ? PrepareSolid(*std::move(mesh), solid_options)
                                             : absl::StatusOr<Solid>(mesh.status());
     if (!solid.ok()) {

@@ -177,7 +177,7 @@ absl::StatusOr<Model> PrepareModel(const std::string& name, const Options& optio
   absl::StatusOr<Mesh> read = ReadMesh(options.data_dir + "/" + name + ".off");
   if (!read.ok()) return read.status();
   ValidateOptions validate;
-  validate.fill_holes = true;  // pig.off is open; closed meshes come back unchanged
+  validate.repair.level = MeshRepair::kFill;  // pig.off is open; closed meshes come back unchanged
   absl::StatusOr<ValidatedMesh> prepared = PrepareMesh(ScaledToBox(*std::move(read)), validate);
   if (!prepared.ok()) return prepared.status();
   BoundaryOracleOptions oracle_options;

@@ -85,7 +85,7 @@ absl::StatusOr<Model> PrepareModel(const std::string& name, const Options& optio
   absl::StatusOr<Mesh> read = ReadMesh(options.data_dir + "/" + name + ".off");
   if (!read.ok()) return read.status();
   SolidOptions solid_options;
-  solid_options.validate.fill_holes = true;  // pig.off is open
+  solid_options.validate.repair.level = MeshRepair::kFill;  // pig.off is open
   absl::StatusOr<Solid> solid = PrepareSolid(ScaledToUnitBox(*std::move(read)), solid_options);
   if (!solid.ok()) return solid.status();
   Model model;

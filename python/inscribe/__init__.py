@@ -1,6 +1,7 @@
 """inscribe: unions of spheres approximating closed triangle meshes.
 
-In-process (the C++ core, bound with pybind11): load_mesh, write_mesh, Mesh, prepare, generate, evaluate,
+In-process (the C++ core, bound with pybind11): load_mesh, write_mesh, Mesh, Repair, prepare,
+generate, evaluate,
 certify, read_spheres, write_spheres, write_mesh, Hierarchy, distance, certified_distance, Scene,
 Deformer, spherize_urdf. Over the service (grpcio): Client, DistanceSession.
 
@@ -26,6 +27,7 @@ from ._inscribe import (
     MeshReport,
     MeshWarning,
     QualityReport,
+    Repair,
     Scene,
     SceneFrame,
     Severity,
@@ -62,7 +64,7 @@ __all__ = [
     "CoverCertificate", "DeformationErrorBounds", "Deformer", "DistanceBatch", "DistanceResult",
     "DistanceSession", "Error", "Hierarchy", "LinkSpheres", "Mesh", "MeshIssue", "MeshReport",
     "MeshWarning",
-    "QualityReport", "RetryPolicy", "Scene", "SceneFrame", "Severity", "Solid", "SphereSet", "SpherizedRobot",
+    "QualityReport", "Repair", "RetryPolicy", "Scene", "SceneFrame", "Severity", "Solid", "SphereSet", "SpherizedRobot",
     "certified_distance", "certify", "distance", "evaluate", "format_curobo_yaml", "generate",
     "load_mesh", "parse_curobo_yaml", "prepare", "read_spheres", "spherize_urdf",
     "write_mesh", "write_spheres",

@@ -254,13 +254,16 @@ class Client:
 
     # ---- calls ---------------------------------------------------------------------------
 
-    def put_mesh(self, mesh: _inscribe.Mesh, *, fill_holes: bool = False,
+    def put_mesh(self, mesh: _inscribe.Mesh, *, repair="safe", fill_holes: bool = False,
                  weld_tolerance: float = 0.0, timeout: Optional[float] = None) -> str:
         """Validates and stores `mesh` on its replica; returns its key "sha256:<hex>" (of the
-        mesh as the server fixed it: coincident vertices welded, also those within
-        weld_tolerance). inscribe.Error FAILED_PRECONDITION for an unusable mesh."""
-        request = _inscribe._put_mesh_request(mesh, fill_holes=fill_holes,
-                                              weld_tolerance=weld_tolerance)
+        mesh as the server repaired it: `repair` is an inscribe.Repair or a level name, as in
+        inscribe.prepare; fill_holes=True is "fill"; coincident vertices are always welded,
+        also those within weld_tolerance). inscribe.Error FAILED_PRECONDITION for an unusable
+        mesh."""
+        request = _inscribe._put_mesh_request(
+            mesh, repair=_inscribe._repair_argument(repair, fill_holes=fill_holes,
+                                                    weld_tolerance=weld_tolerance))
         return self._put(_inscribe._route_key(mesh.sha256), "PutMesh", request,
                          _inscribe._put_mesh_reply, timeout)
 
@@ -271,26 +274,28 @@ class Client:
                  max_voxels: Optional[int] = None, dilation_growth: Optional[float] = None,
                  max_protrusion: Optional[float] = None,
                  cover_resolution: Optional[float] = None, evaluate: bool = True,
-                 quality_samples: Optional[int] = None, fill_holes: bool = False,
-                 selection: Optional[str] = None,
+                 quality_samples: Optional[int] = None, repair="safe",
+                 fill_holes: bool = False, selection: Optional[str] = None,
                  progress: Optional[Callable[[float], None]] = None,
                  progress_interval: float = 0.0,
                  timeout: Optional[float] = None) -> GenerateResult:
         """Spheres for `mesh` (an inscribe.Mesh, uploaded first, or the key of a stored one),
         with the settings of inscribe.generate (None: core's defaults), checked before anything
-        is sent (ValueError naming the field). progress(fraction) is called on this thread as
+        is sent (ValueError naming the field); an uploaded mesh is repaired as `repair` says
+        (put_mesh). progress(fraction) is called on this thread as
         the server reports it, at most every progress_interval seconds (0: the server's 0.5 s).
         The result is cached on the server by content. A mesh uploaded here that the server
         lost before Generate (evicted) is uploaded once more."""
+        asked = _inscribe._repair_argument(repair, fill_holes=fill_holes, weld_tolerance=0.0)
         call = _inscribe._GenerateCall(
             max_spheres=max_spheres, voxel_size=voxel_size, kind=kind, object_angle=object_angle,
             epsilon=epsilon, samples=samples, subdivide_boundary=subdivide_boundary,
             max_voxels=max_voxels, dilation_growth=dilation_growth,
             max_protrusion=max_protrusion, cover_resolution=cover_resolution, evaluate=evaluate,
-            quality_samples=quality_samples, selection=selection, fill_holes=fill_holes,
+            quality_samples=quality_samples, selection=selection, repair=asked,
             progress_interval=progress_interval)
         uploaded = isinstance(mesh, _inscribe.Mesh)
-        key = self.put_mesh(mesh, fill_holes=fill_holes, timeout=timeout) if uploaded else mesh
+        key = self.put_mesh(mesh, repair=asked, timeout=timeout) if uploaded else mesh
 
         def attempt(rpc, left):
             result = None
@@ -312,7 +317,7 @@ class Client:
             if not (uploaded and error.code == "NOT_FOUND"):
                 raise
             # The server lost the mesh in between (evicted): upload it once more.
-            key = self.put_mesh(mesh, fill_holes=fill_holes, timeout=timeout)
+            key = self.put_mesh(mesh, repair=asked, timeout=timeout)
             fields = self._call(_inscribe._route_key(key), attempt, timeout)
         return GenerateResult(**fields)
 
@@ -374,13 +379,14 @@ class Client:
         return DeformationResult(**_inscribe._update_deformation_reply(reply, bounds=bounds))
 
     def inspect_mesh(self, mesh: _inscribe.Mesh, *, skip_self_intersections: bool = False,
-                     fill_holes: bool = False, weld_tolerance: float = 0.0,
+                     repair="safe", fill_holes: bool = False, weld_tolerance: float = 0.0,
                      timeout: Optional[float] = None) -> InspectMeshResult:
         """The server's validation of `mesh` (nothing stored): its key after the server's
-        fixes and its MeshReport."""
+        repairs (`repair` as in put_mesh) and its MeshReport."""
         request = _inscribe._inspect_mesh_request(
-            mesh, skip_self_intersections=skip_self_intersections, fill_holes=fill_holes,
-            weld_tolerance=weld_tolerance)
+            mesh, skip_self_intersections=skip_self_intersections,
+            repair=_inscribe._repair_argument(repair, fill_holes=fill_holes,
+                                              weld_tolerance=weld_tolerance))
         reply = self._unary(_inscribe._route_key(mesh.sha256), "InspectMesh", request, timeout)
         return InspectMeshResult(**_inscribe._inspect_mesh_reply(reply))
 

@@ -45,6 +45,16 @@ class MeshReport:
     weld_moved_within: float
     holes_filled: int
     hole_triangles_added: int
+    duplicate_triangles_removed: int
+    double_walls_removed: int
+    crack_weld_tolerance: float
+    crack_vertices_welded: int
+    wrapped: bool
+    wrap_alpha: float
+    wrap_offset: float
+    wrap_input_triangles: int
+    wrap_triangles: int
+    wrap_reach: float
     volume: float
     bbox_min: Float64Array
     bbox_max: Float64Array
@@ -56,6 +66,17 @@ class MeshReport:
     first_error: str
 
 class MeshWarning(UserWarning): ...
+
+class Repair:
+    def __init__(self, level: str = "safe", *, weld_tolerance: float = 0.0,
+                 wrap_alpha: float = 0.0, wrap_offset: float = 0.0) -> None: ...
+    @property
+    def level(self) -> str: ...
+    weld_tolerance: float
+    wrap_alpha: float
+    wrap_offset: float
+
+RepairLike = Union[Repair, str]
 
 class Mesh:
     def __init__(self, vertices: Float64Array, triangles: Int32Array) -> None: ...
@@ -69,8 +90,10 @@ class Mesh:
     def num_triangles(self) -> int: ...
     @property
     def sha256(self) -> str: ...
-    def validate(self, *, check_self_intersections: bool = True,
+    def validate(self, *, check_self_intersections: bool = True, repair: RepairLike = "safe",
                  fill_holes: bool = False, weld_tolerance: float = 0.0) -> MeshReport: ...
+    def repaired(self, repair: RepairLike = "safe", *,
+                 check_self_intersections: bool = True) -> Tuple[Mesh, MeshReport]: ...
 
 class Solid:
     @property
@@ -82,7 +105,7 @@ class Solid:
 
 def load_mesh(path: str) -> Mesh: ...
 def write_mesh(mesh: Mesh, path: str) -> None: ...
-def prepare(mesh: Mesh, *, fill_holes: bool = False,
+def prepare(mesh: Mesh, *, repair: RepairLike = "safe", fill_holes: bool = False,
             check_self_intersections: bool = True) -> Solid: ...
 
 class QualityReport:
@@ -356,9 +379,11 @@ def _rendezvous_order(route_key: str, names: Sequence[str]) -> list[int]: ...
 # inscribe.Client's messages (client_requests.cpp, client_replies.cpp): requests built and
 # answers read with wire/'s conversions; the client carries the bytes.
 def _rpc_methods() -> list[Tuple[str, str, bool, bool]]: ...
-def _inspect_mesh_request(mesh: Mesh, *, skip_self_intersections: bool, fill_holes: bool,
-                          weld_tolerance: float) -> bytes: ...
-def _put_mesh_request(mesh: Mesh, *, fill_holes: bool, weld_tolerance: float) -> bytes: ...
+def _inspect_mesh_request(mesh: Mesh, *, skip_self_intersections: bool,
+                          repair: RepairLike) -> bytes: ...
+def _put_mesh_request(mesh: Mesh, *, repair: RepairLike) -> bytes: ...
+def _repair_argument(repair: RepairLike, *, fill_holes: bool,
+                     weld_tolerance: float) -> Repair: ...
 
 class _GenerateCall:
     def __init__(self, *, max_spheres: Optional[int], voxel_size: Optional[float], kind: str,
@@ -367,7 +392,7 @@ class _GenerateCall:
                  max_voxels: Optional[int], dilation_growth: Optional[float],
                  max_protrusion: Optional[float], cover_resolution: Optional[float],
                  evaluate: bool, quality_samples: Optional[int], selection: Optional[str],
-                 fill_holes: bool, progress_interval: float) -> None: ...
+                 repair: RepairLike, progress_interval: float) -> None: ...
     def request(self, mesh_sha256: str) -> bytes: ...
     def read(self, message: bytes) -> Tuple[Optional[float], Optional[dict]]: ...
 

@@ -28,8 +28,14 @@ void BindClientReplies(py::module_& m);
 // geometry was repaired (results hold for the mesh `sha256` only). Needs the GIL.
 void WarnAboutMesh(const MeshReport& report, const std::string& sha256);
 
+// The repair a Python call asks for: `repair` (an inscribe.Repair, or its level's name, which
+// converts implicitly) with the older keywords folded in: fill_holes=True is level "fill"
+// (ValueError beside another level than "safe" or "fill"), a weld_tolerance > 0 sets the weld
+// (ValueError beside a different one in `repair`).
+RepairOptions RepairArgument(RepairOptions repair, bool fill_holes, double weld_tolerance);
+
 // PrepareSolid without the GIL; raises as RaiseStatus; warns as WarnAboutMesh.
-std::shared_ptr<Solid> PrepareSolidReleasingGil(const Mesh& mesh, bool fill_holes,
+std::shared_ptr<Solid> PrepareSolidReleasingGil(const Mesh& mesh, const RepairOptions& repair,
                                                 bool check_self_intersections);
 
 // An inscribe.Solid as given, or one prepared from an inscribe.Mesh (default validation);

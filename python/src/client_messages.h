@@ -23,7 +23,7 @@ py::bytes Serialized(const google::protobuf::Message& message);
 // (wire::GenerateRequestToProto) once, before anything is sent.
 class GenerateCall {
  public:
-  GenerateCall(const GenerateArguments& arguments, bool fill_holes, double progress_interval);
+  GenerateCall(const GenerateArguments& arguments, MeshRepair repair, double progress_interval);
 
   // The request for the mesh stored as `mesh_sha256`.
   py::bytes RequestFor(const std::string& mesh_sha256) const;

@@ -61,9 +61,9 @@ std::vector<std::tuple<std::string, std::string, bool, bool>> RpcMethods() {
 
 }  // namespace
 
-GenerateCall::GenerateCall(const GenerateArguments& arguments, bool fill_holes,
+GenerateCall::GenerateCall(const GenerateArguments& arguments, MeshRepair repair,
                            double progress_interval) {
-  wire::GenerateRequestToProto("", SphereSetParametersOf(arguments), fill_holes, &request_);
+  wire::GenerateRequestToProto("", SphereSetParametersOf(arguments), repair, &request_);
   request_.set_progress_interval(progress_interval);
 }
 
@@ -125,27 +125,28 @@ void BindClientRequests(py::module_& m) {
 
   m.def(
       "_inspect_mesh_request",
-      [](const Mesh& mesh, bool skip_self_intersections, bool fill_holes, double weld_tolerance) {
+      [](const Mesh& mesh, bool skip_self_intersections, const RepairOptions& repair) {
         v1::InspectMeshRequest request;
         wire::MeshToProto(mesh, request.mutable_mesh());
         request.set_skip_self_intersections(skip_self_intersections);
-        request.set_fill_holes(fill_holes);
-        request.set_weld_tolerance(weld_tolerance);
+        wire::RepairOptionsToProto(repair, &request);
         return Serialized(request);
       },
-      py::arg("mesh"), py::kw_only(), py::arg("skip_self_intersections"), py::arg("fill_holes"),
-      py::arg("weld_tolerance"));
+      py::arg("mesh"), py::kw_only(), py::arg("skip_self_intersections"), py::arg("repair"));
+
+  m.def("_repair_argument", &RepairArgument, py::arg("repair"), py::kw_only(),
+        py::arg("fill_holes"), py::arg("weld_tolerance"),
+        "The Repair a call asks for, with the older fill_holes and weld_tolerance folded in.");
 
   m.def(
       "_put_mesh_request",
-      [](const Mesh& mesh, bool fill_holes, double weld_tolerance) {
+      [](const Mesh& mesh, const RepairOptions& repair) {
         v1::PutMeshRequest request;
         wire::MeshToProto(mesh, request.mutable_mesh());
-        request.set_fill_holes(fill_holes);
-        request.set_weld_tolerance(weld_tolerance);
+        wire::RepairOptionsToProto(repair, &request);
         return Serialized(request);
       },
-      py::arg("mesh"), py::kw_only(), py::arg("fill_holes"), py::arg("weld_tolerance"));
+      py::arg("mesh"), py::kw_only(), py::arg("repair"));
 
   py::class_<GenerateCall>(m, "_GenerateCall",
                            "A Generate call's settings, checked and converted once: its request "
@@ -158,18 +159,18 @@ void BindClientRequests(py::module_& m) {
                       std::optional<std::int64_t> max_voxels, std::optional<double> dilation_growth,
                       std::optional<double> max_protrusion, std::optional<double> cover_resolution,
                       bool evaluate, std::optional<std::int64_t> quality_samples,
-                      const std::optional<std::string>& selection, bool fill_holes,
+                      const std::optional<std::string>& selection, const RepairOptions& repair,
                       double progress_interval) {
             return GenerateCall({max_spheres, voxel_size, kind, object_angle, epsilon, samples,
                                  subdivide_boundary, max_voxels, dilation_growth, max_protrusion,
                                  cover_resolution, evaluate, quality_samples, selection},
-                                fill_holes, progress_interval);
+                                repair.level, progress_interval);
           }),
           py::kw_only(), py::arg("max_spheres"), py::arg("voxel_size"), py::arg("kind"),
           py::arg("object_angle"), py::arg("epsilon"), py::arg("samples"),
           py::arg("subdivide_boundary"), py::arg("max_voxels"), py::arg("dilation_growth"),
           py::arg("max_protrusion"), py::arg("cover_resolution"), py::arg("evaluate"),
-          py::arg("quality_samples"), py::arg("selection"), py::arg("fill_holes"),
+          py::arg("quality_samples"), py::arg("selection"), py::arg("repair"),
           py::arg("progress_interval"))
       .def("request", &GenerateCall::RequestFor, py::arg("mesh_sha256"))
       .def("read", &GenerateCall::Read, py::arg("message"),

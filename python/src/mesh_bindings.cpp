@@ -59,10 +59,27 @@ void WarnAboutMesh(const MeshReport& report, const std::string& sha256) {
   }
 }
 
-std::shared_ptr<Solid> PrepareSolidReleasingGil(const Mesh& mesh, bool fill_holes,
+RepairOptions RepairArgument(RepairOptions repair, bool fill_holes, double weld_tolerance) {
+  if (fill_holes) {
+    if (repair.level != MeshRepair::kSafe && repair.level != MeshRepair::kFill) {
+      throw py::value_error(absl::StrCat("fill_holes=True asks for repair 'fill', but repair is '",
+                                         MeshRepairName(repair.level), "': give one of them"));
+    }
+    repair.level = MeshRepair::kFill;
+  }
+  if (weld_tolerance != 0.0) {
+    if (repair.weld_tolerance != 0.0 && repair.weld_tolerance != weld_tolerance) {
+      throw py::value_error("weld_tolerance differs from repair.weld_tolerance: give one of them");
+    }
+    repair.weld_tolerance = weld_tolerance;
+  }
+  return repair;
+}
+
+std::shared_ptr<Solid> PrepareSolidReleasingGil(const Mesh& mesh, const RepairOptions& repair,
                                                 bool check_self_intersections) {
   SolidOptions options;
-  options.validate.fill_holes = fill_holes;
+  options.validate.repair = repair;
   options.validate.check_self_intersections = check_self_intersections;
   absl::StatusOr<Solid> solid;
   {
@@ -77,7 +94,7 @@ std::shared_ptr<Solid> PrepareSolidReleasingGil(const Mesh& mesh, bool fill_hole
 std::shared_ptr<Solid> SolidOf(py::handle mesh_or_solid) {
   if (py::isinstance<Solid>(mesh_or_solid)) return mesh_or_solid.cast<std::shared_ptr<Solid>>();
   if (py::isinstance<Mesh>(mesh_or_solid)) {
-    return PrepareSolidReleasingGil(mesh_or_solid.cast<const Mesh&>(), false, true);
+    return PrepareSolidReleasingGil(mesh_or_solid.cast<const Mesh&>(), RepairOptions{}, true);
   }
   throw py::type_error(absl::StrCat("expected an inscribe.Mesh or inscribe.Solid, got ",
                                     std::string(py::str(py::type::of(mesh_or_solid)))));
@@ -94,6 +111,39 @@ void BindMesh(py::module_& m) {
       .value("ERROR", Severity::kError, "the mesh cannot be used to generate spheres")
       .value("WARNING", Severity::kWarning, "usable, but results may suffer")
       .value("FIXED", Severity::kFixed, "was wrong and has been repaired in the returned mesh");
+
+  py::class_<RepairOptions>(
+      m, "Repair",
+      "How much validation may change a mesh to make it usable (core's RepairOptions). A level "
+      "name ('none', 'safe', 'fill', 'wrap', 'auto') converts to Repair(level) wherever a repair "
+      "is taken. none: identical vertices welded, orientation fixed; safe (the default): also "
+      "duplicate triangles and walls stored twice removed, cracks welded within a tolerance from "
+      "the mesh's size; fill: also holes closed; wrap: a watertight alpha wrap of all the "
+      "triangles, enclosing every one of them; auto: safe, then fill, then wrap, until usable.")
+      .def(py::init([](const std::string& level, double weld_tolerance, double wrap_alpha,
+                       double wrap_offset) {
+             RepairOptions repair;
+             repair.level = ValueOrRaise(ParseMeshRepair(level));
+             repair.weld_tolerance = weld_tolerance;
+             repair.wrap_alpha = wrap_alpha;
+             repair.wrap_offset = wrap_offset;
+             return repair;
+           }),
+           py::arg("level") = "safe", py::kw_only(), py::arg("weld_tolerance") = 0.0,
+           py::arg("wrap_alpha") = 0.0, py::arg("wrap_offset") = 0.0,
+           "weld_tolerance: also weld vertices this close (mesh units). wrap_alpha, wrap_offset: "
+           "the wrap's parameters (mesh units; 0: diagonal / 100 and alpha / 30).")
+      .def_property_readonly("level",
+                             [](const RepairOptions& r) { return MeshRepairName(r.level); })
+      .def_readonly("weld_tolerance", &RepairOptions::weld_tolerance)
+      .def_readonly("wrap_alpha", &RepairOptions::wrap_alpha)
+      .def_readonly("wrap_offset", &RepairOptions::wrap_offset)
+      .def("__repr__", [](const RepairOptions& r) {
+        return absl::StrCat("Repair('", MeshRepairName(r.level), "', weld_tolerance=",
+                            r.weld_tolerance, ", wrap_alpha=", r.wrap_alpha,
+                            ", wrap_offset=", r.wrap_offset, ")");
+      });
+  py::implicitly_convertible<py::str, RepairOptions>();
 
   py::class_<MeshIssue>(m, "MeshIssue", "One finding of mesh validation.")
       .def_readonly("severity", &MeshIssue::severity)
@@ -131,6 +181,21 @@ void BindMesh(py::module_& m) {
                     "the weld tolerance when it was > 0 and merged vertices, else 0 (mesh units)")
       .def_readonly("holes_filled", &MeshReport::holes_filled)
       .def_readonly("hole_triangles_added", &MeshReport::hole_triangles_added)
+      .def_readonly("duplicate_triangles_removed", &MeshReport::duplicate_triangles_removed)
+      .def_readonly("double_walls_removed", &MeshReport::double_walls_removed,
+                    "pairs of triangles with the same corners in opposite orders removed")
+      .def_readonly("crack_weld_tolerance", &MeshReport::crack_weld_tolerance,
+                    "the crack weld's tolerance (mesh units; 0 when the mesh had no border)")
+      .def_readonly("crack_vertices_welded", &MeshReport::crack_vertices_welded)
+      .def_readonly("wrapped", &MeshReport::wrapped,
+                    "True when the mesh was replaced by its watertight alpha wrap")
+      .def_readonly("wrap_alpha", &MeshReport::wrap_alpha)
+      .def_readonly("wrap_offset", &MeshReport::wrap_offset)
+      .def_readonly("wrap_input_triangles", &MeshReport::wrap_input_triangles)
+      .def_readonly("wrap_triangles", &MeshReport::wrap_triangles)
+      .def_readonly("wrap_reach", &MeshReport::wrap_reach,
+                    "a proven bound on how far the wrap's surface is from the input triangles "
+                    "(mesh units)")
       .def_readonly("volume", &MeshReport::volume,
                     "enclosed volume of the validated mesh, mesh units cubed")
       .def_property_readonly(
@@ -144,9 +209,10 @@ void BindMesh(py::module_& m) {
       .def_property_readonly("usable", &MeshReport::usable,
                              "True when no issue is an error: spheres can be generated")
       .def_property_readonly("geometry_repaired", &MeshReport::geometry_repaired,
-                             "True when validation changed the surface (a weld within a "
-                             "tolerance, triangles the weld removed, holes filled): results and "
-                             "certificates hold for the repaired mesh only")
+                             "True when validation changed the solid (a weld within a "
+                             "tolerance or across cracks, triangles the weld removed, holes "
+                             "filled, a wrap): results and certificates hold for the repaired "
+                             "mesh only")
       .def_property_readonly("repairs", &MeshReport::repairs,
                              "those repairs in one line, or '' when there were none")
       .def_property_readonly("first_error", &MeshReport::first_error,
@@ -177,20 +243,40 @@ void BindMesh(py::module_& m) {
           "the hash of the validated, re-oriented mesh: see Solid.sha256)")
       .def(
           "validate",
-          [](const Mesh& mesh, bool check_self_intersections, bool fill_holes,
-             double weld_tolerance) {
+          [](const Mesh& mesh, bool check_self_intersections, const RepairOptions& repair,
+             bool fill_holes, double weld_tolerance) {
             ValidateOptions options;
             options.check_self_intersections = check_self_intersections;
-            options.fill_holes = fill_holes;
-            options.weld_tolerance = weld_tolerance;
+            options.repair = RepairArgument(repair, fill_holes, weld_tolerance);
             py::gil_scoped_release release;
             return ValidateMesh(mesh, options).report;
           },
-          py::kw_only(), py::arg("check_self_intersections") = true, py::arg("fill_holes") = false,
+          py::kw_only(), py::arg("check_self_intersections") = true,
+          py::arg("repair") = RepairOptions{}, py::arg("fill_holes") = false,
           py::arg("weld_tolerance") = 0.0,
-          "The validation report (MeshReport) of this mesh; never raises for a bad mesh. "
-          "Coincident vertices are welded first (within weld_tolerance, mesh units; 0: "
-          "identical positions only). Cost O(T log T + V log V).")
+          "The validation report (MeshReport) of this mesh after the repair asked for (an "
+          "inscribe.Repair or a level name; fill_holes=True is 'fill'); never raises for a bad "
+          "mesh. Coincident vertices are welded first (within weld_tolerance, mesh units; 0: "
+          "identical positions only). Cost O(T log T + V log V), more with 'wrap'.")
+      .def(
+          "repaired",
+          [](const Mesh& mesh, const RepairOptions& repair, bool check_self_intersections) {
+            ValidateOptions options;
+            options.check_self_intersections = check_self_intersections;
+            options.repair = repair;
+            ValidatedMesh validated;
+            {
+              py::gil_scoped_release release;
+              validated = ValidateMesh(mesh, options);
+            }
+            return py::make_tuple(std::make_shared<Mesh>(std::move(validated.mesh)),
+                                  validated.report);
+          },
+          py::arg("repair") = RepairOptions{}, py::kw_only(),
+          py::arg("check_self_intersections") = true,
+          "(mesh, report): the mesh as validation returns it after the repair asked for "
+          "(welded, oriented, repaired; the wrap when it wrapped), and its MeshReport. The mesh "
+          "is the input when the report is not usable.")
       .def("__repr__", [](const Mesh& mesh) {
         return absl::StrCat("Mesh(vertices=", mesh.num_vertices(),
                             ", triangles=", mesh.num_triangles(), ")");
@@ -245,12 +331,16 @@ void BindMesh(py::module_& m) {
 
   m.def(
       "prepare",
-      [](const Mesh& mesh, bool fill_holes, bool check_self_intersections) {
-        return PrepareSolidReleasingGil(mesh, fill_holes, check_self_intersections);
+      [](const Mesh& mesh, const RepairOptions& repair, bool fill_holes,
+         bool check_self_intersections) {
+        return PrepareSolidReleasingGil(mesh, RepairArgument(repair, fill_holes, 0.0),
+                                        check_self_intersections);
       },
-      py::arg("mesh"), py::kw_only(), py::arg("fill_holes") = false,
-      py::arg("check_self_intersections") = true,
-      "Validates `mesh` (orientation fixed; holes closed when fill_holes) and builds its "
+      py::arg("mesh"), py::kw_only(), py::arg("repair") = RepairOptions{},
+      py::arg("fill_holes") = false, py::arg("check_self_intersections") = true,
+      "Validates `mesh` (repaired as `repair` allows: an inscribe.Repair or a level name, "
+      "default 'safe'; fill_holes=True is 'fill'; every change is warned about as "
+      "inscribe.MeshWarning) and builds its "
       "boundary oracle. inscribe.Error with code FAILED_PRECONDITION naming the first problem "
       "('mesh is not closed: 6 border edges') when it does not bound a usable solid. Cost "
       "O(T log T).");

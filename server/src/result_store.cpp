@@ -180,7 +180,7 @@ absl::StatusOr<std::shared_ptr<const StoredMeshEntry>> ResultStore::GetMesh(
 }
 
 absl::StatusOr<std::pair<std::shared_ptr<const SphereSetEntry>, CacheSource>> ResultStore::Generate(
-    const std::string& mesh_key, const SphereSetParameters& parameters, bool fill_holes,
+    const std::string& mesh_key, const SphereSetParameters& parameters, MeshRepair repair,
     const GenerationControl& control) {
   if (const std::optional<std::int64_t> budget = EffectiveMaxSpheres(parameters);
       budget && *budget > limits_.max_spheres) {
@@ -188,7 +188,7 @@ absl::StatusOr<std::pair<std::shared_ptr<const SphereSetEntry>, CacheSource>> Re
                                                      "; this server's limit (--max-spheres) is ",
                                                      limits_.max_spheres));
   }
-  const std::string key = wire::GeneratedSphereSetKey(mesh_key, parameters, fill_holes);
+  const std::string key = wire::GeneratedSphereSetKey(mesh_key, parameters, repair);
   // The mesh is looked up only when the result is not cached.
   absl::StatusOr<CacheLookup> found = cache_->GetOrCompute(
       key,

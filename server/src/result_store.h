@@ -93,11 +93,11 @@ class ResultStore {
   absl::StatusOr<std::shared_ptr<const StoredMeshEntry>> GetMesh(const std::string& key);
 
   // The sphere set for (mesh, parameters): cached, or generated (GenerateSphereSet) with
-  // `control` (progress and cancellation). `fill_holes`: the mesh was stored repaired (part
+  // `control` (progress and cancellation). `repair`: how the mesh was stored repaired (part
   // of the key). RESOURCE_EXHAUSTED over the --max-spheres limit, NOT_FOUND for an unknown
   // mesh, GenerateSphereSet's errors.
   absl::StatusOr<std::pair<std::shared_ptr<const SphereSetEntry>, CacheSource>> Generate(
-      const std::string& mesh_key, const SphereSetParameters& parameters, bool fill_holes,
+      const std::string& mesh_key, const SphereSetParameters& parameters, MeshRepair repair,
       const GenerationControl& control);
   absl::StatusOr<std::shared_ptr<const SphereSetEntry>> GetSphereSet(const std::string& key);
 

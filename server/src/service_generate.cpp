@@ -137,6 +137,10 @@ class GenerateReactor final : public grpc::ServerWriteReactor<v1::GenerateRespon
         wire::SphereSetParametersFromProto(*request_, parts_.limits.max_voxels);
     if (!parameters.ok()) return parameters.status();
     parameters_ = *std::move(parameters);
+    absl::StatusOr<MeshRepair> repair = wire::MeshRepairFromProto(
+        request_->parameters().repair(), request_->parameters().fill_holes());
+    if (!repair.ok()) return repair.status();
+    repair_ = *repair;
     absl::StatusOr<std::int64_t> estimate =
         GenerateWorkBytes(parts_.mesh_sizes, request_->mesh_sha256(), parameters_, parts_.limits,
                           parts_.admission.memory_budget_bytes());
@@ -169,8 +173,7 @@ class GenerateReactor final : public grpc::ServerWriteReactor<v1::GenerateRespon
     const ServiceClock::time_point started = ServiceClock::now();
     absl::StatusOr<std::pair<std::shared_ptr<const SphereSetEntry>, CacheSource>> result;
     try {
-      result = parts_.store.Generate(request_->mesh_sha256(), parameters_,
-                                     request_->parameters().fill_holes(), control);
+      result = parts_.store.Generate(request_->mesh_sha256(), parameters_, repair_, control);
     } catch (const std::bad_alloc&) {
       result = absl::ResourceExhaustedError("server ran out of memory generating spheres");
     }
@@ -227,6 +230,7 @@ class GenerateReactor final : public grpc::ServerWriteReactor<v1::GenerateRespon
   grpc::CallbackServerContext* const context_;
   const v1::GenerateRequest* const request_;
   SphereSetParameters parameters_;  // the request's, checked in Start
+  MeshRepair repair_ = MeshRepair::kSafe;  // the repair the mesh was stored with, from Start
   std::atomic<bool> cancel_{false};
   MemoryBudget::Reservation reservation_;  // set in Start, released in Complete
   CallRecord record_;

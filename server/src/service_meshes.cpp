@@ -22,10 +22,11 @@ absl::Status RunInspectMesh(const v1::InspectMeshRequest& request,
                             v1::InspectMeshResponse* response) {
   absl::StatusOr<Mesh> mesh = wire::MeshFromProto(request.mesh());
   if (!mesh.ok()) return mesh.status();
+  absl::StatusOr<RepairOptions> repair = wire::RepairOptionsFromProto(request);
+  if (!repair.ok()) return repair.status();
   ValidateOptions options;
   options.check_self_intersections = !request.skip_self_intersections();
-  options.fill_holes = request.fill_holes();
-  options.weld_tolerance = request.weld_tolerance();
+  options.repair = *repair;
   const ValidatedMesh validated = ValidateMesh(*std::move(mesh), options);
   const MeshReport& report = validated.report;
   // As the CLI does: a hash over NaNs or dangling indices would key nothing usable.
@@ -58,9 +59,10 @@ grpc::ServerUnaryReactor* InscribeService::PutMesh(grpc::CallbackServerContext* 
                     absl::StatusOr<Mesh> mesh = wire::MeshFromProto(request->mesh());
                     if (!mesh.ok()) return mesh.status();
                     bool already = false;
+                    absl::StatusOr<RepairOptions> asked = wire::RepairOptionsFromProto(*request);
+                    if (!asked.ok()) return asked.status();
                     ValidateOptions repair;
-                    repair.fill_holes = request->fill_holes();
-                    repair.weld_tolerance = request->weld_tolerance();
+                    repair.repair = *asked;
                     absl::StatusOr<std::shared_ptr<const StoredMeshEntry>> stored =
                         store_->PutMesh(*std::move(mesh), repair, &already);
                     if (!stored.ok()) return stored.status();

@@ -168,16 +168,21 @@ TEST(CliInfo, RepeatedVerticesAreWeldedAndReported) {
   EXPECT_THAT(text.out, HasSubstr("vertices             1902 (1587 welded: 315 left)"));
   EXPECT_THAT(text.out, HasSubstr("fixed    welded 1587 vertices at identical positions"));
 
-  // Copies up to 2e-9 apart: refused with a hint, welded with --weld-tolerance.
+  // Copies up to 2e-9 apart: welded as cracks by the default --repair safe; with --repair none
+  // refused with a hint; welded with --weld-tolerance.
   Mesh near = testing::PerFaceVertices(*eight);
   for (Eigen::Index v = 0; v < near.num_vertices(); ++v) {
     near.vertices(v, 0) += 1e-12 * static_cast<double>(v + 1);  // every copy apart, < 2e-9
   }
   const std::string near_obj = (dir / "eight_near.obj").string();
   ASSERT_TRUE(testing::WriteMeshWithCgal(near_obj, near, false));
-  const CliRun refused = RunCli("info " + Quote(near_obj));
+  const CliRun safe = RunCli("info --json " + Quote(near_obj));
+  ASSERT_EQ(safe.exit_code, 0) << safe.err;
+  EXPECT_EQ(nlohmann::json::parse(safe.out).at("repair").at("crack_vertices_welded").get<int>(),
+            3 * 634 - 315);
+  const CliRun refused = RunCli("info --repair none " + Quote(near_obj));
   EXPECT_EQ(refused.exit_code, 1);
-  EXPECT_THAT(refused.err, HasSubstr("weld them with a weld tolerance"));
+  EXPECT_THAT(refused.err, HasSubstr("--repair safe welds those within 1e-4 of the size"));
   const CliRun welded = RunCli("info --json --weld-tolerance 1e-6 " + Quote(near_obj));
   ASSERT_EQ(welded.exit_code, 0) << welded.err;
   EXPECT_EQ(nlohmann::json::parse(welded.out).at("counts").at("welded_vertices").get<int>(),

@@ -1,4 +1,4 @@
-// ValidateOptions::fill_holes: closing the border loops of open meshes.
+// MeshRepair::kFill: closing the border loops of open meshes.
 #include "mesh/hole_filling.h"  // private: core/src
 
 #include <gmock/gmock.h>
@@ -35,7 +35,7 @@ using testing::UnitCube;
 
 ValidateOptions FillHoles() {
   ValidateOptions options;
-  options.fill_holes = true;
+  options.repair.level = MeshRepair::kFill;
   return options;
 }
 

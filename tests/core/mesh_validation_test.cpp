@@ -58,7 +58,7 @@ TEST(ValidateMesh, CoordinatesThatOverflowAreAnError) {
   open.vertices(6, 1) = 1.7976931348623157e308;
   open.triangles.conservativeResize(open.num_triangles() - 1, 3);
   ValidateOptions fill;
-  fill.fill_holes = true;
+  fill.repair.level = MeshRepair::kFill;
   const ValidatedMesh refused = ValidateMesh(open, fill);
   EXPECT_TRUE(HasIssue(refused.report, "coordinates_too_large", Severity::kError));
   EXPECT_EQ(refused.report.holes_filled, 0);
@@ -227,7 +227,7 @@ TEST(ValidateMesh, NonManifoldVerticesAreThoseTheBruteForceFinds) {
     }
     ValidateOptions options;
     options.check_self_intersections = false;
-    options.fill_holes = false;  // the brute force counts on the mesh as validated
+    options.repair.level = MeshRepair::kNone;  // the brute force counts on the mesh as validated
     const ValidatedMesh v = ValidateMesh(mesh, options);
     const std::vector<std::int32_t> expected = BruteForceNonManifoldVertices(v.mesh);
     EXPECT_EQ(v.report.non_manifold_vertices, static_cast<std::int64_t>(expected.size())) << round;

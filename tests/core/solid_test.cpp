@@ -36,7 +36,7 @@ TEST(Solid, AnUnusableMeshIsRefusedWithTheReportsFirstError) {
   EXPECT_EQ(open.status().code(), absl::StatusCode::kFailedPrecondition);
   EXPECT_THAT(open.status().message(), HasSubstr("not closed"));
   SolidOptions repair;
-  repair.validate.fill_holes = true;
+  repair.validate.repair.level = MeshRepair::kFill;
   EXPECT_TRUE(PrepareSolid(testing::OpenUnitCube(), repair).ok());
   Mesh nan = testing::UnitCube();
   nan.vertices(0, 1) = std::nan("");

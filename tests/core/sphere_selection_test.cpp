@@ -301,7 +301,7 @@ TEST(SelectByCoverage, BadInputIsAClearError) {
 
 Solid SolidOf(const char* name) {
   SolidOptions options;
-  options.validate.fill_holes = true;
+  options.validate.repair.level = MeshRepair::kFill;
   absl::StatusOr<Solid> solid = PrepareSolid(LoadTestMesh(name), options);
   EXPECT_TRUE(solid.ok()) << solid.status();
   return *std::move(solid);

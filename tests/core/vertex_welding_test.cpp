@@ -111,7 +111,7 @@ TEST(WeldVertices, NearCoincidentCopiesNeedTheTolerance) {
   EXPECT_THAT(exact.report.first_error(), HasSubstr("weld tolerance"));
 
   ValidateOptions near;
-  near.weld_tolerance = 1e-7 * diagonal;
+  near.repair.weld_tolerance = 1e-7 * diagonal;
   const ValidatedMesh welded = ValidateMesh(soup, near);
   ASSERT_TRUE(welded.report.usable()) << welded.report.first_error();
   EXPECT_EQ(welded.report.welded_vertices, 3 * original.num_triangles() - original.num_vertices());
@@ -131,7 +131,7 @@ TEST(WeldVertices, TrianglesThatCollapseAreRemovedAndReported) {
   mesh.triangles.bottomRows(1) << n, n + 1, n + 2;
 
   ValidateOptions near;
-  near.weld_tolerance = 1e-6;
+  near.repair.weld_tolerance = 1e-6;
   const ValidatedMesh v = ValidateMesh(mesh, near);
   ASSERT_TRUE(v.report.usable()) << v.report.first_error();
   EXPECT_EQ(v.report.welded_vertices, 3);
@@ -193,7 +193,7 @@ TEST(WeldVertices, SeparateShellsThatTouchStayApart) {
 TEST(WeldVertices, ToleranceMustBeAFiniteDistance) {
   for (const double tolerance : {-1e-3, std::nan(""), HUGE_VAL}) {
     ValidateOptions options;
-    options.weld_tolerance = tolerance;
+    options.repair.weld_tolerance = tolerance;
     const ValidatedMesh v = ValidateMesh(UnitCube(), options);
     EXPECT_FALSE(v.report.usable()) << tolerance;
     EXPECT_TRUE(HasIssue(v.report, "invalid_weld_tolerance", Severity::kError)) << tolerance;

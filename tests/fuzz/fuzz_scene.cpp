@@ -50,7 +50,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   static const char* const kFormats[] = {"dae", "gltf", "glb", "gltf"};
   const std::string format = kFormats[data[0] & 3];
   const bool from_file = (data[0] & 4) != 0;
-  const bool fill_holes = (data[0] & 8) != 0;
+  const inscribe::MeshRepair repair =
+      (data[0] & 8) != 0 ? inscribe::MeshRepair::kFill : inscribe::MeshRepair::kSafe;
   const std::string bytes(reinterpret_cast<const char*>(data + 1), size - 1);
 
   inscribe::ReadMeshInfo info;
@@ -80,6 +81,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (info.polygons_triangulated > info.polygons) {
     Fail(kTarget, "more polygons triangulated than read");
   }
-  inscribe::fuzz::CheckValidation(kTarget, *std::move(mesh), fill_holes);
+  inscribe::fuzz::CheckValidation(kTarget, *std::move(mesh), repair);
   return 0;
 }

@@ -27,19 +27,29 @@ bool HasBadCoordinatesOrIndices(const Mesh& mesh) {
   return false;
 }
 
-void CheckValidation(const char* target, Mesh mesh, bool fill_holes) {
+void CheckValidation(const char* target, Mesh mesh, MeshRepair repair) {
   const bool broken = HasBadCoordinatesOrIndices(mesh);
   ValidateOptions options;
-  options.fill_holes = fill_holes;
+  options.repair.level = repair;
   const ValidatedMesh validated = ValidateMesh(std::move(mesh), options);
-  // As given, less what welding collapsed, plus what hole filling added.
-  if (validated.report.triangles - validated.report.weld_collapsed_triangles !=
-      validated.mesh.num_triangles() - validated.report.hole_triangles_added) {
-    Fail(target, "the report's triangle count does not match the returned mesh");
-  }
-  if (validated.report.vertices - validated.report.welded_vertices !=
-      validated.mesh.num_vertices()) {
-    Fail(target, "the report's vertex count does not match the returned mesh");
+  const MeshReport& report = validated.report;
+  if (report.wrapped) {
+    if (!report.usable() || !report.closed() ||
+        report.wrap_triangles != validated.mesh.num_triangles() || !(report.wrap_reach >= 0.0)) {
+      Fail(target, "a wrapped mesh is not a usable closed mesh with its own counts");
+    }
+  } else {
+    // As given, less what welding collapsed and the safe fixes removed, plus what hole
+    // filling added.
+    if (report.triangles - report.weld_collapsed_triangles - report.duplicate_triangles_removed -
+            2 * report.double_walls_removed !=
+        validated.mesh.num_triangles() - report.hole_triangles_added) {
+      Fail(target, "the report's triangle count does not match the returned mesh");
+    }
+    if (report.vertices - report.welded_vertices - report.crack_vertices_welded !=
+        validated.mesh.num_vertices()) {
+      Fail(target, "the report's vertex count does not match the returned mesh");
+    }
   }
   if (broken && validated.report.usable()) {
     Fail(target, "a mesh with bad coordinates or indices is usable");

@@ -6,6 +6,7 @@
 #pragma once
 
 #include "inscribe/geometry/mesh.h"
+#include "inscribe/solid/mesh_validation.h"
 
 namespace inscribe::fuzz {
 
@@ -14,7 +15,7 @@ namespace inscribe::fuzz {
 // True when `mesh` has a non-finite coordinate or an index outside [0, #V).
 bool HasBadCoordinatesOrIndices(const Mesh& mesh);
 
-// ValidateMesh(mesh) with hole filling on or off, and the checks above.
-void CheckValidation(const char* target, Mesh mesh, bool fill_holes);
+// ValidateMesh(mesh) with the given repair level, and the checks above.
+void CheckValidation(const char* target, Mesh mesh, MeshRepair repair);
 
 }  // namespace inscribe::fuzz

@@ -30,7 +30,7 @@ TEST(Client, GenerateSendsEverySettingAndConvertsTheResult) {
         EXPECT_TRUE(p.subdivide_boundary());
         EXPECT_TRUE(p.dilate());
         EXPECT_EQ(p.dilation_growth(), 0.5);
-        EXPECT_TRUE(p.fill_holes());
+        EXPECT_EQ(p.repair(), v1::MESH_REPAIR_FILL);
         EXPECT_TRUE(request.skip_quality());
         EXPECT_EQ(request.progress_interval(), 0.25);
         on_progress(0.25);
@@ -47,7 +47,7 @@ TEST(Client, GenerateSendsEverySettingAndConvertsTheResult) {
   settings.parameters.medial.subdivide_boundary = true;
   settings.parameters.kind = SphereSetKind::kDilated;
   settings.parameters.dilation.growth = 0.5;
-  settings.fill_holes = true;
+  settings.repair.level = MeshRepair::kFill;
   settings.parameters.evaluate = false;
   GenerateOptions options;
   options.progress_interval = 0.25;
@@ -85,7 +85,7 @@ TEST(Client, GenerateFromAMeshUploadsItAgainOnceWhenTheServerLostIt) {
     InSequence order;
     for (int upload = 0; upload < 2; ++upload) {
       EXPECT_CALL(*connection, PutMesh(Truly([](const v1::PutMeshRequest& request) {
-                                         return request.fill_holes() &&
+                                         return request.repair().level() == v1::MESH_REPAIR_FILL &&
                                                 request.mesh().triangles_size() == 36;
                                        }),
                                        _))
@@ -101,7 +101,7 @@ TEST(Client, GenerateFromAMeshUploadsItAgainOnceWhenTheServerLostIt) {
   }
   GenerateSettings settings;
   settings.parameters.voxel_size = 0.125;
-  settings.fill_holes = true;
+  settings.repair.level = MeshRepair::kFill;
   absl::StatusOr<GenerateResult> result =
       Client(connection).Generate(testing::UnitCube(), settings);
   ASSERT_TRUE(result.ok()) << result.status();
@@ -142,7 +142,7 @@ TEST(Client, GenerateForAStoredMeshUploadsItOnlyWhenTheServerLostIt) {
     EXPECT_CALL(*connection, Generate(_, _, _))
         .WillOnce(Return(absl::NotFoundError("unknown mesh sha256:cube")));
     EXPECT_CALL(*connection, PutMesh(Truly([](const v1::PutMeshRequest& request) {
-                                       return request.fill_holes() &&
+                                       return request.repair().level() == v1::MESH_REPAIR_FILL &&
                                               request.weld_tolerance() == 0.5 &&
                                               request.mesh().triangles_size() == 36;
                                      }),
@@ -155,8 +155,8 @@ TEST(Client, GenerateForAStoredMeshUploadsItOnlyWhenTheServerLostIt) {
         .WillOnce(Return(GenerateOk()));
   }
   GenerateSettings settings;
-  settings.fill_holes = true;
-  settings.weld_tolerance = 0.5;
+  settings.repair.level = MeshRepair::kFill;
+  settings.repair.weld_tolerance = 0.5;
   absl::StatusOr<GenerateResult> result =
       Client(connection).Generate("sha256:cube", testing::UnitCube(), settings);
   ASSERT_TRUE(result.ok()) << result.status();

@@ -113,7 +113,7 @@ TEST(MeshReportConvert, AWeldedReportKeepsItsCounts) {
 // repaired mesh's report came back "not closed".
 TEST(MeshReportConvert, AHoleFilledReportStaysClosed) {
   ValidateOptions fill;
-  fill.fill_holes = true;
+  fill.repair.level = MeshRepair::kFill;
   const MeshReport report = ValidateMesh(testing::OpenUnitCube(), fill).report;
   ASSERT_GT(report.holes_filled, 0);
   ASSERT_TRUE(report.closed());
@@ -215,9 +215,9 @@ TEST(GenerateParameters, EveryOptionSurvivesTheWire) {
   cover_budget.max_spheres = 64;
   for (const SphereSetParameters& p : {all, budget, paper, defaults, cover, cover_budget}) {
     v1::GenerateRequest request;
-    GenerateRequestToProto("sha256:x", p, true, &request);
+    GenerateRequestToProto("sha256:x", p, MeshRepair::kFill, &request);
     EXPECT_EQ(request.mesh_sha256(), "sha256:x");
-    EXPECT_TRUE(request.parameters().fill_holes());
+    EXPECT_EQ(request.parameters().repair(), v1::MESH_REPAIR_FILL);
     absl::StatusOr<SphereSetParameters> back = SphereSetParametersFromProto(request, limit);
     ASSERT_TRUE(back.ok()) << back.status();
     SphereSetParameters expected = p;
@@ -227,7 +227,7 @@ TEST(GenerateParameters, EveryOptionSurvivesTheWire) {
   }
   // Defaults are never restated on the wire.
   v1::GenerateRequest plain;
-  GenerateRequestToProto("sha256:x", defaults, false, &plain);
+  GenerateRequestToProto("sha256:x", defaults, MeshRepair::kSafe, &plain);
   const v1::GenerateParameters& wire = plain.parameters();
   EXPECT_FALSE(wire.has_screen_samples() || wire.has_corner_screen() ||
                wire.has_pair_angle_margin() || wire.has_dilation_growth() ||

@@ -18,7 +18,7 @@ const std::string kMesh =
 TEST(Keys, GeneratedKeysMatchVersionOneText) {
   SphereSetParameters by_size;
   by_size.voxel_size = 0.1;
-  EXPECT_EQ(GeneratedSphereSetKey(kMesh, by_size, false),
+  EXPECT_EQ(GeneratedSphereSetKey(kMesh, by_size, MeshRepair::kSafe),
             "spheres/v1/0123456789abcdeff9791a86a7a609b2b9c0cb9cf97e7688efd65e9bf382ee05");
 
   SphereSetParameters dilated;  // neither given: core's default budget, 500
@@ -27,22 +27,27 @@ TEST(Keys, GeneratedKeysMatchVersionOneText) {
   dilated.dilation.growth = 0.5;
   dilated.evaluate = false;
   dilated.selection = SphereSelection::kPaper;  // sets made before the choice existed
-  EXPECT_EQ(GeneratedSphereSetKey(kMesh, dilated, true),
+  EXPECT_EQ(GeneratedSphereSetKey(kMesh, dilated, MeshRepair::kFill),
             "spheres/v1/0123456789abcdefe4f0ed8ca1ed48e91844bf8870a4bcde1685ca90d28e3de1");
+  // Without repair levels a mesh was taken as it was; "none" and "safe" keep that key.
+  EXPECT_EQ(GeneratedSphereSetKey(kMesh, by_size, MeshRepair::kNone),
+            GeneratedSphereSetKey(kMesh, by_size, MeshRepair::kSafe));
 }
 
 TEST(Keys, EveryParameterChangesTheKey) {
   SphereSetParameters base;
   base.max_spheres = 100;
   std::set<std::string> keys;
-  const auto add = [&](const SphereSetParameters& p, bool fill_holes = false) {
-    const std::string key = GeneratedSphereSetKey(kMesh, p, fill_holes);
+  const auto add = [&](const SphereSetParameters& p, MeshRepair repair = MeshRepair::kSafe) {
+    const std::string key = GeneratedSphereSetKey(kMesh, p, repair);
     EXPECT_EQ(key.size(), std::string("spheres/v1/").size() + 64);
     EXPECT_EQ(RouteKey(key), RouteKey(kMesh));
     keys.insert(key);
   };
   add(base);
-  add(base, /*fill_holes=*/true);
+  add(base, MeshRepair::kFill);
+  add(base, MeshRepair::kWrap);
+  add(base, MeshRepair::kAuto);
   SphereSetParameters p = base;
   p.max_spheres = 101;
   add(p);
@@ -65,12 +70,12 @@ TEST(Keys, EveryParameterChangesTheKey) {
   EXPECT_EQ(keys.size(), 16u);
   // Growth means nothing without dilation, nor quality samples without evaluation.
   p = base, p.dilation.growth = 0.3;
-  EXPECT_EQ(GeneratedSphereSetKey(kMesh, p, false), GeneratedSphereSetKey(kMesh, base, false));
+  EXPECT_EQ(GeneratedSphereSetKey(kMesh, p, MeshRepair::kSafe), GeneratedSphereSetKey(kMesh, base, MeshRepair::kSafe));
   SphereSetParameters unevaluated = base;
   unevaluated.evaluate = false;
   p = unevaluated, p.quality.surface_samples = 7;
-  EXPECT_EQ(GeneratedSphereSetKey(kMesh, p, false),
-            GeneratedSphereSetKey(kMesh, unevaluated, false));
+  EXPECT_EQ(GeneratedSphereSetKey(kMesh, p, MeshRepair::kSafe),
+            GeneratedSphereSetKey(kMesh, unevaluated, MeshRepair::kSafe));
 }
 
 TEST(Keys, CoversHaveTheirOwnKeysAndLeaveOthersAlone) {
@@ -79,28 +84,28 @@ TEST(Keys, CoversHaveTheirOwnKeysAndLeaveOthersAlone) {
   // A cover's settings mean nothing for other kinds: their keys stay the version-1 ones.
   SphereSetParameters unused = base;
   unused.cover_resolution = 1.0 / 64;
-  EXPECT_EQ(GeneratedSphereSetKey(kMesh, unused, false), GeneratedSphereSetKey(kMesh, base, false));
+  EXPECT_EQ(GeneratedSphereSetKey(kMesh, unused, MeshRepair::kSafe), GeneratedSphereSetKey(kMesh, base, MeshRepair::kSafe));
   SphereSetParameters by_size;
   by_size.voxel_size = 0.1;
   by_size.cover_resolution = 1.0 / 64;
-  EXPECT_EQ(GeneratedSphereSetKey(kMesh, by_size, false),
+  EXPECT_EQ(GeneratedSphereSetKey(kMesh, by_size, MeshRepair::kSafe),
             "spheres/v1/0123456789abcdeff9791a86a7a609b2b9c0cb9cf97e7688efd65e9bf382ee05");
 
-  std::set<std::string> keys = {GeneratedSphereSetKey(kMesh, base, false)};
+  std::set<std::string> keys = {GeneratedSphereSetKey(kMesh, base, MeshRepair::kSafe)};
   SphereSetParameters cover = base;
   cover.kind = SphereSetKind::kCover;
-  keys.insert(GeneratedSphereSetKey(kMesh, cover, false));
+  keys.insert(GeneratedSphereSetKey(kMesh, cover, MeshRepair::kSafe));
   SphereSetParameters p = cover;
   p.cover_resolution = 1.0 / 64;
-  keys.insert(GeneratedSphereSetKey(kMesh, p, false));
+  keys.insert(GeneratedSphereSetKey(kMesh, p, MeshRepair::kSafe));
   p = cover;
   p.max_spheres.reset();
   p.max_protrusion = 0.01;
-  keys.insert(GeneratedSphereSetKey(kMesh, p, false));
+  keys.insert(GeneratedSphereSetKey(kMesh, p, MeshRepair::kSafe));
   p.max_protrusion = 0.02;
-  keys.insert(GeneratedSphereSetKey(kMesh, p, false));
+  keys.insert(GeneratedSphereSetKey(kMesh, p, MeshRepair::kSafe));
   p = base, p.kind = SphereSetKind::kDilated;
-  keys.insert(GeneratedSphereSetKey(kMesh, p, false));
+  keys.insert(GeneratedSphereSetKey(kMesh, p, MeshRepair::kSafe));
   EXPECT_EQ(keys.size(), 6u);
   for (const std::string& key : keys) EXPECT_EQ(RouteKey(key), RouteKey(kMesh));
 }

@@ -36,6 +36,26 @@ nlohmann::json MeshReportJson(const MeshReport& report, const std::string& sha25
                  {"flipped_triangles", report.flipped_triangles}};
   j["self_intersections"] = {{"checked", report.self_intersections_checked},
                              {"pairs", report.self_intersecting_pairs}};
+  // What the repair changed: the hash, volume, bbox and self-intersections above are the
+  // repaired mesh's; `geometry_repaired` says the solid is not the file's as given.
+  nlohmann::json repair = {{"geometry_repaired", report.geometry_repaired()},
+                           {"repairs", report.repairs()},
+                           {"duplicate_triangles_removed", report.duplicate_triangles_removed},
+                           {"double_walls_removed", report.double_walls_removed},
+                           {"crack_weld_tolerance", report.crack_weld_tolerance},
+                           {"crack_vertices_welded", report.crack_vertices_welded},
+                           {"weld_moved_within", report.weld_moved_within},
+                           {"holes_filled", report.holes_filled},
+                           {"hole_triangles_added", report.hole_triangles_added},
+                           {"wrapped", report.wrapped}};
+  if (report.wrapped) {
+    repair["wrap"] = {{"alpha", report.wrap_alpha},
+                      {"offset", report.wrap_offset},
+                      {"input_triangles", report.wrap_input_triangles},
+                      {"triangles", report.wrap_triangles},
+                      {"reach", report.wrap_reach}};
+  }
+  j["repair"] = std::move(repair);
   j["issues"] = std::move(issues);
   return j;
 }

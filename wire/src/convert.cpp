@@ -90,6 +90,84 @@ void MeshToProto(const Mesh& mesh, v1::Mesh* out) {
   out->mutable_triangles()->Assign(t, t + mesh.triangles.size());
 }
 
+v1::MeshRepair MeshRepairToProto(MeshRepair repair) {
+  switch (repair) {
+    case MeshRepair::kNone:
+      return v1::MESH_REPAIR_NONE;
+    case MeshRepair::kSafe:
+      return v1::MESH_REPAIR_SAFE;
+    case MeshRepair::kFill:
+      return v1::MESH_REPAIR_FILL;
+    case MeshRepair::kWrap:
+      return v1::MESH_REPAIR_WRAP;
+    case MeshRepair::kAuto:
+      return v1::MESH_REPAIR_AUTO;
+  }
+  return v1::MESH_REPAIR_UNSPECIFIED;
+}
+
+absl::StatusOr<MeshRepair> MeshRepairFromProto(v1::MeshRepair repair, bool fill_holes) {
+  switch (repair) {
+    case v1::MESH_REPAIR_UNSPECIFIED:
+      return fill_holes ? MeshRepair::kFill : RepairOptions().level;
+    case v1::MESH_REPAIR_NONE:
+      return MeshRepair::kNone;
+    case v1::MESH_REPAIR_SAFE:
+      return MeshRepair::kSafe;
+    case v1::MESH_REPAIR_FILL:
+      return MeshRepair::kFill;
+    case v1::MESH_REPAIR_WRAP:
+      return MeshRepair::kWrap;
+    case v1::MESH_REPAIR_AUTO:
+      return MeshRepair::kAuto;
+    default:
+      break;
+  }
+  return absl::InvalidArgumentError(absl::StrCat(
+      "repair level ", static_cast<int>(repair),
+      " is not defined (MESH_REPAIR_NONE, SAFE, FILL, WRAP or AUTO)"));
+}
+
+namespace {
+
+template <typename Request>
+void RepairToRequest(const RepairOptions& repair, Request* out) {
+  out->set_fill_holes(false);
+  out->set_weld_tolerance(repair.weld_tolerance);
+  v1::MeshRepairOptions* wire = out->mutable_repair();
+  wire->set_level(MeshRepairToProto(repair.level));
+  wire->set_wrap_alpha(repair.wrap_alpha);
+  wire->set_wrap_offset(repair.wrap_offset);
+}
+
+template <typename Request>
+absl::StatusOr<RepairOptions> RepairFromRequest(const Request& request) {
+  absl::StatusOr<MeshRepair> level =
+      MeshRepairFromProto(request.repair().level(), request.fill_holes());
+  if (!level.ok()) return level.status();
+  RepairOptions out;
+  out.level = *level;
+  out.weld_tolerance = request.weld_tolerance();
+  out.wrap_alpha = request.repair().wrap_alpha();
+  out.wrap_offset = request.repair().wrap_offset();
+  return out;
+}
+
+}  // namespace
+
+void RepairOptionsToProto(const RepairOptions& repair, v1::PutMeshRequest* out) {
+  RepairToRequest(repair, out);
+}
+void RepairOptionsToProto(const RepairOptions& repair, v1::InspectMeshRequest* out) {
+  RepairToRequest(repair, out);
+}
+absl::StatusOr<RepairOptions> RepairOptionsFromProto(const v1::PutMeshRequest& request) {
+  return RepairFromRequest(request);
+}
+absl::StatusOr<RepairOptions> RepairOptionsFromProto(const v1::InspectMeshRequest& request) {
+  return RepairFromRequest(request);
+}
+
 void MeshReportToProto(const MeshReport& report, v1::MeshReport* out) {
   out->set_vertices(report.vertices);
   out->set_triangles(report.triangles);
@@ -114,6 +192,16 @@ void MeshReportToProto(const MeshReport& report, v1::MeshReport* out) {
   out->set_self_intersecting_pairs(report.self_intersecting_pairs);
   out->set_holes_filled(report.holes_filled);
   out->set_hole_triangles_added(report.hole_triangles_added);
+  out->set_duplicate_triangles_removed(report.duplicate_triangles_removed);
+  out->set_double_walls_removed(report.double_walls_removed);
+  out->set_crack_weld_tolerance(report.crack_weld_tolerance);
+  out->set_crack_vertices_welded(report.crack_vertices_welded);
+  out->set_wrapped(report.wrapped);
+  out->set_wrap_alpha(report.wrap_alpha);
+  out->set_wrap_offset(report.wrap_offset);
+  out->set_wrap_input_triangles(report.wrap_input_triangles);
+  out->set_wrap_triangles(report.wrap_triangles);
+  out->set_wrap_reach(report.wrap_reach);
   out->set_volume(report.volume);
   out->clear_bbox_min();
   out->clear_bbox_max();
@@ -157,6 +245,16 @@ absl::StatusOr<MeshReport> MeshReportFromProto(const v1::MeshReport& report) {
   out.self_intersecting_pairs = report.self_intersecting_pairs();
   out.holes_filled = report.holes_filled();
   out.hole_triangles_added = report.hole_triangles_added();
+  out.duplicate_triangles_removed = report.duplicate_triangles_removed();
+  out.double_walls_removed = report.double_walls_removed();
+  out.crack_weld_tolerance = report.crack_weld_tolerance();
+  out.crack_vertices_welded = report.crack_vertices_welded();
+  out.wrapped = report.wrapped();
+  out.wrap_alpha = report.wrap_alpha();
+  out.wrap_offset = report.wrap_offset();
+  out.wrap_input_triangles = report.wrap_input_triangles();
+  out.wrap_triangles = report.wrap_triangles();
+  out.wrap_reach = report.wrap_reach();
   out.volume = report.volume();
   out.bbox.min = *lo;
   out.bbox.max = *hi;

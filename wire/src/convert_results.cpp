@@ -43,7 +43,7 @@ absl::StatusOr<DistanceRequest> ToleranceFromProto(const v1::DistanceTolerance& 
 }
 
 void GenerateRequestToProto(const std::string& mesh_sha256, const SphereSetParameters& p,
-                            bool fill_holes, v1::GenerateRequest* out) {
+                            MeshRepair repair, v1::GenerateRequest* out) {
   const SphereSetParameters defaults;
   out->set_mesh_sha256(mesh_sha256);
   v1::GenerateParameters* wire = out->mutable_parameters();
@@ -79,7 +79,7 @@ void GenerateRequestToProto(const std::string& mesh_sha256, const SphereSetParam
   if (p.evaluate && p.quality.surface_samples != defaults.quality.surface_samples) {
     wire->set_quality_samples(p.quality.surface_samples);
   }
-  wire->set_fill_holes(fill_holes);
+  if (repair != RepairOptions().level) wire->set_repair(MeshRepairToProto(repair));
   out->set_skip_quality(!p.evaluate);
 }
 

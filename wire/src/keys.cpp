@@ -79,7 +79,7 @@ std::string ContentRouteKey(absl::string_view spheres_bytes) {
 }
 
 std::string GeneratedSphereSetKey(const std::string& mesh_key, const SphereSetParameters& p,
-                                  bool fill_holes) {
+                                  MeshRepair repair) {
   // Fixed text, every number with 17 significant digits: the same settings always hash alike.
   // Options added after version 1 of this text appear only when they differ from their
   // defaults, so that the keys of sets made before they existed stay what they were.
@@ -91,7 +91,12 @@ std::string GeneratedSphereSetKey(const std::string& mesh_key, const SphereSetPa
       "subdivide_boundary=%d\ndilate=%d\ndilation_growth=%.17g\nfill_holes=%d\nquality=%d\n",
       kSphereAlgorithmVersion, mesh_key, p.voxel_size.value_or(0.0), p.max_spheres.value_or(0),
       p.medial.object_angle, p.medial.epsilon, p.medial.samples, p.medial.subdivide_boundary,
-      dilated, dilated ? p.dilation.growth : 0.0, fill_holes, p.evaluate);
+      dilated, dilated ? p.dilation.growth : 0.0, repair == MeshRepair::kFill, p.evaluate);
+  // Before repair levels, a mesh was either taken as it was or had its holes filled; the safe
+  // fixes only change meshes that were refused before, so "none" and "safe" keep that key.
+  if (repair == MeshRepair::kWrap || repair == MeshRepair::kAuto) {
+    absl::StrAppendFormat(&canonical, "repair=%s\n", MeshRepairName(repair));
+  }
   if (p.medial.screen_samples != medial_defaults.screen_samples) {
     absl::StrAppendFormat(&canonical, "screen_samples=%d\n", p.medial.screen_samples);
   }

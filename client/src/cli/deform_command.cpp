@@ -38,6 +38,15 @@ struct DeformCliOptions {
   RemoteOptions remote;
 };
 
+// The reference's repair: the mildest levels only, which keep its vertices (the deformed file
+// moves them by index): the safe fixes, or with --fill-holes also its holes closed. A crack
+// weld renumbers vertices, so the reference is refused when it needed one (below).
+RepairOptions DeformRepair(const DeformCliOptions& options) {
+  RepairOptions repair;
+  repair.level = options.fill_holes ? MeshRepair::kFill : MeshRepair::kSafe;
+  return repair;
+}
+
 // The deformed file must be the reference file with its vertices moved: same vertex count,
 // same triangles in the same order. Returns "" when it is, else what differs.
 std::string DescribeTopologyDifference(const Mesh& reference, const Mesh& deformed) {
@@ -98,18 +107,19 @@ absl::StatusOr<DeformInputs> ReadInputs(const DeformCliOptions& options) {
   DeformInputs in;
   in.reference_file = *reference;
   ValidateOptions validate;
-  validate.fill_holes = options.fill_holes;
+  validate.repair = DeformRepair(options);
   absl::StatusOr<ValidatedMesh> solid = PrepareMesh(*std::move(reference), validate);
   if (!solid.ok()) {
     return UnusableMeshError(options.reference_path + ": " + std::string(solid.status().message()));
   }
   // The deformed file moves the reference's vertices as the file numbers them; once welded,
   // the solid's vertices are no longer those.
-  if (solid->report.welded_vertices > 0 || solid->report.weld_collapsed_triangles > 0) {
+  if (solid->report.welded_vertices > 0 || solid->report.weld_collapsed_triangles > 0 ||
+      solid->report.crack_vertices_welded > 0) {
     return BadInputError(absl::StrCat(
-        options.reference_path, " repeats vertices at one position (",
-        solid->report.welded_vertices,
-        " welded); deform needs a reference and deformed meshes whose triangles share their "
+        options.reference_path, " repeats vertices at one position or has cracks (",
+        solid->report.welded_vertices + solid->report.crack_vertices_welded,
+        " vertices welded); deform needs a reference and deformed meshes whose triangles share their "
         "vertices: export them with vertices merged (welded)"));
   }
   in.reference_sha256 = FormatSha256(MeshSha256(solid->mesh));
@@ -138,7 +148,7 @@ absl::StatusOr<client::DeformationResult> Deform(const client::Client& client,
                                                  const DeformCliOptions& options,
                                                  const DeformInputs& in) {
   client::PutMeshOptions put;
-  put.fill_holes = options.fill_holes;
+  put.repair = DeformRepair(options);
   absl::StatusOr<client::PutMeshResult> mesh = client.PutMesh(in.reference_file, put);
   if (!mesh.ok()) return mesh.status();
   if (mesh->mesh_sha256 != in.reference_sha256) {

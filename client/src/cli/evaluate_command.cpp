@@ -34,8 +34,7 @@ struct EvaluateCliOptions {
   bool certify = false;
   CoverCertifyOptions certify_options;
   bool json = false;
-  bool fill_holes = false;
-  double weld_tolerance = 0.0;
+  RepairOptions repair;
   RemoteOptions remote;
 };
 
@@ -81,7 +80,7 @@ void PrintText(const EvaluateCliOptions& options, const QualityReport& r) {
 absl::StatusOr<Evaluated> Evaluate(const client::Client& client, const EvaluateCliOptions& options,
                                    const SphereFile& file, const QualityOptions& quality) {
   absl::StatusOr<StoredSolid> solid =
-      StoreSolid(client, options.mesh_path, {options.fill_holes, options.weld_tolerance});
+      StoreSolid(client, options.mesh_path, options.repair);
   if (!solid.ok()) return solid.status();
   absl::StatusOr<QualityReport> report = client.Evaluate(solid->sha256, file.set, quality);
   if (!report.ok()) return report.status();
@@ -135,7 +134,7 @@ void PrintCertificate(const EvaluateCliOptions& options, const SphereFile& file,
 absl::Status RunCertify(const client::Client& client, const EvaluateCliOptions& options,
                         const SphereFile& file) {
   absl::StatusOr<StoredSolid> solid =
-      StoreSolid(client, options.mesh_path, {options.fill_holes, options.weld_tolerance});
+      StoreSolid(client, options.mesh_path, options.repair);
   if (!solid.ok()) return solid.status();
   absl::StatusOr<CoverCertificate> certificate =
       client.CertifyCover(solid->sha256, file.set, options.certify_options);
@@ -214,9 +213,7 @@ void AddEvaluateCommand(CLI::App& app, CommandOutcome* outcome) {
                   "bounding-box diagonal)");
   cmd->add_option("--voxel-size", options->quality.voxel_size,
                   "Voxel size for the fatness test (default: the file's, if it has one)");
-  cmd->add_flag("--fill-holes", options->fill_holes,
-                "Close the mesh's holes first (see inscribe info --fill-holes)");
-  AddWeldToleranceOption(cmd, &options->weld_tolerance);
+  AddRepairOptions(cmd, &options->repair);
   cmd->add_flag("--certify", options->certify,
                 "Instead of the quality report: prove that the spheres contain the whole solid "
                 "(a cover), or give a point of the solid in no sphere; with delta, a sound bound "

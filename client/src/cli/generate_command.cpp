@@ -33,8 +33,7 @@ struct GenerateCliOptions {
   std::string format;
   std::string link;  // cuRobo YAML link name
   bool json = false;
-  bool fill_holes = false;
-  double weld_tolerance = 0.0;
+  RepairOptions repair;
   RemoteOptions remote;
 };
 
@@ -43,9 +42,9 @@ struct Generated {
   GeneratedSphereSet result;  // S_D, S_D+ with --dilate, or a cover with --cover
   std::string mesh_sha256;
   std::int64_t triangles = 0;  // of the validated mesh
-  // MeshReport::repairs: what validation changed of the surface ("" when nothing); the set and
-  // its certificate are then about the repaired mesh, mesh_sha256, only.
-  std::string mesh_repairs;
+  // The service's validation report: what it repaired of the surface; the set and its
+  // certificate are then about the repaired mesh, mesh_sha256, only.
+  MeshReport mesh_report;
   double load_seconds = 0.0;  // reading, storing and validation
   // Remote mode only: the server's key of the set and where it came from ("computed",
   // "memory", "disk", "joined").
@@ -56,13 +55,12 @@ struct Generated {
 absl::StatusOr<Generated> Generate(const client::Client& client,
                                    const GenerateCliOptions& options) {
   absl::StatusOr<StoredSolid> solid =
-      StoreSolid(client, options.mesh_path, {options.fill_holes, options.weld_tolerance});
+      StoreSolid(client, options.mesh_path, options.repair);
   if (!solid.ok()) return solid.status();
 
   client::GenerateSettings settings;
   settings.parameters = options.parameters;
-  settings.fill_holes = options.fill_holes;
-  settings.weld_tolerance = options.weld_tolerance;
+  settings.repair = options.repair;
   ProgressBar progress("generating");
   client::GenerateOptions call;
   call.on_progress = [&progress](double fraction) { progress.Update(fraction); };
@@ -85,7 +83,7 @@ absl::StatusOr<Generated> Generate(const client::Client& client,
   g.cache = std::move(result->cache);
   g.result = *std::move(result);  // the GeneratedSphereSet part
   g.triangles = solid->report.triangles;
-  g.mesh_repairs = solid->report.repairs();
+  g.mesh_report = solid->report;
   g.load_seconds = solid->seconds;
   return g;
 }
@@ -97,7 +95,8 @@ void PrintSummary(const GenerateCliOptions& options, const Generated& g) {
   summary["mesh"] = options.mesh_path;
   summary["mesh_sha256"] = g.mesh_sha256;
   summary["triangles"] = g.triangles;
-  if (!g.mesh_repairs.empty()) summary["mesh_repairs"] = g.mesh_repairs;
+  if (g.mesh_report.geometry_repaired()) summary["mesh_repairs"] = g.mesh_report.repairs();
+  if (g.mesh_report.wrapped) summary["mesh_wrap_reach"] = g.mesh_report.wrap_reach;
   summary["voxel_size"] = r.voxel_size;
   summary["object_angle"] = p.medial.object_angle;
   summary["samples"] = p.medial.samples;
@@ -122,7 +121,13 @@ void PrintSummary(const GenerateCliOptions& options, const Generated& g) {
   }
   summary[kKindParam] = SphereSetKindName(r.kind);
   NamedValues figures = r.dilation ? DilationFigures(*r.dilation) : NamedValues();
-  if (r.cover) figures = CoverFigures(*r.cover);
+  if (r.cover) {
+    figures = CoverFigures(*r.cover);
+    if (const std::optional<double> over =
+            CoverDeltaOverInput(r.cover->certificate.delta, g.mesh_report)) {
+      figures.emplace_back("delta_input", *over);
+    }
+  }
   for (const auto& [name, value] : figures) {
     std::visit([&summary, &name = name](const auto& v) { summary[name] = v; }, value);
   }
@@ -144,7 +149,7 @@ absl::Status RunGenerate(const GenerateCliOptions& options) {
   // The sphere file goes to -o, else to stdout unless --json claims stdout for the summary
   // (as with deform).
   const SphereFile file = GenerationSphereFile(options.parameters, generated->result,
-                                               generated->mesh_sha256, generated->mesh_repairs);
+                                               generated->mesh_sha256, generated->mesh_report);
   if (absl::Status written =
           EmitSphereFile(file, options.output_path, options.format, options.json, options.link);
       !written.ok()) {
@@ -256,9 +261,7 @@ void AddGenerateCommand(CLI::App& app, CommandOutcome* outcome) {
                   "the paper's S_D+; 0.5 halved the distance error on 5 of 6 Table II models)")
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
-  cmd->add_flag("--fill-holes", options->fill_holes,
-                "Close the mesh's holes first (see inscribe info --fill-holes)");
-  AddWeldToleranceOption(cmd, &options->weld_tolerance);
+  AddRepairOptions(cmd, &options->repair);
   cmd->add_flag("--json", options->json,
                 "Print one JSON summary on stdout (spheres, voxel_size, seconds, volumes, nerr, "
                 "quality figures)");

@@ -6,8 +6,10 @@
 #include <memory>
 #include <string>
 
+#include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "command_outcome.h"
+#include "inscribe/geometry/mesh_hash.h"
 #include "inscribe/mesh/mesh_io.h"
 #include "inscribe/solid/mesh_validation.h"
 #include "inscribe/view/report_json.h"
@@ -24,9 +26,9 @@ struct InfoOptions {
   std::string path;
   bool json = false;
   bool skip_self_intersections = false;
-  bool fill_holes = false;
-  double weld_tolerance = 0.0;
+  RepairOptions repair;
   RemoteOptions remote;
+  std::string output_path;  // -o: the repaired mesh
 };
 
 // What info prints: the service's report of the mesh, and how the file was read here.
@@ -85,6 +87,25 @@ void PrintText(const std::string& path, const InfoResult& result) {
   line("verdict", report.usable() ? "usable" : "NOT usable: " + report.first_error());
 }
 
+// -o: the mesh as validation returns it (welded, oriented, repaired as asked), validated here
+// with the same options; it must hash as the service's report says (the same code on the same
+// input), or nothing is written.
+absl::Status WriteRepaired(const InfoOptions& options, Mesh mesh, const std::string& sha256) {
+  ValidateOptions validate;
+  validate.check_self_intersections = !options.skip_self_intersections;
+  validate.repair = options.repair;
+  const ValidatedMesh validated = ValidateMesh(std::move(mesh), validate);
+  if (FormatSha256(MeshSha256(validated.mesh)) != sha256) {
+    return absl::InternalError(absl::StrCat("the repaired mesh here hashes to ",
+                                            FormatSha256(MeshSha256(validated.mesh)),
+                                            ", the service's to ", sha256, "; nothing written"));
+  }
+  if (absl::Status written = WriteMesh(options.output_path, validated.mesh); !written.ok()) {
+    return BadInputError(written.message());
+  }
+  return absl::OkStatus();
+}
+
 absl::Status RunInfo(const InfoOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   InfoResult result;
@@ -94,8 +115,7 @@ absl::Status RunInfo(const InfoOptions& options) {
   if (!session.ok()) return session.status();
   client::InspectMeshOptions inspect;
   inspect.skip_self_intersections = options.skip_self_intersections;
-  inspect.fill_holes = options.fill_holes;
-  inspect.weld_tolerance = options.weld_tolerance;
+  inspect.repair = options.repair;
   absl::StatusOr<client::InspectMeshResult> inspected =
       (*session)->client().InspectMesh(*mesh, inspect);
   if (!inspected.ok()) return inspected.status();
@@ -107,12 +127,6 @@ absl::Status RunInfo(const InfoOptions& options) {
     nlohmann::json j = MeshReportJson(report, result.sha256);
     j["path"] = options.path;
     j["polygons_triangulated"] = result.read.polygons_triangulated;
-    // With --fill-holes the hash, volume and self-intersections describe the repaired mesh;
-    // these two say how it was repaired.
-    if (options.fill_holes) {
-      j["holes_filled"] = report.holes_filled;
-      j["hole_triangles_added"] = report.hole_triangles_added;
-    }
     j["seconds"] = result.seconds;
     if (options.remote.enabled()) j["server"] = options.remote.server;
     std::cout << j.dump() << "\n";
@@ -120,6 +134,7 @@ absl::Status RunInfo(const InfoOptions& options) {
     PrintText(options.path, result);
   }
   if (!report.usable()) return UnusableMeshError(options.path + ": " + report.first_error());
+  if (!options.output_path.empty()) return WriteRepaired(options, *std::move(mesh), result.sha256);
   return absl::OkStatus();
 }
 
@@ -134,10 +149,10 @@ void AddInfoCommand(CLI::App& app, CommandOutcome* outcome) {
   cmd->add_flag("--json", options->json, "Print one JSON object on stdout");
   cmd->add_flag("--skip-self-intersections", options->skip_self_intersections,
                 "Skip the exact self-intersection test (faster on huge meshes)");
-  cmd->add_flag("--fill-holes", options->fill_holes,
-                "Close every hole (border loop) with triangles between its border vertices, "
-                "then validate, hash and describe the repaired mesh");
-  AddWeldToleranceOption(cmd, &options->weld_tolerance);
+  AddRepairOptions(cmd, &options->repair);
+  cmd->add_option("-o,--output", options->output_path,
+                  "Write the mesh as validated and repaired (OFF, OBJ, PLY or STL by extension) "
+                  "when it is usable");
   AddRemoteOptions(cmd, &options->remote, 60.0);
   cmd->callback([options, outcome] {
     *outcome = CommandOutcome{RunInfo(*options), options->remote.server};

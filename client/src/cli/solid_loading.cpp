@@ -29,13 +29,39 @@ double SecondsSince(std::chrono::steady_clock::time_point start) {
 
 }  // namespace
 
-void AddWeldToleranceOption(CLI::App* cmd, double* weld_tolerance) {
-  cmd->add_option("--weld-tolerance", *weld_tolerance,
+void AddRepairOptions(CLI::App* cmd, RepairOptions* repair) {
+  CLI::Option* level =
+      cmd->add_option_function<std::string>(
+             "--repair",
+             [repair](const std::string& name) {
+               // IsMember below admits only the names ParseMeshRepair knows.
+               repair->level = ParseMeshRepair(name).value_or(repair->level);
+             },
+             "How much the mesh may be changed to make it usable: none (identical vertices "
+             "welded, orientation fixed), safe (also duplicate triangles and walls stored twice "
+             "removed, cracks welded within a tolerance from the mesh's size; the default), "
+             "fill (also holes closed), wrap (a watertight alpha wrap of all the triangles), "
+             "auto (safe, then fill, then wrap, until the mesh is usable)")
+          ->check(CLI::IsMember({"none", "safe", "fill", "wrap", "auto"}));
+  cmd->add_flag_callback(
+         "--fill-holes", [repair] { repair->level = MeshRepair::kFill; },
+         "Close the mesh's holes (the same as --repair fill)")
+      ->excludes(level);
+  cmd->add_option("--weld-tolerance", repair->weld_tolerance,
                   "Also weld vertices this close (mesh units), for files that repeat each vertex "
                   "per face with slightly different coordinates; exactly coincident vertices are "
                   "always welded")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  cmd->add_option("--wrap-alpha", repair->wrap_alpha,
+                  "The wrap's alpha (mesh units): gaps and holes narrower than about this are "
+                  "bridged; smaller costs more (about 1/alpha^2). Default: the bounding box's "
+                  "diagonal / 100")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--wrap-offset", repair->wrap_offset,
+                  "How far outside the input triangles the wrap lies (mesh units). Default: "
+                  "alpha / 30")
+      ->check(CLI::PositiveNumber);
 }
 
 absl::StatusOr<LoadedSolid> LoadSolid(const std::string& path, const SolidLoadOptions& options) {
@@ -43,8 +69,7 @@ absl::StatusOr<LoadedSolid> LoadSolid(const std::string& path, const SolidLoadOp
   absl::StatusOr<Mesh> mesh = ReadMesh(path, nullptr);
   if (!mesh.ok()) return BadInputError(mesh.status().message());
   SolidOptions solid_options;
-  solid_options.validate.fill_holes = options.fill_holes;
-  solid_options.validate.weld_tolerance = options.weld_tolerance;
+  solid_options.validate.repair = options;
   absl::StatusOr<Solid> solid = PrepareSolid(*std::move(mesh), solid_options);
   if (!solid.ok()) return UnusableMeshError(path + ": " + std::string(solid.status().message()));
   NoteRepairs(path, solid->report, solid->sha256);
@@ -57,8 +82,7 @@ absl::StatusOr<StoredSolid> StoreSolid(const client::Client& client, const std::
   absl::StatusOr<Mesh> mesh = ReadMesh(path, nullptr);
   if (!mesh.ok()) return BadInputError(mesh.status().message());
   client::PutMeshOptions put;
-  put.fill_holes = options.fill_holes;
-  put.weld_tolerance = options.weld_tolerance;
+  put.repair = options;
   absl::StatusOr<client::PutMeshResult> stored = client.PutMesh(*mesh, put);
   if (!stored.ok()) {
     if (stored.status().code() == absl::StatusCode::kFailedPrecondition) {

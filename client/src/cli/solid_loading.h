@@ -13,18 +13,16 @@
 
 namespace inscribe::cli {
 
-struct SolidLoadOptions {
-  // Close the mesh's holes before use (ValidateOptions::fill_holes, `--fill-holes`); the hash
-  // and the oracle are then those of the repaired mesh, and one line on stderr says so.
-  bool fill_holes = false;
-  // Weld vertices within this distance too (ValidateOptions::weld_tolerance,
-  // `--weld-tolerance`, mesh units); exactly coincident ones always are.
-  double weld_tolerance = 0.0;
-};
+// How the commands that validate a mesh may repair it: core's RepairOptions (level, weld
+// tolerance, wrap parameters). The hash, the oracle and every result are then those of the
+// repaired mesh, and stderr says what was done.
+using SolidLoadOptions = RepairOptions;
 
-// Registers `--weld-tolerance D` (a finite distance >= 0, mesh units) on `cmd`, the one
-// definition every command that validates a mesh shares.
-void AddWeldToleranceOption(CLI::App* cmd, double* weld_tolerance);
+// Registers the repair options on `cmd`, the one definition every command that validates a
+// mesh shares: `--repair none|safe|fill|wrap|auto` (default safe), `--fill-holes` (the same as
+// `--repair fill`), `--weld-tolerance D` (a finite distance >= 0, mesh units), `--wrap-alpha A`
+// and `--wrap-offset O` (mesh units > 0; default from the mesh's size).
+void AddRepairOptions(CLI::App* cmd, RepairOptions* repair);
 
 struct LoadedSolid {
   Solid solid;

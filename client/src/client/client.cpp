@@ -98,7 +98,7 @@ v1::GenerateRequest GenerateRequestFor(const std::string& mesh_sha256,
                                        const GenerateSettings& settings,
                                        const GenerateOptions& options) {
   v1::GenerateRequest request;
-  wire::GenerateRequestToProto(mesh_sha256, settings.parameters, settings.fill_holes, &request);
+  wire::GenerateRequestToProto(mesh_sha256, settings.parameters, settings.repair.level, &request);
   request.set_progress_interval(options.progress_interval);
   return request;
 }
@@ -120,11 +120,10 @@ absl::StatusOr<GenerateResult> GenerateUntil(Connection& connection, const Retry
   return result;
 }
 
-v1::PutMeshRequest PutMeshRequestFor(const Mesh& mesh, bool fill_holes, double weld_tolerance) {
+v1::PutMeshRequest PutMeshRequestFor(const Mesh& mesh, const RepairOptions& repair) {
   v1::PutMeshRequest request;
   wire::MeshToProto(mesh, request.mutable_mesh());
-  request.set_fill_holes(fill_holes);
-  request.set_weld_tolerance(weld_tolerance);
+  wire::RepairOptionsToProto(repair, &request);
   return request;
 }
 
@@ -181,8 +180,7 @@ absl::StatusOr<InspectMeshResult> Client::InspectMesh(const Mesh& mesh,
   v1::InspectMeshRequest request;
   wire::MeshToProto(mesh, request.mutable_mesh());
   request.set_skip_self_intersections(options.skip_self_intersections);
-  request.set_fill_holes(options.fill_holes);
-  request.set_weld_tolerance(options.weld_tolerance);
+  wire::RepairOptionsToProto(options.repair, &request);
   absl::StatusOr<v1::InspectMeshResponse> response =
       Retried(options_.retry, DeadlineAfter(options.timeout, options_),
               [&](Deadline d) { return connection_->InspectMesh(request, d); });
@@ -195,7 +193,7 @@ absl::StatusOr<InspectMeshResult> Client::InspectMesh(const Mesh& mesh,
 absl::StatusOr<PutMeshResult> Client::PutMesh(const Mesh& mesh,
                                               const PutMeshOptions& options) const {
   return PutMeshUntil(*connection_, options_.retry,
-                      PutMeshRequestFor(mesh, options.fill_holes, options.weld_tolerance),
+                      PutMeshRequestFor(mesh, options.repair),
                       DeadlineAfter(options.timeout, options_));
 }
 
@@ -219,8 +217,7 @@ absl::StatusOr<GenerateResult> Client::Generate(const Mesh& mesh, const Generate
   }
   // One deadline for the uploads and generations together; the mesh is converted once.
   const Deadline deadline = DeadlineAfter(options.timeout, options_);
-  const v1::PutMeshRequest put =
-      PutMeshRequestFor(mesh, settings.fill_holes, settings.weld_tolerance);
+  const v1::PutMeshRequest put = PutMeshRequestFor(mesh, settings.repair);
   absl::StatusOr<PutMeshResult> stored = PutMeshUntil(*connection_, options_.retry, put, deadline);
   if (!stored.ok()) return stored.status();
   return GenerateUploadingAgain(*connection_, options_.retry, put, stored->mesh_sha256, settings,
@@ -235,7 +232,7 @@ absl::StatusOr<GenerateResult> Client::Generate(const std::string& mesh_sha256, 
   }
   return GenerateUploadingAgain(
       *connection_, options_.retry,
-      PutMeshRequestFor(mesh, settings.fill_holes, settings.weld_tolerance), mesh_sha256, settings,
+      PutMeshRequestFor(mesh, settings.repair), mesh_sha256, settings,
       options, DeadlineAfter(options.timeout, options_));
 }
 

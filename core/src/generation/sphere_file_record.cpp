@@ -1,6 +1,8 @@
 #include "inscribe/generation/sphere_file_record.h"
 
+#include <cmath>
 #include <cstdint>
+#include <limits>
 #include <type_traits>
 #include <utility>
 #include <variant>
@@ -149,8 +151,15 @@ NamedValues CoverFigures(const GeneratedCover& cover) {
   return stats;
 }
 
+std::optional<double> CoverDeltaOverInput(double delta, const MeshReport& mesh) {
+  if (mesh.holes_filled > 0) return std::nullopt;
+  const double moved = mesh.wrapped ? mesh.wrap_reach : mesh.weld_moved_within;
+  if (!(moved > 0.0)) return std::nullopt;
+  return std::nextafter(delta + moved, std::numeric_limits<double>::infinity());
+}
+
 SphereFile GenerationSphereFile(const SphereSetParameters& p, const GeneratedSphereSet& r,
-                                const std::string& mesh_sha256, const std::string& mesh_repairs) {
+                                const std::string& mesh_sha256, const MeshReport& mesh) {
   // A cover's internal set is the cover generator's own: no epsilon, runs or voxel counts.
   const bool medial_run = r.kind != SphereSetKind::kCover;
   SphereFile file;
@@ -183,7 +192,11 @@ SphereFile GenerationSphereFile(const SphereSetParameters& p, const GeneratedSph
     if (p.max_protrusion) file.params.emplace_back("max_protrusion", *p.max_protrusion);
     file.params.emplace_back("cover_resolution", p.cover_resolution);
   }
-  if (!mesh_repairs.empty()) file.params.emplace_back("mesh_repairs", mesh_repairs);
+  if (mesh.geometry_repaired()) file.params.emplace_back("mesh_repairs", mesh.repairs());
+  if (mesh.wrapped) {
+    file.params.emplace_back("mesh_wrap_alpha", mesh.wrap_alpha);
+    file.params.emplace_back("mesh_wrap_offset", mesh.wrap_offset);
+  }
 
   file.stats = {{"seconds", r.generation_seconds}};
   if (medial_run) file.stats.emplace_back("search_runs", static_cast<std::int64_t>(r.runs));
@@ -202,7 +215,11 @@ SphereFile GenerationSphereFile(const SphereSetParameters& p, const GeneratedSph
   if (r.cover) {
     file.protrusions = r.cover->certificate.protrusions;
     for (auto& figure : CoverFigures(*r.cover)) figures.push_back(std::move(figure));
+    if (const std::optional<double> over = CoverDeltaOverInput(r.cover->certificate.delta, mesh)) {
+      figures.emplace_back("delta_input", *over);
+    }
   }
+  if (mesh.wrapped) figures.emplace_back("mesh_wrap_reach", mesh.wrap_reach);
   for (auto& figure : figures) file.stats.push_back(std::move(figure));
   return file;
 }

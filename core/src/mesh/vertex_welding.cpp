@@ -9,7 +9,6 @@
 
 #include <algorithm>
 #include <array>
-#include <boost/iterator/counting_iterator.hpp>
 #include <limits>
 #include <numeric>
 #include <vector>
@@ -47,18 +46,21 @@ std::vector<std::int32_t> ExactRepresentatives(const Mesh& mesh) {
 }
 
 // The same within `tolerance`: in index order, each vertex not yet merged is kept and takes
-// every later unmerged vertex within the tolerance (CGAL's kd-tree range search).
-std::vector<std::int32_t> NearRepresentatives(const Mesh& mesh, double tolerance) {
+// every later unmerged vertex within the tolerance (CGAL's kd-tree range search). With
+// `only`, the vertices it does not mark are neither searched nor taken.
+std::vector<std::int32_t> NearRepresentatives(const Mesh& mesh, double tolerance,
+                                              const std::vector<char>* only) {
   const auto n = static_cast<std::size_t>(mesh.num_vertices());
   std::vector<Point> points;
   points.reserve(n);
+  std::vector<std::size_t> searched;
   for (std::size_t v = 0; v < n; ++v) {
     const auto i = static_cast<Eigen::Index>(v);
     points.emplace_back(mesh.vertices(i, 0), mesh.vertices(i, 1), mesh.vertices(i, 2));
+    if (only == nullptr || (*only)[v]) searched.push_back(v);
   }
   const Traits traits(CGAL::make_property_map(points));
-  Tree tree(boost::counting_iterator<std::size_t>(0), boost::counting_iterator<std::size_t>(n),
-            Tree::Splitter(), traits);
+  Tree tree(searched.begin(), searched.end(), Tree::Splitter(), traits);
   tree.build();
   const double squared = tolerance * tolerance;
   std::vector<std::int32_t> representative(n, -1);
@@ -66,6 +68,7 @@ std::vector<std::int32_t> NearRepresentatives(const Mesh& mesh, double tolerance
   for (std::size_t v = 0; v < n; ++v) {
     if (representative[v] >= 0) continue;
     representative[v] = static_cast<std::int32_t>(v);
+    if (only != nullptr && !(*only)[v]) continue;
     found.clear();
     tree.search(std::back_inserter(found), Sphere(v, tolerance, 0.0, traits));
     for (std::size_t w : found) {
@@ -80,10 +83,10 @@ std::vector<std::int32_t> NearRepresentatives(const Mesh& mesh, double tolerance
 
 }  // namespace
 
-Weld WeldVertices(Mesh& mesh, double tolerance) {
+Weld WeldVertices(Mesh& mesh, double tolerance, const std::vector<char>* only) {
   Weld weld;
   const std::vector<std::int32_t> group =
-      tolerance > 0.0 ? NearRepresentatives(mesh, tolerance) : ExactRepresentatives(mesh);
+      tolerance > 0.0 ? NearRepresentatives(mesh, tolerance, only) : ExactRepresentatives(mesh);
   const auto nv = static_cast<std::size_t>(mesh.num_vertices());
   bool any = false;
   for (std::size_t v = 0; v < nv && !any; ++v) any = group[v] != static_cast<std::int32_t>(v);

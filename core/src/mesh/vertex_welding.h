@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <vector>
 
 #include "inscribe/geometry/mesh.h"
 
@@ -20,6 +21,9 @@ struct Weld {
 // edge is not made there. Kept vertices keep their order and coordinates; triangles keep
 // their order and corner order. Needs finite coordinates and in-range indices. Cost
 // O(#V log #V + #T log #T) (CGAL's kd-tree when tolerance > 0).
-Weld WeldVertices(Mesh& mesh, double tolerance);
+//
+// `only` (tolerance > 0): when given (one entry per vertex), only the vertices it marks are
+// grouped, with each other; every other vertex stays its own.
+Weld WeldVertices(Mesh& mesh, double tolerance, const std::vector<char>* only = nullptr);
 
 }  // namespace inscribe::internal

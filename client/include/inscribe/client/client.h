@@ -56,10 +56,9 @@ struct ClientOptions {
 struct InspectMeshOptions {
   // Skip the exact self-intersection test (O(#T log #T) on the server).
   bool skip_self_intersections = false;
-  // Close the mesh's holes first; the report and hash are the repaired mesh's.
-  bool fill_holes = false;
-  // Weld vertices within this distance too (mesh units); exactly coincident ones always are.
-  double weld_tolerance = 0.0;
+  // How the server may repair the mesh (core's RepairOptions: level, weld tolerance, wrap
+  // parameters); the report and hash are the repaired mesh's.
+  RepairOptions repair;
   // Overrides ClientOptions::default_timeout for this call.
   std::optional<std::chrono::milliseconds> timeout;
 };
@@ -80,9 +79,7 @@ struct CallOptions {
 
 // The repairs PutMesh asks the server for; the stored mesh and its key are the repaired mesh's.
 struct PutMeshOptions : CallOptions {
-  bool fill_holes = false;
-  // Weld vertices within this distance too (mesh units); exactly coincident ones always are.
-  double weld_tolerance = 0.0;
+  RepairOptions repair;  // core's RepairOptions (level, weld tolerance, wrap parameters)
 };
 
 struct PutMeshResult {
@@ -95,8 +92,7 @@ struct PutMeshResult {
 // core's (SphereSetParameters), and the mesh repair Generate(mesh, ...) asks PutMesh for.
 struct GenerateSettings {
   SphereSetParameters parameters;
-  bool fill_holes = false;
-  double weld_tolerance = 0.0;  // PutMeshOptions::weld_tolerance, for Generate(mesh, ...)
+  RepairOptions repair;  // PutMeshOptions::repair, for Generate(mesh, ...)
 };
 
 struct GenerateOptions : CallOptions {
@@ -331,12 +327,12 @@ class Client {
   absl::StatusOr<GenerateResult> Generate(const std::string& mesh_sha256,
                                           const GenerateSettings& settings,
                                           const GenerateOptions& options = {}) const;
-  // Uploads `mesh` (PutMesh, with settings.fill_holes and weld_tolerance) and generates; if the
+  // Uploads `mesh` (PutMesh, with settings.repair) and generates; if the
   // server lost the mesh in between (NOT_FOUND: evicted), uploads it once more.
   absl::StatusOr<GenerateResult> Generate(const Mesh& mesh, const GenerateSettings& settings,
                                           const GenerateOptions& options = {}) const;
   // Spheres for `mesh`, which the caller stored as `mesh_sha256` (PutMesh with
-  // settings.fill_holes and weld_tolerance); if the server lost it since (NOT_FOUND: evicted),
+  // settings.repair); if the server lost it since (NOT_FOUND: evicted),
   // uploads it once more and asks again, as the overload above does. One deadline for all.
   absl::StatusOr<GenerateResult> Generate(const std::string& mesh_sha256, const Mesh& mesh,
                                           const GenerateSettings& settings,

@@ -11,6 +11,7 @@
 #include "inscribe/balls/sphere_io.h"
 #include "inscribe/cover/cover_certificate.h"
 #include "inscribe/generation/sphere_set_generation.h"
+#include "inscribe/solid/mesh_validation.h"
 
 namespace inscribe {
 
@@ -21,16 +22,27 @@ inline constexpr char kKindParam[] = "kind";
 //   params: kind, voxel_size (the one used), object_angle, epsilon (medial runs), the medial
 //     settings (samples, screen_samples, pair_angle_margin, corner_screen, subdivide_boundary),
 //     max_spheres and selection (a budget), dilation_growth (dilated), max_protrusion and
-//     cover_resolution (covers), mesh_repairs (when `mesh_repairs` is not empty:
-//     MeshReport::repairs, what validation changed of the user's surface);
+//     cover_resolution (covers), mesh_repairs (when `mesh`'s geometry was repaired:
+//     MeshReport::repairs, what validation changed of the user's solid), and for a wrapped
+//     mesh mesh_wrap_alpha and mesh_wrap_offset;
 //   stats: seconds (the generation's, GeneratedSphereSet::generation_seconds), search_runs
 //     (medial runs), pool_size and covered_fraction (optimised), the quality figures
 //     (QualityFigures; when evaluated), visited_voxels and closest_point_queries (medial runs),
-//     the dilation's figures (DilationFigures) and a cover's (CoverFigures).
+//     the dilation's figures (DilationFigures) and a cover's (CoverFigures); for a wrapped mesh
+//     mesh_wrap_reach, and for a cover of a mesh whose repair moved its surface (a wrap, a weld
+//     within a tolerance) delta_input (CoverDeltaOverInput).
 // Lengths in mesh units, angles in radians. A cover's protrusions go with it.
 SphereFile GenerationSphereFile(const SphereSetParameters& parameters,
                                 const GeneratedSphereSet& result, const std::string& mesh_sha256,
-                                const std::string& mesh_repairs);
+                                const MeshReport& mesh);
+
+// How far a certified cover of the repaired mesh reaches beyond the triangles of the mesh as
+// given, when the repair moved the surface by a known bound: every point of the union lies in
+// the repaired solid or within delta + that bound of the input triangles. The bound is the
+// wrap's reach (a wrapped mesh) or the weld tolerance (vertices welded within one, which moves
+// each point of the surface by at most it). Rounded up. nullopt when neither applies (nothing
+// moved: delta itself holds; or holes were filled, whose patch has no bound to the input).
+std::optional<double> CoverDeltaOverInput(double delta, const MeshReport& mesh);
 
 // volume_mesh, volume_union, nerr, nerr_is_exact, protrusion_max, coverage,
 // boundary_to_union_hausdorff, surface_samples, fat.

@@ -158,11 +158,24 @@ void ToleranceToProto(const DistanceRequest& tolerance, v1::DistanceTolerance* o
 // INVALID_ARGUMENT for negative or non-finite errors or a NaN closer_than.
 absl::StatusOr<DistanceRequest> ToleranceFromProto(const v1::DistanceTolerance& tolerance);
 
+// Mesh repair levels. MESH_REPAIR_UNSPECIFIED is core's default (safe), or fill when the
+// request's older `fill_holes` flag is set; INVALID_ARGUMENT for a value the proto does not
+// define.
+v1::MeshRepair MeshRepairToProto(MeshRepair repair);
+absl::StatusOr<MeshRepair> MeshRepairFromProto(v1::MeshRepair repair, bool fill_holes);
+// The repair a PutMesh or InspectMesh request asks for (its repair, weld_tolerance and older
+// fill_holes fields) and back. Errors as MeshRepairFromProto's (the numbers are judged by
+// ValidateMesh, which names the bad one).
+void RepairOptionsToProto(const RepairOptions& repair, v1::PutMeshRequest* out);
+void RepairOptionsToProto(const RepairOptions& repair, v1::InspectMeshRequest* out);
+absl::StatusOr<RepairOptions> RepairOptionsFromProto(const v1::PutMeshRequest& request);
+absl::StatusOr<RepairOptions> RepairOptionsFromProto(const v1::InspectMeshRequest& request);
+
 // Generation parameters. A field at core's default is left unset (or 0 where the proto says
-// "0 = default"), so the wire never restates a default. `fill_holes` is the mesh repair the
-// caller asked for; parameters.evaluate goes as skip_quality.
+// "0 = default"), so the wire never restates a default. `repair` is the mesh repair the
+// caller stored the mesh with; parameters.evaluate goes as skip_quality.
 void GenerateRequestToProto(const std::string& mesh_sha256, const SphereSetParameters& parameters,
-                            bool fill_holes, v1::GenerateRequest* out);
+                            MeshRepair repair, v1::GenerateRequest* out);
 // The core parameters of a request, core's defaults where the wire leaves a field unset, then
 // CheckSphereSetParameters: INVALID_ARGUMENT "parameters: <why>". Exactly one of voxel_size,
 // max_spheres (> 0) and max_protrusion must be set on the wire, and at most one of dilate and

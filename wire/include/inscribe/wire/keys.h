@@ -12,6 +12,7 @@
 #include "inscribe/distance/sphere_hierarchy.h"
 #include "inscribe/generation/sphere_set_generation.h"
 #include "inscribe/medial/sphere_deformation.h"
+#include "inscribe/solid/mesh_validation.h"
 
 namespace inscribe::wire {
 
@@ -39,9 +40,9 @@ std::string ContentRouteKey(absl::string_view spheres_bytes);
 
 // "spheres/v1/<64 hex>" of a generated set: RoutePrefix(mesh_key), then SHA-256 digits of a
 // fixed text of the algorithm version, the mesh key and every parameter (defaults resolved,
-// numbers with 17 significant digits). `fill_holes`: the mesh was repaired before generation.
+// numbers with 17 significant digits). `repair`: how the mesh was repaired when stored.
 std::string GeneratedSphereSetKey(const std::string& mesh_key,
-                                  const SphereSetParameters& parameters, bool fill_holes);
+                                  const SphereSetParameters& parameters, MeshRepair repair);
 
 // "spheres/v1/<64 hex>" of an uploaded set: the route prefix of `mesh_key`, else of
 // `derived_from` (the key of the set it was computed from), else none (a full SHA-256), then

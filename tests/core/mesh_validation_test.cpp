@@ -320,10 +320,21 @@ TEST(ValidateMesh, DuplicatedFaceIsNonManifold) {
   tet.vertices << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1;
   tet.triangles.resize(5, 3);
   tet.triangles << 0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3, 1, 3, 2;
-  const ValidatedMesh v = ValidateMesh(tet);
+  ValidateOptions none;
+  none.repair.level = MeshRepair::kNone;
+  const ValidatedMesh v = ValidateMesh(tet, none);
   EXPECT_FALSE(v.report.usable());
   EXPECT_EQ(v.report.duplicate_triangles, 1);
   EXPECT_EQ(v.report.non_manifold_edges, 3);
+  EXPECT_THAT(v.report.first_error(), HasSubstr("--repair safe removes duplicate triangles"));
+  // The safe fixes drop the later copy (its edges are in three triangles, not four: a face
+  // listed twice, not a wall between two bodies), and the tetrahedron is whole.
+  const ValidatedMesh safe = ValidateMesh(tet);
+  ASSERT_TRUE(safe.report.usable()) << safe.report.first_error();
+  EXPECT_EQ(safe.report.duplicate_triangles_removed, 1);
+  EXPECT_EQ(safe.report.double_walls_removed, 0);
+  EXPECT_EQ(safe.mesh.num_triangles(), 4);
+  EXPECT_NEAR(safe.report.volume, 1.0 / 6.0, 1e-15);
 }
 
 class RealMeshes : public ::testing::TestWithParam<const char*> {};

@@ -83,6 +83,7 @@ TEST(WeldVertices, PerFaceObjOfADemoMeshIsTheMeshAgain) {
 
   ValidateOptions no_weld;
   no_weld.weld_vertices = false;
+  no_weld.repair.level = MeshRepair::kNone;
   const ValidatedMesh open = ValidateMesh(*read, no_weld);
   EXPECT_FALSE(open.report.usable());
   EXPECT_TRUE(HasIssue(open.report, "not_closed", Severity::kError));
@@ -105,10 +106,16 @@ TEST(WeldVertices, NearCoincidentCopiesNeedTheTolerance) {
         soup.vertices(3 * t + k, axis) += 1e-9 * diagonal * offset(random);
     }
   }
-  const ValidatedMesh exact = ValidateMesh(soup);
+  ValidateOptions none;
+  none.repair.level = MeshRepair::kNone;
+  const ValidatedMesh exact = ValidateMesh(soup, none);
   EXPECT_FALSE(exact.report.usable());
   EXPECT_TRUE(HasIssue(exact.report, "not_closed", Severity::kError));
-  EXPECT_THAT(exact.report.first_error(), HasSubstr("weld tolerance"));
+  EXPECT_THAT(exact.report.first_error(), HasSubstr("--weld-tolerance"));
+  // The default safe repair welds them as cracks: the same mesh again.
+  const ValidatedMesh cracks = ValidateMesh(soup);
+  ASSERT_TRUE(cracks.report.usable()) << cracks.report.first_error();
+  EXPECT_EQ(MeshSha256(cracks.mesh), MeshSha256(ValidateMesh(original).mesh));
 
   ValidateOptions near;
   near.repair.weld_tolerance = 1e-7 * diagonal;
@@ -148,10 +155,14 @@ TEST(WeldVertices, TrianglesThatCollapseAreRemovedAndReported) {
   }
   // Exactly: only the copy of vertex 0 coincides, and the sliver, a sheet of its own, would
   // only touch the cube there: nothing is welded, and the sliver's edges are borders.
-  const ValidatedMesh exact = ValidateMesh(mesh);
+  ValidateOptions none;
+  none.repair.level = MeshRepair::kNone;
+  const ValidatedMesh exact = ValidateMesh(mesh, none);
   EXPECT_EQ(exact.report.welded_vertices, 0);
   EXPECT_EQ(exact.report.weld_collapsed_triangles, 0);
   EXPECT_FALSE(exact.report.usable());
+  // The crack weld never merges the sliver's own corners (an edge joins each pair): still open.
+  EXPECT_FALSE(ValidateMesh(mesh).report.usable());
 
   // A triangle that repeated a corner as given is not the weld's: it stays, a degenerate one.
   Mesh given = UnitCube();

@@ -124,7 +124,7 @@ std::vector<BrokenMesh> BrokenMeshCorpus() {
   }
   for (const double fraction : {1e-9, 1e-7, 1e-5, 1e-4}) {
     // Size: the sphere's diameter, 2.
-    corpus.push_back(Entry("crack-" + std::to_string(static_cast<int>(std::round(std::log10(fraction)))),
+    corpus.push_back(Entry("crack-1e" + std::to_string(static_cast<int>(std::round(std::log10(fraction)))),
                            CrackedSphere(2.0 * fraction), MeshRepair::kSafe, {sphere}));
   }
   corpus.push_back(Entry("crack-millimetres", CrackedSphere(2000.0 * 1e-5, 1000.0),

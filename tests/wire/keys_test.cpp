@@ -67,7 +67,7 @@ TEST(Keys, EveryParameterChangesTheKey) {
   p = base, p.evaluate = false, add(p);
   p = base, p.quality.surface_samples = 5000, add(p);
   p = base, p.selection = SphereSelection::kPaper, add(p);
-  EXPECT_EQ(keys.size(), 16u);
+  EXPECT_EQ(keys.size(), 18u);
   // Growth means nothing without dilation, nor quality samples without evaluation.
   p = base, p.dilation.growth = 0.3;
   EXPECT_EQ(GeneratedSphereSetKey(kMesh, p, MeshRepair::kSafe), GeneratedSphereSetKey(kMesh, base, MeshRepair::kSafe));

@@ -59,22 +59,44 @@ std::vector<std::int32_t> NearRepresentatives(const Mesh& mesh, double tolerance
     points.emplace_back(mesh.vertices(i, 0), mesh.vertices(i, 1), mesh.vertices(i, 2));
     if (only == nullptr || (*only)[v]) searched.push_back(v);
   }
+  // With `only`, vertices an edge joins are never merged (that would collapse its triangles).
+  std::vector<std::pair<std::int32_t, std::int32_t>> edges;
+  if (only != nullptr) {
+    for (Eigen::Index t = 0; t < mesh.triangles.rows(); ++t) {
+      for (int k = 0; k < 3; ++k) {
+        const std::int32_t a = mesh.triangles(t, k), b = mesh.triangles(t, (k + 1) % 3);
+        edges.emplace_back(std::min(a, b), std::max(a, b));
+      }
+    }
+    std::sort(edges.begin(), edges.end());
+  }
+  auto joined = [&edges](std::size_t a, std::size_t b) {
+    const auto e = std::make_pair(static_cast<std::int32_t>(std::min(a, b)),
+                                  static_cast<std::int32_t>(std::max(a, b)));
+    return std::binary_search(edges.begin(), edges.end(), e);
+  };
   const Traits traits(CGAL::make_property_map(points));
   Tree tree(searched.begin(), searched.end(), Tree::Splitter(), traits);
   tree.build();
   const double squared = tolerance * tolerance;
   std::vector<std::int32_t> representative(n, -1);
-  std::vector<std::size_t> found;
+  std::vector<std::size_t> found, cluster;
   for (std::size_t v = 0; v < n; ++v) {
     if (representative[v] >= 0) continue;
     representative[v] = static_cast<std::int32_t>(v);
     if (only != nullptr && !(*only)[v]) continue;
     found.clear();
     tree.search(std::back_inserter(found), Sphere(v, tolerance, 0.0, traits));
+    std::sort(found.begin(), found.end());
+    cluster.assign(1, v);
     for (std::size_t w : found) {
       if (w > v && representative[w] < 0 &&
-          CGAL::squared_distance(points[v], points[w]) <= squared) {
+          CGAL::squared_distance(points[v], points[w]) <= squared &&
+          (only == nullptr ||
+           std::none_of(cluster.begin(), cluster.end(),
+                        [&](std::size_t member) { return joined(member, w); }))) {
         representative[w] = static_cast<std::int32_t>(v);
+        if (only != nullptr) cluster.push_back(w);
       }
     }
   }

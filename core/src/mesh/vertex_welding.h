@@ -23,7 +23,8 @@ struct Weld {
 // O(#V log #V + #T log #T) (CGAL's kd-tree when tolerance > 0).
 //
 // `only` (tolerance > 0): when given (one entry per vertex), only the vertices it marks are
-// grouped, with each other; every other vertex stays its own.
+// grouped, with each other, and never two that an edge joins (which would collapse its
+// triangles); every other vertex stays its own.
 Weld WeldVertices(Mesh& mesh, double tolerance, const std::vector<char>* only = nullptr);
 
 }  // namespace inscribe::internal

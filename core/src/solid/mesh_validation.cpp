@@ -171,10 +171,7 @@ void CheckEdges(const Mesh& mesh, const std::vector<EdgeUse>& uses, const EdgeGr
                      ? "; no two triangles share an edge: if the file repeats each vertex per "
                        "face at slightly different positions, --repair safe welds those within "
                        "1e-4 of the size, --weld-tolerance D any within D"
-                     : "; --repair safe welds cracks narrower than 1e-4 of the size, --repair "
-                       "fill also closes holes (no vertex moves), --repair wrap wraps any mesh "
-                       "in a watertight surface (about alpha/30 larger; seconds for 100k "
-                       "triangles), --repair auto tries each in turn"),
+                     : ""),
              report.border_edges);
   }
   if (report.non_manifold_edges > 0) {
@@ -184,9 +181,7 @@ void CheckEdges(const Mesh& mesh, const std::vector<EdgeUse>& uses, const EdgeGr
                      Plural(report.non_manifold_edges, "edge is", "edges are"),
                      " shared by more than two triangles (first: vertices ", first_non_manifold->lo,
                      "-", first_non_manifold->hi, ", in ", first_non_manifold_count,
-                     " triangles); --repair safe removes duplicate triangles and walls stored "
-                     "twice, --repair wrap (or auto) wraps any mesh in a watertight surface "
-                     "(about alpha/30 larger; seconds for 100k triangles)"),
+                     " triangles)"),
         report.non_manifold_edges);
   }
   // Inconsistent orientation is reported by the orientation step, which knows if it is fixed.
@@ -308,6 +303,38 @@ void CheckOrientation(Mesh& mesh, const std::vector<EdgeUse>& uses, const EdgeGr
   }
   report.flat_shells = internal::OrientComponentsOutward(mesh, component, report.components, flip);
   ReportFlips(flip, component, report);
+}
+
+// Appends to the errors a repair can fix the levels above `tried` that would fix them, with
+// what they cost.
+void AppendRemedies(MeshReport& report, MeshRepair tried) {
+  const char* wrap =
+      "--repair wrap wraps any mesh in a watertight surface (about alpha/30 outside it; a "
+      "second or two per 100k triangles), --repair auto tries each level in turn";
+  for (MeshIssue& issue : report.issues) {
+    if (issue.severity != Severity::kError) continue;
+    std::string remedy;
+    if (issue.code == "not_closed") {
+      if (tried == MeshRepair::kNone) {
+        remedy = "--repair safe welds cracks narrower than 1e-4 of the size, ";
+      }
+      if (tried != MeshRepair::kFill && tried != MeshRepair::kAuto) {
+        absl::StrAppend(&remedy, "--repair fill closes holes (no vertex moves), ");
+      }
+      absl::StrAppend(&remedy, wrap);
+    } else if (issue.code == "non_manifold_edges") {
+      if (tried == MeshRepair::kNone) {
+        remedy = "--repair safe removes duplicate triangles and walls stored twice, ";
+      }
+      absl::StrAppend(&remedy, wrap);
+    } else if (issue.code == "not_orientable" || issue.code == "no_volume" ||
+               issue.code == "inconsistent_orientation") {
+      remedy = wrap;
+    }
+    if (!remedy.empty() && issue.message.find("--repair wrap") == std::string::npos) {
+      absl::StrAppend(&issue.message, "; ", remedy);
+    }
+  }
 }
 
 // Appends why the holes stay open to the "not closed" error, the one line users see.
@@ -439,9 +466,24 @@ bool WeldCoincidentVertices(Mesh& mesh, double tolerance, MeshReport& report) {
 
 
 // MeshRepair::kSafe: removes triangles that repeat an earlier one's corners in the same cyclic
-// order, then every pair of triangles with the same corners in opposite orders (a wall stored
-// once for each of the two bodies it separates). Kept triangles keep their order.
+// order, then deals with each pair of triangles with the same corners in opposite orders: when
+// each of its edges is in four or more triangles, a wall stored once for each of the two
+// bodies it separates, both go (the bodies' union is left); otherwise a face listed twice, the
+// later copy goes (the orientation fix then turns the kept one as its neighbours need). Kept
+// triangles keep their order.
 void RemoveDuplicatesAndDoubleWalls(Mesh& mesh, MeshReport& report) {
+  // How many triangles use each edge, looked up by (lo, hi).
+  const std::vector<EdgeUse> uses = internal::SortedEdgeUses(mesh);
+  const EdgeGroups groups = GroupEdges(uses);
+  auto edge_uses = [&](std::int32_t a, std::int32_t b) -> std::size_t {
+    const std::int32_t lo = std::min(a, b), hi = std::max(a, b);
+    const auto it = std::lower_bound(
+        groups.ranges.begin(), groups.ranges.end(), std::make_pair(lo, hi),
+        [&](const std::pair<std::size_t, std::size_t>& r, const std::pair<std::int32_t, std::int32_t>& e) {
+          return std::make_pair(uses[r.first].lo, uses[r.first].hi) < e;
+        });
+    return it == groups.ranges.end() ? 0 : it->second - it->first;
+  };
   // Key: the corners rotated so that the smallest comes first (same cyclic order, same key),
   // and the parity of the order (+1: rising after the smallest corner, -1: falling).
   struct Key {
@@ -482,8 +524,16 @@ void RemoveDuplicatesAndDoubleWalls(Mesh& mesh, MeshReport& report) {
           static_cast<std::int64_t>(rising.size() + falling.size()) -
           (rising.empty() ? 0 : 1) - (falling.empty() ? 0 : 1);
       if (!rising.empty() && !falling.empty()) {
-        removed[rising[0]] = removed[falling[0]] = 1;
-        ++report.double_walls_removed;
+        const std::array<std::int32_t, 3>& c = keys[i].sorted;
+        const bool wall = edge_uses(c[0], c[1]) >= 4 && edge_uses(c[1], c[2]) >= 4 &&
+                          edge_uses(c[0], c[2]) >= 4;
+        if (wall) {
+          removed[rising[0]] = removed[falling[0]] = 1;
+          ++report.double_walls_removed;
+        } else {
+          removed[std::max(rising[0], falling[0])] = 1;
+          ++report.duplicate_triangles_removed;
+        }
       }
     }
     i = j;
@@ -501,7 +551,7 @@ void RemoveDuplicatesAndDoubleWalls(Mesh& mesh, MeshReport& report) {
              absl::StrCat("removed ",
                           Plural(report.duplicate_triangles_removed, "triangle that repeats",
                                  "triangles that repeat"),
-                          " an earlier one's corners in the same order"),
+                          " an earlier one's corners"),
              report.duplicate_triangles_removed);
   }
   if (report.double_walls_removed > 0) {
@@ -712,8 +762,8 @@ ValidatedMesh ValidateSteps(Mesh mesh, const ValidateOptions& options, Mesh* sou
     if (mesh.num_triangles() == 0) {
       AddIssue(report, Severity::kError, "no_triangles",
                "mesh has no triangles left once the walls stored twice were removed: a sheet "
-               "stored in both orientations bounds no solid (--repair wrap makes a thin solid "
-               "around it)",
+               "stored in both orientations bounds no solid; --repair wrap makes a thin solid "
+               "around it",
                0);
       return ValidatedMesh{std::move(mesh), std::move(report)};
     }
@@ -736,7 +786,7 @@ ValidatedMesh ValidateSteps(Mesh mesh, const ValidateOptions& options, Mesh* sou
   if (report.usable() && !(report.volume > 0.0)) {
     AddIssue(report, Severity::kError, "no_volume",
              absl::StrFormat("mesh encloses no volume (signed volume %g): a sheet or flat part "
-                             "bounds no solid; --repair wrap makes a thin solid around it",
+                             "bounds no solid",
                              report.volume),
              0);
   }
@@ -789,6 +839,7 @@ ValidatedMesh ValidateSteps(Mesh mesh, const ValidateOptions& options, Mesh* sou
                    [](const MeshIssue& a, const MeshIssue& b) {
                      return static_cast<int>(a.severity) < static_cast<int>(b.severity);
                    });
+  AppendRemedies(report, options.repair.level);
   return ValidatedMesh{std::move(mesh), std::move(report)};
 }
 

@@ -109,7 +109,7 @@ int main(int argc, char** argv) {
   app.add_option("--sizes", sizes, "Icosphere subdivision levels (20 * 4^L triangles)");
   CLI11_PARSE(app, argc, argv);
   const int failures = inscribe::CorpusTable();
-  std::printf("## The wrap at the default alpha (diagonal / 100), against validation alone\n\n");
+  std::printf("## The wrap at the default alpha (diagonal / 50), against validation alone\n\n");
   std::printf("| input | triangles | none, s | wrap, s | wrap / none | wrap triangles | alpha | "
               "offset | reach / offset | usable |\n");
   std::printf("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n");

@@ -86,8 +86,8 @@ TEST(CliInfo, FillHolesMakesTheOpenPigUsable) {
   EXPECT_TRUE(j.at("usable").get<bool>());
   EXPECT_EQ(j.at("triangles").get<int>(), 891);  // as given
   EXPECT_EQ(j.at("counts").at("border_edges").get<int>(), 55);
-  EXPECT_EQ(j.at("holes_filled").get<int>(), 7);
-  EXPECT_EQ(j.at("hole_triangles_added").get<int>(), 41);
+  EXPECT_EQ(j.at("repair").at("holes_filled").get<int>(), 7);
+  EXPECT_EQ(j.at("repair").at("hole_triangles_added").get<int>(), 41);
   EXPECT_GT(j.at("volume").get<double>(), 0.0);
   bool reported = false;
   for (const auto& issue : j.at("issues")) {

@@ -25,7 +25,7 @@ using testing::BrokenMeshCorpus;
 using testing::WindingOracle;
 
 // The wrap's alpha for these small meshes: a twentieth of the diagonal (the default, a
-// hundredth, makes tens of thousands of triangles: TakesItsDefaultsFromTheMeshesSize).
+// fiftieth, makes thousands of triangles: TakesItsDefaultsFromTheMeshesSize).
 ValidatedMesh Repaired(const Mesh& mesh, MeshRepair level) {
   ValidateOptions options;
   options.repair.level = level;

@@ -56,7 +56,7 @@ void AddRepairOptions(CLI::App* cmd, RepairOptions* repair) {
   cmd->add_option("--wrap-alpha", repair->wrap_alpha,
                   "The wrap's alpha (mesh units): gaps and holes narrower than about this are "
                   "bridged; smaller costs more (about 1/alpha^2). Default: the bounding box's "
-                  "diagonal / 100")
+                  "diagonal / 50")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--wrap-offset", repair->wrap_offset,
                   "How far outside the input triangles the wrap lies (mesh units). Default: "

@@ -683,7 +683,7 @@ double CrackWeldTolerance(const Mesh& mesh) {
   return std::max(tolerance, 1e-9 * diagonal);
 }
 
-double DefaultWrapAlpha(double diagonal) { return diagonal / 100.0; }
+double DefaultWrapAlpha(double diagonal) { return diagonal / 50.0; }
 double DefaultWrapOffset(double alpha) { return alpha / 30.0; }
 
 bool MeshReport::usable() const {

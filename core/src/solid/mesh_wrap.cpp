@@ -14,11 +14,13 @@
 #include <atomic>
 #include <cmath>
 #include <cstddef>
+#include <limits>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "mesh/mesh_topology.h"
+#include "solid/closest_point_triangle.h"
 #include "solid/triangle_bvh.h"
 
 namespace inscribe::internal {
@@ -158,63 +160,70 @@ std::string CheckWrapEncloses(const Mesh& wrap, const Mesh& input) {
 
 double WrapReachBound(const Mesh& wrap, const Mesh& input) {
   const TriangleBvh bvh = TriangleBvh::Build(input);
-  // Distances from the wrap's vertices to the input, padded for the rounding of the closest
-  // point's computation (relative 1e-12, far above its error for coordinates below
-  // kMaxMeshCoordinate).
-  auto distance = [&bvh](const Vector3& p) {
-    const BoundaryPoint closest = bvh.ClosestPoint(p);
-    return (p - closest.point).norm() * (1.0 + 1e-12) + 1e-300;
+  // Rounding: the closest-point computation errs far below a 1e-12 relative and 1e-14 of the
+  // coordinates' magnitude absolute pad.
+  const double magnitude = std::max(input.vertices.cwiseAbs().maxCoeff(),
+                                    wrap.vertices.cwiseAbs().maxCoeff());
+  auto padded = [magnitude](double d) { return d * (1.0 + 1e-12) + 1e-14 * magnitude; };
+  auto to_triangle = [&input](const Vector3& p, std::int32_t t) {
+    Vector3 weights;
+    const Vector3 q = ClosestPointOnTriangle(
+        p, input.vertices.row(input.triangles(t, 0)).transpose(),
+        input.vertices.row(input.triangles(t, 1)).transpose(),
+        input.vertices.row(input.triangles(t, 2)).transpose(), &weights);
+    return (p - q).norm();
   };
-  std::vector<double> corner(static_cast<std::size_t>(wrap.num_vertices()), 0.0);
+  // The distance to one input triangle is convex, so over a wrap triangle it peaks at a corner:
+  // sup over the triangle of the distance to the input is at most, for any input triangle j,
+  // the largest corner distance to j. Candidates j: the triangles nearest to the corners and
+  // the centroid.
+  struct Corner {
+    Vector3 p;
+    std::int32_t nearest;
+    double d;
+  };
+  auto corner_of = [&](const Vector3& p) {
+    const BoundaryPoint closest = bvh.ClosestPoint(p);
+    return Corner{p, closest.triangle, (p - closest.point).norm()};
+  };
+  std::vector<Corner> corners(static_cast<std::size_t>(wrap.num_vertices()));
   tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, wrap.vertices.rows()),
                     [&](const tbb::blocked_range<Eigen::Index>& r) {
                       for (Eigen::Index v = r.begin(); v != r.end(); ++v) {
-                        corner[static_cast<std::size_t>(v)] =
-                            distance(wrap.vertices.row(v).transpose());
+                        corners[static_cast<std::size_t>(v)] =
+                            corner_of(wrap.vertices.row(v).transpose());
                       }
                     });
-  // Every corner distance is a distance some point of the wrap has: the largest is a lower
-  // bound on the reach, and a triangle's bound needs no refining once it is near that.
-  const double floor = corner.empty() ? 0.0 : *std::max_element(corner.begin(), corner.end());
-  struct Corner {
-    Vector3 p;
-    double d;
-  };
-  const double pad = 1.0 + 1e-12;
-  // Over the triangle (a, b, c): each point x is within |x - q| of any point q whose distance
-  // to the input is known, and the farthest point of a triangle from q is a corner; q runs over
-  // the corners and the centroid.
-  auto bound = [&](const Corner& a, const Corner& b, const Corner& c, const Corner& m) {
-    const double ab = (a.p - b.p).norm(), bc = (b.p - c.p).norm(), ca = (c.p - a.p).norm();
-    const double to_m =
-        std::max({(a.p - m.p).norm(), (b.p - m.p).norm(), (c.p - m.p).norm()}) * pad;
-    return std::min({a.d + std::max(ab, ca) * pad, b.d + std::max(ab, bc) * pad,
-                     c.d + std::max(bc, ca) * pad, m.d + to_m});
-  };
-  auto centroid = [&](const Corner& a, const Corner& b, const Corner& c) {
-    const Vector3 p = (a.p + b.p + c.p) / 3;
-    return Corner{p, distance(p)};
+  // The largest corner distance is attained: a lower bound on the answer, and the level below
+  // which a triangle's bound needs no refining.
+  double floor = 0.0;
+  for (const Corner& c : corners) floor = std::max(floor, c.d);
+  auto bound = [&](const Corner& a, const Corner& b, const Corner& c) {
+    const Corner m = corner_of((a.p + b.p + c.p) / 3);
+    double best = std::numeric_limits<double>::infinity();
+    for (const std::int32_t j : {a.nearest, b.nearest, c.nearest, m.nearest}) {
+      best = std::min(best, std::max({to_triangle(a.p, j), to_triangle(b.p, j),
+                                      to_triangle(c.p, j)}));
+    }
+    return padded(best);
   };
   auto refine = [&](auto&& self, const Corner& a, const Corner& b, const Corner& c,
                     int depth) -> double {
-    const double here = bound(a, b, c, centroid(a, b, c));
+    const double here = bound(a, b, c);
     if (depth == 0 || here <= 1.25 * floor) return here;
-    const Corner ab{(a.p + b.p) / 2, distance((a.p + b.p) / 2)};
-    const Corner bc{(b.p + c.p) / 2, distance((b.p + c.p) / 2)};
-    const Corner ca{(c.p + a.p) / 2, distance((c.p + a.p) / 2)};
+    const Corner ab = corner_of((a.p + b.p) / 2);
+    const Corner bc = corner_of((b.p + c.p) / 2);
+    const Corner ca = corner_of((c.p + a.p) / 2);
     return std::max({self(self, a, ab, ca, depth - 1), self(self, ab, b, bc, depth - 1),
                      self(self, ca, bc, c, depth - 1), self(self, ab, bc, ca, depth - 1)});
   };
   return tbb::parallel_reduce(
-      tbb::blocked_range<Eigen::Index>(0, wrap.triangles.rows()), floor,
+      tbb::blocked_range<Eigen::Index>(0, wrap.triangles.rows()), padded(floor),
       [&](const tbb::blocked_range<Eigen::Index>& r, double worst) {
         for (Eigen::Index t = r.begin(); t != r.end(); ++t) {
-          Corner c[3];
-          for (int k = 0; k < 3; ++k) {
-            const std::int32_t v = wrap.triangles(t, k);
-            c[k] = Corner{wrap.vertices.row(v).transpose(), corner[static_cast<std::size_t>(v)]};
-          }
-          worst = std::max(worst, refine(refine, c[0], c[1], c[2], 4));
+          worst = std::max(worst, refine(refine, corners[wrap.triangles(t, 0)],
+                                         corners[wrap.triangles(t, 1)],
+                                         corners[wrap.triangles(t, 2)], 4));
         }
         return worst;
       },

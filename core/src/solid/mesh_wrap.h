@@ -25,12 +25,12 @@ absl::StatusOr<Mesh> AlphaWrap(const Mesh& soup, double alpha, double offset);
 std::string CheckWrapEncloses(const Mesh& wrap, const Mesh& input);
 
 // An upper bound on the distance from any point of `wrap`'s triangles to the nearest triangle
-// of `input` (mesh units). Per wrap triangle: for each of its corners and its centroid, the
-// distance to the input (closest point over a BVH, padded for rounding) plus that point's
-// farthest distance to the rest of the triangle (a corner: the triangle is convex), which
-// bounds every point of it by the triangle inequality; the least of those. A triangle whose
-// bound exceeds 1.25 times the largest corner distance (a lower bound on the answer) is split
-// in four, four levels deep at most. Parallel (TBB).
+// of `input` (mesh units). The distance to one input triangle is convex, so over a wrap
+// triangle it is at most its largest value at the corners; the bound of a wrap triangle is the
+// least of those over the input triangles nearest to its corners and centroid (closest points
+// over a BVH; padded for rounding). A triangle whose bound exceeds 1.25 times the largest
+// corner distance (which the wrap attains: a lower bound on the answer) is split in four, four
+// levels deep at most. Parallel (TBB).
 double WrapReachBound(const Mesh& wrap, const Mesh& input);
 
 }  // namespace inscribe::internal

@@ -157,7 +157,7 @@ absl::StatusOr<MeshRepair> ParseMeshRepair(const std::string& name);
 double CrackWeldTolerance(const Mesh& mesh);
 
 // The wrap's default parameters for a mesh whose bounding box has diagonal `diagonal`:
-// alpha = diagonal / 100, offset = alpha / 30 (CGAL's recommended ratio).
+// alpha = diagonal / 50, offset = alpha / 30 (CGAL's recommended ratio).
 double DefaultWrapAlpha(double diagonal);
 double DefaultWrapOffset(double alpha);
 

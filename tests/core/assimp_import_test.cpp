@@ -383,5 +383,22 @@ TEST_F(AssimpImportTest, EmbeddedBuffersThatAreNotBase64AreRefused) {
               AllOf(HasSubstr("gltf data"), HasSubstr("buffers[0] is an embedded (data:) URI")));
 }
 
+// assimp 5.2 crashed on an indexed LINE_LOOP whose first line has an index past the positions
+// (fuzz_scene, seed glb-line-loop-index-past-positions); lines are not read, so such a
+// primitive is refused.
+TEST_F(AssimpImportTest, IndexedLineLoopsAreRefused) {
+  const std::unique_ptr<aiScene> scene =
+      MakeScene({testing::UnitCube()}, {{0, Eigen::Matrix4d::Identity()}});
+  const std::string path = Export(*scene, "gltf2", "cube.gltf");
+  nlohmann::json gltf = nlohmann::json::parse(Contents(path));
+  ASSERT_TRUE(gltf["meshes"][0]["primitives"][0].contains("indices"));
+  gltf["meshes"][0]["primitives"][0]["mode"] = 2;
+  const std::string edited = Write("cube.gltf", gltf.dump());
+  absl::StatusOr<Mesh> read = ReadMesh(edited);
+  EXPECT_EQ(read.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(read.status().message(),
+              AllOf(HasSubstr(edited), HasSubstr("indexed LINE_LOOP primitive")));
+}
+
 }  // namespace
 }  // namespace inscribe

@@ -125,6 +125,8 @@ void ColladaSeeds(const std::string& dir) {
   const std::size_t p = dae.find("<p>");
   Seed(dir, "dae-index-out-of-range", kDae, std::string(dae).replace(p, 4, "<p>4000000 "));
   Seed(dir, "dae-mismatched-tag", kDae, Edited(dae, "<instance_geometry", "<instance_nothing"));
+  // A letter in an index list: assimp 5.2 stalls on it, appending zeros until memory runs out.
+  Seed(dir, "dae-index-list-letter", kDae, std::string(dae).insert(p + 3, "0 x "));
 
   const std::unique_ptr<aiScene> quads =
       inscribe::testing::MakeScene({cube}, {{0, Eigen::Matrix4d::Identity()}});
@@ -361,6 +363,14 @@ void GltfSeeds(const std::string& dir) {
         {"values", {{"bufferView", vv}}}};
     g.Node(g.MeshOf({Gltf::Primitive(p, i)}));
     Both(dir, "sparse", g);
+    // Broken: the indices without their view (assimp 5.2 reads through a null pointer), and
+    // more moved corners than the views hold.
+    json& sparse = g.Json()["accessors"][p]["sparse"];
+    sparse["indices"].erase("bufferView");
+    Both(dir, "sparse-indices-without-view", g);
+    sparse["indices"]["bufferView"] = iv;
+    sparse["count"] = 3;
+    Both(dir, "sparse-count-past-views", g);
   }
   {  // Broken: an index past the positions, an accessor past its view, a NaN position.
     Gltf g;
@@ -377,6 +387,8 @@ void GltfSeeds(const std::string& dir) {
     const auto [np, ni] = n.Add(nan, kUint16);
     n.Node(n.MeshOf({Gltf::Primitive(np, ni)}));
     Both(dir, "nan", n);
+    // Not base64: assimp 5.2 leaked its decoding buffer on a byte above 0x7f.
+    Seed(dir, "gltf-data-uri-not-base64", kGltf, Edited(n.Text(), ";base64,", ";base64,\xc3\xa9"));
   }
   {  // Empty: a scene of nodes without meshes.
     Gltf g;

@@ -68,7 +68,7 @@ absl::StatusOr<MjcfGeom> ReadGeom(const Node& node, const Attributes& a,
     if (!rotation.ok() || (from - to).norm() < 1e-10) {
       return AttributeError(a.at("fromto"), "fromto", "its two points coincide");
     }
-    origin.xyz = 0.5 * (from + to);
+    origin.xyz = from + 0.5 * (to - from);  // no overflow where from + to would
     origin.rotation = *rotation;
     // The half length along the axis; boxes and ellipsoids take size[0] across it both ways.
     const double half = 0.5 * (from - to).norm();
@@ -138,6 +138,9 @@ absl::StatusOr<MjcfGeom> ReadGeom(const Node& node, const Attributes& a,
     }
   }
   if (!sized.ok()) return sized;
+  if (!std::isfinite(shape.length) || !shape.size.allFinite()) {
+    return ErrorAt(node, absl::StrCat("<geom size=\"", Text(a, "size"), "\">: too large"));
+  }
   if (geom.type != MjcfGeomType::kMesh && a.count("mesh")) {
     return ErrorAt(node, absl::StrCat("<geom type=\"", type,
                                       "\" mesh=...>: a primitive fitted to a mesh is not read; "

@@ -386,8 +386,8 @@ absl::Status Reader::ReadJoint(const Node& node, int body, const std::string& ch
   }
   absl::StatusOr<Vector3> axis = Vector(a, "axis", Vector3::UnitZ());
   if (!axis.ok()) return axis.status();
-  if (!(axis->norm() > 1e-15)) {
-    return AttributeError(a.at("axis"), "axis", "the axis is zero");
+  if (const double norm = axis->norm(); !(std::isfinite(norm) && norm > 1e-15)) {
+    return AttributeError(a.at("axis"), "axis", "the axis is zero (or too long to normalise)");
   }
   const bool hinge = joint.type == MjcfJointType::kHinge;
   const double unit = hinge && compiler_.angles.degrees ? M_PI / 180.0 : 1.0;
@@ -408,6 +408,9 @@ absl::Status Reader::ReadJoint(const Node& node, int body, const std::string& ch
   if (limited && *range) {
     lower = (**range)[0] * unit - joint.ref;
     upper = (**range)[1] * unit - joint.ref;
+    if (!std::isfinite(lower) || !std::isfinite(upper)) {
+      return AttributeError(a.at("range"), "range", "too large (less ref)");
+    }
     if (lower > upper) {
       return AttributeError(a.at("range"), "range", "the lower limit is above the upper one");
     }

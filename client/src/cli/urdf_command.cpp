@@ -425,6 +425,8 @@ void AddUrdfCommand(CLI::App& app, CommandOutcome* outcome) {
       "Spherize a robot: every link's collision meshes (visual when it has none; box, "
       "cylinder and sphere too) become spheres in the link's frame, certified covers by "
       "default; writes the URDF with sphere collisions and cuRobo's collision_spheres YAML. "
+      "A MuJoCo model (MJCF) is read too: every body's collision geoms (capsules and "
+      "ellipsoids too) become spheres in the body's frame, written as cuRobo YAML to -o. "
       "Links that cannot be done are named, kept as they were, and make the exit status 1");
   cmd->alias("robot");
   cmd->add_option("ROBOT", options->urdf_path,

@@ -6,6 +6,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <random>
 #include <string>
 #include <vector>
@@ -13,6 +15,8 @@
 #include "absl/strings/str_cat.h"
 #include "inscribe/robot/kinematics.h"
 #include "inscribe/robot/mjcf_robot.h"
+#include "inscribe/robot/robot_file.h"
+#include "inscribe/robot/spherized_mjcf.h"
 #include "inscribe/robot/urdf_spherize.h"
 #include "mjcf_test_models.h"
 
@@ -219,6 +223,81 @@ TEST(MjcfAgainstMujoco, HandWithManySmallBodies) {
 
 TEST(MjcfAgainstMujoco, QuadrupedWithFreeAndBallJoints) {
   ExpectSamePoses(WriteQuadruped(FreshFolder("mjcf_quadruped")), 50);
+}
+
+// The spherized model MuJoCo loads: the same bodies with the same masses and inertias (the
+// solid geoms keep them, the spheres weigh nothing), one sphere geom per sphere with the
+// solid's contact settings, the solid geoms no longer colliding, and every sphere where our
+// kinematics puts it at random configurations.
+void ExpectSpherizedModelLoads(const std::string& path) {
+  absl::StatusOr<RobotFile> file = ReadRobotFile(path);
+  ASSERT_TRUE(file.ok()) << file.status();
+  UrdfSpherizeOptions options;
+  options.max_spheres_per_link = 5;
+  absl::StatusOr<RobotSpherizeResult> spherized = SpherizeRobot(file->robot(), options);
+  ASSERT_TRUE(spherized.ok()) << spherized.status();
+  const std::string out_folder = FreshFolder("mjcf_spherized_out");
+  absl::StatusOr<std::string> text = SpherizedMjcf(*file, spherized->links, out_folder);
+  ASSERT_TRUE(text.ok()) << text.status();
+  const std::string out = out_folder + "/spherized.xml";
+  std::ofstream(out) << *text;
+  MujocoModel original(path), spheres(out);
+  ASSERT_NE(spheres.model, nullptr) << spheres.error << "\n" << *text;
+  const mjModel& a = *original.model;
+  const mjModel& b = *spheres.model;
+  ASSERT_EQ(a.nbody, b.nbody);
+  for (int i = 0; i < a.nbody; ++i) {
+    EXPECT_NEAR(a.body_mass[i], b.body_mass[i], 1e-12 * (1 + a.body_mass[i])) << i;
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_NEAR(a.body_inertia[3 * i + k], b.body_inertia[3 * i + k],
+                  1e-12 * (1 + a.body_inertia[3 * i + k]));
+    }
+  }
+  std::size_t total = 0;
+  for (const LinkSpherizeResult& link : spherized->links) total += link.spheres.size();
+  int sphere_geoms = 0;
+  for (int g = 0; g < b.ngeom; ++g) {
+    if (b.geom_group[g] == 3 && b.geom_type[g] == mjGEOM_SPHERE && b.geom_contype[g] == 1) {
+      ++sphere_geoms;
+    }
+  }
+  EXPECT_EQ(sphere_geoms, static_cast<int>(total));
+  // Every other geom that collided before was a solid one and collides no more.
+  EXPECT_EQ(b.ngeom, a.ngeom + static_cast<int>(total));
+  absl::StatusOr<Kinematics> kinematics = Kinematics::Create(file->robot());
+  ASSERT_TRUE(kinematics.ok());
+  std::mt19937_64 random(3);
+  std::uniform_real_distribution<double> angle(-M_PI, M_PI);
+  double worst = 0.0;
+  for (int sample = 0; sample < 10; ++sample) {
+    std::vector<double> q;
+    for (std::size_t v = 0; v < kinematics->variables().size(); ++v) q.push_back(angle(random));
+    const std::vector<double> qpos = Qpos(*file->mjcf, *kinematics, q, b);
+    std::copy(qpos.begin(), qpos.end(), spheres.data->qpos);
+    mj_kinematics(spheres.model, spheres.data);
+    const std::vector<Eigen::Isometry3d> poses = *kinematics->LinkPoses(q);
+    std::vector<std::size_t> next(static_cast<std::size_t>(b.nbody), 0);
+    for (int g = 0; g < b.ngeom; ++g) {
+      if (b.geom_group[g] != 3 || b.geom_type[g] != mjGEOM_SPHERE || b.geom_contype[g] != 1) {
+        continue;
+      }
+      const int body = b.geom_bodyid[g];
+      const MjcfBody& mjcf_body = file->mjcf->bodies[static_cast<std::size_t>(body)];
+      const LinkSpherizeResult& link = spherized->links[static_cast<std::size_t>(mjcf_body.link)];
+      ASSERT_LT(next[static_cast<std::size_t>(body)], link.spheres.size());
+      const Sphere& sphere = link.spheres[next[static_cast<std::size_t>(body)]++];
+      const Vector3 ours = poses[static_cast<std::size_t>(mjcf_body.link)] * sphere.center;
+      worst = std::max(worst, (ours - Vec(spheres.data->geom_xpos + 3 * g)).norm());
+      EXPECT_EQ(b.geom_size[3 * g], sphere.radius);
+    }
+  }
+  EXPECT_LT(worst, 1e-9);
+}
+
+TEST(MjcfAgainstMujoco, SpherizedModelsLoadWithTheSameMassesAndSpheresInPlace) {
+  const std::string folder = FreshFolder("mjcf_spherized");
+  ExpectSpherizedModelLoads(WriteArm(folder + "/arm"));
+  ExpectSpherizedModelLoads(WriteQuadruped(folder + "/quadruped"));
 }
 
 #else

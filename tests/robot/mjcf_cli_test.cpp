@@ -28,7 +28,7 @@ TEST(MjcfCli, EveryBodySpherizedIntoTheYaml) {
   const std::string folder = FreshFolder("mjcf_cli");
   const std::string model = WriteArm(folder);
   const CliRun run = RunCli("robot " + model + " -o " + folder +
-                            "/arm.yml --max-spheres-per-link 5 --samples 100 --json");
+                            "/arm_spheres.xml --max-spheres-per-link 5 --samples 100 --json");
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const nlohmann::json report = nlohmann::json::parse(run.out);
   EXPECT_EQ(report["format"], "mjcf");
@@ -44,6 +44,10 @@ TEST(MjcfCli, EveryBodySpherizedIntoTheYaml) {
   EXPECT_EQ(listed, (std::set<std::string>{"world", "base", "shoulder", "upper", "fore", "hand",
                                            "camera_mount"}));
   EXPECT_THAT(run.err, HasSubstr("'camera_mount'"));  // visual geoms stand in
+  // The spherized model is the library's, and the YAML sits beside it.
+  EXPECT_EQ(report["output"], folder + "/arm_spheres.xml");
+  EXPECT_EQ(report["yaml"], folder + "/arm_spheres.yml");
+  EXPECT_THAT(Slurp(folder + "/arm_spheres.xml"), HasSubstr("class=\"inscribe_sphere\""));
   // The YAML holds every spherized body, as the library spherizes it.
   absl::StatusOr<MjcfModel> parsed = ReadMjcf(model);
   ASSERT_TRUE(parsed.ok());
@@ -51,7 +55,8 @@ TEST(MjcfCli, EveryBodySpherizedIntoTheYaml) {
   options.max_spheres_per_link = 5;
   absl::StatusOr<RobotSpherizeResult> library = SpherizeRobot(parsed->robot, options);
   ASSERT_TRUE(library.ok());
-  absl::StatusOr<std::vector<LinkSpheres>> yaml = ParseCuroboYaml(Slurp(folder + "/arm.yml"));
+  absl::StatusOr<std::vector<LinkSpheres>> yaml =
+      ParseCuroboYaml(Slurp(folder + "/arm_spheres.yml"));
   ASSERT_TRUE(yaml.ok()) << yaml.status();
   std::map<std::string, std::vector<Sphere>> written;
   for (const LinkSpheres& link : *yaml) written[link.link] = link.spheres;
@@ -70,7 +75,7 @@ TEST(MjcfCli, EveryBodySpherizedIntoTheYaml) {
   }
   // The table names the bodies and no joint-chain link; `urdf` reads it the same way.
   const CliRun table =
-      RunCli("urdf " + model + " -o " + folder + "/arm2.yml --max-spheres-per-link 3");
+      RunCli("urdf " + model + " -o " + folder + "/arm2.xml --max-spheres-per-link 3");
   ASSERT_EQ(table.exit_code, 0) << table.err;
   EXPECT_THAT(table.out, HasSubstr("camera_mount"));
   EXPECT_THAT(table.out, ::testing::Not(HasSubstr("fore/elbow")));
@@ -80,16 +85,17 @@ TEST(MjcfCli, SolidByGroupAndRefusals) {
   const std::string folder = FreshFolder("mjcf_cli_refusals");
   const std::string model = WriteArm(folder);
   const CliRun group = RunCli("robot " + model + " -o " + folder +
-                              "/g.yml --solid-group 2 --max-spheres-per-link 3 --json");
+                              "/g.xml --solid-group 2 --max-spheres-per-link 3 --json");
   ASSERT_EQ(group.exit_code, 0) << group.err;
   // Group 2 (the visual class) leaves the upper arm without solid geoms: its others stand in.
   EXPECT_THAT(group.err, HasSubstr("body 'upper'"));
-  const CliRun yaml = RunCli("robot " + model + " -o " + folder + "/a.yml --yaml b.yml");
-  EXPECT_EQ(yaml.exit_code, 64);
-  EXPECT_THAT(yaml.err, HasSubstr("give no --yaml"));
+  const CliRun same =
+      RunCli("robot " + model + " -o " + folder + "/a.xml --yaml " + folder + "/a.xml");
+  EXPECT_EQ(same.exit_code, 64);
+  EXPECT_THAT(same.err, HasSubstr("would overwrite"));
   WriteText(folder + "/bad.xml",
             "<mujoco>\n<worldbody>\n<geom type=\"cone\"/>\n</worldbody>\n</mujoco>");
-  const CliRun bad = RunCli("robot " + folder + "/bad.xml -o " + folder + "/bad.yml");
+  const CliRun bad = RunCli("robot " + folder + "/bad.xml -o " + folder + "/bad_out.xml");
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_THAT(bad.err, HasSubstr("bad.xml line 3: <geom type=\"cone\">"));
   WriteText(folder + "/r.urdf", "<robot name=\"r\"><link name=\"a\"/></robot>");

@@ -23,6 +23,7 @@
 #include "inscribe/robot/robot_file.h"
 #include "inscribe/robot/self_collision.h"
 #include "inscribe/robot/self_collision_srdf.h"
+#include "inscribe/robot/spherized_mjcf.h"
 #include "inscribe/robot/spherized_urdf.h"
 #include "inscribe/robot/urdf_robot.h"
 #include "inscribe/robot/urdf_spherize.h"
@@ -116,10 +117,9 @@ absl::StatusOr<UrdfSpherizeOptions> SpherizeOptionsOf(const UrdfCliOptions& opti
   return spherize;
 }
 
-// --yaml, or OUT with its extension replaced by .yml; for an MJCF model, OUT itself.
-std::string YamlPath(const UrdfCliOptions& options, bool mjcf) {
+// --yaml, or OUT with its extension replaced by .yml.
+std::string YamlPath(const UrdfCliOptions& options) {
   if (!options.yaml_path.empty()) return options.yaml_path;
-  if (mjcf) return options.output_path;
   return fs::path(options.output_path).replace_extension(".yml").string();
 }
 
@@ -191,7 +191,7 @@ void PrintJson(const UrdfCliOptions& options, const UrdfSpherizeOptions& spheriz
   report["urdf"] = options.urdf_path;
   report["format"] = robot::RobotFormatName(file.format);
   report["robot"] = file.robot().name;
-  report["output"] = file.format == robot::RobotFormat::kUrdf ? options.output_path : "";
+  report["output"] = options.output_path;
   report["yaml"] = yaml_path;
   report["kind"] = SphereSetKindName(spherize.kind);
   report["padding"] = spherize.padding;
@@ -265,8 +265,7 @@ void PrintTable(const robot::RobotFile& file, const RobotSpherizeResult& result,
     spheres += static_cast<std::int64_t>(link.spheres.size());
   }
   if (matrix) std::cout << MatrixSummary(*matrix) << "\n";
-  const std::string written =
-      file.format == robot::RobotFormat::kUrdf ? output_path + ", " + yaml_path : yaml_path;
+  const std::string written = output_path + ", " + yaml_path;
   std::cout << absl::StrFormat("wrote %s%s (%d spheres) in %.3f s", written,
                                srdf_path.empty() ? "" : " and " + srdf_path, spheres, seconds);
   if (skipped > 0) std::cout << absl::StrFormat("; %d link(s) skipped, kept as they were", skipped);
@@ -295,11 +294,8 @@ absl::Status RunUrdf(const UrdfCliOptions& options) {
     return UsageError("--solid-class and --solid-group choose MJCF geoms; " + options.urdf_path +
                       " is a URDF (its links' <collision> elements are the solid)");
   }
-  if (is_mjcf && !options.yaml_path.empty()) {
-    return UsageError("an MJCF model's spheres are written as cuRobo YAML to -o; give no --yaml");
-  }
-  const std::string yaml_path = YamlPath(options, is_mjcf);
-  if (!is_mjcf && SameFile(yaml_path, options.output_path)) {
+  const std::string yaml_path = YamlPath(options);
+  if (SameFile(yaml_path, options.output_path)) {
     return UsageError("the YAML would overwrite -o " + options.output_path +
                       "; give --yaml PATH or an -o ending in .urdf");
   }
@@ -362,12 +358,14 @@ absl::Status RunUrdf(const UrdfCliOptions& options) {
               << kinematics.status().message() << "\n";
   }
 
-  std::vector<std::pair<std::string, std::string>> outputs;
-  if (!is_mjcf) {
-    absl::StatusOr<std::string> urdf = SpherizedUrdf(file->bytes, results);
-    if (!urdf.ok()) return BugError(urdf.status().message());  // ParseUrdf accepted them
-    outputs.emplace_back(options.output_path, *std::move(urdf));
-  }
+  absl::StatusOr<std::string> spherized_model =
+      is_mjcf
+          ? robot::SpherizedMjcf(*file, results, fs::absolute(options.output_path).parent_path())
+          : SpherizedUrdf(file->bytes, results);
+  // The parsers accepted these documents.
+  if (!spherized_model.ok()) return BugError(spherized_model.status().message());
+  std::vector<std::pair<std::string, std::string>> outputs = {
+      {options.output_path, *std::move(spherized_model)}};
   std::vector<std::string> left_out;
   std::string yaml;
   if (matrix) {
@@ -426,7 +424,8 @@ void AddUrdfCommand(CLI::App& app, CommandOutcome* outcome) {
       "cylinder and sphere too) become spheres in the link's frame, certified covers by "
       "default; writes the URDF with sphere collisions and cuRobo's collision_spheres YAML. "
       "A MuJoCo model (MJCF) is read too: every body's collision geoms (capsules and "
-      "ellipsoids too) become spheres in the body's frame, written as cuRobo YAML to -o. "
+      "ellipsoids too) become spheres in the body's frame, written as the MJCF with sphere "
+      "geoms and as cuRobo YAML. "
       "Links that cannot be done are named, kept as they were, and make the exit status 1");
   cmd->alias("robot");
   cmd->add_option("ROBOT", options->urdf_path,
@@ -477,7 +476,8 @@ void AddUrdfCommand(CLI::App& app, CommandOutcome* outcome) {
                   "= OFFSET in the link's frame (the side the normal points to) before "
                   "spherizing, e.g. a table under the base; repeatable");
   cmd->add_option("-o,--output", options->output_path,
-                  "The spherized URDF to write; for an MJCF model, the cuRobo YAML")
+                  "The spherized URDF to write; for an MJCF model, the spherized MJCF (one file, "
+                  "includes inlined)")
       ->required();
   cmd->add_option("--yaml", options->yaml_path,
                   "cuRobo collision_spheres YAML to write (default: -o with extension .yml)");

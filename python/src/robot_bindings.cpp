@@ -20,6 +20,7 @@
 #include "inscribe/robot/robot_file.h"
 #include "inscribe/robot/self_collision.h"
 #include "inscribe/robot/self_collision_srdf.h"
+#include "inscribe/robot/spherized_mjcf.h"
 #include "inscribe/robot/spherized_urdf.h"
 #include "inscribe/robot/urdf_robot.h"
 #include "inscribe/robot/urdf_spherize.h"
@@ -194,6 +195,20 @@ void BindRobot(py::module_& m) {
           },
           "The URDF text with one sphere <collision> per sphere in spherized links (URDF "
           "input only).")
+      .def(
+          "mjcf",
+          [](const SpherizedRobot& r, const std::string& directory) {
+            if (r.file.format != robot::RobotFormat::kMjcf) {
+              RaiseStatus(absl::InvalidArgumentError(r.file.path +
+                                                     " is a URDF: use urdf() for its spheres"));
+            }
+            return ValueOrRaise(robot::SpherizedMjcf(r.file, r.links, directory));
+          },
+          py::arg("directory"),
+          "The spherized MuJoCo model's text (MJCF input only), as `inscribe robot -o` writes "
+          "it, for a file in `directory` (mesh paths are written relative to it): every "
+          "spherized body's solid geoms kept for their mass but no longer colliding, one "
+          "massless group-3 sphere geom per sphere in the solid geom's class.")
       .def(
           "self_collision",
           [](const SpherizedRobot& r, std::int64_t samples, std::uint64_t seed,

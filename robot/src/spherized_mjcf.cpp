@@ -48,25 +48,14 @@ class Writer {
     document.InsertEndChild(mujoco);
     for (const auto& [name, value] : root.attributes)
       mujoco->SetAttribute(name.c_str(), value.c_str());
-    bool has_compiler = false, has_default = false;
-    for (const Node& child : root.children) {
-      has_compiler = has_compiler || child.name == "compiler";
-      has_default = has_default || child.name == "default";
-    }
+    bool has_compiler = false;
+    for (const Node& child : root.children) has_compiler = has_compiler || child.name == "compiler";
     if (!has_compiler) {
       tinyxml2::XMLElement* compiler = mujoco->InsertNewChildElement("compiler");
       compiler->SetAttribute("meshdir", Relative("").c_str());
       compiler->SetAttribute("texturedir", Relative("").c_str());
     }
-    if (!has_default) AddSphereClass(mujoco->InsertNewChildElement("default"));
-    bool class_added = !has_default;
-    for (const Node& child : root.children) {
-      tinyxml2::XMLElement* element = Copy(child, mujoco, /*body=*/-1);
-      if (child.name == "default" && !class_added) {
-        AddSphereClass(element);
-        class_added = true;
-      }
-    }
+    for (const Node& child : root.children) Copy(child, mujoco, /*body=*/-1);
     tinyxml2::XMLPrinter printer;
     document.Print(&printer);
     return printer.CStr();
@@ -79,15 +68,6 @@ class Writer {
     std::string relative = absolute.lexically_relative(output_).string();
     if (relative.empty()) relative = ".";
     return relative + "/";
-  }
-
-  void AddSphereClass(tinyxml2::XMLElement* main_default) {
-    tinyxml2::XMLElement* sphere = main_default->InsertNewChildElement("default");
-    sphere->SetAttribute("class", kSphereGeomClass);
-    tinyxml2::XMLElement* geom = sphere->InsertNewChildElement("geom");
-    geom->SetAttribute("type", "sphere");
-    geom->SetAttribute("group", 3);
-    geom->SetAttribute("mass", 0);
   }
 
   // `node` copied under `parent`; `body` is the index of the body it is in (-1 outside

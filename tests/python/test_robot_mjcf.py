@@ -84,6 +84,10 @@ def test_bodies_spherized_from_their_collision_geoms(tmp_path):
                                                                              "camera"}
     with pytest.raises(ValueError, match="MJCF model"):
         robot.urdf()
+    text = robot.mjcf(str(tmp_path))
+    total = sum(len(spheres) for spheres in robot.spheres.values())
+    assert text.count('group="3" mass="0"') == total  # one massless sphere geom per sphere
+    assert text.count('contype="0" conaffinity="0"') >= 3  # the solids no longer collide
 
 
 def test_solid_chosen_by_group_or_class(tmp_path):

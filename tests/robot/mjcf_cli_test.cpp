@@ -47,7 +47,7 @@ TEST(MjcfCli, EveryBodySpherizedIntoTheYaml) {
   // The spherized model is the library's, and the YAML sits beside it.
   EXPECT_EQ(report["output"], folder + "/arm_spheres.xml");
   EXPECT_EQ(report["yaml"], folder + "/arm_spheres.yml");
-  EXPECT_THAT(Slurp(folder + "/arm_spheres.xml"), HasSubstr("class=\"inscribe_sphere\""));
+  EXPECT_THAT(Slurp(folder + "/arm_spheres.xml"), HasSubstr("group=\"3\" mass=\"0\""));
   // The YAML holds every spherized body, as the library spherizes it.
   absl::StatusOr<MjcfModel> parsed = ReadMjcf(model);
   ASSERT_TRUE(parsed.ok());

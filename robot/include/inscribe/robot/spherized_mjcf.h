@@ -12,20 +12,16 @@
 
 namespace inscribe::robot {
 
-// The class the sphere geoms are in: group 3 (MuJoCo Menagerie's collision group), no mass.
-inline constexpr char kSphereGeomClass[] = "inscribe_sphere";
-
 // `file` (an MJCF RobotFile) with, in every body whose link is kSpherized in `links` (one per
 // file.robot() link, SpherizeRobot's order): each solid geom kept where it is with contype and
 // conaffinity 0 (it no longer collides, and still gives the body the mass and inertia MuJoCo
 // computed from it, so nothing is counted twice), and after the first of them one
-// `<geom class="inscribe_sphere" type="sphere" size="r" pos="x y z">` per sphere (the body's
-// frame, shortest round-trip decimals) with the solid geom's class and contact settings
-// (contype, conaffinity, condim, friction, solref, solimp, solmix, priority, margin, gap; its
-// own where written, else its class's; 1 and 1 when visual geoms stood in for a missing solid)
-// and mass 0. A `<default class="inscribe_sphere">` (group
-// 3, mass 0) is added under the main class. Visual geoms, explicit <inertial>s and everything
-// else are kept as written; <include>s are inlined; `meshdir` and `texturedir` are rewritten
+// `<geom type="sphere" size="r" pos="x y z" group="3" mass="0">` per sphere (the body's frame,
+// shortest round-trip decimals) in the solid geom's default class (Menagerie's `collision`),
+// with its contact settings (contype, conaffinity, condim, friction, solref, solimp, solmix,
+// priority, margin, gap; its own where written, else its class's; 1 and 1 when visual geoms
+// stood in for a missing solid). Visual geoms, explicit <inertial>s and everything else are
+// kept as written; <include>s are inlined; `meshdir` and `texturedir` are rewritten
 // relative to `output_directory` (absolute, the folder the result is written to) so the files
 // are found from there. INVALID_ARGUMENT for a URDF file or a wrong number of links.
 absl::StatusOr<std::string> SpherizedMjcf(const RobotFile& file,

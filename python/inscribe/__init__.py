@@ -3,7 +3,7 @@
 In-process (the C++ core, bound with pybind11): load_mesh, write_mesh, Mesh, Repair, prepare,
 generate, evaluate,
 certify, read_spheres, write_spheres, write_mesh, Hierarchy, distance, certified_distance, Scene,
-Deformer, spherize_urdf. Over the service (grpcio): Client, DistanceSession.
+Deformer, spherize_robot (URDF or MJCF), spherize_urdf. Over the service (grpcio): Client, DistanceSession.
 
 Units and frames: every length is in the mesh's own units, every point in the mesh's own frame
 unless a docstring says "world frame"; poses are rows [qw, qx, qy, qz, tx, ty, tz] (unit
@@ -44,6 +44,7 @@ from ._inscribe import (
     parse_curobo_yaml,
     prepare,
     read_spheres,
+    spherize_robot,
     spherize_urdf,
     write_mesh,
     write_spheres,
@@ -66,6 +67,6 @@ __all__ = [
     "MeshWarning",
     "QualityReport", "Repair", "RetryPolicy", "Scene", "SceneFrame", "Severity", "Solid", "SphereSet", "SpherizedRobot",
     "certified_distance", "certify", "distance", "evaluate", "format_curobo_yaml", "generate",
-    "load_mesh", "parse_curobo_yaml", "prepare", "read_spheres", "spherize_urdf",
+    "load_mesh", "parse_curobo_yaml", "prepare", "read_spheres", "spherize_robot", "spherize_urdf",
     "write_mesh", "write_spheres",
 ]

@@ -356,12 +356,28 @@ class SelfCollision:
 
 class SpherizedRobot:
     name: str
+    format: str  # "urdf" or "mjcf"
     links: list[LinkSpheres]
+    spheres: dict[str, Float64Array]  # spherized link or body -> (N, 4) [x, y, z, r]
+    warnings: list[str]
     def urdf(self) -> str: ...
+    def mjcf(self, directory: str) -> str: ...
     def self_collision(self, *, samples: int = 10000, seed: int = 0,
                        always_fraction: float = 0.95,
                        progress: Optional[Callable[[float], object]] = None) -> SelfCollision: ...
     def curobo_yaml(self, self_collision: Optional[SelfCollision] = None) -> str: ...
+
+def spherize_robot(path: str, *, kind: str = "cover", max_spheres: Optional[int] = None,
+                   max_spheres_per_link: Optional[int] = None,
+                   max_protrusion: Optional[float] = None,
+                   voxel_size: Optional[float] = None,
+                   link_max_spheres: Mapping[str, int] = ...,
+                   padding: float = 0.0,
+                   clip_planes: Sequence[tuple[str, tuple[float, float, float], float]] = (),
+                   package_paths: Sequence[str] = (),
+                   solid_classes: Sequence[str] = (),
+                   solid_groups: Sequence[int] = (),
+                   progress: Optional[Callable[[float], object]] = None) -> SpherizedRobot: ...
 
 def spherize_urdf(path: str, *, kind: str = "cover", max_spheres: Optional[int] = None,
                   max_spheres_per_link: Optional[int] = None,

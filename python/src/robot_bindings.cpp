@@ -1,4 +1,5 @@
-// Robots: spherize a URDF's links (what `inscribe urdf` does), and write the results.
+// Robots: spherize the links of a URDF or the bodies of a MuJoCo model (what `inscribe urdf`
+// does), and write the results.
 #include <pybind11/stl.h>
 
 #include <array>
@@ -16,8 +17,10 @@
 #include "bindings.h"
 #include "inscribe/generation/sphere_set_generation.h"
 #include "inscribe/robot/kinematics.h"
+#include "inscribe/robot/robot_file.h"
 #include "inscribe/robot/self_collision.h"
 #include "inscribe/robot/self_collision_srdf.h"
+#include "inscribe/robot/spherized_mjcf.h"
 #include "inscribe/robot/spherized_urdf.h"
 #include "inscribe/robot/urdf_robot.h"
 #include "inscribe/robot/urdf_spherize.h"
@@ -31,16 +34,6 @@ namespace {
 namespace fs = std::filesystem;
 using robot::LinkSpherizeResult;
 using robot::LinkStatus;
-
-std::string ReadText(const std::string& path) {
-  std::error_code error;
-  if (!fs::exists(path, error)) RaiseStatus(absl::NotFoundError(path + ": no such file"));
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream bytes;
-  bytes << in.rdbuf();
-  if (!in) RaiseStatus(absl::InvalidArgumentError(path + ": cannot be read"));
-  return bytes.str();
-}
 
 // (N, 4) float64 [x, y, z, r] rows, a copy.
 py::array_t<double> SphereArray(const std::vector<Sphere>& spheres) {
@@ -59,14 +52,76 @@ struct PySelfCollision {
 };
 
 struct SpherizedRobot {
-  std::string name;
-  std::string urdf_path;
-  std::vector<LinkSpherizeResult> links;
+  robot::RobotFile file;
+  std::vector<LinkSpherizeResult> links;  // one per file.robot() link
 };
+
+using ClipPlanes = std::vector<std::tuple<std::string, std::array<double, 3>, double>>;
+
+// What spherize_robot and spherize_urdf do: read by content, spherize every link.
+SpherizedRobot Spherize(const std::string& path, const std::string& kind,
+                        std::optional<std::int64_t> max_spheres,
+                        std::optional<std::int64_t> max_spheres_per_link,
+                        std::optional<double> max_protrusion, std::optional<double> voxel_size,
+                        const std::map<std::string, std::int64_t>& link_max_spheres, double padding,
+                        const ClipPlanes& clip_planes,
+                        const std::vector<std::string>& package_paths,
+                        const robot::MjcfReadOptions& mjcf, const py::object& progress) {
+  absl::StatusOr<robot::RobotFile> file = robot::ReadRobotFile(path, mjcf);
+  if (!file.ok()) RaiseStatus(file.status());
+  robot::UrdfSpherizeOptions options;
+  options.kind = ValueOrRaise(ParseSphereSetKind(kind));
+  options.max_spheres = max_spheres;
+  options.max_spheres_per_link = max_spheres_per_link;
+  options.max_protrusion = max_protrusion;
+  options.voxel_size = voxel_size;
+  options.link_max_spheres = link_max_spheres;
+  options.padding = padding;
+  for (const auto& [link, normal, offset] : clip_planes) {
+    options.clip_planes.push_back(
+        robot::ClipPlane{link, Vector3(normal[0], normal[1], normal[2]), offset});
+  }
+  options.packages = robot::PackageSearchFromEnvironment(package_paths);
+  options.urdf_dir = file->directory;
+  absl::StatusOr<robot::RobotSpherizeResult> spherized;
+  OkOrRaise(RunInterruptible(progress, [&](const GenerationControl& control) {
+    spherized = robot::SpherizeRobot(file->robot(), options, control);
+    return spherized.status();
+  }));
+  return SpherizedRobot{*std::move(file), std::move(spherized->links)};
+}
+
+// The keyword arguments spherize_robot and spherize_urdf share, documented once.
+constexpr char kSpherizeDoc[] =
+    "each link's collision geometry (visual when none) becomes spheres in the link's frame "
+    "(metres): kind 'cover' (default; certified to hold the link, with delta), 'internal' or "
+    "'dilated'. At most one mode: max_spheres for the whole robot (covers share it by "
+    "greedy marginal gain on their estimated delta), max_spheres_per_link (the default, "
+    "DEFAULT_MAX_SPHERES_PER_LINK), max_protrusion (covers: every link's delta at most this, "
+    "fewest spheres) or voxel_size (internal, dilated). link_max_spheres: {link: N} budgets "
+    "of their own. padding: metres added to every radius. clip_planes: [(link, (nx, ny, nz), "
+    "offset)] cuts off what lies beyond n . x = offset in the link's frame. package_paths are "
+    "searched for package:// before ROS_PACKAGE_PATH and AMENT_PREFIX_PATH. A link that "
+    "cannot be done is 'skipped' with its error, never silently dropped. Ctrl-C cancels. "
+    "Returns a SpherizedRobot.";
 
 }  // namespace
 
 void BindRobot(py::module_& m) {
+  // pybind11 keeps a docstring's pointer until the module is set up: these outlive that.
+  static const std::string robot_doc =
+      std::string(
+          "Spherizes every link of the URDF or every body of the MuJoCo model (MJCF) at `path`, "
+          "told apart by the root element, as `inscribe urdf` does. In MJCF a body's solid is "
+          "its geoms that take part in contacts (contype or conaffinity non-zero, as MuJoCo "
+          "Menagerie's collision class), else its visual ones with a warning; solid_classes "
+          "(default classes, inherited ones count) and solid_groups choose others. Then ") +
+      kSpherizeDoc;
+  static const std::string urdf_doc =
+      std::string(
+          "Spherizes every link of the robot at `path` as `inscribe urdf` does "
+          "(spherize_robot without its MJCF options): ") +
+      kSpherizeDoc;
   m.attr("DEFAULT_MAX_SPHERES_PER_LINK") = robot::kDefaultMaxSpheresPerLink;
 
   py::class_<LinkSpherizeResult>(m, "LinkSpheres", "One link of a spherized robot.")
@@ -104,21 +159,62 @@ void BindRobot(py::module_& m) {
       });
 
   py::class_<SpherizedRobot>(m, "SpherizedRobot", "A URDF robot with spheres for its links.")
-      .def_readonly("name", &SpherizedRobot::name)
-      .def_readonly("links", &SpherizedRobot::links)
+      .def_property_readonly("name", [](const SpherizedRobot& r) { return r.file.robot().name; })
+      .def_property_readonly(
+          "format", [](const SpherizedRobot& r) { return robot::RobotFormatName(r.file.format); },
+          "'urdf' or 'mjcf', as read from the file's root element")
+      .def_readonly("links", &SpherizedRobot::links,
+                    "one LinkSpheres per link; for MJCF also the links of multi-coordinate "
+                    "joints (BODY/JOINT, no geometry)")
+      .def_property_readonly(
+          "spheres",
+          [](const SpherizedRobot& r) {
+            py::dict out;
+            for (std::size_t l = 0; l < r.links.size(); ++l) {
+              if (r.links[l].status != LinkStatus::kSpherized) continue;
+              out[py::str(r.links[l].link)] = SphereArray(r.links[l].spheres);
+            }
+            return out;
+          },
+          "{link or body name: (N, 4) float64 [x, y, z, r]} for every spherized link, in its "
+          "own frame (an MJCF body's frame), metres")
+      .def_property_readonly(
+          "warnings", [](const SpherizedRobot& r) { return r.file.warnings(); },
+          "MJCF: bodies whose visual geoms stood in for missing collision ones, geoms that are "
+          "no solid (planes); none for URDF")
       .def(
           "urdf",
           [](const SpherizedRobot& r) {
-            return ValueOrRaise(robot::SpherizedUrdf(ReadText(r.urdf_path), r.links));
+            if (r.file.format != robot::RobotFormat::kUrdf) {
+              RaiseStatus(absl::InvalidArgumentError(
+                  r.file.path +
+                  " is an MJCF model: there is no URDF to write; use spheres or "
+                  "curobo_yaml()"));
+            }
+            return ValueOrRaise(robot::SpherizedUrdf(r.file.bytes, r.links));
           },
-          "The URDF text with one sphere <collision> per sphere in spherized links.")
+          "The URDF text with one sphere <collision> per sphere in spherized links (URDF "
+          "input only).")
+      .def(
+          "mjcf",
+          [](const SpherizedRobot& r, const std::string& directory) {
+            if (r.file.format != robot::RobotFormat::kMjcf) {
+              RaiseStatus(absl::InvalidArgumentError(r.file.path +
+                                                     " is a URDF: use urdf() for its spheres"));
+            }
+            return ValueOrRaise(robot::SpherizedMjcf(r.file, r.links, directory));
+          },
+          py::arg("directory"),
+          "The spherized MuJoCo model's text (MJCF input only), as `inscribe robot -o` writes "
+          "it, for a file in `directory` (mesh paths are written relative to it): every "
+          "spherized body's solid geoms kept for their mass but no longer colliding, one "
+          "massless group-3 sphere geom per sphere in the solid geom's class.")
       .def(
           "self_collision",
           [](const SpherizedRobot& r, std::int64_t samples, std::uint64_t seed,
              double always_fraction, const py::object& progress) {
-            absl::StatusOr<robot::UrdfRobot> parsed = robot::ParseUrdf(ReadText(r.urdf_path));
-            if (!parsed.ok()) RaiseStatus(parsed.status());
-            const robot::Kinematics kinematics = ValueOrRaise(robot::Kinematics::Create(*parsed));
+            const robot::Kinematics kinematics =
+                ValueOrRaise(robot::Kinematics::Create(r.file.robot()));
             robot::SelfCollisionOptions options;
             options.samples = samples;
             options.seed = seed;
@@ -130,7 +226,7 @@ void BindRobot(py::module_& m) {
                   kinematics, robot::LinkCollisionGeometries(r.links), options);
               return matrix.status();
             }));
-            return PySelfCollision{*std::move(matrix), r.name};
+            return PySelfCollision{*std::move(matrix), r.file.robot().name};
           },
           py::kw_only(), py::arg("samples") = robot::SelfCollisionOptions{}.samples,
           py::arg("seed") = robot::SelfCollisionOptions{}.seed,
@@ -147,9 +243,9 @@ void BindRobot(py::module_& m) {
             std::string yaml;
             if (self_collision != nullptr) {
               yaml = ValueOrRaise(robot::SpherizedCuroboYaml(
-                  r.links, r.name, self_collision->matrix, {}, &left_out));
+                  r.links, r.file.robot().name, self_collision->matrix, {}, &left_out));
             } else {
-              yaml = robot::SpherizedCuroboYaml(r.links, r.name, &left_out);
+              yaml = robot::SpherizedCuroboYaml(r.links, r.file.robot().name, &left_out);
             }
             if (!left_out.empty()) {
               RaiseStatus(absl::InvalidArgumentError(
@@ -198,59 +294,45 @@ void BindRobot(py::module_& m) {
           "MoveIt's SRDF with the disabled pairs, as `inscribe urdf --srdf` writes it.");
 
   m.def(
-      "spherize_urdf",
+      "spherize_robot",
       [](const std::string& path, const std::string& kind, std::optional<std::int64_t> max_spheres,
          std::optional<std::int64_t> max_spheres_per_link, std::optional<double> max_protrusion,
          std::optional<double> voxel_size,
          const std::map<std::string, std::int64_t>& link_max_spheres, double padding,
-         const std::vector<std::tuple<std::string, std::array<double, 3>, double>>& clip_planes,
-         const std::vector<std::string>& package_paths, const py::object& progress) {
-        const std::string bytes = ReadText(path);
-        absl::StatusOr<robot::UrdfRobot> parsed = robot::ParseUrdf(bytes);
-        if (!parsed.ok()) {
-          RaiseStatus(absl::Status(parsed.status().code(),
-                                   absl::StrCat(path, ": ", parsed.status().message())));
-        }
-        robot::UrdfSpherizeOptions options;
-        options.kind = ValueOrRaise(ParseSphereSetKind(kind));
-        options.max_spheres = max_spheres;
-        options.max_spheres_per_link = max_spheres_per_link;
-        options.max_protrusion = max_protrusion;
-        options.voxel_size = voxel_size;
-        options.link_max_spheres = link_max_spheres;
-        options.padding = padding;
-        for (const auto& [link, normal, offset] : clip_planes) {
-          options.clip_planes.push_back(
-              robot::ClipPlane{link, Vector3(normal[0], normal[1], normal[2]), offset});
-        }
-        options.packages = robot::PackageSearchFromEnvironment(package_paths);
-        options.urdf_dir = fs::absolute(path).parent_path().string();
-        absl::StatusOr<robot::RobotSpherizeResult> spherized;
-        OkOrRaise(RunInterruptible(progress, [&](const GenerationControl& control) {
-          spherized = robot::SpherizeRobot(*parsed, options, control);
-          return spherized.status();
-        }));
-        return SpherizedRobot{parsed->name, path, std::move(spherized->links)};
+         const ClipPlanes& clip_planes, const std::vector<std::string>& package_paths,
+         const std::vector<std::string>& solid_classes, const std::vector<int>& solid_groups,
+         const py::object& progress) {
+        robot::MjcfReadOptions mjcf;
+        mjcf.solid.classes = solid_classes;
+        mjcf.solid.groups = solid_groups;
+        return Spherize(path, kind, max_spheres, max_spheres_per_link, max_protrusion, voxel_size,
+                        link_max_spheres, padding, clip_planes, package_paths, mjcf, progress);
       },
       py::arg("path"), py::kw_only(), py::arg("kind") = "cover",
       py::arg("max_spheres") = py::none(), py::arg("max_spheres_per_link") = py::none(),
       py::arg("max_protrusion") = py::none(), py::arg("voxel_size") = py::none(),
       py::arg("link_max_spheres") = std::map<std::string, std::int64_t>{}, py::arg("padding") = 0.0,
-      py::arg("clip_planes") =
-          std::vector<std::tuple<std::string, std::array<double, 3>, double>>{},
-      py::arg("package_paths") = std::vector<std::string>{}, py::arg("progress") = py::none(),
-      "Spherizes every link of the URDF at `path` as `inscribe urdf` does: each link's "
-      "collision geometry (visual when none) becomes spheres in the link's frame (metres): "
-      "kind 'cover' (default; certified to hold the link, with delta), 'internal' or "
-      "'dilated'. At most one mode: max_spheres for the whole robot (covers share it by "
-      "greedy marginal gain on their estimated delta), max_spheres_per_link (the default, "
-      "DEFAULT_MAX_SPHERES_PER_LINK), max_protrusion (covers: every link's delta at most this, "
-      "fewest spheres) or voxel_size (internal, dilated). link_max_spheres: {link: N} budgets "
-      "of their own. padding: metres added to every radius. clip_planes: [(link, (nx, ny, nz), "
-      "offset)] cuts off what lies beyond n . x = offset in the link's frame. package_paths are "
-      "searched for package:// before ROS_PACKAGE_PATH and AMENT_PREFIX_PATH. A link that "
-      "cannot be done is 'skipped' with its error, never silently dropped. Ctrl-C cancels. "
-      "Returns a SpherizedRobot.");
+      py::arg("clip_planes") = ClipPlanes{}, py::arg("package_paths") = std::vector<std::string>{},
+      py::arg("solid_classes") = std::vector<std::string>{},
+      py::arg("solid_groups") = std::vector<int>{}, py::arg("progress") = py::none(),
+      robot_doc.c_str());
+  m.def(
+      "spherize_urdf",
+      [](const std::string& path, const std::string& kind, std::optional<std::int64_t> max_spheres,
+         std::optional<std::int64_t> max_spheres_per_link, std::optional<double> max_protrusion,
+         std::optional<double> voxel_size,
+         const std::map<std::string, std::int64_t>& link_max_spheres, double padding,
+         const ClipPlanes& clip_planes, const std::vector<std::string>& package_paths,
+         const py::object& progress) {
+        return Spherize(path, kind, max_spheres, max_spheres_per_link, max_protrusion, voxel_size,
+                        link_max_spheres, padding, clip_planes, package_paths, {}, progress);
+      },
+      py::arg("path"), py::kw_only(), py::arg("kind") = "cover",
+      py::arg("max_spheres") = py::none(), py::arg("max_spheres_per_link") = py::none(),
+      py::arg("max_protrusion") = py::none(), py::arg("voxel_size") = py::none(),
+      py::arg("link_max_spheres") = std::map<std::string, std::int64_t>{}, py::arg("padding") = 0.0,
+      py::arg("clip_planes") = ClipPlanes{}, py::arg("package_paths") = std::vector<std::string>{},
+      py::arg("progress") = py::none(), urdf_doc.c_str());
 }
 
 }  // namespace inscribe::python

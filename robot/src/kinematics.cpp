@@ -28,6 +28,7 @@ struct Kinematics::Tree {
     Eigen::Isometry3d origin = Eigen::Isometry3d::Identity();
     UrdfJointType type = UrdfJointType::kFixed;
     Vector3 axis = Vector3::UnitX();
+    Vector3 anchor = Vector3::Zero();  // UrdfJoint::anchor
     int variable = -1;
     double multiplier = 1.0;
     double offset = 0.0;
@@ -159,7 +160,9 @@ absl::StatusOr<Kinematics> Kinematics::Create(const UrdfRobot& robot) {
     if (has_axis && !(joint.axis.allFinite() && joint.axis.norm() > 0.0)) {
       return JointError(joint, "its axis is zero or not finite");
     }
-    if (!joint.origin.xyz.allFinite() || !joint.origin.rpy.allFinite()) {
+    if (!joint.origin.xyz.allFinite() || !joint.origin.rpy.allFinite() ||
+        (joint.origin.rotation && !joint.origin.rotation->allFinite()) ||
+        !joint.anchor.allFinite()) {
       return JointError(joint, "its origin is not finite");
     }
     const bool limited =
@@ -238,10 +241,11 @@ absl::StatusOr<Kinematics> Kinematics::Create(const UrdfRobot& robot) {
     const UrdfJoint& joint = robot.joints[j];
     Tree::Motion& m = tree->motion[link];
     m.origin = Eigen::Isometry3d::Identity();
-    m.origin.linear() = RotationFromRpy(joint.origin.rpy);
+    m.origin.linear() = OriginRotation(joint.origin);
     m.origin.translation() = joint.origin.xyz;
     m.type = joint.type;
     m.axis = joint.axis.normalized();
+    m.anchor = joint.anchor;
     m.variable = (*sources)[j].variable;
     m.multiplier = (*sources)[j].multiplier;
     m.offset = (*sources)[j].offset;
@@ -299,8 +303,12 @@ absl::Status Kinematics::LinkPoses(absl::Span<const double> q,
       }
       if (m.type == UrdfJointType::kPrismatic) {
         pose.translate(value * m.axis);
-      } else {
+      } else if (m.anchor.isZero()) {
         pose.rotate(Eigen::AngleAxisd(value, m.axis));
+      } else {
+        pose.translate(m.anchor);
+        pose.rotate(Eigen::AngleAxisd(value, m.axis));
+        pose.translate(-m.anchor);
       }
     }
     (*poses)[link] = pose;

@@ -2,6 +2,8 @@
 
 #include <cassert>
 #include <cmath>
+#include <utility>
+#include <vector>
 
 namespace inscribe::robot {
 
@@ -48,6 +50,73 @@ Mesh CylinderMesh(double radius, double length, int sides) {
     mesh.triangles.row(4 * i + 1) << i, sides + j, sides + i;
     mesh.triangles.row(4 * i + 2) << bottom, j, i;               // bottom cap faces -z
     mesh.triangles.row(4 * i + 3) << top, sides + i, sides + j;  // top cap faces +z
+  }
+  return mesh;
+}
+
+namespace {
+
+// The surface of revolution about z through `rings` (z, radius) from top to bottom, each ring
+// `sides` vertices (one on +x), closed by the poles (0, 0, top) and (0, 0, bottom) with fans.
+// Outward oriented when the rings run from top to bottom with positive radii.
+Mesh RevolutionMesh(const std::vector<std::pair<double, double>>& rings, double top, double bottom,
+                    int sides) {
+  const int n = static_cast<int>(rings.size());
+  Mesh mesh;
+  mesh.vertices.resize(n * sides + 2, 3);
+  for (int r = 0; r < n; ++r) {
+    for (int i = 0; i < sides; ++i) {
+      const double angle = 2.0 * M_PI * i / sides;
+      mesh.vertices.row(r * sides + i) << rings[r].second * std::cos(angle),
+          rings[r].second * std::sin(angle), rings[r].first;
+    }
+  }
+  const int north = n * sides, south = n * sides + 1;
+  mesh.vertices.row(north) << 0.0, 0.0, top;
+  mesh.vertices.row(south) << 0.0, 0.0, bottom;
+  mesh.triangles.resize(2 * sides * n, 3);
+  int t = 0;
+  for (int i = 0; i < sides; ++i) {
+    const int j = (i + 1) % sides;
+    mesh.triangles.row(t++) << north, i, j;
+    for (int r = 0; r + 1 < n; ++r) {
+      const int up = r * sides, down = (r + 1) * sides;
+      mesh.triangles.row(t++) << up + i, down + i, down + j;
+      mesh.triangles.row(t++) << up + i, down + j, up + j;
+    }
+    mesh.triangles.row(t++) << south, (n - 1) * sides + j, (n - 1) * sides + i;
+  }
+  return mesh;
+}
+
+}  // namespace
+
+Mesh CapsuleMesh(double radius, double length, int sides, int quarter_bands) {
+  assert(radius > 0.0 && length >= 0.0 && sides >= 3 && quarter_bands >= 1);
+  const double h = 0.5 * length;
+  std::vector<std::pair<double, double>> rings;
+  // Latitudes from the north pole down to the equator on the top cap, then the bottom cap's
+  // from its equator down; one equator ring when there is no cylinder part.
+  for (int k = 1; k <= quarter_bands; ++k) {
+    const double polar = 0.5 * M_PI * k / quarter_bands;
+    const double z = k == quarter_bands ? 0.0 : radius * std::cos(polar);
+    const double rho = k == quarter_bands ? radius : radius * std::sin(polar);
+    rings.emplace_back(h + z, rho);
+  }
+  for (int k = length > 0.0 ? quarter_bands : quarter_bands + 1; k < 2 * quarter_bands; ++k) {
+    const double polar = 0.5 * M_PI * k / quarter_bands;
+    const double z = k == quarter_bands ? 0.0 : radius * std::cos(polar);
+    const double rho = k == quarter_bands ? radius : radius * std::sin(polar);
+    rings.emplace_back(-h + z, rho);
+  }
+  return RevolutionMesh(rings, h + radius, -h - radius, sides);
+}
+
+Mesh EllipsoidMesh(const Vector3& radii, int sides, int quarter_bands) {
+  assert((radii.array() > 0.0).all() && sides >= 3 && quarter_bands >= 1);
+  Mesh mesh = CapsuleMesh(1.0, 0.0, sides, quarter_bands);
+  for (Eigen::Index i = 0; i < mesh.vertices.rows(); ++i) {
+    mesh.vertices.row(i) = mesh.vertices.row(i).cwiseProduct(radii.transpose());
   }
   return mesh;
 }

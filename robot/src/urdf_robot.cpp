@@ -509,6 +509,10 @@ Eigen::Matrix3d RotationFromRpy(const Vector3& rpy) {
       .toRotationMatrix();
 }
 
+Eigen::Matrix3d OriginRotation(const UrdfOrigin& origin) {
+  return origin.rotation ? *origin.rotation : RotationFromRpy(origin.rpy);
+}
+
 std::string DescribeUrdfElement(const UrdfElement& element, bool from_visual) {
   std::string text =
       absl::StrCat("line ", element.line, " (<", from_visual ? "visual" : "collision", ">");

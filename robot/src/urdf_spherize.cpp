@@ -504,6 +504,12 @@ absl::StatusOr<Mesh> ElementMeshInLinkFrame(const UrdfElement& element,
     case UrdfShape::kCylinder:
       mesh = CylinderMesh(geometry.radius, geometry.length);
       break;
+    case UrdfShape::kCapsule:
+      mesh = CapsuleMesh(geometry.radius, geometry.length);
+      break;
+    case UrdfShape::kEllipsoid:
+      mesh = EllipsoidMesh(geometry.size);
+      break;
     case UrdfShape::kSphere:
       return absl::InvalidArgumentError("a <sphere> is kept as it is; it has no mesh");
     case UrdfShape::kUnsupported:
@@ -514,7 +520,7 @@ absl::StatusOr<Mesh> ElementMeshInLinkFrame(const UrdfElement& element,
                              "> is not URDF geometry inscribe can spherize (mesh, box, "
                              "cylinder, sphere)"));
   }
-  return TransformMesh(std::move(mesh), scale, RotationFromRpy(element.origin.rpy),
+  return TransformMesh(std::move(mesh), scale, OriginRotation(element.origin),
                        element.origin.xyz);
 }
 

@@ -78,6 +78,9 @@ void CheckPromises(const UrdfRobot& robot) {
         case UrdfShape::kSphere:
           if (!Positive(g.radius)) Fail("a parsed sphere radius is not positive");
           break;
+        case UrdfShape::kCapsule:
+        case UrdfShape::kEllipsoid:
+          Fail("ParseUrdf made an MJCF-only shape (capsule or ellipsoid)");
         case UrdfShape::kUnsupported:
           break;
       }

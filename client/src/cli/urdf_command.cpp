@@ -20,8 +20,10 @@
 #include "inscribe/base/atomic_file.h"
 #include "inscribe/generation/sphere_set_generation.h"
 #include "inscribe/robot/kinematics.h"
+#include "inscribe/robot/robot_file.h"
 #include "inscribe/robot/self_collision.h"
 #include "inscribe/robot/self_collision_srdf.h"
+#include "inscribe/robot/spherized_mjcf.h"
 #include "inscribe/robot/spherized_urdf.h"
 #include "inscribe/robot/urdf_robot.h"
 #include "inscribe/robot/urdf_spherize.h"
@@ -34,7 +36,6 @@ using robot::LinkSpherizeResult;
 using robot::LinkStatus;
 using robot::LinkStatusName;
 using robot::PackageSearchFromEnvironment;
-using robot::ParseUrdf;
 using robot::RobotSpherizeResult;
 using robot::SpherizedCuroboYaml;
 using robot::SpherizedUrdf;
@@ -44,9 +45,6 @@ using robot::UrdfSpherizeOptions;
 namespace {
 
 namespace fs = std::filesystem;
-
-// Larger files are refused before reading: real URDFs are kilobytes to a few megabytes.
-constexpr std::uintmax_t kMaxUrdfBytes = 256u << 20;
 
 struct UrdfCliOptions {
   std::string urdf_path;
@@ -65,25 +63,10 @@ struct UrdfCliOptions {
   std::int64_t samples = robot::SelfCollisionOptions{}.samples;
   std::uint64_t seed = robot::SelfCollisionOptions{}.seed;
   bool json = false;
+  // MJCF: which geoms are a body's solid (none: MuJoCo's contact rule).
+  std::vector<std::string> solid_classes;
+  std::vector<int> solid_groups;
 };
-
-// The whole file, or why not (NOT_FOUND, INVALID_ARGUMENT; the message names the path).
-absl::StatusOr<std::string> ReadWholeFile(const std::string& path) {
-  std::error_code error;
-  if (!fs::exists(path, error)) return absl::NotFoundError(path + ": no such file");
-  if (fs::is_directory(path, error)) return absl::InvalidArgumentError(path + ": is a directory");
-  const std::uintmax_t size = fs::file_size(path, error);
-  if (!error && size > kMaxUrdfBytes) {
-    return absl::InvalidArgumentError(absl::StrFormat(
-        "%s: %d bytes is more than the %d a URDF may have", path, size, kMaxUrdfBytes));
-  }
-  std::ifstream in(path, std::ios::in | std::ios::binary);
-  if (!in) return absl::InvalidArgumentError(path + ": cannot open it for reading");
-  std::ostringstream contents;
-  contents << in.rdbuf();
-  if (in.bad()) return absl::InvalidArgumentError(path + ": read error");
-  return contents.str();
-}
 
 // "LINK=VALUE" split at the last '=' (link names may hold '=').
 absl::StatusOr<std::pair<std::string, std::string>> SplitLinkValue(const std::string& text,
@@ -200,13 +183,14 @@ std::string MatrixSummary(const robot::SelfCollisionMatrix& matrix) {
 }
 
 void PrintJson(const UrdfCliOptions& options, const UrdfSpherizeOptions& spherize,
-               const UrdfRobot& robot, const RobotSpherizeResult& result,
+               const robot::RobotFile& file, const RobotSpherizeResult& result,
                const std::optional<robot::SelfCollisionMatrix>& matrix,
                const std::string& yaml_path, const std::vector<std::string>& left_out,
                double seconds) {
   nlohmann::json report;
   report["urdf"] = options.urdf_path;
-  report["robot"] = robot.name;
+  report["format"] = robot::RobotFormatName(file.format);
+  report["robot"] = file.robot().name;
   report["output"] = options.output_path;
   report["yaml"] = yaml_path;
   report["kind"] = SphereSetKindName(spherize.kind);
@@ -216,7 +200,10 @@ void PrintJson(const UrdfCliOptions& options, const UrdfSpherizeOptions& spheriz
   std::int64_t spheres = 0;
   std::optional<double> delta;
   nlohmann::json links = nlohmann::json::array();
-  for (const LinkSpherizeResult& link_result : result.links) {
+  for (std::size_t l = 0; l < result.links.size(); ++l) {
+    // MJCF's links of multi-coordinate joints have no geometry and name no body: not listed.
+    if (!file.IsDescribedLink(static_cast<int>(l))) continue;
+    const LinkSpherizeResult& link_result = result.links[l];
     nlohmann::json link;
     link["link"] = link_result.link;
     link["status"] = LinkStatusName(link_result.status);
@@ -244,6 +231,7 @@ void PrintJson(const UrdfCliOptions& options, const UrdfSpherizeOptions& spheriz
   report["spheres"] = spheres;
   if (delta) report["delta"] = *delta;
   report["left_out_of_yaml"] = left_out;
+  report["warnings"] = file.warnings();
   if (matrix) report["self_collision"] = MatrixJson(*matrix, options.srdf_path);
   report["spherize_seconds"] = result.seconds;
   report["seconds"] = seconds;
@@ -251,7 +239,7 @@ void PrintJson(const UrdfCliOptions& options, const UrdfSpherizeOptions& spheriz
   std::cout << report.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
 }
 
-void PrintTable(const RobotSpherizeResult& result,
+void PrintTable(const robot::RobotFile& file, const RobotSpherizeResult& result,
                 const std::optional<robot::SelfCollisionMatrix>& matrix,
                 const std::string& output_path, const std::string& yaml_path,
                 const std::string& srdf_path, const std::vector<std::string>& left_out,
@@ -263,7 +251,9 @@ void PrintTable(const RobotSpherizeResult& result,
                                "delta (mm)", "seconds", "note");
   int skipped = 0;
   std::int64_t spheres = 0;
-  for (const LinkSpherizeResult& link : result.links) {
+  for (std::size_t l = 0; l < result.links.size(); ++l) {
+    if (!file.IsDescribedLink(static_cast<int>(l))) continue;  // MJCF's joint chains' links
+    const LinkSpherizeResult& link = result.links[l];
     std::string note = link.error;
     if (link.status == LinkStatus::kSpherized && link.from_visual) note = "visual geometry";
     const std::string delta =
@@ -275,7 +265,8 @@ void PrintTable(const RobotSpherizeResult& result,
     spheres += static_cast<std::int64_t>(link.spheres.size());
   }
   if (matrix) std::cout << MatrixSummary(*matrix) << "\n";
-  std::cout << absl::StrFormat("wrote %s, %s%s (%d spheres) in %.3f s", output_path, yaml_path,
+  const std::string written = output_path + ", " + yaml_path;
+  std::cout << absl::StrFormat("wrote %s%s (%d spheres) in %.3f s", written,
                                srdf_path.empty() ? "" : " and " + srdf_path, spheres, seconds);
   if (skipped > 0) std::cout << absl::StrFormat("; %d link(s) skipped, kept as they were", skipped);
   if (!left_out.empty()) {
@@ -290,6 +281,18 @@ absl::Status RunUrdf(const UrdfCliOptions& options) {
   if (!spherize.ok()) return UsageError(spherize.status().message());
   if (absl::Status checked = robot::CheckUrdfSpherizeOptions(*spherize); !checked.ok()) {
     return UsageError(checked.message());
+  }
+  // Read first: the outputs depend on the format. A missing output directory is still found
+  // before any spherizing.
+  robot::MjcfReadOptions mjcf;
+  mjcf.solid.classes = options.solid_classes;
+  mjcf.solid.groups = options.solid_groups;
+  absl::StatusOr<robot::RobotFile> file = robot::ReadRobotFile(options.urdf_path, mjcf);
+  if (!file.ok()) return BadInputError(file.status().message());
+  const bool is_mjcf = file->format == robot::RobotFormat::kMjcf;
+  if (!is_mjcf && (!options.solid_classes.empty() || !options.solid_groups.empty())) {
+    return UsageError("--solid-class and --solid-group choose MJCF geoms; " + options.urdf_path +
+                      " is a URDF (its links' <collision> elements are the solid)");
   }
   const std::string yaml_path = YamlPath(options);
   if (SameFile(yaml_path, options.output_path)) {
@@ -316,16 +319,14 @@ absl::Status RunUrdf(const UrdfCliOptions& options) {
                            " does not exist");
     }
   }
-  absl::StatusOr<std::string> bytes = ReadWholeFile(options.urdf_path);
-  if (!bytes.ok()) return BadInputError(bytes.status().message());
-  absl::StatusOr<UrdfRobot> robot = ParseUrdf(*bytes);
-  if (!robot.ok()) {
-    return BadInputError(options.urdf_path + ": " + std::string(robot.status().message()));
+  const UrdfRobot& robot = file->robot();
+  for (const std::string& warning : file->warnings()) {
+    std::cerr << "inscribe: " << options.urdf_path << ": " << warning << "\n";
   }
 
   spherize->packages = PackageSearchFromEnvironment(options.package_paths);
-  spherize->urdf_dir = fs::absolute(options.urdf_path).parent_path().string();
-  absl::StatusOr<RobotSpherizeResult> spherized = SpherizeRobot(*robot, *spherize);
+  spherize->urdf_dir = file->directory;
+  absl::StatusOr<RobotSpherizeResult> spherized = SpherizeRobot(robot, *spherize);
   if (!spherized.ok()) return UsageError(spherized.status().message());
   const std::vector<LinkSpherizeResult>& results = spherized->links;
   for (const LinkSpherizeResult& link : results) {
@@ -340,7 +341,7 @@ absl::Status RunUrdf(const UrdfCliOptions& options) {
   // The self-collision matrix, for the SRDF and the YAML's self_collision_ignore. A joint tree
   // the kinematics refuses only matters when an SRDF was asked for.
   std::optional<robot::SelfCollisionMatrix> matrix;
-  absl::StatusOr<robot::Kinematics> kinematics = robot::Kinematics::Create(*robot);
+  absl::StatusOr<robot::Kinematics> kinematics = robot::Kinematics::Create(robot);
   if (kinematics.ok()) {
     robot::SelfCollisionOptions collision;
     collision.samples = options.samples;
@@ -357,28 +358,33 @@ absl::Status RunUrdf(const UrdfCliOptions& options) {
               << kinematics.status().message() << "\n";
   }
 
-  absl::StatusOr<std::string> urdf = SpherizedUrdf(*bytes, results);
-  if (!urdf.ok()) return BugError(urdf.status().message());  // ParseUrdf accepted them
+  absl::StatusOr<std::string> spherized_model =
+      is_mjcf
+          ? robot::SpherizedMjcf(*file, results, fs::absolute(options.output_path).parent_path())
+          : SpherizedUrdf(file->bytes, results);
+  // The parsers accepted these documents.
+  if (!spherized_model.ok()) return BugError(spherized_model.status().message());
+  std::vector<std::pair<std::string, std::string>> outputs = {
+      {options.output_path, *std::move(spherized_model)}};
   std::vector<std::string> left_out;
   std::string yaml;
   if (matrix) {
     // The padding is in the radii already: no extra self-collision buffer.
     absl::StatusOr<std::string> with_matrix =
-        SpherizedCuroboYaml(results, robot->name, *matrix, {}, &left_out);
+        SpherizedCuroboYaml(results, robot.name, *matrix, {}, &left_out);
     if (!with_matrix.ok()) return BugError(with_matrix.status().message());
     yaml = *std::move(with_matrix);
   } else {
-    yaml = SpherizedCuroboYaml(results, robot->name, &left_out);
+    yaml = SpherizedCuroboYaml(results, robot.name, &left_out);
   }
   for (const std::string& link : left_out) {
     std::cerr << "inscribe: link '" << link << "' is spherized in " << options.output_path
               << " but left out of " << yaml_path
               << ": cuRobo YAML link names are letters, digits and _ - . /\n";
   }
-  std::vector<std::pair<std::string, std::string>> outputs = {{options.output_path, *urdf},
-                                                              {yaml_path, yaml}};
+  outputs.emplace_back(yaml_path, yaml);
   if (!options.srdf_path.empty()) {
-    outputs.emplace_back(options.srdf_path, robot::SelfCollisionSrdf(*matrix, robot->name));
+    outputs.emplace_back(options.srdf_path, robot::SelfCollisionSrdf(*matrix, robot.name));
   }
   for (const auto& [path, contents] : outputs) {
     if (absl::Status written = WriteFileAtomically(path, contents); !written.ok()) {
@@ -389,10 +395,10 @@ absl::Status RunUrdf(const UrdfCliOptions& options) {
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (options.json) {
-    PrintJson(options, *spherize, *robot, *spherized, matrix, yaml_path, left_out, seconds);
+    PrintJson(options, *spherize, *file, *spherized, matrix, yaml_path, left_out, seconds);
   } else {
-    PrintTable(*spherized, matrix, options.output_path, yaml_path, options.srdf_path, left_out,
-               seconds);
+    PrintTable(*file, *spherized, matrix, options.output_path, yaml_path, options.srdf_path,
+               left_out, seconds);
   }
   const auto skipped = std::count_if(results.begin(), results.end(), [](const auto& result) {
     return result.status == LinkStatus::kSkipped;
@@ -417,10 +423,21 @@ void AddUrdfCommand(CLI::App& app, CommandOutcome* outcome) {
       "Spherize a robot: every link's collision meshes (visual when it has none; box, "
       "cylinder and sphere too) become spheres in the link's frame, certified covers by "
       "default; writes the URDF with sphere collisions and cuRobo's collision_spheres YAML. "
+      "A MuJoCo model (MJCF) is read too: every body's collision geoms (capsules and "
+      "ellipsoids too) become spheres in the body's frame, written as the MJCF with sphere "
+      "geoms and as cuRobo YAML. "
       "Links that cannot be done are named, kept as they were, and make the exit status 1");
+  cmd->alias("robot");
   cmd->add_option("ROBOT", options->urdf_path,
-                  "URDF file (expand xacro first: xacro robot.urdf.xacro > robot.urdf)")
+                  "URDF file (expand xacro first: xacro robot.urdf.xacro > robot.urdf) or MuJoCo "
+                  "model (MJCF), told apart by the root element")
       ->required();
+  cmd->add_option("--solid-class", options->solid_classes,
+                  "MJCF: a default class whose geoms (and its sub-classes') are the bodies' "
+                  "solids, instead of the geoms that take part in contacts; repeatable");
+  cmd->add_option("--solid-group", options->solid_groups,
+                  "MJCF: a geom group (e.g. 3, MuJoCo Menagerie's collision group) whose geoms "
+                  "are the bodies' solids; repeatable");
   cmd->add_option("--package-path", options->package_paths,
                   "Directory holding ROS packages (or a package itself) for package:// URIs; "
                   "repeatable, searched before ROS_PACKAGE_PATH and AMENT_PREFIX_PATH");
@@ -458,7 +475,10 @@ void AddUrdfCommand(CLI::App& app, CommandOutcome* outcome) {
                   "LINK=NX,NY,NZ,OFFSET: cut off what lies beyond the plane NX x + NY y + NZ z "
                   "= OFFSET in the link's frame (the side the normal points to) before "
                   "spherizing, e.g. a table under the base; repeatable");
-  cmd->add_option("-o,--output", options->output_path, "The spherized URDF to write")->required();
+  cmd->add_option("-o,--output", options->output_path,
+                  "The spherized URDF to write; for an MJCF model, the spherized MJCF (one file, "
+                  "includes inlined)")
+      ->required();
   cmd->add_option("--yaml", options->yaml_path,
                   "cuRobo collision_spheres YAML to write (default: -o with extension .yml)");
   cmd->add_option("--srdf", options->srdf_path,

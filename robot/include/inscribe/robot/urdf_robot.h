@@ -1,8 +1,10 @@
-// A URDF robot description as `inscribe urdf` needs it: each link's collision geometry (its
+// A robot description as `inscribe urdf` needs it: each link's collision geometry (its
 // visual geometry when it has no <collision>), with origins and mesh scales, and where the
-// mesh files are (package://, file:// and relative paths), and its joints. Parsed with
-// tinyxml2. Materials, inertials and the rest are not represented: the writer
-// (spherized_urdf.h) edits the original document instead.
+// mesh files are (package://, file:// and relative paths), and its joints. ParseUrdf reads it
+// from URDF (tinyxml2); ParseMjcf (mjcf_robot.h) fills the same model from a MuJoCo model, using
+// what URDF lacks: explicit rotations, capsules, ellipsoids and joint anchors. Materials,
+// inertials and the rest are not represented: the writer (spherized_urdf.h) edits the original
+// document instead.
 #pragma once
 
 #include <Eigen/Core>
@@ -21,6 +23,10 @@ namespace inscribe::robot {
 struct UrdfOrigin {
   Vector3 xyz = Vector3::Zero();
   Vector3 rpy = Vector3::Zero();
+  // When set, the rotation itself (orthonormal, determinant 1), used instead of rpy: how MJCF's
+  // orientations (quat, axisangle, euler, xyaxes, zaxis, fromto) are kept without a lossy
+  // conversion to angles. ParseUrdf leaves it unset.
+  std::optional<Eigen::Matrix3d> rotation;
 };
 
 // URDF's rpy convention: fixed axes, roll about X, then pitch about Y, then yaw about Z, so
@@ -28,11 +34,17 @@ struct UrdfOrigin {
 // link's frame.
 Eigen::Matrix3d RotationFromRpy(const Vector3& rpy);
 
+// The origin's rotation: `rotation` when set, else RotationFromRpy(rpy). The one place the two
+// are told apart.
+Eigen::Matrix3d OriginRotation(const UrdfOrigin& origin);
+
 enum class UrdfShape {
   kMesh,
   kBox,
   kCylinder,
   kSphere,
+  kCapsule,      // MJCF only: a cylinder of `radius` and `length` along z capped by hemispheres
+  kEllipsoid,    // MJCF only: semi-axes `size` along x, y, z
   kUnsupported,  // a <geometry> child URDF does not define (e.g. <capsule>), or none
 };
 
@@ -44,7 +56,9 @@ struct UrdfGeometry {
   Vector3 scale = Vector3::Ones();
   // kBox: side lengths along the element's x, y, z; metres, > 0.
   Vector3 size = Vector3::Zero();
-  // kCylinder (axis z, centred on the element's origin) and kSphere: metres, > 0.
+  // kEllipsoid: the semi-axes (radii) along x, y, z; metres, > 0.
+  // kCylinder and kCapsule (axis z, centred on the element's origin; `length` is the cylinder
+  // part's whole length, without the caps) and kSphere: metres, > 0.
   double radius = 0.0;
   double length = 0.0;
   // kUnsupported: the element found under <geometry>, e.g. "capsule"; "" when it is empty.
@@ -100,6 +114,10 @@ struct UrdfJoint {
   std::string parent, child;  // link names
   UrdfOrigin origin;
   Vector3 axis = Vector3::UnitX();  // unit length (normalised when parsed); URDF's default
+  // A point of the child's frame the axis passes through: the child's frame is
+  // parent * origin * T(anchor) * motion * T(-anchor). MJCF's joint `pos`; zero for URDF
+  // (whose axes pass through the joint frame's origin). Metres.
+  Vector3 anchor = Vector3::Zero();
   // <limit lower upper>: radians or metres; both 0 when absent (URDF's defaults). Not used for
   // continuous joints. lower <= upper.
   double lower = 0.0;

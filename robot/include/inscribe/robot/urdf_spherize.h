@@ -82,8 +82,9 @@ UrdfSpherizeOptions WithDefaultMode(UrdfSpherizeOptions options);
 
 // An element's geometry as a closed mesh in its LINK's frame: for a <mesh>, the file scaled
 // per axis (mirrored, with the triangles turned to keep them outward, when the scale has an odd
-// number of negative components) and then moved by the element's origin, p -> R(rpy) (s . p) +
-// xyz; for <box> and <cylinder>, BoxMesh and CylinderMesh moved by the origin. Metres.
+// number of negative components) and then moved by the element's origin, p -> R (s . p) + xyz
+// (R = OriginRotation); for boxes, cylinders, capsules and ellipsoids, BoxMesh, CylinderMesh,
+// CapsuleMesh and EllipsoidMesh moved by the origin. Metres.
 // A mesh file is read by ReadMesh (.stl, .obj, .ply, .off, and COLLADA .dae and glTF
 // .gltf/.glb with every node's transform and COLLADA's <unit> applied and <up_axis> not: the
 // file's own axes, as ROS's loaders take them). Not validated (welding is validation's).

@@ -377,6 +377,8 @@ def spherize_robot(path: str, *, kind: str = "cover", max_spheres: Optional[int]
                    package_paths: Sequence[str] = (),
                    solid_classes: Sequence[str] = (),
                    solid_groups: Sequence[int] = (),
+                   repair: RepairLike = "safe",
+                   link_repair: Mapping[str, RepairLike] = ...,
                    progress: Optional[Callable[[float], object]] = None) -> SpherizedRobot: ...
 
 def spherize_urdf(path: str, *, kind: str = "cover", max_spheres: Optional[int] = None,
@@ -387,6 +389,8 @@ def spherize_urdf(path: str, *, kind: str = "cover", max_spheres: Optional[int] 
                   padding: float = 0.0,
                   clip_planes: Sequence[tuple[str, tuple[float, float, float], float]] = (),
                   package_paths: Sequence[str] = (),
+                  repair: RepairLike = "safe",
+                  link_repair: Mapping[str, RepairLike] = ...,
                   progress: Optional[Callable[[float], object]] = None) -> SpherizedRobot: ...
 
 def _route_key(key: str) -> str: ...

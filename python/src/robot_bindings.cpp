@@ -66,7 +66,9 @@ SpherizedRobot Spherize(const std::string& path, const std::string& kind,
                         const std::map<std::string, std::int64_t>& link_max_spheres, double padding,
                         const ClipPlanes& clip_planes,
                         const std::vector<std::string>& package_paths,
-                        const robot::MjcfReadOptions& mjcf, const py::object& progress) {
+                        const robot::MjcfReadOptions& mjcf, const RepairOptions& repair,
+                        const std::map<std::string, RepairOptions>& link_repair,
+                        const py::object& progress) {
   absl::StatusOr<robot::RobotFile> file = robot::ReadRobotFile(path, mjcf);
   if (!file.ok()) RaiseStatus(file.status());
   robot::UrdfSpherizeOptions options;
@@ -76,6 +78,8 @@ SpherizedRobot Spherize(const std::string& path, const std::string& kind,
   options.max_protrusion = max_protrusion;
   options.voxel_size = voxel_size;
   options.link_max_spheres = link_max_spheres;
+  options.repair = repair;
+  options.link_repair = link_repair;
   options.padding = padding;
   for (const auto& [link, normal, offset] : clip_planes) {
     options.clip_planes.push_back(
@@ -99,7 +103,9 @@ constexpr char kSpherizeDoc[] =
     "greedy marginal gain on their estimated delta), max_spheres_per_link (the default, "
     "DEFAULT_MAX_SPHERES_PER_LINK), max_protrusion (covers: every link's delta at most this, "
     "fewest spheres) or voxel_size (internal, dilated). link_max_spheres: {link: N} budgets "
-    "of their own. padding: metres added to every radius. clip_planes: [(link, (nx, ny, nz), "
+    "of their own (0 leaves a link out). repair: how each mesh may be repaired (an "
+    "inscribe.Repair or a level name, default 'safe'; see inscribe.prepare), link_repair: "
+    "{link: repair} instead for those links. padding: metres added to every radius. clip_planes: [(link, (nx, ny, nz), "
     "offset)] cuts off what lies beyond n . x = offset in the link's frame. package_paths are "
     "searched for package:// before ROS_PACKAGE_PATH and AMENT_PREFIX_PATH. A link that "
     "cannot be done is 'skipped' with its error, never silently dropped. Ctrl-C cancels. "
@@ -301,12 +307,14 @@ void BindRobot(py::module_& m) {
          const std::map<std::string, std::int64_t>& link_max_spheres, double padding,
          const ClipPlanes& clip_planes, const std::vector<std::string>& package_paths,
          const std::vector<std::string>& solid_classes, const std::vector<int>& solid_groups,
+         const RepairOptions& repair, const std::map<std::string, RepairOptions>& link_repair,
          const py::object& progress) {
         robot::MjcfReadOptions mjcf;
         mjcf.solid.classes = solid_classes;
         mjcf.solid.groups = solid_groups;
         return Spherize(path, kind, max_spheres, max_spheres_per_link, max_protrusion, voxel_size,
-                        link_max_spheres, padding, clip_planes, package_paths, mjcf, progress);
+                        link_max_spheres, padding, clip_planes, package_paths, mjcf, repair,
+                        link_repair, progress);
       },
       py::arg("path"), py::kw_only(), py::arg("kind") = "cover",
       py::arg("max_spheres") = py::none(), py::arg("max_spheres_per_link") = py::none(),
@@ -314,8 +322,9 @@ void BindRobot(py::module_& m) {
       py::arg("link_max_spheres") = std::map<std::string, std::int64_t>{}, py::arg("padding") = 0.0,
       py::arg("clip_planes") = ClipPlanes{}, py::arg("package_paths") = std::vector<std::string>{},
       py::arg("solid_classes") = std::vector<std::string>{},
-      py::arg("solid_groups") = std::vector<int>{}, py::arg("progress") = py::none(),
-      robot_doc.c_str());
+      py::arg("solid_groups") = std::vector<int>{}, py::arg("repair") = RepairOptions{},
+      py::arg("link_repair") = std::map<std::string, RepairOptions>{},
+      py::arg("progress") = py::none(), robot_doc.c_str());
   m.def(
       "spherize_urdf",
       [](const std::string& path, const std::string& kind, std::optional<std::int64_t> max_spheres,
@@ -323,15 +332,19 @@ void BindRobot(py::module_& m) {
          std::optional<double> voxel_size,
          const std::map<std::string, std::int64_t>& link_max_spheres, double padding,
          const ClipPlanes& clip_planes, const std::vector<std::string>& package_paths,
+         const RepairOptions& repair, const std::map<std::string, RepairOptions>& link_repair,
          const py::object& progress) {
         return Spherize(path, kind, max_spheres, max_spheres_per_link, max_protrusion, voxel_size,
-                        link_max_spheres, padding, clip_planes, package_paths, {}, progress);
+                        link_max_spheres, padding, clip_planes, package_paths, {}, repair,
+                        link_repair, progress);
       },
       py::arg("path"), py::kw_only(), py::arg("kind") = "cover",
       py::arg("max_spheres") = py::none(), py::arg("max_spheres_per_link") = py::none(),
       py::arg("max_protrusion") = py::none(), py::arg("voxel_size") = py::none(),
       py::arg("link_max_spheres") = std::map<std::string, std::int64_t>{}, py::arg("padding") = 0.0,
       py::arg("clip_planes") = ClipPlanes{}, py::arg("package_paths") = std::vector<std::string>{},
+      py::arg("repair") = RepairOptions{},
+      py::arg("link_repair") = std::map<std::string, RepairOptions>{},
       py::arg("progress") = py::none(), urdf_doc.c_str());
 }
 

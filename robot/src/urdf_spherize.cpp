@@ -37,8 +37,11 @@ struct PreparedElement {
 // The element's geometry in its link frame, cut by the link's clip planes (unit normals).
 // Nothing (no solid, no sphere) when it lies wholly beyond a plane.
 absl::Status PrepareElement(const UrdfElement& element, const UrdfSpherizeOptions& options,
+                            const RepairOptions& repair,
                             const std::vector<const ClipPlane*>& planes,
                             PreparedElement* prepared) {
+  SolidOptions solid_options;
+  solid_options.validate.repair = repair;
   if (element.geometry.shape == UrdfShape::kSphere) {
     const Sphere sphere{element.origin.xyz, element.geometry.radius};
     for (const ClipPlane* plane : planes) {
@@ -52,7 +55,7 @@ absl::Status PrepareElement(const UrdfElement& element, const UrdfSpherizeOption
   if (!mesh.ok()) return mesh.status();
   if (!planes.empty()) {
     // Cutting needs a closed, consistently oriented mesh: validate (and repair) first.
-    absl::StatusOr<ValidatedMesh> validated = PrepareMesh(*std::move(mesh));
+    absl::StatusOr<ValidatedMesh> validated = PrepareMesh(*std::move(mesh), solid_options.validate);
     if (!validated.ok()) {
       return absl::FailedPreconditionError(
           absl::StrCat("the mesh is not a usable closed solid: ", validated.status().message()));
@@ -65,7 +68,9 @@ absl::Status PrepareElement(const UrdfElement& element, const UrdfSpherizeOption
       mesh = *std::move(clipped);
     }
   }
-  absl::StatusOr<Solid> solid = PrepareSolid(*std::move(mesh));
+  // Once cut, the mesh is closed (the clip keeps it so): no repair beyond the safe one.
+  if (!planes.empty()) solid_options.validate.repair.level = MeshRepair::kSafe;
+  absl::StatusOr<Solid> solid = PrepareSolid(*std::move(mesh), solid_options);
   if (!solid.ok()) {
     return absl::FailedPreconditionError(
         absl::StrCat("the mesh is not a usable closed solid: ", solid.status().message()));
@@ -260,12 +265,18 @@ absl::Status CheckUrdfSpherizeOptions(const UrdfSpherizeOptions& options) {
     }
   }
   for (const auto& [link, n] : options.link_max_spheres) {
+    if (n == 0) continue;  // the link is left out
     if (absl::Status s = check_budget(absl::StrCat("the budget of link '", link, "'").c_str(), n);
         !s.ok()) {
       return s;
     }
   }
-  if (!options.link_max_spheres.empty() && (options.max_protrusion || options.voxel_size)) {
+  // A budget of 0 (leave the link out) goes with every mode; other per-link budgets only with
+  // the budget modes.
+  const bool budgets = std::any_of(options.link_max_spheres.begin(),
+                                   options.link_max_spheres.end(),
+                                   [](const auto& entry) { return entry.second != 0; });
+  if (budgets && (options.max_protrusion || options.voxel_size)) {
     return absl::InvalidArgumentError(
         "per-link budgets go with max_spheres or max_spheres_per_link, not with "
         "max_protrusion or voxel_size");
@@ -358,6 +369,12 @@ absl::StatusOr<RobotSpherizeResult> SpherizeRobot(const UrdfRobot& robot,
           absl::StrCat("a per-link budget names link '", link, "', which the robot does not have"));
     }
   }
+  for (const auto& [link, repair] : options.link_repair) {
+    if (link_index.count(link) == 0) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("a per-link repair names link '", link, "', which the robot does not have"));
+    }
+  }
 
   RobotSpherizeResult out;
   out.links.resize(robot.links.size());
@@ -372,6 +389,12 @@ absl::StatusOr<RobotSpherizeResult> SpherizeRobot(const UrdfRobot& robot,
     result.elements = static_cast<int>(link.elements.size());
     const auto link_start = std::chrono::steady_clock::now();
     const std::size_t first = elements.size();
+    if (const auto budget = options.link_max_spheres.find(link.name);
+        budget != options.link_max_spheres.end() && budget->second == 0) {
+      result.status = LinkStatus::kSkipped;
+      result.error = "left out: its budget is 0 (--link-max-spheres)";
+      continue;
+    }
     for (std::size_t k = 0; k < link.elements.size(); ++k) {
       if (control.cancelled()) return absl::CancelledError("robot spherization cancelled");
       PreparedElement prepared;
@@ -379,7 +402,10 @@ absl::StatusOr<RobotSpherizeResult> SpherizeRobot(const UrdfRobot& robot,
       prepared.element = static_cast<int>(k);
       absl::Status status;
       try {
-        status = PrepareElement(link.elements[k], options, planes[l], &prepared);
+        const auto own = options.link_repair.find(link.name);
+        status = PrepareElement(link.elements[k], options,
+                                own == options.link_repair.end() ? options.repair : own->second,
+                                planes[l], &prepared);
       } catch (const std::exception& e) {
         // CGAL or an allocation giving up on hostile input: this link's problem, not the run's.
         status = absl::InternalError(absl::StrCat("internal error while preparing: ", e.what()));

@@ -114,3 +114,27 @@ def test_the_client_sends_the_repair(server):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", inscribe.MeshWarning)
         assert key == inscribe.prepare(cup, repair=inscribe.Repair("wrap", wrap_alpha=0.1)).sha256
+
+
+def test_a_robot_whose_link_mesh_is_open_spherizes_every_link_with_a_repair(tmp_path):
+    inscribe.write_mesh(open_cup(), str(tmp_path / "cup.off"))
+    (tmp_path / "robot.urdf").write_text("""<robot name="r">
+  <link name="base"><collision><geometry><box size="0.2 0.2 0.1"/></geometry></collision></link>
+  <link name="cup"><collision><geometry><mesh filename="cup.off"/></geometry></collision></link>
+  <joint name="j" type="revolute"><parent link="base"/><child link="cup"/>
+    <origin xyz="0 0 0.3"/><axis xyz="0 0 1"/><limit lower="-1" upper="1"/></joint>
+</robot>""")
+    path = str(tmp_path / "robot.urdf")
+    default = inscribe.spherize_urdf(path, max_spheres_per_link=8)
+    cup = default.links[1]
+    assert cup.status == "skipped" and "--repair" in cup.error
+    for kwargs in ({"repair": "auto"}, {"link_repair": {"cup": "fill"}},
+                   {"repair": inscribe.Repair("wrap", wrap_alpha=0.1)}):
+        robot = inscribe.spherize_urdf(path, max_spheres_per_link=8, **kwargs)
+        assert [link.status for link in robot.links] == ["spherized", "spherized"], kwargs
+        assert any("fixed" in w for w in robot.links[1].warnings), kwargs
+    # A budget of 0 leaves a link out, and says so.
+    robot = inscribe.spherize_urdf(path, max_spheres_per_link=8, repair="auto",
+                                   link_max_spheres={"base": 0})
+    assert robot.links[0].status == "skipped" and "left out" in robot.links[0].error
+    assert robot.links[1].status == "spherized"

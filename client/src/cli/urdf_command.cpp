@@ -28,6 +28,7 @@
 #include "inscribe/robot/urdf_robot.h"
 #include "inscribe/robot/urdf_spherize.h"
 #include "nlohmann/json.hpp"
+#include "solid_loading.h"
 
 namespace inscribe::cli {
 
@@ -55,6 +56,8 @@ struct UrdfCliOptions {
   std::optional<double> max_protrusion;
   std::optional<double> voxel_size;
   std::vector<std::string> link_budgets;  // LINK=N
+  RepairOptions repair;                   // --repair and the rest, for every link
+  std::vector<std::string> link_repairs;  // LINK=LEVEL
   std::vector<std::string> clips;         // LINK=NX,NY,NZ,OFFSET
   double padding = 0.0;
   std::string output_path;
@@ -99,6 +102,20 @@ absl::StatusOr<UrdfSpherizeOptions> SpherizeOptionsOf(const UrdfCliOptions& opti
           "--link-max-spheres '%s': '%s' is not a whole number", text, parts->second));
     }
     spherize.link_max_spheres[parts->first] = n;
+  }
+  spherize.repair = options.repair;
+  for (const std::string& text : options.link_repairs) {
+    absl::StatusOr<std::pair<std::string, std::string>> parts =
+        SplitLinkValue(text, "--link-repair");
+    if (!parts.ok()) return parts.status();
+    absl::StatusOr<MeshRepair> level = ParseMeshRepair(parts->second);
+    if (!level.ok()) {
+      return absl::InvalidArgumentError(
+          absl::StrFormat("--link-repair '%s': %s", text, level.status().message()));
+    }
+    RepairOptions repair = options.repair;
+    repair.level = *level;
+    spherize.link_repair[parts->first] = repair;
   }
   for (const std::string& text : options.clips) {
     absl::StatusOr<std::pair<std::string, std::string>> parts = SplitLinkValue(text, "--clip");
@@ -466,7 +483,11 @@ void AddUrdfCommand(CLI::App& app, CommandOutcome* outcome) {
     }
   }
   cmd->add_option("--link-max-spheres", options->link_budgets,
-                  "LINK=N: that link gets N spheres of its own, outside the shared budget; "
+                  "LINK=N: that link gets N spheres of its own, outside the shared budget (0: "
+                  "leave it out, e.g. a static base); repeatable");
+  AddRepairOptions(cmd, &options->repair);
+  cmd->add_option("--link-repair", options->link_repairs,
+                  "LINK=LEVEL: that link's meshes repaired at this --repair level instead; "
                   "repeatable");
   cmd->add_option("--padding", options->padding,
                   "Metres added to every radius, as a planner's collision buffer (covers: >= 0, "

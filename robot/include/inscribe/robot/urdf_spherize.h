@@ -23,6 +23,7 @@
 #include "inscribe/medial/medial_spheres.h"
 #include "inscribe/medial/sphere_dilation.h"
 #include "inscribe/robot/urdf_robot.h"
+#include "inscribe/solid/mesh_validation.h"
 
 namespace inscribe::robot {
 
@@ -52,8 +53,12 @@ struct UrdfSpherizeOptions {
   std::optional<double> max_protrusion;
   std::optional<double> voxel_size;
   // In the budget modes: these links (by name) get exactly their own budget, outside the
-  // robot's shared one.
+  // robot's shared one; 0 leaves the link out (a static base), said in its result.
   std::map<std::string, std::int64_t> link_max_spheres;
+  // How each element's mesh may be repaired (core's RepairOptions, default safe), and per link
+  // (by name) instead.
+  RepairOptions repair;
+  std::map<std::string, RepairOptions> link_repair;
   // Added to every radius (metres), as planners' collision buffers: a cover stays a cover
   // with delta + padding. Covers: >= 0; internal and dilated sets: any value leaving every
   // radius positive.

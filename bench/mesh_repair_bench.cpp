@@ -79,9 +79,10 @@ int CorpusTable() {
     }
     std::printf(" %s |\n", cover.c_str());
   }
-  std::printf("\n%d of %d usable with the defaults or one --repair option; %d without a certified "
-              "cover from auto\n\n",
-              usable_by_one_option, total, failures);
+  std::printf(
+      "\n%d of %d usable with the defaults or one --repair option; %d without a certified "
+      "cover from auto\n\n",
+      usable_by_one_option, total, failures);
   return failures;
 }
 
@@ -110,8 +111,9 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   const int failures = inscribe::CorpusTable();
   std::printf("## The wrap at the default alpha (diagonal / 50), against validation alone\n\n");
-  std::printf("| input | triangles | none, s | wrap, s | wrap / none | wrap triangles | alpha | "
-              "offset | reach / offset | usable |\n");
+  std::printf(
+      "| input | triangles | none, s | wrap, s | wrap / none | wrap triangles | alpha | "
+      "offset | reach / offset | usable |\n");
   std::printf("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n");
   const std::vector<std::string> levels = absl::StrSplit(quick ? std::string("5") : sizes, ',');
   for (const std::string& level : levels) {

@@ -43,8 +43,7 @@ std::shared_ptr<PySphereSet> Generate(
 
   // The params and stats a sphere file records of a generation: the same as `inscribe
   // generate` writes.
-  SphereFile file =
-      GenerationSphereFile(parameters, *generated, solid->sha256, solid->report);
+  SphereFile file = GenerationSphereFile(parameters, *generated, solid->sha256, solid->report);
   auto result = std::make_shared<PySphereSet>();
   result->kind = SphereSetKindName(generated->kind);
   result->mesh_sha256 = std::move(file.mesh_sha256);

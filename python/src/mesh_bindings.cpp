@@ -139,8 +139,8 @@ void BindMesh(py::module_& m) {
       .def_readonly("wrap_alpha", &RepairOptions::wrap_alpha)
       .def_readonly("wrap_offset", &RepairOptions::wrap_offset)
       .def("__repr__", [](const RepairOptions& r) {
-        return absl::StrCat("Repair('", MeshRepairName(r.level), "', weld_tolerance=",
-                            r.weld_tolerance, ", wrap_alpha=", r.wrap_alpha,
+        return absl::StrCat("Repair('", MeshRepairName(r.level),
+                            "', weld_tolerance=", r.weld_tolerance, ", wrap_alpha=", r.wrap_alpha,
                             ", wrap_offset=", r.wrap_offset, ")");
       });
   py::implicitly_convertible<py::str, RepairOptions>();

@@ -59,16 +59,13 @@ struct SpherizedRobot {
 using ClipPlanes = std::vector<std::tuple<std::string, std::array<double, 3>, double>>;
 
 // What spherize_robot and spherize_urdf do: read by content, spherize every link.
-SpherizedRobot Spherize(const std::string& path, const std::string& kind,
-                        std::optional<std::int64_t> max_spheres,
-                        std::optional<std::int64_t> max_spheres_per_link,
-                        std::optional<double> max_protrusion, std::optional<double> voxel_size,
-                        const std::map<std::string, std::int64_t>& link_max_spheres, double padding,
-                        const ClipPlanes& clip_planes,
-                        const std::vector<std::string>& package_paths,
-                        const robot::MjcfReadOptions& mjcf, const RepairOptions& repair,
-                        const std::map<std::string, RepairOptions>& link_repair,
-                        const py::object& progress) {
+SpherizedRobot Spherize(
+    const std::string& path, const std::string& kind, std::optional<std::int64_t> max_spheres,
+    std::optional<std::int64_t> max_spheres_per_link, std::optional<double> max_protrusion,
+    std::optional<double> voxel_size, const std::map<std::string, std::int64_t>& link_max_spheres,
+    double padding, const ClipPlanes& clip_planes, const std::vector<std::string>& package_paths,
+    const robot::MjcfReadOptions& mjcf, const RepairOptions& repair,
+    const std::map<std::string, RepairOptions>& link_repair, const py::object& progress) {
   absl::StatusOr<robot::RobotFile> file = robot::ReadRobotFile(path, mjcf);
   if (!file.ok()) RaiseStatus(file.status());
   robot::UrdfSpherizeOptions options;
@@ -105,7 +102,8 @@ constexpr char kSpherizeDoc[] =
     "fewest spheres) or voxel_size (internal, dilated). link_max_spheres: {link: N} budgets "
     "of their own (0 leaves a link out). repair: how each mesh may be repaired (an "
     "inscribe.Repair or a level name, default 'safe'; see inscribe.prepare), link_repair: "
-    "{link: repair} instead for those links. padding: metres added to every radius. clip_planes: [(link, (nx, ny, nz), "
+    "{link: repair} instead for those links. padding: metres added to every radius. clip_planes: "
+    "[(link, (nx, ny, nz), "
     "offset)] cuts off what lies beyond n . x = offset in the link's frame. package_paths are "
     "searched for package:// before ROS_PACKAGE_PATH and AMENT_PREFIX_PATH. A link that "
     "cannot be done is 'skipped' with its error, never silently dropped. Ctrl-C cancels. "

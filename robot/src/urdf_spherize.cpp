@@ -273,8 +273,7 @@ absl::Status CheckUrdfSpherizeOptions(const UrdfSpherizeOptions& options) {
   }
   // A budget of 0 (leave the link out) goes with every mode; other per-link budgets only with
   // the budget modes.
-  const bool budgets = std::any_of(options.link_max_spheres.begin(),
-                                   options.link_max_spheres.end(),
+  const bool budgets = std::any_of(options.link_max_spheres.begin(), options.link_max_spheres.end(),
                                    [](const auto& entry) { return entry.second != 0; });
   if (budgets && (options.max_protrusion || options.voxel_size)) {
     return absl::InvalidArgumentError(
@@ -546,8 +545,7 @@ absl::StatusOr<Mesh> ElementMeshInLinkFrame(const UrdfElement& element,
                              "> is not URDF geometry inscribe can spherize (mesh, box, "
                              "cylinder, sphere)"));
   }
-  return TransformMesh(std::move(mesh), scale, OriginRotation(element.origin),
-                       element.origin.xyz);
+  return TransformMesh(std::move(mesh), scale, OriginRotation(element.origin), element.origin.xyz);
 }
 
 std::vector<std::int64_t> LinkSphereBudgets(std::int64_t max_spheres,

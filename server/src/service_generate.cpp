@@ -229,7 +229,7 @@ class GenerateReactor final : public grpc::ServerWriteReactor<v1::GenerateRespon
   const ServiceParts parts_;
   grpc::CallbackServerContext* const context_;
   const v1::GenerateRequest* const request_;
-  SphereSetParameters parameters_;  // the request's, checked in Start
+  SphereSetParameters parameters_;         // the request's, checked in Start
   MeshRepair repair_ = MeshRepair::kSafe;  // the repair the mesh was stored with, from Start
   std::atomic<bool> cancel_{false};
   MemoryBudget::Reservation reservation_;  // set in Start, released in Complete

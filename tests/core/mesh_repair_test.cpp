@@ -70,8 +70,8 @@ double Disagreement(const Mesh& repaired, const std::vector<Mesh>& intended, dou
   for (int i = 0; i < 4000; ++i) {
     Vector3 p;
     for (int k = 0; k < 3; ++k) {
-      p[k] = std::uniform_real_distribution<double>(box.min[k] - grow[k],
-                                                    box.max[k] + grow[k])(rng);
+      p[k] =
+          std::uniform_real_distribution<double>(box.min[k] - grow[k], box.max[k] + grow[k])(rng);
     }
     if (truth_repaired.Distance(p) < margin) continue;
     bool near = false, inside_intended = false, reliable = true;
@@ -99,8 +99,8 @@ TEST_P(CorpusRepair, UsableAtTheLevelItNeedsAndAutoAndRefusedBelow) {
                               MeshRepair::kWrap};
   for (const MeshRepair level : order) {
     const ValidatedMesh v = Repaired(entry.mesh, level);
-    const bool expected = level == MeshRepair::kWrap ||
-                          static_cast<int>(level) >= static_cast<int>(entry.needs);
+    const bool expected =
+        level == MeshRepair::kWrap || static_cast<int>(level) >= static_cast<int>(entry.needs);
     EXPECT_EQ(v.report.usable(), expected)
         << MeshRepairName(level) << ": " << v.report.first_error();
     if (!v.report.usable()) {

@@ -1,10 +1,10 @@
 // libFuzzer target: the mesh loader. The first byte picks the format (bits 0-1: off, obj, stl,
-// ply) and the repair level (bits 2-3: safe, fill, none, auto); the rest goes through ParseMesh, the path ReadMesh, the CLI
-// and the server take, and a mesh that parses through ValidateMesh as they do. Findings:
-// crashes, sanitizer reports, hangs, and broken promises, which abort: a refusal without a
-// message, and validation's promises (validated_mesh_checks.h). ParseMesh passes non-finite
-// coordinates (binary STL and PLY hold any bit pattern) and indices past int32 (as -1) through;
-// validation must then refuse the mesh. Inputs are meant to stay small (-max_len 4096):
+// ply) and the repair level (bits 2-3: safe, fill, none, auto); the rest goes through ParseMesh,
+// the path ReadMesh, the CLI and the server take, and a mesh that parses through ValidateMesh as
+// they do. Findings: crashes, sanitizer reports, hangs, and broken promises, which abort: a refusal
+// without a message, and validation's promises (validated_mesh_checks.h). ParseMesh passes
+// non-finite coordinates (binary STL and PLY hold any bit pattern) and indices past int32 (as -1)
+// through; validation must then refuse the mesh. Inputs are meant to stay small (-max_len 4096):
 // validation costs O(#T log #T), hole filling up to O(n^2) per loop, the wrap grows with the
 // mesh's area over alpha^2 (alpha from its size: bounded).
 #include <cstddef>

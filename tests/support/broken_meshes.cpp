@@ -57,7 +57,8 @@ Mesh CrackedSphere(double gap, double radius) {
   std::vector<std::int32_t> copy(static_cast<std::size_t>(sphere.num_vertices()), -1);
   Eigen::Index extra = 0;
   for (std::size_t v = 0; v < copy.size(); ++v) {
-    if (in_upper[v] && in_lower[v]) copy[v] = static_cast<std::int32_t>(sphere.num_vertices() + extra++);
+    if (in_upper[v] && in_lower[v])
+      copy[v] = static_cast<std::int32_t>(sphere.num_vertices() + extra++);
   }
   out.vertices.resize(sphere.num_vertices() + extra, 3);
   out.vertices.topRows(sphere.num_vertices()) = sphere.vertices;
@@ -109,10 +110,10 @@ std::vector<BrokenMesh> BrokenMeshCorpus() {
     corpus.push_back(Entry("mixed-orientation-sphere", mixed, MeshRepair::kNone, {sphere}));
   }
   const Mesh other = Box(Vector3(0.5, 0.25, 0.25), Vector3(1.5, 1.25, 1.25));
-  corpus.push_back(Entry("overlapping-boxes", Concatenate(cube, other), MeshRepair::kNone,
-                         {cube, other}));
-  corpus.push_back(Entry("per-face-vertices-cube", PerFaceVertices(cube), MeshRepair::kNone,
-                         {cube}));
+  corpus.push_back(
+      Entry("overlapping-boxes", Concatenate(cube, other), MeshRepair::kNone, {cube, other}));
+  corpus.push_back(
+      Entry("per-face-vertices-cube", PerFaceVertices(cube), MeshRepair::kNone, {cube}));
   {
     // An exporter that rounds each face's copy of a vertex differently: every edge a border.
     Mesh jitter = PerFaceVertices(sphere);
@@ -124,8 +125,9 @@ std::vector<BrokenMesh> BrokenMeshCorpus() {
   }
   for (const double fraction : {1e-9, 1e-7, 1e-5, 1e-4}) {
     // Size: the sphere's diameter, 2.
-    corpus.push_back(Entry("crack-1e" + std::to_string(static_cast<int>(std::round(std::log10(fraction)))),
-                           CrackedSphere(2.0 * fraction), MeshRepair::kSafe, {sphere}));
+    corpus.push_back(
+        Entry("crack-1e" + std::to_string(static_cast<int>(std::round(std::log10(fraction)))),
+              CrackedSphere(2.0 * fraction), MeshRepair::kSafe, {sphere}));
   }
   corpus.push_back(Entry("crack-millimetres", CrackedSphere(2000.0 * 1e-5, 1000.0),
                          MeshRepair::kSafe, {Icosphere(2, Vector3::Zero(), 1000.0)}));
@@ -145,16 +147,16 @@ std::vector<BrokenMesh> BrokenMeshCorpus() {
     corpus.push_back(Entry("duplicate-triangles-cube", repeated, MeshRepair::kSafe, {cube}));
   }
   corpus.push_back(Entry("faces-removed-cube", OpenUnitCube(), MeshRepair::kFill, {cube}));
-  corpus.push_back(
-      Entry("faces-removed-sphere", WithoutTriangles(sphere, {5, 77, 200}), MeshRepair::kFill,
-            {sphere}));
+  corpus.push_back(Entry("faces-removed-sphere", WithoutTriangles(sphere, {5, 77, 200}),
+                         MeshRepair::kFill, {sphere}));
   {
     // A cup: the box without its top face (a square hole of 4 border edges).
     const Mesh cup = WithoutTriangles(cube, {});
     std::vector<Eigen::Index> top;
     for (Eigen::Index t = 0; t < cube.triangles.rows(); ++t) {
       bool all_top = true;
-      for (int k = 0; k < 3; ++k) all_top = all_top && cube.vertices(cube.triangles(t, k), 2) == 1.0;
+      for (int k = 0; k < 3; ++k)
+        all_top = all_top && cube.vertices(cube.triangles(t, k), 2) == 1.0;
       if (all_top) top.push_back(t);
     }
     corpus.push_back(Entry("open-cup", WithoutTriangles(cup, top), MeshRepair::kFill, {cube}));
@@ -162,8 +164,8 @@ std::vector<BrokenMesh> BrokenMeshCorpus() {
                            MeshRepair::kFill, {Scaled(cube, 1000.0)}));
   }
   corpus.push_back(Entry("lone-sheet", Square(), MeshRepair::kWrap));
-  corpus.push_back(Entry("sheet-stored-twice", Concatenate(Square(), Inverted(Square())),
-                         MeshRepair::kWrap));
+  corpus.push_back(
+      Entry("sheet-stored-twice", Concatenate(Square(), Inverted(Square())), MeshRepair::kWrap));
   {
     // A fin: one triangle hanging off an edge of the cube, which three triangles then share.
     Mesh fin = cube;

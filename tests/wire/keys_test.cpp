@@ -70,7 +70,8 @@ TEST(Keys, EveryParameterChangesTheKey) {
   EXPECT_EQ(keys.size(), 18u);
   // Growth means nothing without dilation, nor quality samples without evaluation.
   p = base, p.dilation.growth = 0.3;
-  EXPECT_EQ(GeneratedSphereSetKey(kMesh, p, MeshRepair::kSafe), GeneratedSphereSetKey(kMesh, base, MeshRepair::kSafe));
+  EXPECT_EQ(GeneratedSphereSetKey(kMesh, p, MeshRepair::kSafe),
+            GeneratedSphereSetKey(kMesh, base, MeshRepair::kSafe));
   SphereSetParameters unevaluated = base;
   unevaluated.evaluate = false;
   p = unevaluated, p.quality.surface_samples = 7;
@@ -84,7 +85,8 @@ TEST(Keys, CoversHaveTheirOwnKeysAndLeaveOthersAlone) {
   // A cover's settings mean nothing for other kinds: their keys stay the version-1 ones.
   SphereSetParameters unused = base;
   unused.cover_resolution = 1.0 / 64;
-  EXPECT_EQ(GeneratedSphereSetKey(kMesh, unused, MeshRepair::kSafe), GeneratedSphereSetKey(kMesh, base, MeshRepair::kSafe));
+  EXPECT_EQ(GeneratedSphereSetKey(kMesh, unused, MeshRepair::kSafe),
+            GeneratedSphereSetKey(kMesh, base, MeshRepair::kSafe));
   SphereSetParameters by_size;
   by_size.voxel_size = 0.1;
   by_size.cover_resolution = 1.0 / 64;

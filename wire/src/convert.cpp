@@ -123,9 +123,9 @@ absl::StatusOr<MeshRepair> MeshRepairFromProto(v1::MeshRepair repair, bool fill_
     default:
       break;
   }
-  return absl::InvalidArgumentError(absl::StrCat(
-      "repair level ", static_cast<int>(repair),
-      " is not defined (MESH_REPAIR_NONE, SAFE, FILL, WRAP or AUTO)"));
+  return absl::InvalidArgumentError(
+      absl::StrCat("repair level ", static_cast<int>(repair),
+                   " is not defined (MESH_REPAIR_NONE, SAFE, FILL, WRAP or AUTO)"));
 }
 
 namespace {

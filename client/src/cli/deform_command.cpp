@@ -116,11 +116,12 @@ absl::StatusOr<DeformInputs> ReadInputs(const DeformCliOptions& options) {
   // the solid's vertices are no longer those.
   if (solid->report.welded_vertices > 0 || solid->report.weld_collapsed_triangles > 0 ||
       solid->report.crack_vertices_welded > 0) {
-    return BadInputError(absl::StrCat(
-        options.reference_path, " repeats vertices at one position or has cracks (",
-        solid->report.welded_vertices + solid->report.crack_vertices_welded,
-        " vertices welded); deform needs a reference and deformed meshes whose triangles share their "
-        "vertices: export them with vertices merged (welded)"));
+    return BadInputError(
+        absl::StrCat(options.reference_path, " repeats vertices at one position or has cracks (",
+                     solid->report.welded_vertices + solid->report.crack_vertices_welded,
+                     " vertices welded); deform needs a reference and deformed meshes whose "
+                     "triangles share their "
+                     "vertices: export them with vertices merged (welded)"));
   }
   in.reference_sha256 = FormatSha256(MeshSha256(solid->mesh));
   if (!file->mesh_sha256.empty() && file->mesh_sha256 != in.reference_sha256) {

@@ -79,8 +79,7 @@ void PrintText(const EvaluateCliOptions& options, const QualityReport& r) {
 // PutMesh, then Evaluate with the spheres sent inline.
 absl::StatusOr<Evaluated> Evaluate(const client::Client& client, const EvaluateCliOptions& options,
                                    const SphereFile& file, const QualityOptions& quality) {
-  absl::StatusOr<StoredSolid> solid =
-      StoreSolid(client, options.mesh_path, options.repair);
+  absl::StatusOr<StoredSolid> solid = StoreSolid(client, options.mesh_path, options.repair);
   if (!solid.ok()) return solid.status();
   absl::StatusOr<QualityReport> report = client.Evaluate(solid->sha256, file.set, quality);
   if (!report.ok()) return report.status();
@@ -133,8 +132,7 @@ void PrintCertificate(const EvaluateCliOptions& options, const SphereFile& file,
 // --certify: PutMesh, then CertifyCover with the spheres sent inline. Not a cover is exit 1.
 absl::Status RunCertify(const client::Client& client, const EvaluateCliOptions& options,
                         const SphereFile& file) {
-  absl::StatusOr<StoredSolid> solid =
-      StoreSolid(client, options.mesh_path, options.repair);
+  absl::StatusOr<StoredSolid> solid = StoreSolid(client, options.mesh_path, options.repair);
   if (!solid.ok()) return solid.status();
   absl::StatusOr<CoverCertificate> certificate =
       client.CertifyCover(solid->sha256, file.set, options.certify_options);

@@ -54,8 +54,7 @@ struct Generated {
 // PutMesh, then Generate with the progress bar fed by the service's messages.
 absl::StatusOr<Generated> Generate(const client::Client& client,
                                    const GenerateCliOptions& options) {
-  absl::StatusOr<StoredSolid> solid =
-      StoreSolid(client, options.mesh_path, options.repair);
+  absl::StatusOr<StoredSolid> solid = StoreSolid(client, options.mesh_path, options.repair);
   if (!solid.ok()) return solid.status();
 
   client::GenerateSettings settings;

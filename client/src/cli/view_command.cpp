@@ -152,8 +152,7 @@ absl::Status RunView(const ViewCliOptions& options) {
   if (!page_path.ok()) return page_path.status();
   const std::string& output = *page_path;
 
-  absl::StatusOr<LoadedSolid> solid =
-      LoadSolid(options.mesh_path, options.repair);
+  absl::StatusOr<LoadedSolid> solid = LoadSolid(options.mesh_path, options.repair);
   if (!solid.ok()) return solid.status();
   if (!file->mesh_sha256.empty() && file->mesh_sha256 != solid->solid.sha256) {
     std::cerr << "inscribe: warning: " << options.spheres_path << " was made for mesh "

@@ -192,8 +192,7 @@ absl::StatusOr<InspectMeshResult> Client::InspectMesh(const Mesh& mesh,
 
 absl::StatusOr<PutMeshResult> Client::PutMesh(const Mesh& mesh,
                                               const PutMeshOptions& options) const {
-  return PutMeshUntil(*connection_, options_.retry,
-                      PutMeshRequestFor(mesh, options.repair),
+  return PutMeshUntil(*connection_, options_.retry, PutMeshRequestFor(mesh, options.repair),
                       DeadlineAfter(options.timeout, options_));
 }
 
@@ -230,10 +229,9 @@ absl::StatusOr<GenerateResult> Client::Generate(const std::string& mesh_sha256, 
   if (absl::Status checked = CheckSphereSetParameters(settings.parameters); !checked.ok()) {
     return checked;
   }
-  return GenerateUploadingAgain(
-      *connection_, options_.retry,
-      PutMeshRequestFor(mesh, settings.repair), mesh_sha256, settings,
-      options, DeadlineAfter(options.timeout, options_));
+  return GenerateUploadingAgain(*connection_, options_.retry,
+                                PutMeshRequestFor(mesh, settings.repair), mesh_sha256, settings,
+                                options, DeadlineAfter(options.timeout, options_));
 }
 
 absl::StatusOr<PutSphereSetResult> Client::PutSphereSet(const SphereSet& spheres,

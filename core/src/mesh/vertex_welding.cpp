@@ -92,9 +92,9 @@ std::vector<std::int32_t> NearRepresentatives(const Mesh& mesh, double tolerance
     for (std::size_t w : found) {
       if (w > v && representative[w] < 0 &&
           CGAL::squared_distance(points[v], points[w]) <= squared &&
-          (only == nullptr ||
-           std::none_of(cluster.begin(), cluster.end(),
-                        [&](std::size_t member) { return joined(member, w); }))) {
+          (only == nullptr || std::none_of(cluster.begin(), cluster.end(), [&](std::size_t member) {
+             return joined(member, w);
+           }))) {
         representative[w] = static_cast<std::int32_t>(v);
         if (only != nullptr) cluster.push_back(w);
       }

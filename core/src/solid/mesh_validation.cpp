@@ -180,8 +180,7 @@ void CheckEdges(const Mesh& mesh, const std::vector<EdgeUse>& uses, const EdgeGr
         absl::StrCat("mesh is not edge-manifold: ",
                      Plural(report.non_manifold_edges, "edge is", "edges are"),
                      " shared by more than two triangles (first: vertices ", first_non_manifold->lo,
-                     "-", first_non_manifold->hi, ", in ", first_non_manifold_count,
-                     " triangles)"),
+                     "-", first_non_manifold->hi, ", in ", first_non_manifold_count, " triangles)"),
         report.non_manifold_edges);
   }
   // Inconsistent orientation is reported by the orientation step, which knows if it is fixed.
@@ -344,10 +343,11 @@ void NoteHolesNotFilled(MeshReport& report, const std::string& why) {
   }
 }
 
-// Hole filling (MeshRepair::kFill, kAuto) on a mesh with border edges: makes orientation consistent on a copy,
-// closes every hole of the copy (internal::FillHoles), then orients the closed copy outward
-// and returns it in `mesh`. When any hole cannot be closed, `mesh` is left as given, checked
-// as without fill_holes, and the "not closed" error says why. Cost O(#T log #T) plus CGAL's.
+// Hole filling (MeshRepair::kFill, kAuto) on a mesh with border edges: makes orientation consistent
+// on a copy, closes every hole of the copy (internal::FillHoles), then orients the closed copy
+// outward and returns it in `mesh`. When any hole cannot be closed, `mesh` is left as given,
+// checked as without fill_holes, and the "not closed" error says why. Cost O(#T log #T) plus
+// CGAL's.
 void FillHolesAndOrient(Mesh& mesh, const std::vector<EdgeUse>& uses, const EdgeGroups& groups,
                         const ValidateOptions& options, MeshReport& report) {
   auto keep_open = [&](const std::string& why) {
@@ -464,7 +464,6 @@ bool WeldCoincidentVertices(Mesh& mesh, double tolerance, MeshReport& report) {
   return true;
 }
 
-
 // MeshRepair::kSafe: removes triangles that repeat an earlier one's corners in the same cyclic
 // order, then deals with each pair of triangles with the same corners in opposite orders: when
 // each of its edges is in four or more triangles, a wall stored once for each of the two
@@ -477,11 +476,12 @@ void RemoveDuplicatesAndDoubleWalls(Mesh& mesh, MeshReport& report) {
   const EdgeGroups groups = GroupEdges(uses);
   auto edge_uses = [&](std::int32_t a, std::int32_t b) -> std::size_t {
     const std::int32_t lo = std::min(a, b), hi = std::max(a, b);
-    const auto it = std::lower_bound(
-        groups.ranges.begin(), groups.ranges.end(), std::make_pair(lo, hi),
-        [&](const std::pair<std::size_t, std::size_t>& r, const std::pair<std::int32_t, std::int32_t>& e) {
-          return std::make_pair(uses[r.first].lo, uses[r.first].hi) < e;
-        });
+    const auto it =
+        std::lower_bound(groups.ranges.begin(), groups.ranges.end(), std::make_pair(lo, hi),
+                         [&](const std::pair<std::size_t, std::size_t>& r,
+                             const std::pair<std::int32_t, std::int32_t>& e) {
+                           return std::make_pair(uses[r.first].lo, uses[r.first].hi) < e;
+                         });
     return it == groups.ranges.end() ? 0 : it->second - it->first;
   };
   // Key: the corners rotated so that the smallest comes first (same cyclic order, same key),
@@ -521,12 +521,12 @@ void RemoveDuplicatesAndDoubleWalls(Mesh& mesh, MeshReport& report) {
       for (std::size_t k = 1; k < rising.size(); ++k) removed[rising[k]] = 1;
       for (std::size_t k = 1; k < falling.size(); ++k) removed[falling[k]] = 1;
       report.duplicate_triangles_removed +=
-          static_cast<std::int64_t>(rising.size() + falling.size()) -
-          (rising.empty() ? 0 : 1) - (falling.empty() ? 0 : 1);
+          static_cast<std::int64_t>(rising.size() + falling.size()) - (rising.empty() ? 0 : 1) -
+          (falling.empty() ? 0 : 1);
       if (!rising.empty() && !falling.empty()) {
         const std::array<std::int32_t, 3>& c = keys[i].sorted;
-        const bool wall = edge_uses(c[0], c[1]) >= 4 && edge_uses(c[1], c[2]) >= 4 &&
-                          edge_uses(c[0], c[2]) >= 4;
+        const bool wall =
+            edge_uses(c[0], c[1]) >= 4 && edge_uses(c[1], c[2]) >= 4 && edge_uses(c[0], c[2]) >= 4;
         if (wall) {
           removed[rising[0]] = removed[falling[0]] = 1;
           ++report.double_walls_removed;
@@ -555,13 +555,13 @@ void RemoveDuplicatesAndDoubleWalls(Mesh& mesh, MeshReport& report) {
              report.duplicate_triangles_removed);
   }
   if (report.double_walls_removed > 0) {
-    AddIssue(report, Severity::kFixed, "double_walls_removed",
-             absl::StrCat("removed ",
-                          Plural(report.double_walls_removed, "wall stored twice",
-                                 "walls stored twice"),
-                          " (the same triangle in both orientations, as where two bodies touch): "
-                          "the solid is the bodies' union"),
-             report.double_walls_removed);
+    AddIssue(
+        report, Severity::kFixed, "double_walls_removed",
+        absl::StrCat("removed ",
+                     Plural(report.double_walls_removed, "wall stored twice", "walls stored twice"),
+                     " (the same triangle in both orientations, as where two bodies touch): "
+                     "the solid is the bodies' union"),
+        report.double_walls_removed);
   }
 }
 
@@ -603,12 +603,12 @@ void WeldCracks(Mesh& mesh, MeshReport& report) {
   const std::int64_t border_after = CountBorderEdges(welded, &non_manifold_after);
   if (welded.num_triangles() == 0 || border_after >= border_before ||
       non_manifold_after > non_manifold_before) {
-    AddIssue(report, Severity::kWarning, "cracks_not_welded",
-             absl::StrFormat("welding the border's vertices within %g would %s; not done", tolerance,
-                             non_manifold_after > non_manifold_before
-                                 ? "make edges non-manifold"
-                                 : "close no border edge"),
-             0);
+    AddIssue(
+        report, Severity::kWarning, "cracks_not_welded",
+        absl::StrFormat("welding the border's vertices within %g would %s; not done", tolerance,
+                        non_manifold_after > non_manifold_before ? "make edges non-manifold"
+                                                                 : "close no border edge"),
+        0);
     return;
   }
   report.crack_vertices_welded = weld.merged_vertices;
@@ -637,7 +637,6 @@ const char* SeverityName(Severity severity) {
   return "unknown";
 }
 
-
 const char* MeshRepairName(MeshRepair repair) {
   switch (repair) {
     case MeshRepair::kNone:
@@ -659,8 +658,8 @@ absl::StatusOr<MeshRepair> ParseMeshRepair(const std::string& name) {
                        MeshRepair::kAuto}) {
     if (name == MeshRepairName(r)) return r;
   }
-  return absl::InvalidArgumentError(absl::StrCat(
-      "unknown mesh repair '", name, "': use none, safe, fill, wrap or auto"));
+  return absl::InvalidArgumentError(
+      absl::StrCat("unknown mesh repair '", name, "': use none, safe, fill, wrap or auto"));
 }
 
 double CrackWeldTolerance(const Mesh& mesh) {
@@ -672,7 +671,8 @@ double CrackWeldTolerance(const Mesh& mesh) {
   lengths.reserve(groups.ranges.size());
   for (const auto& [begin, end] : groups.ranges) {
     if (end - begin < 2) continue;
-    lengths.push_back((mesh.vertices.row(uses[begin].lo) - mesh.vertices.row(uses[begin].hi)).norm());
+    lengths.push_back(
+        (mesh.vertices.row(uses[begin].lo) - mesh.vertices.row(uses[begin].hi)).norm());
   }
   double tolerance = 1e-4 * diagonal;
   if (!lengths.empty()) {
@@ -752,7 +752,8 @@ ValidatedMesh ValidateSteps(Mesh mesh, const ValidateOptions& options, Mesh* sou
              huge);
     return ValidatedMesh{std::move(mesh), std::move(report)};
   }
-  if (options.weld_vertices && !WeldCoincidentVertices(mesh, options.repair.weld_tolerance, report)) {
+  if (options.weld_vertices &&
+      !WeldCoincidentVertices(mesh, options.repair.weld_tolerance, report)) {
     return ValidatedMesh{std::move(mesh), std::move(report)};
   }
   if (soup != nullptr) *soup = mesh;
@@ -775,7 +776,8 @@ ValidatedMesh ValidateSteps(Mesh mesh, const ValidateOptions& options, Mesh* sou
   const EdgeGroups groups = GroupEdges(uses);
   CheckEdges(mesh, uses, groups, report);
   CheckVertexManifold(mesh, uses, groups, report);
-  const bool fill = options.repair.level == MeshRepair::kFill || options.repair.level == MeshRepair::kAuto;
+  const bool fill =
+      options.repair.level == MeshRepair::kFill || options.repair.level == MeshRepair::kAuto;
   if (fill && report.border_edges > 0) {
     FillHolesAndOrient(mesh, uses, groups, options, report);
   } else {
@@ -855,8 +857,10 @@ ValidatedMesh WrapSoup(ValidatedMesh input, const Mesh& soup, const ValidateOpti
   };
   const BoundingBox box = ComputeBoundingBox(soup.vertices);
   const double diagonal = (box.max - box.min).norm();
-  const double alpha = options.repair.wrap_alpha > 0.0 ? options.repair.wrap_alpha : DefaultWrapAlpha(diagonal);
-  const double offset = options.repair.wrap_offset > 0.0 ? options.repair.wrap_offset : DefaultWrapOffset(alpha);
+  const double alpha =
+      options.repair.wrap_alpha > 0.0 ? options.repair.wrap_alpha : DefaultWrapAlpha(diagonal);
+  const double offset =
+      options.repair.wrap_offset > 0.0 ? options.repair.wrap_offset : DefaultWrapOffset(alpha);
   if (!(diagonal > 0.0)) return fail("the mesh's vertices are all at one point");
   absl::StatusOr<Mesh> wrap = internal::AlphaWrap(soup, alpha, offset);
   if (!wrap.ok()) return fail(std::string(wrap.status().message()));
@@ -865,12 +869,12 @@ ValidatedMesh WrapSoup(ValidatedMesh input, const Mesh& soup, const ValidateOpti
   plain.check_self_intersections = options.check_self_intersections;
   ValidatedMesh wrapped = ValidateMesh(*std::move(wrap), plain);
   if (!wrapped.report.usable()) {
-    return fail(absl::StrCat("the wrap is not a usable solid (", wrapped.report.first_error(),
-                             ")"));
+    return fail(
+        absl::StrCat("the wrap is not a usable solid (", wrapped.report.first_error(), ")"));
   }
   if (const std::string why = internal::CheckWrapEncloses(wrapped.mesh, soup); !why.empty()) {
-    return fail(absl::StrCat("it does not enclose the input (", why,
-                             "); a larger --wrap-offset may help"));
+    return fail(
+        absl::StrCat("it does not enclose the input (", why, "); a larger --wrap-offset may help"));
   }
   MeshReport out = std::move(report);
   // A patch tried before the wrap is not in the returned mesh.
@@ -927,7 +931,8 @@ ValidatedMesh WrapSoup(ValidatedMesh input, const Mesh& soup, const ValidateOpti
 }  // namespace
 
 ValidatedMesh ValidateMesh(Mesh mesh, const ValidateOptions& options) {
-  const bool may_wrap = options.repair.level == MeshRepair::kWrap || options.repair.level == MeshRepair::kAuto;
+  const bool may_wrap =
+      options.repair.level == MeshRepair::kWrap || options.repair.level == MeshRepair::kAuto;
   if (may_wrap) {
     MeshReport report;
     report.vertices = mesh.num_vertices();

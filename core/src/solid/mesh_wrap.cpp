@@ -126,8 +126,8 @@ std::string CheckWrapEncloses(const Mesh& wrap, const Mesh& input) {
     bool on_surface = false;
     const Vector3 p = input.vertices.row(v).transpose();
     if (bvh.XRayWinding(p, &on_surface) == 0 || on_surface) {
-      return absl::StrFormat("input vertex %d (%g, %g, %g) is %s the wrap", v, p.x(), p.y(),
-                             p.z(), on_surface ? "on the surface of" : "outside");
+      return absl::StrFormat("input vertex %d (%g, %g, %g) is %s the wrap", v, p.x(), p.y(), p.z(),
+                             on_surface ? "on the surface of" : "outside");
     }
   }
   // No input triangle meets the wrap's surface.
@@ -152,8 +152,7 @@ std::string CheckWrapEncloses(const Mesh& wrap, const Mesh& input) {
                              }
                            });
   if (first_input >= 0) {
-    return absl::StrCat("input triangle ", first_input, " meets the wrap's triangle ",
-                        first_wrap);
+    return absl::StrCat("input triangle ", first_input, " meets the wrap's triangle ", first_wrap);
   }
   return "";
 }
@@ -162,15 +161,15 @@ double WrapReachBound(const Mesh& wrap, const Mesh& input) {
   const TriangleBvh bvh = TriangleBvh::Build(input);
   // Rounding: the closest-point computation errs far below a 1e-12 relative and 1e-14 of the
   // coordinates' magnitude absolute pad.
-  const double magnitude = std::max(input.vertices.cwiseAbs().maxCoeff(),
-                                    wrap.vertices.cwiseAbs().maxCoeff());
+  const double magnitude =
+      std::max(input.vertices.cwiseAbs().maxCoeff(), wrap.vertices.cwiseAbs().maxCoeff());
   auto padded = [magnitude](double d) { return d * (1.0 + 1e-12) + 1e-14 * magnitude; };
   auto to_triangle = [&input](const Vector3& p, std::int32_t t) {
     Vector3 weights;
-    const Vector3 q = ClosestPointOnTriangle(
-        p, input.vertices.row(input.triangles(t, 0)).transpose(),
-        input.vertices.row(input.triangles(t, 1)).transpose(),
-        input.vertices.row(input.triangles(t, 2)).transpose(), &weights);
+    const Vector3 q =
+        ClosestPointOnTriangle(p, input.vertices.row(input.triangles(t, 0)).transpose(),
+                               input.vertices.row(input.triangles(t, 1)).transpose(),
+                               input.vertices.row(input.triangles(t, 2)).transpose(), &weights);
     return (p - q).norm();
   };
   // The distance to one input triangle is convex, so over a wrap triangle it peaks at a corner:
@@ -202,8 +201,8 @@ double WrapReachBound(const Mesh& wrap, const Mesh& input) {
     const Corner m = corner_of((a.p + b.p + c.p) / 3);
     double best = std::numeric_limits<double>::infinity();
     for (const std::int32_t j : {a.nearest, b.nearest, c.nearest, m.nearest}) {
-      best = std::min(best, std::max({to_triangle(a.p, j), to_triangle(b.p, j),
-                                      to_triangle(c.p, j)}));
+      best =
+          std::min(best, std::max({to_triangle(a.p, j), to_triangle(b.p, j), to_triangle(c.p, j)}));
     }
     return padded(best);
   };
@@ -221,9 +220,9 @@ double WrapReachBound(const Mesh& wrap, const Mesh& input) {
       tbb::blocked_range<Eigen::Index>(0, wrap.triangles.rows()), padded(floor),
       [&](const tbb::blocked_range<Eigen::Index>& r, double worst) {
         for (Eigen::Index t = r.begin(); t != r.end(); ++t) {
-          worst = std::max(worst, refine(refine, corners[wrap.triangles(t, 0)],
-                                         corners[wrap.triangles(t, 1)],
-                                         corners[wrap.triangles(t, 2)], 4));
+          worst = std::max(
+              worst, refine(refine, corners[wrap.triangles(t, 0)], corners[wrap.triangles(t, 1)],
+                            corners[wrap.triangles(t, 2)], 4));
         }
         return worst;
       },

@@ -79,8 +79,8 @@ struct MeshReport {
   // `wrapped` describe the input; components, flipped_triangles, flat_shells, the
   // self-intersection figures, volume and bbox describe the wrap.
   bool wrapped = false;
-  double wrap_alpha = 0.0;   // mesh units
-  double wrap_offset = 0.0;  // mesh units
+  double wrap_alpha = 0.0;                // mesh units
+  double wrap_offset = 0.0;               // mesh units
   std::int64_t wrap_input_triangles = 0;  // the triangles wrapped
   std::int64_t wrap_triangles = 0;        // the wrap's
   // An upper bound on how far any point of the wrap's surface is from the nearest input
@@ -109,8 +109,7 @@ struct MeshReport {
   // of identical positions and removed duplicates and double walls change no point of the
   // solid.
   bool geometry_repaired() const {
-    return weld_moved_within > 0.0 || weld_collapsed_triangles > 0 || holes_filled > 0 ||
-           wrapped;
+    return weld_moved_within > 0.0 || weld_collapsed_triangles > 0 || holes_filled > 0 || wrapped;
   }
   // Those repairs in one line ("welded 3 vertices within 0.02 ...; filled 1 hole ..."), or ""
   // when geometry_repaired() is false.
@@ -197,10 +196,10 @@ struct ValidateOptions {
   // inward, for any number of components (exact winding numbers). The solid is then where the
   // mesh's winding number is not zero (InsideTest).
   bool fix_orientation = true;
-  // Hole filling closes every hole (border loop) with triangles between its own border vertices (no vertex
-  // is added; CGAL's triangulate_hole: the constrained Delaunay triangulation of a near-planar
-  // loop, else the triangulation with the smallest largest dihedral angle, then the smallest
-  // area), after orientation is made consistent and before the closedness check. All holes
+  // Hole filling closes every hole (border loop) with triangles between its own border vertices (no
+  // vertex is added; CGAL's triangulate_hole: the constrained Delaunay triangulation of a
+  // near-planar loop, else the triangulation with the smallest largest dihedral angle, then the
+  // smallest area), after orientation is made consistent and before the closedness check. All holes
   // are filled or none: nothing is when the mesh is not edge-manifold, a vertex is on the
   // border twice, a loop exceeds the caps below (or, when not near planar, 1,000 edges or a
   // fixed work budget shared by all loops) or CGAL finds no triangulation for it; the mesh

@@ -34,7 +34,7 @@ struct EvaluateCliOptions {
   bool certify = false;
   CoverCertifyOptions certify_options;
   bool json = false;
-  RepairOptions repair;
+  SolidLoadOptions load;  // --scale and the repair options
   RemoteOptions remote;
 };
 
@@ -79,7 +79,7 @@ void PrintText(const EvaluateCliOptions& options, const QualityReport& r) {
 // PutMesh, then Evaluate with the spheres sent inline.
 absl::StatusOr<Evaluated> Evaluate(const client::Client& client, const EvaluateCliOptions& options,
                                    const SphereFile& file, const QualityOptions& quality) {
-  absl::StatusOr<StoredSolid> solid = StoreSolid(client, options.mesh_path, options.repair);
+  absl::StatusOr<StoredSolid> solid = StoreSolid(client, options.mesh_path, options.load);
   if (!solid.ok()) return solid.status();
   absl::StatusOr<QualityReport> report = client.Evaluate(solid->sha256, file.set, quality);
   if (!report.ok()) return report.status();
@@ -132,7 +132,7 @@ void PrintCertificate(const EvaluateCliOptions& options, const SphereFile& file,
 // --certify: PutMesh, then CertifyCover with the spheres sent inline. Not a cover is exit 1.
 absl::Status RunCertify(const client::Client& client, const EvaluateCliOptions& options,
                         const SphereFile& file) {
-  absl::StatusOr<StoredSolid> solid = StoreSolid(client, options.mesh_path, options.repair);
+  absl::StatusOr<StoredSolid> solid = StoreSolid(client, options.mesh_path, options.load);
   if (!solid.ok()) return solid.status();
   absl::StatusOr<CoverCertificate> certificate =
       client.CertifyCover(solid->sha256, file.set, options.certify_options);
@@ -211,7 +211,7 @@ void AddEvaluateCommand(CLI::App& app, CommandOutcome* outcome) {
                   "bounding-box diagonal)");
   cmd->add_option("--voxel-size", options->quality.voxel_size,
                   "Voxel size for the fatness test (default: the file's, if it has one)");
-  AddRepairOptions(cmd, &options->repair);
+  AddSolidLoadOptions(cmd, &options->load);
   cmd->add_flag("--certify", options->certify,
                 "Instead of the quality report: prove that the spheres contain the whole solid "
                 "(a cover), or give a point of the solid in no sphere; with delta, a sound bound "

@@ -33,7 +33,7 @@ struct GenerateCliOptions {
   std::string format;
   std::string link;  // cuRobo YAML link name
   bool json = false;
-  RepairOptions repair;
+  SolidLoadOptions load;  // --scale and the repair options
   RemoteOptions remote;
 };
 
@@ -54,12 +54,12 @@ struct Generated {
 // PutMesh, then Generate with the progress bar fed by the service's messages.
 absl::StatusOr<Generated> Generate(const client::Client& client,
                                    const GenerateCliOptions& options) {
-  absl::StatusOr<StoredSolid> solid = StoreSolid(client, options.mesh_path, options.repair);
+  absl::StatusOr<StoredSolid> solid = StoreSolid(client, options.mesh_path, options.load);
   if (!solid.ok()) return solid.status();
 
   client::GenerateSettings settings;
   settings.parameters = options.parameters;
-  settings.repair = options.repair;
+  settings.repair = options.load.repair;
   ProgressBar progress("generating");
   client::GenerateOptions call;
   call.on_progress = [&progress](double fraction) { progress.Update(fraction); };
@@ -260,7 +260,7 @@ void AddGenerateCommand(CLI::App& app, CommandOutcome* outcome) {
                   "the paper's S_D+; 0.5 halved the distance error on 5 of 6 Table II models)")
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
-  AddRepairOptions(cmd, &options->repair);
+  AddSolidLoadOptions(cmd, &options->load);
   cmd->add_flag("--json", options->json,
                 "Print one JSON summary on stdout (spheres, voxel_size, seconds, volumes, nerr, "
                 "quality figures)");

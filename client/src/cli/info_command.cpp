@@ -26,7 +26,7 @@ struct InfoOptions {
   std::string path;
   bool json = false;
   bool skip_self_intersections = false;
-  RepairOptions repair;
+  SolidLoadOptions load;  // --scale and the repair options
   RemoteOptions remote;
   std::string output_path;  // -o: the repaired mesh
 };
@@ -93,7 +93,7 @@ void PrintText(const std::string& path, const InfoResult& result) {
 absl::Status WriteRepaired(const InfoOptions& options, Mesh mesh, const std::string& sha256) {
   ValidateOptions validate;
   validate.check_self_intersections = !options.skip_self_intersections;
-  validate.repair = options.repair;
+  validate.repair = options.load.repair;
   const ValidatedMesh validated = ValidateMesh(std::move(mesh), validate);
   if (FormatSha256(MeshSha256(validated.mesh)) != sha256) {
     return absl::InternalError(absl::StrCat("the repaired mesh here hashes to ",
@@ -109,13 +109,13 @@ absl::Status WriteRepaired(const InfoOptions& options, Mesh mesh, const std::str
 absl::Status RunInfo(const InfoOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   InfoResult result;
-  absl::StatusOr<Mesh> mesh = ReadMesh(options.path, &result.read);
-  if (!mesh.ok()) return BadInputError(mesh.status().message());
+  absl::StatusOr<Mesh> mesh = ReadScaledMesh(options.path, options.load.scale, &result.read);
+  if (!mesh.ok()) return mesh.status();
   absl::StatusOr<std::unique_ptr<ServiceSession>> session = ServiceSession::Open(options.remote);
   if (!session.ok()) return session.status();
   client::InspectMeshOptions inspect;
   inspect.skip_self_intersections = options.skip_self_intersections;
-  inspect.repair = options.repair;
+  inspect.repair = options.load.repair;
   absl::StatusOr<client::InspectMeshResult> inspected =
       (*session)->client().InspectMesh(*mesh, inspect);
   if (!inspected.ok()) return inspected.status();
@@ -149,7 +149,7 @@ void AddInfoCommand(CLI::App& app, CommandOutcome* outcome) {
   cmd->add_flag("--json", options->json, "Print one JSON object on stdout");
   cmd->add_flag("--skip-self-intersections", options->skip_self_intersections,
                 "Skip the exact self-intersection test (faster on huge meshes)");
-  AddRepairOptions(cmd, &options->repair);
+  AddSolidLoadOptions(cmd, &options->load);
   cmd->add_option("-o,--output", options->output_path,
                   "Write the mesh as validated and repaired (OFF, OBJ, PLY or STL by extension) "
                   "when it is usable");

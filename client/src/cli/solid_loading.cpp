@@ -64,12 +64,28 @@ void AddRepairOptions(CLI::App* cmd, RepairOptions* repair) {
       ->check(CLI::PositiveNumber);
 }
 
+void AddSolidLoadOptions(CLI::App* cmd, SolidLoadOptions* options) {
+  AddRepairOptions(cmd, &options->repair);
+  cmd->add_option("--scale", options->scale,
+                  "Multiply the mesh's coordinates by this as it is read (0.001: a mesh in "
+                  "millimetres to metres); the hash and every result are the scaled mesh's")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+}
+
+absl::StatusOr<Mesh> ReadScaledMesh(const std::string& path, double scale, ReadMeshInfo* info) {
+  absl::StatusOr<Mesh> mesh = ReadMesh(path, info);
+  if (!mesh.ok()) return BadInputError(mesh.status().message());
+  if (scale != 1.0) mesh->vertices *= scale;
+  return mesh;
+}
+
 absl::StatusOr<LoadedSolid> LoadSolid(const std::string& path, const SolidLoadOptions& options) {
   const auto start = std::chrono::steady_clock::now();
-  absl::StatusOr<Mesh> mesh = ReadMesh(path, nullptr);
-  if (!mesh.ok()) return BadInputError(mesh.status().message());
+  absl::StatusOr<Mesh> mesh = ReadScaledMesh(path, options.scale);
+  if (!mesh.ok()) return mesh.status();
   SolidOptions solid_options;
-  solid_options.validate.repair = options;
+  solid_options.validate.repair = options.repair;
   absl::StatusOr<Solid> solid = PrepareSolid(*std::move(mesh), solid_options);
   if (!solid.ok()) return UnusableMeshError(path + ": " + std::string(solid.status().message()));
   NoteRepairs(path, solid->report, solid->sha256);
@@ -79,10 +95,10 @@ absl::StatusOr<LoadedSolid> LoadSolid(const std::string& path, const SolidLoadOp
 absl::StatusOr<StoredSolid> StoreSolid(const client::Client& client, const std::string& path,
                                        const SolidLoadOptions& options) {
   const auto start = std::chrono::steady_clock::now();
-  absl::StatusOr<Mesh> mesh = ReadMesh(path, nullptr);
-  if (!mesh.ok()) return BadInputError(mesh.status().message());
+  absl::StatusOr<Mesh> mesh = ReadScaledMesh(path, options.scale);
+  if (!mesh.ok()) return mesh.status();
   client::PutMeshOptions put;
-  put.repair = options;
+  put.repair = options.repair;
   absl::StatusOr<client::PutMeshResult> stored = client.PutMesh(*mesh, put);
   if (!stored.ok()) {
     if (stored.status().code() == absl::StatusCode::kFailedPrecondition) {

@@ -41,7 +41,7 @@ struct ViewCliOptions {
   int sph_level = -1;
   std::int64_t samples = 100'000;
   std::uint64_t seed = 1;
-  RepairOptions repair;
+  SolidLoadOptions load;  // --scale and the repair options
   std::string title;
   std::vector<std::string> package_paths;  // robots: where package:// URIs are looked for
   // Options given that only the mesh form reads, by name, to refuse them for a robot.
@@ -152,7 +152,7 @@ absl::Status RunView(const ViewCliOptions& options) {
   if (!page_path.ok()) return page_path.status();
   const std::string& output = *page_path;
 
-  absl::StatusOr<LoadedSolid> solid = LoadSolid(options.mesh_path, options.repair);
+  absl::StatusOr<LoadedSolid> solid = LoadSolid(options.mesh_path, options.load);
   if (!solid.ok()) return solid.status();
   if (!file->mesh_sha256.empty() && file->mesh_sha256 != solid->solid.sha256) {
     std::cerr << "inscribe: warning: " << options.spheres_path << " was made for mesh "
@@ -219,7 +219,7 @@ void AddViewCommand(CLI::App& app, CommandOutcome* outcome) {
       ->capture_default_str()
       ->check(CLI::Range(std::int64_t{1}, std::int64_t{10'000'000}));
   cmd->add_option("--seed", options->seed, "Seed of the samples")->capture_default_str();
-  AddRepairOptions(cmd, &options->repair);
+  AddSolidLoadOptions(cmd, &options->load);
   cmd->add_option("--title", options->title,
                   "Heading of the page (default: the mesh and sphere file names)");
   cmd->add_option("--package-path", options->package_paths,
@@ -229,7 +229,7 @@ void AddViewCommand(CLI::App& app, CommandOutcome* outcome) {
   cmd->callback([cmd, options, outcome] {
     for (const char* name :
          {"--format", "--link", "--sph-level", "--samples", "--seed", "--fill-holes", "--repair",
-          "--weld-tolerance", "--wrap-alpha", "--wrap-offset"}) {
+          "--weld-tolerance", "--wrap-alpha", "--wrap-offset", "--scale"}) {
       if (cmd->get_option(name)->count() > 0) options->mesh_only_given.push_back(name);
     }
     outcome->status = RunView(*options);

@@ -188,17 +188,22 @@ void BindRobot(py::module_& m) {
           "no solid (planes); none for URDF")
       .def(
           "urdf",
-          [](const SpherizedRobot& r) {
+          [](const SpherizedRobot& r, const std::optional<std::string>& directory) {
             if (r.file.format != robot::RobotFormat::kUrdf) {
               RaiseStatus(absl::InvalidArgumentError(
                   r.file.path +
                   " is an MJCF model: there is no URDF to write; use spheres or "
                   "curobo_yaml()"));
             }
-            return ValueOrRaise(robot::SpherizedUrdf(r.file.bytes, r.links));
+            if (!directory) return ValueOrRaise(robot::SpherizedUrdf(r.file.bytes, r.links));
+            return ValueOrRaise(robot::SpherizedUrdf(
+                r.file.bytes, r.links, r.file.directory,
+                std::filesystem::absolute(*directory).lexically_normal().string()));
           },
+          py::arg("directory") = py::none(),
           "The URDF text with one sphere <collision> per sphere in spherized links (URDF "
-          "input only).")
+          "input only). With `directory` (the folder the text will be written to), relative "
+          "mesh paths are rewritten to resolve from there, as `inscribe urdf -o` writes them.")
       .def(
           "mjcf",
           [](const SpherizedRobot& r, const std::string& directory) {

@@ -1,6 +1,7 @@
 #include "inscribe/robot/primitive_meshes.h"
 
 #include <cassert>
+#include <algorithm>
 #include <cmath>
 #include <utility>
 #include <vector>
@@ -28,9 +29,12 @@ Mesh BoxMesh(const Vector3& size) {
   return mesh;
 }
 
-Mesh CylinderMesh(double radius, double length, int sides) {
+Mesh CylinderMesh(double radius, double length, int sides, PrimitiveFit fit) {
   assert(radius > 0.0 && length > 0.0 && sides >= 3);
   const double h = 0.5 * length;
+  if (fit == PrimitiveFit::kEnclosing) {
+    radius *= (1.0 + kEnclosingMargin) / std::cos(M_PI / sides);
+  }
   Mesh mesh;
   // Rim vertices: bottom ring 0..n-1, top ring n..2n-1; then the two cap centres.
   mesh.vertices.resize(2 * sides + 2, 3);
@@ -91,8 +95,9 @@ Mesh RevolutionMesh(const std::vector<std::pair<double, double>>& rings, double 
 
 }  // namespace
 
-Mesh CapsuleMesh(double radius, double length, int sides, int quarter_bands) {
+Mesh CapsuleMesh(double radius, double length, int sides, int quarter_bands, PrimitiveFit fit) {
   assert(radius > 0.0 && length >= 0.0 && sides >= 3 && quarter_bands >= 1);
+  if (fit == PrimitiveFit::kEnclosing) radius *= EnclosingScale(sides, quarter_bands);
   const double h = 0.5 * length;
   std::vector<std::pair<double, double>> rings;
   // Latitudes from the north pole down to the equator on the top cap, then the bottom cap's
@@ -112,13 +117,59 @@ Mesh CapsuleMesh(double radius, double length, int sides, int quarter_bands) {
   return RevolutionMesh(rings, h + radius, -h - radius, sides);
 }
 
-Mesh EllipsoidMesh(const Vector3& radii, int sides, int quarter_bands) {
+Mesh EllipsoidMesh(const Vector3& radii, int sides, int quarter_bands, PrimitiveFit fit) {
   assert((radii.array() > 0.0).all() && sides >= 3 && quarter_bands >= 1);
-  Mesh mesh = CapsuleMesh(1.0, 0.0, sides, quarter_bands);
+  Mesh mesh = CapsuleMesh(1.0, 0.0, sides, quarter_bands, fit);
   for (Eigen::Index i = 0; i < mesh.vertices.rows(); ++i) {
     mesh.vertices.row(i) = mesh.vertices.row(i).cwiseProduct(radii.transpose());
   }
   return mesh;
+}
+
+namespace {
+
+// The smallest distance from the centre to a face plane of the unit sphere's inside
+// triangulation. Its faces are isosceles trapezoids split in two and triangles at the poles,
+// every vertex on the sphere: the distance is below 1 and close to it.
+double SmallestFaceDistance(int sides, int quarter_bands) {
+  const Mesh mesh = CapsuleMesh(1.0, 0.0, sides, quarter_bands, PrimitiveFit::kInside);
+  double smallest = 1.0;
+  for (Eigen::Index t = 0; t < mesh.triangles.rows(); ++t) {
+    const Vector3 a = mesh.vertices.row(mesh.triangles(t, 0)).transpose();
+    const Vector3 b = mesh.vertices.row(mesh.triangles(t, 1)).transpose();
+    const Vector3 c = mesh.vertices.row(mesh.triangles(t, 2)).transpose();
+    const Vector3 normal = (b - a).cross(c - a).normalized();
+    // The plane's distance from the centre, as the least over the three corners (the same
+    // number up to rounding; the least is the safe one).
+    smallest = std::min({smallest, normal.dot(a), normal.dot(b), normal.dot(c)});
+  }
+  return smallest;
+}
+
+}  // namespace
+
+double EnclosingScale(int sides, int quarter_bands) {
+  return (1.0 + kEnclosingMargin) / SmallestFaceDistance(sides, quarter_bands);
+}
+
+double CylinderExcess(double radius, PrimitiveFit fit, int sides) {
+  const double c = std::cos(M_PI / sides);
+  return fit == PrimitiveFit::kInside ? radius * (1.0 - c)
+                                      : radius * ((1.0 + kEnclosingMargin) / c - 1.0);
+}
+
+double CapsuleExcess(double radius, PrimitiveFit fit, int sides, int quarter_bands) {
+  // Inside: the mesh holds the ball of the smallest face distance. Enclosing: the mesh lies in
+  // the ball of its vertices' radius. Both swept along the axis for the capsule.
+  return fit == PrimitiveFit::kInside
+             ? radius * (1.0 - SmallestFaceDistance(sides, quarter_bands))
+             : radius * (EnclosingScale(sides, quarter_bands) - 1.0);
+}
+
+double EllipsoidExcess(const Vector3& radii, PrimitiveFit fit, int sides, int quarter_bands) {
+  // The affine image of the ball's bounds: ellipsoids of radii scaled by the same factors,
+  // whose surfaces lie at most (factor difference) * largest radius apart.
+  return CapsuleExcess(radii.maxCoeff(), fit, sides, quarter_bands);
 }
 
 }  // namespace inscribe::robot

@@ -5,12 +5,14 @@
 #include <cassert>
 #include <charconv>
 #include <cmath>
+#include <filesystem>
 #include <map>
 #include <set>
 #include <utility>
 
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/match.h"
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_replace.h"
 #include "inscribe/balls/sphere_io.h"
@@ -73,6 +75,39 @@ void ReplaceCollisions(XMLDocument& document, XMLElement& link, const LinkSpheri
   }
 }
 
+// The <mesh filename> of a relative path (plain or file://), written relative to
+// `output_directory` instead of `source_directory` (both absolute); package:// and absolute
+// paths name the same file from anywhere and stay as they are.
+void RewriteRelativeMeshPaths(XMLElement& root, const std::string& source_directory,
+                              const std::string& output_directory) {
+  namespace fs = std::filesystem;
+  const fs::path source = fs::path(source_directory).lexically_normal();
+  const fs::path output = fs::path(output_directory).lexically_normal();
+  if (source == output) return;
+  for (XMLElement* link = root.FirstChildElement("link"); link != nullptr;
+       link = link->NextSiblingElement("link")) {
+    for (XMLElement* part = link->FirstChildElement(); part != nullptr;
+         part = part->NextSiblingElement()) {
+      XMLElement* geometry = part->FirstChildElement("geometry");
+      XMLElement* mesh = geometry == nullptr ? nullptr : geometry->FirstChildElement("mesh");
+      const char* filename = mesh == nullptr ? nullptr : mesh->Attribute("filename");
+      if (filename == nullptr) continue;
+      std::string path = filename;
+      std::string scheme;
+      if (absl::StartsWith(path, "file://")) {
+        scheme = "file://";
+        path = path.substr(scheme.size());
+      } else if (path.find("://") != std::string::npos) {
+        continue;
+      }
+      if (path.empty() || fs::path(path).is_absolute()) continue;
+      const fs::path relative = (source / path).lexically_normal().lexically_relative(output);
+      if (relative.empty()) continue;  // different roots (not on POSIX paths)
+      mesh->SetAttribute("filename", (scheme + relative.generic_string()).c_str());
+    }
+  }
+}
+
 }  // namespace
 
 std::string ShortestDecimal(double value) {
@@ -82,7 +117,9 @@ std::string ShortestDecimal(double value) {
 }
 
 absl::StatusOr<std::string> SpherizedUrdf(absl::string_view urdf_bytes,
-                                          const std::vector<LinkSpherizeResult>& links) {
+                                          const std::vector<LinkSpherizeResult>& links,
+                                          const std::string& source_directory,
+                                          const std::string& output_directory) {
   XMLDocument document;
   if (document.Parse(urdf_bytes.data(), urdf_bytes.size()) != tinyxml2::XML_SUCCESS ||
       document.RootElement() == nullptr) {
@@ -105,6 +142,9 @@ absl::StatusOr<std::string> SpherizedUrdf(absl::string_view urdf_bytes,
               absl::StrCat("inscribe urdf: not spherized, geometry kept as it was: ", result.error))
               .c_str()));
     }
+  }
+  if (!source_directory.empty() && !output_directory.empty()) {
+    RewriteRelativeMeshPaths(*document.RootElement(), source_directory, output_directory);
   }
   tinyxml2::XMLPrinter printer;
   document.Print(&printer);

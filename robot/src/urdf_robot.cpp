@@ -150,6 +150,16 @@ absl::StatusOr<UrdfGeometry> ParseGeometry(const XMLElement& element, const std:
     geometry.shape = UrdfShape::kCylinder;
     geometry.radius = *radius;
     geometry.length = *length;
+  } else if (kind == "capsule" || kind == "drake:capsule") {
+    // As urdfdom's Capsule and Drake read it: `length` is the cylinder's, between the caps'
+    // centres, along z.
+    absl::StatusOr<double> radius = ParsePositive(*shape, "radius", link);
+    if (!radius.ok()) return radius.status();
+    absl::StatusOr<double> length = ParsePositive(*shape, "length", link);
+    if (!length.ok()) return length.status();
+    geometry.shape = UrdfShape::kCapsule;
+    geometry.radius = *radius;
+    geometry.length = *length;
   } else if (kind == "sphere") {
     absl::StatusOr<double> radius = ParsePositive(*shape, "radius", link);
     if (!radius.ok()) return radius.status();

@@ -31,8 +31,31 @@ struct PreparedElement {
   std::optional<Solid> solid;    // mesh elements
   std::optional<Sphere> sphere;  // <sphere> elements, in the link frame
   double volume = -1.0;          // of the mesh (m^3); -1 for a sphere
+  double excess = 0.0;           // a cover's mesh beyond the true shape (curved primitives)
   std::int64_t budget = 0;       // budget modes
 };
+
+// The fit of curved primitives that `options.kind` needs: a cover must hold the true shape, an
+// internal or dilated set must stay inside it.
+PrimitiveFit FitFor(const UrdfSpherizeOptions& options) {
+  return options.kind == SphereSetKind::kCover ? PrimitiveFit::kEnclosing : PrimitiveFit::kInside;
+}
+
+// How far a cover of ElementMeshInLinkFrame's mesh may protrude beyond the element's true
+// shape beyond its certified delta: the enclosing mesh's own excess (0 for meshes and boxes,
+// which are the shape).
+double CoverExcess(const UrdfGeometry& geometry) {
+  switch (geometry.shape) {
+    case UrdfShape::kCylinder:
+      return CylinderExcess(geometry.radius, PrimitiveFit::kEnclosing);
+    case UrdfShape::kCapsule:
+      return CapsuleExcess(geometry.radius, PrimitiveFit::kEnclosing);
+    case UrdfShape::kEllipsoid:
+      return EllipsoidExcess(geometry.size, PrimitiveFit::kEnclosing);
+    default:
+      return 0.0;
+  }
+}
 
 // The element's geometry in its link frame, cut by the link's clip planes (unit normals).
 // Nothing (no solid, no sphere) when it lies wholly beyond a plane.
@@ -76,6 +99,7 @@ absl::Status PrepareElement(const UrdfElement& element, const UrdfSpherizeOption
         absl::StrCat("the mesh is not a usable closed solid: ", solid.status().message()));
   }
   prepared->volume = solid->report.volume;
+  if (options.kind == SphereSetKind::kCover) prepared->excess = CoverExcess(element.geometry);
   prepared->solid.emplace(*std::move(solid));
   return absl::OkStatus();
 }
@@ -100,7 +124,7 @@ absl::StatusOr<ElementSpheres> GenerateElement(const PreparedElement& element,
     CoverParameters parameters;
     parameters.certify.resolution = options.cover_resolution;
     if (options.max_protrusion) {
-      parameters.max_protrusion = *options.max_protrusion - options.padding;
+      parameters.max_protrusion = *options.max_protrusion - options.padding - element.excess;
     } else {
       parameters.max_spheres = element.budget;
     }
@@ -112,8 +136,13 @@ absl::StatusOr<ElementSpheres> GenerateElement(const PreparedElement& element,
         UpperBoundSpheres({}, cover->set.spheres, cover->certificate.protrusions);
     if (!cores.ok()) return cores.status();
     out.spheres = std::move(cover->set.spheres);
-    out.cores = *std::move(cores);
-    out.delta = cover->certificate.delta;
+    // A core inside the enclosing mesh of a convex primitive, shrunk by the mesh's excess over
+    // the shape, is inside the shape (the mesh lies within excess of it).
+    for (Sphere core : *cores) {
+      core.radius -= element.excess;
+      if (core.radius > 0.0) out.cores.push_back(core);
+    }
+    out.delta = cover->certificate.delta + element.excess;
     out.runs = 1;
     return out;
   }
@@ -527,13 +556,14 @@ absl::StatusOr<Mesh> ElementMeshInLinkFrame(const UrdfElement& element,
       mesh = BoxMesh(geometry.size);
       break;
     case UrdfShape::kCylinder:
-      mesh = CylinderMesh(geometry.radius, geometry.length);
+      mesh = CylinderMesh(geometry.radius, geometry.length, kCylinderSides, FitFor(options));
       break;
     case UrdfShape::kCapsule:
-      mesh = CapsuleMesh(geometry.radius, geometry.length);
+      mesh = CapsuleMesh(geometry.radius, geometry.length, kCylinderSides, kQuarterBands,
+                         FitFor(options));
       break;
     case UrdfShape::kEllipsoid:
-      mesh = EllipsoidMesh(geometry.size);
+      mesh = EllipsoidMesh(geometry.size, kCylinderSides, kQuarterBands, FitFor(options));
       break;
     case UrdfShape::kSphere:
       return absl::InvalidArgumentError("a <sphere> is kept as it is; it has no mesh");
@@ -543,7 +573,7 @@ absl::StatusOr<Mesh> ElementMeshInLinkFrame(const UrdfElement& element,
               ? std::string("no geometry (an empty or missing <geometry>)")
               : absl::StrCat("<", geometry.unsupported,
                              "> is not URDF geometry inscribe can spherize (mesh, box, "
-                             "cylinder, sphere)"));
+                             "cylinder, sphere, capsule)"));
   }
   return TransformMesh(std::move(mesh), scale, OriginRotation(element.origin), element.origin.xyz);
 }

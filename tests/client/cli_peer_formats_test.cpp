@@ -139,6 +139,35 @@ TEST_F(CliPeerFormats, CertifyReadsCoversInEveryPeerFormat) {
   EXPECT_TRUE(nlohmann::json::parse(arm.out).contains("uncovered_point"));
 }
 
+// A cover made on the mesh in millimetres (generate --scale 1000), converted to metres
+// (convert --scale 0.001), certifies on the metre mesh; the conversion says what it drops.
+TEST_F(CliPeerFormats, ConvertScalesACoverMadeInMillimetresBackToMetres) {
+  const std::string mm = Path("cover_mm.json"), m = Path("cover_m.json");
+  const CliRun made =
+      RunCli("generate " + mesh_ + " --scale 1000 --cover --max-spheres 40 -o " + Quote(mm));
+  ASSERT_EQ(made.exit_code, 0) << made.err;
+  const CliRun converted = RunCli("convert --json " + Quote(mm) + " --scale 0.001 -o " + Quote(m));
+  ASSERT_EQ(converted.exit_code, 0) << converted.err;
+  EXPECT_THAT(converted.err, AllOf(HasSubstr("--scale 0.001"), HasSubstr("mesh hash"),
+                                   HasSubstr("certificate")));
+  const nlohmann::json summary = nlohmann::json::parse(converted.out);
+  EXPECT_EQ(summary.at("scale").get<double>(), 0.001);
+  EXPECT_EQ(summary.at("mesh_sha256").get<std::string>(), "");
+  absl::StatusOr<SphereFile> before = ReadSphereFile(mm), after = ReadSphereFile(m);
+  ASSERT_TRUE(before.ok() && after.ok());
+  ASSERT_EQ(before->set.spheres.size(), after->set.spheres.size());
+  for (std::size_t i = 0; i < after->set.spheres.size(); ++i) {
+    EXPECT_EQ(after->set.spheres[i].radius, before->set.spheres[i].radius * 0.001) << i;
+  }
+  EXPECT_TRUE(after->stats.empty());  // the millimetre certificate is not carried over
+  const CliRun certify = RunCli("evaluate --certify --json " + mesh_ + " " + Quote(m));
+  ASSERT_EQ(certify.exit_code, 0) << certify.err;
+  EXPECT_TRUE(nlohmann::json::parse(certify.out).at("certified").get<bool>());
+  const CliRun bad = RunCli("convert " + Quote(mm) + " --scale -2 -o " + Quote(Path("x.json")));
+  EXPECT_EQ(bad.exit_code, 64);
+  EXPECT_THAT(bad.err, AllOf(HasSubstr("--scale"), HasSubstr("> 0")));
+}
+
 TEST_F(CliPeerFormats, DistanceReadsYamlLinksAndSphLevels) {
   std::ofstream(Path("poses.txt")) << "1 0 0 0 3 0 0\n1 0 0 0 0.5 0.2 0\n0.7071067811865476 0 "
                                       "0.7071067811865476 0 2 1 0\n";

@@ -557,7 +557,7 @@ TEST_F(CliUrdf, BadInputIsRefusedClearlyNeverWithACrash) {
     <mesh filename="package://nopkg/m.stl"/></geometry></collision></link>
   <link name="collada"><collision><geometry>
     <mesh filename="package://pkg/meshes/arm.dae"/></geometry></collision></link>
-  <link name="capsule"><collision><geometry><capsule radius="1" length="2"/></geometry>
+  <link name="cone"><collision><geometry><cone radius="1" length="2"/></geometry>
     </collision></link>
   <link name="fine"><collision><geometry><sphere radius="0.1"/></geometry></collision></link>
   <link name="odd:name"><collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision>
@@ -573,7 +573,7 @@ TEST_F(CliUrdf, BadInputIsRefusedClearlyNeverWithACrash) {
   EXPECT_THAT(errors["huge"], HasSubstr("coordinate"));
   EXPECT_THAT(errors["unknown_package"], HasSubstr("package 'nopkg'"));
   EXPECT_THAT(errors["collada"], HasSubstr("arm.dae"));  // read like any mesh: not found
-  EXPECT_THAT(errors["capsule"], HasSubstr("<capsule>"));
+  EXPECT_THAT(errors["cone"], HasSubstr("<cone>"));
   EXPECT_EQ(errors.count("fine"), 0u);
   EXPECT_EQ(report.at("spherized"), 2);
   // Spherized in the URDF, but not a name cuRobo's YAML can carry: said, not dropped silently.

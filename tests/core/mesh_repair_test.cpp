@@ -6,11 +6,17 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <optional>
+#include <variant>
 #include <random>
 #include <string>
 #include <vector>
 
+#include "inscribe/generation/sphere_file_record.h"
+#include "inscribe/generation/sphere_set_generation.h"
 #include "inscribe/solid/mesh_validation.h"
+#include "inscribe/solid/solid.h"
 #include "support/broken_meshes.h"
 #include "support/brute_force_closest_point.h"
 #include "support/mesh_issues.h"
@@ -167,6 +173,57 @@ TEST(Wrap, EnclosesTheInputAndLiesWithinItsReach) {
     EXPECT_TRUE(testing::HasIssue(v.report, "wrapped", Severity::kFixed));
     EXPECT_TRUE(v.report.geometry_repaired());
   }
+}
+
+// An internal set of a wrapped mesh reaches past the input surface by at most the recorded
+// protrusion_input: every point of its spheres (centres and 60 surface points each) is inside
+// the intended solid (brute-force winding number) or within protrusion_input of an input
+// triangle (brute-force distance).
+TEST(Wrap, InternalSetsReachPastTheInputByAtMostTheirBound) {
+  std::mt19937 rng(5);
+  std::normal_distribution<double> normal;
+  int checked = 0;
+  for (const BrokenMesh& entry : BrokenMeshCorpus()) {
+    if (entry.intended.empty()) continue;
+    SCOPED_TRACE(entry.name);
+    absl::StatusOr<Solid> solid = MakeSolid(Repaired(entry.mesh, MeshRepair::kWrap));
+    ASSERT_TRUE(solid.ok()) << solid.status();
+    const std::optional<double> bound = InternalProtrusionOverInput(solid->report);
+    ASSERT_TRUE(bound.has_value());
+    EXPECT_EQ(*bound, solid->report.wrap_reach);
+    SphereSetParameters parameters;
+    parameters.max_spheres = 24;
+    parameters.evaluate = false;
+    absl::StatusOr<GeneratedSphereSet> set = GenerateSphereSet(*solid, parameters);
+    ASSERT_TRUE(set.ok()) << set.status();
+    const SphereFile file = GenerationSphereFile(parameters, *set, solid->sha256, solid->report);
+    bool recorded = false;
+    for (const auto& [name, value] : file.stats) {
+      if (name == "protrusion_input") recorded = std::get<double>(value) == *bound;
+    }
+    EXPECT_TRUE(recorded);
+    std::vector<WindingOracle> parts(entry.intended.begin(), entry.intended.end());
+    for (const Sphere& sphere : set->set.spheres) {
+      for (int i = 0; i <= 60; ++i) {
+        Vector3 p = sphere.center;
+        if (i > 0) {
+          const Vector3 d(normal(rng), normal(rng), normal(rng));
+          p += sphere.radius * d.normalized();
+        }
+        bool inside = false;
+        for (const WindingOracle& part : parts) {
+          const testing::WindingSample w = part.At(p);
+          inside = inside || (w.reliable && w.inside());
+        }
+        if (inside) continue;
+        ++checked;
+        EXPECT_LE(testing::BruteForceDistance(entry.mesh, p), *bound * (1 + 1e-12))
+            << p.transpose();
+      }
+    }
+  }
+  EXPECT_GT(checked, 0);  // points outside the intended solid were met and bounded
+  std::printf("[ points   ] %d sphere points outside the intended solids, all bounded\n", checked);
 }
 
 TEST(Wrap, TakesItsDefaultsFromTheMeshesSize) {

@@ -118,3 +118,44 @@ def test_self_collision_matrix_srdf_and_yaml_are_the_clis(tmp_path):
     two_roots.write_text(ROBOT.format(mesh=mesh_path("eight.off")))
     with pytest.raises(ValueError, match="root"):
         inscribe.spherize_urdf(str(two_roots)).self_collision(samples=10)
+
+
+def test_relative_mesh_paths_resolve_from_the_output_folder(tmp_path):
+    import shutil
+    (tmp_path / "robot").mkdir()
+    (tmp_path / "meshes").mkdir()
+    shutil.copy(mesh_path("eight.off"), tmp_path / "meshes" / "eight.off")
+    (tmp_path / "meshes" / "open.off").write_text(
+        "OFF\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n3 0 1 3\n")
+    urdf = tmp_path / "robot" / "robot.urdf"
+    urdf.write_text("""<?xml version="1.0"?>
+<robot name="paths">
+  <link name="a">
+    <visual><geometry><mesh filename="../meshes/eight.off" scale="0.05 0.05 0.05"/></geometry></visual>
+    <collision><geometry><mesh filename="../meshes/eight.off" scale="0.05 0.05 0.05"/></geometry></collision>
+  </link>
+  <link name="b">
+    <collision><geometry><mesh filename="file://../meshes/open.off"/></geometry></collision>
+  </link>
+  <joint name="j" type="fixed"><parent link="a"/><child link="b"/></joint>
+</robot>
+""")
+    out = tmp_path / "out" / "deeper" / "spherized.urdf"
+    out.parent.mkdir(parents=True)
+    run = run_cli("urdf", urdf, "-o", out, "--max-spheres-per-link", "8", "--repair", "none",
+                  check=False)
+    assert run.returncode == 1, run.stderr  # link b is skipped
+    text = out.read_text()
+    # The visual and the skipped link's kept collision name the same files from the output.
+    assert 'filename="../../meshes/eight.off"' in text
+    assert 'filename="file://../../meshes/open.off"' in text
+    assert (out.parent / "../../meshes/eight.off").resolve() == (
+        tmp_path / "meshes" / "eight.off").resolve()
+    robot = inscribe.spherize_urdf(str(urdf), max_spheres_per_link=8, repair="none")
+    assert robot.urdf(directory=str(out.parent)) == text
+    assert 'filename="../meshes/eight.off"' in robot.urdf()  # no folder: as written
+    # The output is itself a robot whose meshes are found: its skipped link is skipped for
+    # the same reason, not for a missing file.
+    again = inscribe.spherize_urdf(str(out), max_spheres_per_link=8, repair="none")
+    assert [link.status for link in again.links] == ["spherized", "skipped"]
+    assert "does not exist" not in again.links[1].error

@@ -69,9 +69,12 @@ constexpr char kRobot[] = R"(<?xml version="1.0"?>
   <link name="eye"><visual><origin xyz="0 0 1"/>
     <geometry><cylinder radius="0.5" length="2"/></geometry></visual></link>
   <link name="ball"><collision><geometry><sphere radius="0.25"/></geometry></collision></link>
-  <link name="capsule"><collision><geometry><capsule radius="1" length="2"/></geometry>
+  <link name="cone"><collision><geometry><cone radius="1" length="2"/></geometry>
     </collision></link>
   <link name="empty"/>
+  <link name="capsules"><collision><geometry><capsule radius="0.1" length="0.4"/></geometry>
+    </collision><collision><geometry><drake:capsule radius="0.2" length="0.3"/></geometry>
+    </collision></link>
   <joint name="j" type="fixed"><parent link="base"/><child link="eye"/></joint>
 </robot>
 )";
@@ -80,7 +83,7 @@ TEST(UrdfParse, ReadsCollisionsVisualFallbackOriginsAndEveryShape) {
   const absl::StatusOr<UrdfRobot> robot = ParseUrdf(kRobot);
   ASSERT_TRUE(robot.ok()) << robot.status();
   EXPECT_EQ(robot->name, "r");
-  ASSERT_EQ(robot->links.size(), 5u);
+  ASSERT_EQ(robot->links.size(), 6u);
 
   const UrdfLink& base = robot->links[0];
   EXPECT_EQ(base.name, "base");
@@ -109,8 +112,18 @@ TEST(UrdfParse, ReadsCollisionsVisualFallbackOriginsAndEveryShape) {
   EXPECT_EQ(robot->links[2].elements.at(0).geometry.shape, UrdfShape::kSphere);
   EXPECT_EQ(robot->links[2].elements.at(0).geometry.radius, 0.25);
   EXPECT_EQ(robot->links[3].elements.at(0).geometry.shape, UrdfShape::kUnsupported);
-  EXPECT_EQ(robot->links[3].elements.at(0).geometry.unsupported, "capsule");
+  EXPECT_EQ(robot->links[3].elements.at(0).geometry.unsupported, "cone");
   EXPECT_TRUE(robot->links[4].elements.empty());
+  // Capsules as urdfdom and Drake write them: the cylinder's length between the caps' centres.
+  const UrdfLink& capsules = robot->links.at(5);
+  ASSERT_EQ(capsules.elements.size(), 2u);
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_EQ(capsules.elements[i].geometry.shape, UrdfShape::kCapsule) << i;
+  }
+  EXPECT_EQ(capsules.elements[0].geometry.radius, 0.1);
+  EXPECT_EQ(capsules.elements[0].geometry.length, 0.4);
+  EXPECT_EQ(capsules.elements[1].geometry.radius, 0.2);
+  EXPECT_EQ(capsules.elements[1].geometry.length, 0.3);
 }
 
 // The message of ParseUrdf's error for `urdf`, which must fail with INVALID_ARGUMENT.

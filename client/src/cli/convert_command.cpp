@@ -20,6 +20,7 @@ struct ConvertCliOptions {
   std::string from;  // input format; empty: ReadSphereFile's choice (extension, else sniffed)
   std::string to;    // output format; empty: from the output's extension, else JSON
   int sph_level = -1;
+  double scale = 1.0;  // centres and radii multiplied by it (ScaledSphereFile)
   std::string link;       // the cuRobo YAML link to read
   std::string yaml_link;  // the cuRobo YAML link to write under
   bool json = false;
@@ -68,6 +69,21 @@ absl::Status RunConvert(const ConvertCliOptions& options) {
   read.yaml_link = options.link;
   absl::StatusOr<SphereFile> file = ReadSphereFile(options.input_path, read);
   if (!file.ok()) return BadInputError(file.status().message());
+  // What scaling drops (it describes the unscaled mesh), then what the format leaves out.
+  std::vector<std::string> scaled_away;
+  if (options.scale != 1.0) {
+    if (!file->mesh_sha256.empty()) scaled_away.push_back("mesh hash");
+    if (!file->params.empty()) scaled_away.push_back("params");
+    if (!file->stats.empty()) scaled_away.push_back("stats (a certificate among them)");
+    if (!file->protrusions.empty()) scaled_away.push_back("protrusions");
+    file = ScaledSphereFile(*std::move(file), options.scale);
+    if (!file.ok()) return UsageError(std::string(file.status().message()) + " (--scale)");
+    if (!scaled_away.empty()) {
+      std::cerr << "inscribe: note: --scale " << options.scale
+                << " drops what describes the unscaled mesh: " << absl::StrJoin(scaled_away, ", ")
+                << "\n";
+    }
+  }
   if (absl::Status written =
           EmitSphereFile(*file, options.output_path, std::string(SphereFileFormatName(to)),
                          /*json_summary=*/false, yaml_link);
@@ -88,6 +104,8 @@ absl::Status RunConvert(const ConvertCliOptions& options) {
     summary["spheres"] = file->set.spheres.size();
     summary["mesh_sha256"] = file->mesh_sha256;
     summary["left_out"] = dropped;
+    summary["scale"] = options.scale;
+    summary["dropped_by_scale"] = scaled_away;
     std::cout << summary.dump() << "\n";
   } else if (!options.output_path.empty()) {
     std::cout << "wrote " << file->set.spheres.size() << " spheres to " << options.output_path
@@ -120,6 +138,11 @@ void AddConvertCommand(CLI::App& app, CommandOutcome* outcome) {
   cmd->add_option("--yaml-link", options->yaml_link,
                   "Link name the spheres are listed under in YAML output (default: --link, "
                   "else mesh)");
+  cmd->add_option("--scale", options->scale,
+                  "Multiply centres and radii by S (0.001: spheres of a millimetre mesh in "
+                  "metres); drops the mesh hash, params and certificate, which name the "
+                  "unscaled mesh")
+      ->capture_default_str();
   cmd->add_flag("--json", options->json, "Print one JSON summary on stdout (needs -o)");
   cmd->callback([options, outcome] { outcome->status = RunConvert(*options); });
 }

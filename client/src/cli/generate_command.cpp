@@ -127,6 +127,11 @@ void PrintSummary(const GenerateCliOptions& options, const Generated& g) {
       figures.emplace_back("delta_input", *over);
     }
   }
+  if (r.kind == SphereSetKind::kInternal) {
+    if (const std::optional<double> over = InternalProtrusionOverInput(g.mesh_report)) {
+      figures.emplace_back("protrusion_input", *over);
+    }
+  }
   for (const auto& [name, value] : figures) {
     std::visit([&summary, &name = name](const auto& v) { summary[name] = v; }, value);
   }

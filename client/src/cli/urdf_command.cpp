@@ -378,7 +378,8 @@ absl::Status RunUrdf(const UrdfCliOptions& options) {
   absl::StatusOr<std::string> spherized_model =
       is_mjcf
           ? robot::SpherizedMjcf(*file, results, fs::absolute(options.output_path).parent_path())
-          : SpherizedUrdf(file->bytes, results);
+          : SpherizedUrdf(file->bytes, results, file->directory,
+                          fs::absolute(options.output_path).parent_path());
   // The parsers accepted these documents.
   if (!spherized_model.ok()) return BugError(spherized_model.status().message());
   std::vector<std::pair<std::string, std::string>> outputs = {

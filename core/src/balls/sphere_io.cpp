@@ -268,6 +268,29 @@ absl::StatusOr<SphereFile> ParseSphereFile(absl::string_view bytes, SphereFileFo
   return file;
 }
 
+absl::StatusOr<SphereFile> ScaledSphereFile(SphereFile file, double scale) {
+  if (!(std::isfinite(scale) && scale > 0.0)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("the scale must be a finite number > 0, got ", scale));
+  }
+  for (std::size_t i = 0; i < file.set.spheres.size(); ++i) {
+    Sphere& sphere = file.set.spheres[i];
+    sphere.center *= scale;
+    sphere.radius *= scale;
+    if (!sphere.center.allFinite() || !std::isfinite(sphere.radius) || !(sphere.radius > 0.0)) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "sphere ", i, " scaled by ", scale, " is ",
+          std::isfinite(sphere.radius) && sphere.center.allFinite() ? "of radius 0" : "not finite",
+          ": choose a scale within the range of doubles"));
+    }
+  }
+  file.mesh_sha256.clear();
+  file.params.clear();
+  file.stats.clear();
+  file.protrusions.clear();
+  return file;
+}
+
 absl::StatusOr<SphereFile> ReadSphereFile(const std::string& path,
                                           const SphereFileReadOptions& options) {
   std::error_code ec;

@@ -151,11 +151,28 @@ NamedValues CoverFigures(const GeneratedCover& cover) {
   return stats;
 }
 
-std::optional<double> CoverDeltaOverInput(double delta, const MeshReport& mesh) {
+namespace {
+
+// How far the repair moved the surface from the input triangles, when it has a bound: the
+// wrap's reach, or the tolerance vertices were welded within. nullopt when nothing moved or
+// holes were filled (a patch has no bound to the input).
+std::optional<double> SurfaceMovedByRepair(const MeshReport& mesh) {
   if (mesh.holes_filled > 0) return std::nullopt;
   const double moved = mesh.wrapped ? mesh.wrap_reach : mesh.weld_moved_within;
   if (!(moved > 0.0)) return std::nullopt;
-  return std::nextafter(delta + moved, std::numeric_limits<double>::infinity());
+  return moved;
+}
+
+}  // namespace
+
+std::optional<double> CoverDeltaOverInput(double delta, const MeshReport& mesh) {
+  const std::optional<double> moved = SurfaceMovedByRepair(mesh);
+  if (!moved) return std::nullopt;
+  return std::nextafter(delta + *moved, std::numeric_limits<double>::infinity());
+}
+
+std::optional<double> InternalProtrusionOverInput(const MeshReport& mesh) {
+  return SurfaceMovedByRepair(mesh);
 }
 
 SphereFile GenerationSphereFile(const SphereSetParameters& p, const GeneratedSphereSet& r,
@@ -217,6 +234,11 @@ SphereFile GenerationSphereFile(const SphereSetParameters& p, const GeneratedSph
     for (auto& figure : CoverFigures(*r.cover)) figures.push_back(std::move(figure));
     if (const std::optional<double> over = CoverDeltaOverInput(r.cover->certificate.delta, mesh)) {
       figures.emplace_back("delta_input", *over);
+    }
+  }
+  if (r.kind == SphereSetKind::kInternal) {
+    if (const std::optional<double> over = InternalProtrusionOverInput(mesh)) {
+      figures.emplace_back("protrusion_input", *over);
     }
   }
   if (mesh.wrapped) figures.emplace_back("mesh_wrap_reach", mesh.wrap_reach);

@@ -126,6 +126,14 @@ absl::StatusOr<SphereFile> ParseSphereFile(absl::string_view bytes, SphereFileFo
 absl::StatusOr<SphereFile> ReadSphereFile(const std::string& path,
                                           const SphereFileReadOptions& options = {});
 
+// `file` in units `scale` times larger (e.g. 0.001 for spheres made on a mesh in millimetres,
+// to use in metres): centres and radii multiplied by `scale`; contacts kept (they name the
+// same triangles of the scaled mesh); the mesh hash, params, stats and protrusions dropped,
+// since they describe the unscaled mesh and its generation (a scaled cover is certified again
+// against the scaled mesh, e.g. by `evaluate --certify --scale`). INVALID_ARGUMENT for a scale
+// that is not finite and > 0 or a sphere that would overflow or vanish. O(#spheres).
+absl::StatusOr<SphereFile> ScaledSphereFile(SphereFile file, double scale);
+
 // Formats `file` and writes it to `path` atomically: into a temporary file in the same
 // directory, flushed to disk, then renamed over `path`, so readers see the old file or the
 // whole new one, never a part. Errors: as FormatSphereFile; NOT_FOUND when the directory does

@@ -30,7 +30,8 @@ inline constexpr char kKindParam[] = "kind";
 //     (QualityFigures; when evaluated), visited_voxels and closest_point_queries (medial runs),
 //     the dilation's figures (DilationFigures) and a cover's (CoverFigures); for a wrapped mesh
 //     mesh_wrap_reach, and for a cover of a mesh whose repair moved its surface (a wrap, a weld
-//     within a tolerance) delta_input (CoverDeltaOverInput).
+//     within a tolerance) delta_input (CoverDeltaOverInput), for an internal set of one
+//     protrusion_input (InternalProtrusionOverInput).
 // Lengths in mesh units, angles in radians. A cover's protrusions go with it.
 SphereFile GenerationSphereFile(const SphereSetParameters& parameters,
                                 const GeneratedSphereSet& result, const std::string& mesh_sha256,
@@ -43,6 +44,16 @@ SphereFile GenerationSphereFile(const SphereSetParameters& parameters,
 // each point of the surface by at most it). Rounded up. nullopt when neither applies (nothing
 // moved: delta itself holds; or holes were filled, whose patch has no bound to the input).
 std::optional<double> CoverDeltaOverInput(double delta, const MeshReport& mesh);
+
+// How far an internal set of the repaired mesh may reach outside the input's surface, under the
+// same conditions: the wrap's reach or the weld tolerance. For a wrap the bound is proved as
+// follows: the set lies inside the wrap, every point of the wrap's surface lies within
+// wrap_reach of an input triangle, so a point of the set farther than wrap_reach from every
+// input triangle cannot reach the wrap's outside without passing that close to one: it is
+// enclosed by the input (in its material, or in a cavity or an alpha-narrow gap the wrap
+// filled). Every other point lies within the bound of an input triangle. nullopt as for
+// CoverDeltaOverInput.
+std::optional<double> InternalProtrusionOverInput(const MeshReport& mesh);
 
 // volume_mesh, volume_union, nerr, nerr_is_exact, protrusion_max, coverage,
 // boundary_to_union_hausdorff, surface_samples, fat.

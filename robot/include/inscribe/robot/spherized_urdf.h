@@ -20,10 +20,16 @@ namespace inscribe::robot {
 // radius="r"/></geometry>, link frame, metres, each number the shortest decimal that reads back
 // as the same double. A kSkipped link keeps its collisions and gets, as its first child, a
 // comment with the reason. Joints, visuals, inertials, materials, other links and comments are
-// untouched (the document is re-indented by tinyxml2's printer). Links are matched by name;
-// results naming no link are ignored. INVALID_ARGUMENT if the bytes are not XML.
+// untouched (the document is re-indented by tinyxml2's printer), but for where the result is
+// to be written: given both directories (absolute), every relative <mesh filename> (plain or
+// file://) of a link's visuals and kept collisions is rewritten relative to
+// `output_directory` instead of `source_directory` (the URDF's own), so it names the same file
+// from the output; package:// and absolute paths stay. Links are matched by name; results
+// naming no link are ignored. INVALID_ARGUMENT if the bytes are not XML.
 absl::StatusOr<std::string> SpherizedUrdf(absl::string_view urdf_bytes,
-                                          const std::vector<LinkSpherizeResult>& links);
+                                          const std::vector<LinkSpherizeResult>& links,
+                                          const std::string& source_directory = "",
+                                          const std::string& output_directory = "");
 
 // cuRobo's `collision_spheres` YAML (FormatCuroboYaml) with the spheres of every kSpherized
 // link, in the order given; skipped links and links without geometry are left out, and so are

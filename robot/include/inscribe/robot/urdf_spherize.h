@@ -89,7 +89,9 @@ UrdfSpherizeOptions WithDefaultMode(UrdfSpherizeOptions options);
 // per axis (mirrored, with the triangles turned to keep them outward, when the scale has an odd
 // number of negative components) and then moved by the element's origin, p -> R (s . p) + xyz
 // (R = OriginRotation); for boxes, cylinders, capsules and ellipsoids, BoxMesh, CylinderMesh,
-// CapsuleMesh and EllipsoidMesh moved by the origin. Metres.
+// CapsuleMesh and EllipsoidMesh moved by the origin, the curved ones enclosing the true shape
+// for covers (options.kind; a link's delta then adds the mesh's excess over the shape) and
+// inside it otherwise (PrimitiveFit). Metres.
 // A mesh file is read by ReadMesh (.stl, .obj, .ply, .off, and COLLADA .dae and glTF
 // .gltf/.glb with every node's transform and COLLADA's <unit> applied and <up_axis> not: the
 // file's own axes, as ROS's loaders take them). Not validated (welding is validation's).

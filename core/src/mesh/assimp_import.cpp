@@ -1,5 +1,6 @@
 #include "mesh/assimp_import.h"
 
+#include <assimp/BaseImporter.h>
 #include <assimp/config.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -13,6 +14,7 @@
 #include <fstream>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <sstream>
 #include <utility>
 #include <vector>
@@ -34,10 +36,22 @@ Transform ToEigen(const aiMatrix4x4& m) {
   return t;
 }
 
-void ConfigureImporter(Assimp::Importer& importer) {
+void ConfigureImporter(Assimp::Importer& importer, const std::string& format) {
   // The file's own axes: assimp would otherwise rotate a Z_UP COLLADA scene to Y up through
   // the root's transform. The <unit> scale stays on the root's transform, where it is applied.
   importer.SetPropertyBool(AI_CONFIG_IMPORT_COLLADA_IGNORE_UP_DIRECTION, true);
+  // Only the readers of `format` (COLLADA's; glTF 1 and 2 for .gltf and .glb): when they cannot
+  // read the bytes, assimp 5.2 would try each of its other 60-odd readers on them, none of
+  // which the checks of assimp_guards.cpp know (fuzz_scene: a .glb beginning "quick3ds" went to
+  // the Quick3D reader, which asked for 1.5 TB). UnregisterLoader hands the reader back.
+  for (std::size_t i = importer.GetImporterCount(); i-- > 0;) {
+    Assimp::BaseImporter* reader = importer.GetImporter(i);
+    std::set<std::string> extensions;
+    reader->GetExtensionList(extensions);
+    if (extensions.count(format) == 0 && importer.UnregisterLoader(reader) == AI_SUCCESS) {
+      delete reader;
+    }
+  }
 }
 
 // Counts the polygons as stored, then triangulates them (aiProcess_Triangulate). No other
@@ -175,7 +189,7 @@ absl::StatusOr<Mesh> ImportSceneFile(const std::string& path, ReadMeshInfo* info
     }
   }
   Assimp::Importer importer;
-  ConfigureImporter(importer);
+  ConfigureImporter(importer, format);
   const aiScene* scene = Triangulated(importer, importer.ReadFile(path, 0), info);
   if (scene == nullptr) return ImportError(path, format, importer.GetErrorString());
   return SceneToMesh(*scene, path, format);
@@ -197,7 +211,7 @@ absl::StatusOr<Mesh> ImportSceneBytes(const std::string& bytes, const std::strin
     }
   }
   Assimp::Importer importer;
-  ConfigureImporter(importer);
+  ConfigureImporter(importer, format);
   const aiScene* scene = Triangulated(
       importer, importer.ReadFileFromMemory(bytes.data(), bytes.size(), 0, format.c_str()), info);
   if (scene == nullptr) return ImportError(what, format, importer.GetErrorString());

@@ -131,7 +131,15 @@ void ColladaSeeds(const std::string& dir) {
   const std::unique_ptr<aiScene> quads =
       inscribe::testing::MakeScene({cube}, {{0, Eigen::Matrix4d::Identity()}});
   MakeQuads(*quads->mMeshes[0]);
-  Seed(dir, "dae-quads", kDae, Exported(*quads, "collada"));
+  const std::string quads_dae = Exported(*quads, "collada");
+  Seed(dir, "dae-quads", kDae, quads_dae);
+  // Broken: a <polylist> without its <vcount> (assimp 5.2 indexes the empty list: a crash),
+  // and one announcing more polygons than the file holds (it reserves 32 GB for them).
+  const std::size_t vcount = quads_dae.find("<vcount>");
+  Seed(dir, "dae-polylist-without-vcount", kDae,
+       std::string(quads_dae).erase(vcount, quads_dae.find("</vcount>") + 9 - vcount));
+  Seed(dir, "dae-polylist-count-past-file", kDae,
+       Edited(quads_dae, "<polylist count=\"6\"", "<polylist count=\"4000000000\""));
   for (unsigned f = 0; f < 6; ++f) quads->mMeshes[0]->mFaces[f].mNumIndices = 2;
   quads->mMeshes[0]->mPrimitiveTypes = aiPrimitiveType_LINE;
   Seed(dir, "dae-lines", kDae, Exported(*quads, "collada"));
@@ -343,6 +351,19 @@ void GltfSeeds(const std::string& dir) {
     g.Node(g.MeshOf({Gltf::Primitive(p, s, kModeStrip)}));
     g.Node(g.MeshOf({Gltf::Primitive(p, f, kModeFan)}), {{"translation", {0, 0, 2}}});
     Both(dir, "strip-fan", g);
+    // Broken: a strip of one index and a fan of two (assimp 5.2 allocates count - 2 faces,
+    // 2^64 - 1 bytes for the strip), and a fan with an index past the positions (read: the
+    // triangles reaching past are dropped).
+    g.Json()["accessors"][s]["count"] = 1;
+    g.Json()["accessors"][f]["count"] = 2;
+    Both(dir, "strip-fan-too-few-indices", g);
+    Gltf past;
+    const int pp = past.Add(cube, kUint16).first;  // the cube's own indices unused
+    std::string past_fan;
+    for (int v : {0, 1, 3, 9, 2, 6}) Gltf::PutIndex(past_fan, kUint16, v);
+    const int pf = past.Accessor(past.View(past_fan), kUint16, 6, "SCALAR");
+    past.Node(past.MeshOf({Gltf::Primitive(pp, pf, kModeFan)}));
+    Both(dir, "fan-index-past-positions", past);
     Gltf lines;
     const auto [lp, li] = lines.Add(cube, kUint16);
     lines.Node(lines.MeshOf({Gltf::Primitive(lp, li, kModeLines)}));

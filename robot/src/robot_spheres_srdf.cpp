@@ -136,6 +136,11 @@ absl::StatusOr<std::string> FormatSrdfRobotSpheres(const RobotSpheres& model,
           absl::StrCat("the SRDF to merge into: ", parsed.status().message()));
     }
     robot = document.RootElement();
+    if (const XMLElement* link = robot->FirstChildElement("link"); link != nullptr) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "the SRDF to merge into has a <link> (line ", link->GetLineNum(),
+          "): it is a URDF, not an SRDF"));
+    }
     if (robot->Attribute("name") == nullptr) robot->SetAttribute("name", model.robot_name.c_str());
     // Ours replace the elements about the same links and pairs; the rest stays as it was.
     std::vector<XMLElement*> replaced;

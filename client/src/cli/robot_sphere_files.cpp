@@ -66,8 +66,9 @@ absl::Status WriteRobotSpheres(const robot::RobotSpheres& model, RobotSpheresFor
   }
   absl::StatusOr<std::string> text = robot::FormatRobotSpheres(model, format, options);
   if (!text.ok()) {
-    return BadInputError(std::string(robot::RobotSpheresFormatName(format)) + ": " +
-                         std::string(text.status().message()));
+    return BadInputError((path.empty() ? std::string("stdout") : path) + " (" +
+                         robot::RobotSpheresFormatName(format) +
+                         "): " + std::string(text.status().message()));
   }
   if (path.empty()) {
     std::cout << *text;

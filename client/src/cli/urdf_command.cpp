@@ -214,6 +214,7 @@ void PrintJson(const UrdfCliOptions& options, const UrdfSpherizeOptions& spheriz
   report["robot"] = file.robot().name;
   report["output"] = options.output_path;
   report["yaml"] = yaml_path;
+  report["spheres_files"] = options.sphere_paths;
   report["kind"] = SphereSetKindName(spherize.kind);
   report["padding"] = spherize.padding;
   AddMode(robot::WithDefaultMode(spherize), &report);
@@ -263,8 +264,8 @@ void PrintJson(const UrdfCliOptions& options, const UrdfSpherizeOptions& spheriz
 void PrintTable(const robot::RobotFile& file, const RobotSpherizeResult& result,
                 const std::optional<robot::SelfCollisionMatrix>& matrix,
                 const std::string& output_path, const std::string& yaml_path,
-                const std::string& srdf_path, const std::vector<std::string>& left_out,
-                double seconds) {
+                const std::string& srdf_path, const std::vector<std::string>& sphere_paths,
+                const std::vector<std::string>& left_out, double seconds) {
   std::size_t width = 4;
   for (const LinkSpherizeResult& link : result.links) width = std::max(width, link.link.size());
   const int w = static_cast<int>(width);
@@ -286,7 +287,8 @@ void PrintTable(const robot::RobotFile& file, const RobotSpherizeResult& result,
     spheres += static_cast<std::int64_t>(link.spheres.size());
   }
   if (matrix) std::cout << MatrixSummary(*matrix) << "\n";
-  const std::string written = output_path + ", " + yaml_path;
+  std::string written = output_path + ", " + yaml_path;
+  for (const std::string& path : sphere_paths) written += ", " + path;
   std::cout << absl::StrFormat("wrote %s%s (%d spheres) in %.3f s", written,
                                srdf_path.empty() ? "" : " and " + srdf_path, spheres, seconds);
   if (skipped > 0) std::cout << absl::StrFormat("; %d link(s) skipped, kept as they were", skipped);
@@ -327,8 +329,12 @@ absl::Status RunUrdf(const UrdfCliOptions& options) {
   }
   std::vector<robot::RobotSpheresFormat> sphere_formats;
   for (const std::string& path : options.sphere_paths) {
+    // The extension decides where it names one format; --format picks the layout of .urdf
+    // files (urdf or morphit) and the format of files with other extensions.
+    const std::optional<robot::RobotSpheresFormat> by_extension = RobotFormatOfPath(path);
+    const bool settled = by_extension && *by_extension != robot::RobotSpheresFormat::kUrdf;
     absl::StatusOr<robot::RobotSpheresFormat> format =
-        RobotOutputFormat(options.sphere_format, path);
+        settled ? *by_extension : RobotOutputFormat(options.sphere_format, path);
     if (!format.ok()) return format.status();
     if (is_mjcf && (*format == robot::RobotSpheresFormat::kUrdf ||
                     *format == robot::RobotSpheresFormat::kMorphit)) {
@@ -457,7 +463,7 @@ absl::Status RunUrdf(const UrdfCliOptions& options) {
     PrintJson(options, *spherize, *file, *spherized, matrix, yaml_path, left_out, seconds);
   } else {
     PrintTable(*file, *spherized, matrix, options.output_path, yaml_path, options.srdf_path,
-               left_out, seconds);
+               options.sphere_paths, left_out, seconds);
   }
   const auto skipped = std::count_if(results.begin(), results.end(), [](const auto& result) {
     return result.status == LinkStatus::kSkipped;
@@ -554,8 +560,9 @@ void AddUrdfCommand(CLI::App& app, CommandOutcome* outcome) {
                   "robot configuration, .xrdf cuMotion, .srdf MoveIt (merged into an SRDF "
                   "already there), .urdf VAMP's spherized URDF; repeatable");
   cmd->add_option("--format", options->sphere_format,
-                  "The format of the --spheres files: curobo, xrdf, srdf, urdf (VAMP, cricket) "
-                  "or morphit (a child link per sphere)")
+                  "The layout of .urdf --spheres files, urdf (VAMP, cricket; the default) or "
+                  "morphit (a child link per sphere), and the format of files whose extension "
+                  "names none (curobo, xrdf, srdf, urdf, morphit)")
       ->check(CLI::IsMember({"curobo", "yaml", "xrdf", "srdf", "urdf", "vamp", "morphit"},
                             CLI::ignore_case));
   cmd->add_option("--samples", options->samples,

@@ -65,7 +65,7 @@ struct UrdfCliOptions {
   std::string output_path;
   std::string yaml_path;
   std::string srdf_path;
-  std::vector<std::string> sphere_paths;  // --spheres, each in sphere_format or its extension's
+  std::vector<std::string> sphere_paths;  // --spheres [FORMAT:]PATH
   std::string sphere_format;
   std::int64_t samples = robot::SelfCollisionOptions{}.samples;
   std::uint64_t seed = robot::SelfCollisionOptions{}.seed;
@@ -328,13 +328,28 @@ absl::Status RunUrdf(const UrdfCliOptions& options) {
     return UsageError("--srdf " + options.srdf_path + " would overwrite another output");
   }
   std::vector<robot::RobotSpheresFormat> sphere_formats;
-  for (const std::string& path : options.sphere_paths) {
-    // The extension decides where it names one format; --format picks the layout of .urdf
-    // files (urdf or morphit) and the format of files with other extensions.
-    const std::optional<robot::RobotSpheresFormat> by_extension = RobotFormatOfPath(path);
-    const bool settled = by_extension && *by_extension != robot::RobotSpheresFormat::kUrdf;
+  std::vector<std::string> sphere_paths;
+  for (const std::string& spec : options.sphere_paths) {
+    // FORMAT:PATH names the format of that file; otherwise the extension decides where it
+    // names one, and --format picks the layout of .urdf files (urdf or morphit) and the
+    // format of files with other extensions.
+    std::string path = spec;
+    std::optional<robot::RobotSpheresFormat> named;
+    if (const std::size_t colon = spec.find(':'); colon != std::string::npos) {
+      absl::StatusOr<robot::RobotSpheresFormat> prefix =
+          robot::ParseRobotSpheresFormat(spec.substr(0, colon));
+      if (prefix.ok()) {
+        named = *prefix;
+        path = spec.substr(colon + 1);
+      }
+    }
+    const absl::StatusOr<robot::RobotSpheresFormat> by_extension =
+        robot::RobotSpheresFormatFromPath(path);
+    const bool settled = by_extension.ok() && *by_extension != robot::RobotSpheresFormat::kUrdf;
     absl::StatusOr<robot::RobotSpheresFormat> format =
-        settled ? *by_extension : RobotOutputFormat(options.sphere_format, path);
+        named     ? *named
+        : settled ? *by_extension
+                  : RobotOutputFormat(options.sphere_format, path);
     if (!format.ok()) return format.status();
     if (is_mjcf && (*format == robot::RobotSpheresFormat::kUrdf ||
                     *format == robot::RobotSpheresFormat::kMorphit)) {
@@ -346,6 +361,7 @@ absl::Status RunUrdf(const UrdfCliOptions& options) {
       return UsageError("--spheres " + path + " would overwrite another output");
     }
     sphere_formats.push_back(*format);
+    sphere_paths.push_back(path);
   }
   if (options.samples < 1 || options.samples > robot::kMaxSelfCollisionSamples) {
     return UsageError(absl::StrFormat("--samples must lie in 1..%d, got %d",
@@ -354,8 +370,7 @@ absl::Status RunUrdf(const UrdfCliOptions& options) {
 
   // Before any work: a missing output directory would otherwise only show at the end.
   std::vector<std::string> written_paths = {options.output_path, yaml_path, options.srdf_path};
-  written_paths.insert(written_paths.end(), options.sphere_paths.begin(),
-                       options.sphere_paths.end());
+  written_paths.insert(written_paths.end(), sphere_paths.begin(), sphere_paths.end());
   for (const std::string& path : written_paths) {
     if (path.empty()) continue;
     const fs::path directory = fs::absolute(path).parent_path();
@@ -448,9 +463,9 @@ absl::Status RunUrdf(const UrdfCliOptions& options) {
       return written;
     }
   }
-  for (std::size_t i = 0; i < options.sphere_paths.size(); ++i) {
+  for (std::size_t i = 0; i < sphere_paths.size(); ++i) {
     NoteDroppedParts(model, sphere_formats[i]);
-    if (absl::Status written = WriteRobotSpheres(model, sphere_formats[i], options.sphere_paths[i],
+    if (absl::Status written = WriteRobotSpheres(model, sphere_formats[i], sphere_paths[i],
                                                  options.urdf_path, comment);
         !written.ok()) {
       return written;
@@ -463,7 +478,7 @@ absl::Status RunUrdf(const UrdfCliOptions& options) {
     PrintJson(options, *spherize, *file, *spherized, matrix, yaml_path, left_out, seconds);
   } else {
     PrintTable(*file, *spherized, matrix, options.output_path, yaml_path, options.srdf_path,
-               options.sphere_paths, left_out, seconds);
+               sphere_paths, left_out, seconds);
   }
   const auto skipped = std::count_if(results.begin(), results.end(), [](const auto& result) {
     return result.status == LinkStatus::kSkipped;
@@ -558,7 +573,8 @@ void AddUrdfCommand(CLI::App& app, CommandOutcome* outcome) {
                   "Also write the spheres (and the matrix's disabled pairs) as a planner reads "
                   "them, in the format --format names or the extension says: .yml cuRobo's "
                   "robot configuration, .xrdf cuMotion, .srdf MoveIt (merged into an SRDF "
-                  "already there), .urdf VAMP's spherized URDF; repeatable");
+                  "already there), .urdf VAMP's spherized URDF; FORMAT:PATH names the format "
+                  "of one file (e.g. morphit:arm_spheres.urdf); repeatable");
   cmd->add_option("--format", options->sphere_format,
                   "The layout of .urdf --spheres files, urdf (VAMP, cricket; the default) or "
                   "morphit (a child link per sphere), and the format of files whose extension "

@@ -27,7 +27,8 @@ bool SameSpheres(const std::vector<Sphere>& a, const std::vector<Sphere>& b) {
 
 absl::Status CheckBuffers(const std::map<std::string, double>& buffers, const char* key) {
   for (const auto& [link, value] : buffers) {
-    if (link.empty()) return absl::InvalidArgumentError(absl::StrCat(key, " of an empty link name"));
+    if (link.empty())
+      return absl::InvalidArgumentError(absl::StrCat(key, " of an empty link name"));
     if (!std::isfinite(value)) {
       return absl::InvalidArgumentError(
           absl::StrCat(key, " of link '", link, "' is ", value, ", not a finite number"));
@@ -79,9 +80,8 @@ absl::StatusOr<RobotSpheresFormat> ParseRobotSpheresFormat(absl::string_view nam
   if (lower == "srdf") return RobotSpheresFormat::kSrdf;
   if (lower == "urdf" || lower == "vamp") return RobotSpheresFormat::kUrdf;
   if (lower == "morphit") return RobotSpheresFormat::kMorphit;
-  return absl::InvalidArgumentError(
-      absl::StrCat("unknown robot sphere format '", name,
-                   "' (expected curobo, xrdf, srdf, urdf or morphit)"));
+  return absl::InvalidArgumentError(absl::StrCat(
+      "unknown robot sphere format '", name, "' (expected curobo, xrdf, srdf, urdf or morphit)"));
 }
 
 absl::StatusOr<RobotSpheresFormat> RobotSpheresFormatFromPath(const std::string& path) {
@@ -111,8 +111,8 @@ absl::StatusOr<RobotSpheresFormat> DetectRobotSpheresFormat(absl::string_view by
   }
   const std::size_t first = bytes.find_first_not_of(" \t\r\n");
   if (first != absl::string_view::npos && bytes[first] == '<') {
-    return absl::InvalidArgumentError(absl::StrCat("line ", document.ErrorLineNum(),
-                                                   ": not well-formed XML (URDF or SRDF)"));
+    return absl::InvalidArgumentError(
+        absl::StrCat("line ", document.ErrorLineNum(), ": not well-formed XML (URDF or SRDF)"));
   }
   return internal::IsXrdfDocument(bytes) ? RobotSpheresFormat::kXrdf : RobotSpheresFormat::kCurobo;
 }
@@ -135,8 +135,7 @@ RobotSpheresFormatParts RobotSpheresFormatCarries(RobotSpheresFormat format) {
   return parts;
 }
 
-std::vector<std::string> RobotSpheresDropped(const RobotSpheres& model,
-                                             RobotSpheresFormat format) {
+std::vector<std::string> RobotSpheresDropped(const RobotSpheres& model, RobotSpheresFormat format) {
   const RobotSpheresFormatParts parts = RobotSpheresFormatCarries(format);
   std::vector<std::string> dropped;
   if (!parts.empty_links) {
@@ -208,10 +207,9 @@ absl::Status CheckRobotSpheres(const RobotSpheres& model) {
       return absl::InvalidArgumentError("an ignored pair with an empty link name");
     }
     if (!(pair.first < pair.second)) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("ignored pair ('", pair.first, "', '", pair.second, "') ",
-                       pair.first == pair.second ? "pairs a link with itself"
-                                                 : "is not ordered (a < b)"));
+      return absl::InvalidArgumentError(absl::StrCat(
+          "ignored pair ('", pair.first, "', '", pair.second, "') ",
+          pair.first == pair.second ? "pairs a link with itself" : "is not ordered (a < b)"));
     }
   }
   if (absl::Status s = CheckBuffers(model.self_collision_buffer, "self_collision_buffer");
@@ -239,8 +237,7 @@ absl::StatusOr<std::string> FormatRobotSpheres(const RobotSpheres& model, RobotS
   return absl::InvalidArgumentError("unknown robot sphere format");
 }
 
-absl::StatusOr<RobotSpheres> ParseRobotSpheres(absl::string_view bytes,
-                                               RobotSpheresFormat format) {
+absl::StatusOr<RobotSpheres> ParseRobotSpheres(absl::string_view bytes, RobotSpheresFormat format) {
   switch (format) {
     case RobotSpheresFormat::kCurobo:
       return internal::ParseCuroboRobotSpheres(bytes);
@@ -277,9 +274,9 @@ absl::StatusOr<RobotSpheres> ReadRobotSpheresFile(const std::string& path,
   }
   absl::StatusOr<RobotSpheres> model = ParseRobotSpheres(*bytes, *format);
   if (!model.ok()) {
-    return absl::Status(model.status().code(),
-                        absl::StrCat(path, " (", RobotSpheresFormatName(*format),
-                                     "): ", model.status().message()));
+    return absl::Status(
+        model.status().code(),
+        absl::StrCat(path, " (", RobotSpheresFormatName(*format), "): ", model.status().message()));
   }
   if (read_as != nullptr) *read_as = *format;
   return model;

@@ -40,8 +40,9 @@ bool HasMorphitSphereLinks(absl::string_view bytes);
 // replaces it: "... N spheres in place of the link's collision geometry".
 inline constexpr char kSphereCommentMark[] = "spheres in place of the link's collision geometry";
 
-// In `link`, every <collision> and every comment holding kSphereCommentMark replaced by an XML comment and one sphere <collision> per sphere
-// (origin xyz = centre, rpy 0), where the first collision was, else after the last <visual>.
+// In `link`, every <collision> and every comment holding kSphereCommentMark replaced by an XML
+// comment and one sphere <collision> per sphere (origin xyz = centre, rpy 0), where the first
+// collision was, else after the last <visual>.
 void ReplaceLinkCollisions(tinyxml2::XMLDocument& document, tinyxml2::XMLElement& link,
                            const std::vector<Sphere>& spheres, const std::string& comment);
 

@@ -67,9 +67,9 @@ absl::StatusOr<XMLDocument*> ParseDocument(absl::string_view bytes, XMLDocument*
         absl::StrCat("line ", document->ErrorLineNum(), ": not well-formed XML"));
   }
   if (std::string(document->RootElement()->Name()) != "robot") {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "line ", document->RootElement()->GetLineNum(), ": the root element is <",
-        document->RootElement()->Name(), ">, not <robot>"));
+    return absl::InvalidArgumentError(
+        absl::StrCat("line ", document->RootElement()->GetLineNum(), ": the root element is <",
+                     document->RootElement()->Name(), ">, not <robot>"));
   }
   return document;
 }
@@ -107,7 +107,8 @@ absl::StatusOr<RobotSpheres> ParseSrdfRobotSpheres(absl::string_view bytes) {
       if (!a.ok()) return a.status();
       absl::StatusOr<std::string> b = RequiredAttribute(*element, "link2");
       if (!b.ok()) return b.status();
-      if (*a == *b) return ElementError(*element, absl::StrCat("pairs link '", *a, "' with itself"));
+      if (*a == *b)
+        return ElementError(*element, absl::StrCat("pairs link '", *a, "' with itself"));
       const char* reason = element->Attribute("reason");
       model.self_collision_ignore.emplace(std::minmax(*a, *b), reason == nullptr ? "" : reason);
     }
@@ -137,9 +138,9 @@ absl::StatusOr<std::string> FormatSrdfRobotSpheres(const RobotSpheres& model,
     }
     robot = document.RootElement();
     if (const XMLElement* link = robot->FirstChildElement("link"); link != nullptr) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          "the SRDF to merge into has a <link> (line ", link->GetLineNum(),
-          "): it is a URDF, not an SRDF"));
+      return absl::InvalidArgumentError(absl::StrCat("the SRDF to merge into has a <link> (line ",
+                                                     link->GetLineNum(),
+                                                     "): it is a URDF, not an SRDF"));
     }
     if (robot->Attribute("name") == nullptr) robot->SetAttribute("name", model.robot_name.c_str());
     // Ours replace the elements about the same links and pairs; the rest stays as it was.

@@ -73,9 +73,8 @@ absl::StatusOr<XMLDocument*> ParseBase(absl::string_view base, XMLDocument* docu
         absl::StrCat("the base URDF, line ", document->ErrorLineNum(), ": not well-formed XML"));
   }
   if (std::string(document->RootElement()->Name()) != "robot") {
-    return absl::InvalidArgumentError(absl::StrCat("the base URDF's root element is <",
-                                                   document->RootElement()->Name(),
-                                                   ">, not <robot>"));
+    return absl::InvalidArgumentError(absl::StrCat(
+        "the base URDF's root element is <", document->RootElement()->Name(), ">, not <robot>"));
   }
   return document;
 }
@@ -142,8 +141,8 @@ void ReplaceLinkCollisions(XMLDocument& document, XMLElement& link,
     link.InsertAfterChild(anchor, last);
   }
   for (const Sphere& sphere : spheres) {
-    last = link.InsertAfterChild(last,
-                                 SphereElement(document, "collision", sphere.center, sphere.radius));
+    last = link.InsertAfterChild(
+        last, SphereElement(document, "collision", sphere.center, sphere.radius));
   }
 }
 
@@ -191,9 +190,8 @@ absl::StatusOr<RobotSpheres> ParseUrdfRobotSpheres(absl::string_view bytes) {
     absl::StatusOr<bool> has = read_link(link);
     if (!has.ok()) return has.status();
     if (!*has) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("line ", link.line, ": MorphIt sphere link '", link.name,
-                       "' has no sphere <collision>"));
+      return absl::InvalidArgumentError(absl::StrCat("line ", link.line, ": MorphIt sphere link '",
+                                                     link.name, "' has no sphere <collision>"));
     }
     sphere_links.insert(link.name);
     // The child's frame in the parent's: p -> R p + t of the fixed joint's origin.

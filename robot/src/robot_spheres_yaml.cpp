@@ -38,9 +38,8 @@ std::string Quoted(const std::string& name) { return absl::StrCat("\"", name, "\
 absl::Status CheckYamlNames(const RobotSpheres& model, const char* format) {
   auto check = [&](const std::string& name) -> absl::Status {
     if (IsCuroboLinkName(name)) return absl::OkStatus();
-    return absl::InvalidArgumentError(
-        absl::StrCat(format, " cannot carry the link name '", name,
-                     "' (letters, digits and _ - . / only)"));
+    return absl::InvalidArgumentError(absl::StrCat(format, " cannot carry the link name '", name,
+                                                   "' (letters, digits and _ - . / only)"));
   };
   for (const LinkSpheres& link : model.links) {
     if (absl::Status s = check(link.link); !s.ok()) return s;
@@ -268,9 +267,8 @@ absl::StatusOr<std::string> FormatCuroboRobotSpheres(const RobotSpheres& model,
   std::vector<std::string> names;
   for (const LinkSpheres& link : model.links) names.push_back(Quoted(link.link));
   absl::StatusOr<std::string> spheres = FormatCuroboYaml(
-      model.links, options.comment.empty()
-                       ? "cuRobo robot_cfg.kinematics keys; link frames, metres"
-                       : options.comment);
+      model.links, options.comment.empty() ? "cuRobo robot_cfg.kinematics keys; link frames, metres"
+                                           : options.comment);
   if (!spheres.ok()) return spheres.status();
   // The comment, then collision_link_names, then FormatCuroboYaml's collision_spheres.
   const std::size_t body = spheres->find("collision_spheres:");
@@ -317,9 +315,9 @@ absl::StatusOr<RobotSpheres> ParseCuroboRobotSpheres(absl::string_view bytes) {
         }
       }
     }
-    if (absl::Status s = ReadBuffers(kinematics["collision_sphere_buffer"],
-                                     "collision_sphere_buffer", &model.links,
-                                     &model.collision_buffer);
+    if (absl::Status s =
+            ReadBuffers(kinematics["collision_sphere_buffer"], "collision_sphere_buffer",
+                        &model.links, &model.collision_buffer);
         !s.ok()) {
       return s;
     }
@@ -357,7 +355,8 @@ absl::StatusOr<std::string> FormatXrdfRobotSpheres(const RobotSpheres& model,
   AppendBufferMap(model.self_collision_buffer, "    ", &out);
   absl::StrAppend(&out, "  ignore:");
   AppendIgnore(model.self_collision_ignore, "    ", &out);
-  absl::StrAppend(&out, "\ngeometry:\n  ", group, ":\n    spheres:", model.links.empty() ? " {}\n" : "\n");
+  absl::StrAppend(&out, "\ngeometry:\n  ", group,
+                  ":\n    spheres:", model.links.empty() ? " {}\n" : "\n");
   for (const LinkSpheres& link : model.links) {
     absl::StrAppend(&out, "      ", Quoted(link.link), ":", link.spheres.empty() ? " []\n" : "\n");
     for (const Sphere& s : link.spheres) {
@@ -406,7 +405,8 @@ absl::StatusOr<RobotSpheres> ParseXrdfRobotSpheres(absl::string_view bytes) {
                      absl::StrCat("geometry has no group '", group, "'"));
       }
       const YAML::Node entry = geometry[group];
-      if (!entry.IsMap()) return Error(entry, absl::StrCat("geometry '", group, "' is not a mapping"));
+      if (!entry.IsMap())
+        return Error(entry, absl::StrCat("geometry '", group, "' is not a mapping"));
       if (absl::Status s = ReadXrdfSpheres(entry["spheres"], group, &model.links); !s.ok()) {
         return s;
       }

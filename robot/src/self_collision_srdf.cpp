@@ -13,8 +13,7 @@ std::string SelfCollisionSrdf(const SelfCollisionMatrix& matrix, const std::stri
   model.robot_name = robot_name;
   for (const LinkPairCollision& pair : matrix.pairs) {
     if (!CollisionDisabled(pair.type)) continue;
-    model.self_collision_ignore[std::minmax(matrix.links[pair.link_a],
-                                            matrix.links[pair.link_b])] =
+    model.self_collision_ignore[std::minmax(matrix.links[pair.link_a], matrix.links[pair.link_b])] =
         CollisionPairClassName(pair.type);
   }
   RobotSpheresWriteOptions options;
@@ -25,10 +24,10 @@ std::string SelfCollisionSrdf(const SelfCollisionMatrix& matrix, const std::stri
 }
 
 std::string SelfCollisionComment(const SelfCollisionMatrix& matrix) {
-  return absl::StrCat("inscribe: self-collision matrix over ", matrix.samples,
-                      " random configurations (seed ", matrix.seed, "), always at ",
-                      matrix.always_fraction, "; bounds ",
-                      matrix.certified ? "certified for the links' solids" : "for the spheres only");
+  return absl::StrCat(
+      "inscribe: self-collision matrix over ", matrix.samples, " random configurations (seed ",
+      matrix.seed, "), always at ", matrix.always_fraction, "; bounds ",
+      matrix.certified ? "certified for the links' solids" : "for the spheres only");
 }
 
 }  // namespace inscribe::robot

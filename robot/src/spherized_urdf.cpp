@@ -120,8 +120,8 @@ absl::StatusOr<std::string> SpherizedCuroboYaml(const std::vector<LinkSpherizeRe
   }
   RobotSpheres model = RobotSpheresFromSpherized(written, robot_name, &matrix, written_buffers);
   for (auto it = model.self_collision_ignore.begin(); it != model.self_collision_ignore.end();) {
-    const bool both = written_buffers.count(it->first.first) != 0 &&
-                      written_buffers.count(it->first.second) != 0;
+    const bool both =
+        written_buffers.count(it->first.first) != 0 && written_buffers.count(it->first.second) != 0;
     it = both ? std::next(it) : model.self_collision_ignore.erase(it);
   }
   RobotSpheresWriteOptions options;

@@ -17,9 +17,9 @@
 namespace inscribe {
 namespace {
 
-using ::testing::HasSubstr;
 using robot::RobotSpheres;
 using robot::RobotSpheresFormat;
+using ::testing::HasSubstr;
 namespace fs = std::filesystem;
 
 std::string Quote(const fs::path& path) { return "'" + path.string() + "'"; }
@@ -49,12 +49,12 @@ class RobotSpheresCli : public ::testing::Test {
   <joint name="j3" type="fixed"><parent link="hand"/><child link="tool"/><origin xyz="0.1 0 0"/></joint>
 </robot>
 )";
-    const CliRun run = RunCli("urdf " + Quote(dir_ / "arm.urdf") + " -o " +
-                              Quote(dir_ / "arm_spherized.urdf") + " --samples 500 --json" +
-                              " --spheres " + Quote(dir_ / "arm.yml") + " --spheres " +
-                              Quote(dir_ / "arm.xrdf") + " --spheres " + Quote(dir_ / "arm.srdf") +
-                              " --spheres " + Quote(dir_ / "arm_vamp.urdf") + " --spheres " +
-                              "morphit:" + Quote(dir_ / "arm_morphit.urdf"));
+    const CliRun run =
+        RunCli("urdf " + Quote(dir_ / "arm.urdf") + " -o " + Quote(dir_ / "arm_spherized.urdf") +
+               " --samples 500 --json" + " --spheres " + Quote(dir_ / "arm.yml") + " --spheres " +
+               Quote(dir_ / "arm.xrdf") + " --spheres " + Quote(dir_ / "arm.srdf") + " --spheres " +
+               Quote(dir_ / "arm_vamp.urdf") + " --spheres " +
+               "morphit:" + Quote(dir_ / "arm_morphit.urdf"));
     ASSERT_EQ(run.exit_code, 0) << run.err;
     report_ = nlohmann::json::parse(run.out);
   }
@@ -74,8 +74,10 @@ class RobotSpheresCli : public ::testing::Test {
 
 const std::vector<std::pair<std::string, RobotSpheresFormat>>& Files() {
   static const std::vector<std::pair<std::string, RobotSpheresFormat>> files = {
-      {"arm.yml", RobotSpheresFormat::kCurobo},   {"arm.xrdf", RobotSpheresFormat::kXrdf},
-      {"arm.srdf", RobotSpheresFormat::kSrdf},    {"arm_vamp.urdf", RobotSpheresFormat::kUrdf},
+      {"arm.yml", RobotSpheresFormat::kCurobo},
+      {"arm.xrdf", RobotSpheresFormat::kXrdf},
+      {"arm.srdf", RobotSpheresFormat::kSrdf},
+      {"arm_vamp.urdf", RobotSpheresFormat::kUrdf},
       {"arm_morphit.urdf", RobotSpheresFormat::kMorphit}};
   return files;
 }
@@ -116,10 +118,10 @@ TEST_F(RobotSpheresCli, ConvertGoesBetweenEveryPairOfFormats) {
       EXPECT_EQ(summary.at("format"), to);
       EXPECT_EQ(summary.at("from"), robot::RobotSpheresFormatName(from));
       // What the target leaves out is said, on stderr and in the summary.
-      const bool loses_pairs = (to == "urdf" || to == "morphit") &&
-                               (from == RobotSpheresFormat::kCurobo ||
-                                from == RobotSpheresFormat::kXrdf ||
-                                from == RobotSpheresFormat::kSrdf);
+      const bool loses_pairs =
+          (to == "urdf" || to == "morphit") &&
+          (from == RobotSpheresFormat::kCurobo || from == RobotSpheresFormat::kXrdf ||
+           from == RobotSpheresFormat::kSrdf);
       if (loses_pairs) {
         EXPECT_THAT(run.err, HasSubstr("leaves out: self_collision_ignore")) << input << to;
       }
@@ -161,7 +163,8 @@ TEST_F(RobotSpheresCli, ConvertMergesIntoAnSrdfAndRefusesWhatItCannotDo) {
   EXPECT_EQ(run.exit_code, 2);
   EXPECT_THAT(run.err, HasSubstr("bad.xrdf (xrdf): line"));
   // --link picks one set, which a robot conversion does not.
-  run = RunCli("convert " + Quote(Path("arm.yml")) + " -o " + Quote(Path("x.xrdf")) + " --link base");
+  run =
+      RunCli("convert " + Quote(Path("arm.yml")) + " -o " + Quote(Path("x.xrdf")) + " --link base");
   EXPECT_EQ(run.exit_code, 64);
 }
 

@@ -42,8 +42,8 @@ bool IsUrdf(RobotSpheresFormat format) {
 // Names YAML would read as other types or that look like paths and numbers, all within the
 // characters cuRobo's keys carry; none of the form "P_sphere<k>".
 std::string OddName(std::mt19937_64& rng, int index) {
-  static const char* kWords[] = {"null", "true", "no", "1", ".inf", "-", "a/b", "/x", "0x1f",
-                                 "1e3", "link.0", "--", "_", "Yes", "off", "nan"};
+  static const char* kWords[] = {"null", "true", "no",     "1",  ".inf", "-",   "a/b", "/x",
+                                 "0x1f", "1e3",  "link.0", "--", "_",    "Yes", "off", "nan"};
   std::uniform_int_distribution<int> word(0, std::size(kWords) - 1);
   return absl::StrCat(kWords[word(rng)], index % 3 == 0 ? "" : "-", index);
 }
@@ -65,8 +65,9 @@ RobotSpheres RandomRobot(std::uint64_t seed, bool odd_xml_names = false) {
     link.link = odd_xml_names ? absl::StrCat("l<", l, ">&'\"") : OddName(rng, l);
     const int n = l == 1 ? 0 : std::uniform_int_distribution<int>(1, 60)(rng);
     for (int i = 0; i < n; ++i) {
-      link.spheres.push_back(Sphere{Vector3(RandomLength(rng), RandomLength(rng), RandomLength(rng)),
-                                    std::abs(RandomLength(rng)) + 1e-15});
+      link.spheres.push_back(
+          Sphere{Vector3(RandomLength(rng), RandomLength(rng), RandomLength(rng)),
+                 std::abs(RandomLength(rng)) + 1e-15});
     }
     model.links.push_back(std::move(link));
   }
@@ -104,11 +105,13 @@ std::string BaseUrdf(const RobotSpheres& model) {
     tinyxml2::XMLElement* link = robot->InsertNewChildElement("link");
     link->SetAttribute("name", names[i].c_str());
     tinyxml2::XMLElement* visual = link->InsertNewChildElement("visual");
-    visual->InsertNewChildElement("geometry")->InsertNewChildElement("box")->SetAttribute(
-        "size", "0.1 0.2 0.3");
+    visual->InsertNewChildElement("geometry")
+        ->InsertNewChildElement("box")
+        ->SetAttribute("size", "0.1 0.2 0.3");
     tinyxml2::XMLElement* collision = link->InsertNewChildElement("collision");
-    collision->InsertNewChildElement("geometry")->InsertNewChildElement("box")->SetAttribute(
-        "size", "0.1 0.2 0.3");
+    collision->InsertNewChildElement("geometry")
+        ->InsertNewChildElement("box")
+        ->SetAttribute("size", "0.1 0.2 0.3");
     if (i == 0) continue;
     tinyxml2::XMLElement* joint = robot->InsertNewChildElement("joint");
     joint->SetAttribute("name", absl::StrCat("j", i).c_str());
@@ -132,9 +135,8 @@ absl::StatusOr<RobotSpheres> WriteAndRead(const RobotSpheres& model, RobotSphere
   if (!detected.ok()) return detected.status();
   // MorphIt's layout is told apart by its sphere links, which a robot without spheres lacks.
   const bool has_spheres = !RobotSpheresCarried(model, format).links.empty();
-  EXPECT_TRUE(*detected == format ||
-              (format == RobotSpheresFormat::kMorphit && !has_spheres &&
-               *detected == RobotSpheresFormat::kUrdf))
+  EXPECT_TRUE(*detected == format || (format == RobotSpheresFormat::kMorphit && !has_spheres &&
+                                      *detected == RobotSpheresFormat::kUrdf))
       << RobotSpheresFormatName(format) << " detected as " << RobotSpheresFormatName(*detected);
   return ParseRobotSpheres(*text, format);
 }
@@ -151,14 +153,13 @@ TEST(RobotSpheres, EveryFormatPairRoundTripsRandomRobotsExactly) {
       ASSERT_EQ(*once, RobotSpheresCarried(model, a)) << RobotSpheresFormatName(a);
       for (RobotSpheresFormat b : kFormats) {
         const absl::StatusOr<RobotSpheres> twice = WriteAndRead(*once, b, base);
-        ASSERT_TRUE(twice.ok()) << RobotSpheresFormatName(a) << " -> "
-                                << RobotSpheresFormatName(b) << ": " << twice.status();
+        ASSERT_TRUE(twice.ok()) << RobotSpheresFormatName(a) << " -> " << RobotSpheresFormatName(b)
+                                << ": " << twice.status();
         // The URDF layouts carry the name of the URDF they are written into (the base's).
         RobotSpheres expected = RobotSpheresCarried(RobotSpheresCarried(model, a), b);
         if (IsUrdf(b)) expected.robot_name = model.robot_name;
-        EXPECT_EQ(*twice, expected)
-            << "seed " << seed << ": " << RobotSpheresFormatName(a) << " -> "
-            << RobotSpheresFormatName(b);
+        EXPECT_EQ(*twice, expected) << "seed " << seed << ": " << RobotSpheresFormatName(a)
+                                    << " -> " << RobotSpheresFormatName(b);
         ++pairs;
       }
     }
@@ -250,7 +251,8 @@ TEST(RobotSpheres, ReadsCuroboRobotFilesAsCuroboLaysThemOut) {
   EXPECT_EQ(model->self_collision_ignore.count({"panda_link0", "panda_link1"}), 1u);
   EXPECT_EQ(DetectRobotSpheresFormat(yaml).value(), RobotSpheresFormat::kCurobo);
   // Written back: one number for the shared world buffer.
-  const absl::StatusOr<std::string> written = FormatRobotSpheres(*model, RobotSpheresFormat::kCurobo);
+  const absl::StatusOr<std::string> written =
+      FormatRobotSpheres(*model, RobotSpheresFormat::kCurobo);
   ASSERT_TRUE(written.ok());
   EXPECT_THAT(*written, HasSubstr("collision_sphere_buffer: 0.004\n"));
   EXPECT_THAT(*written, HasSubstr("collision_link_names: [\"panda_link0\", \"panda_hand\"]\n"));
@@ -342,7 +344,7 @@ TEST(RobotSpheres, ReadsVampAndMorphitUrdfsInTheParentLinksFrame) {
 </robot>)";
   const absl::StatusOr<RobotSpheres> model = ParseRobotSpheres(vamp, RobotSpheresFormat::kUrdf);
   ASSERT_TRUE(model.ok()) << model.status();
-  ASSERT_EQ(model->links.size(), 1u);  // b is not spherized
+  ASSERT_EQ(model->links.size(), 1u);                                    // b is not spherized
   EXPECT_EQ(model->links[0].spheres[0].center, Vector3(0.1, 0.2, 0.3));  // rpy moves no centre
   EXPECT_EQ(model->links[0].spheres[1].radius, 2.0);
   EXPECT_EQ(DetectRobotSpheresFormat(vamp).value(), RobotSpheresFormat::kUrdf);
@@ -397,11 +399,11 @@ TEST(RobotSpheres, WritingIntoAnSrdfReplacesOursAndKeepsTheRest) {
   const absl::StatusOr<std::string> merged =
       FormatRobotSpheres(model, RobotSpheresFormat::kSrdf, options);
   ASSERT_TRUE(merged.ok()) << merged.status();
-  for (const char* kept : {"<group name=\"arm\">", "<group_state name=\"ready\"",
-                           "<end_effector name=\"hand\"", "<virtual_joint name=\"world\"",
-                           "made by the setup assistant", "link=\"z\"",
-                           "<disable_collisions link1=\"c\" link2=\"x\" reason=\"User\"/>",
-                           "<robot name=\"panda\">"}) {
+  for (const char* kept :
+       {"<group name=\"arm\">", "<group_state name=\"ready\"", "<end_effector name=\"hand\"",
+        "<virtual_joint name=\"world\"", "made by the setup assistant", "link=\"z\"",
+        "<disable_collisions link1=\"c\" link2=\"x\" reason=\"User\"/>",
+        "<robot name=\"panda\">"}) {
     EXPECT_THAT(*merged, HasSubstr(kept));
   }
   EXPECT_THAT(*merged, ::testing::Not(HasSubstr("9 9 9")));
@@ -424,7 +426,8 @@ TEST(RobotSpheres, MalformedFilesAreRefusedNamingTheLineAndTheKey) {
     std::string message;
   };
   const std::vector<Case> cases = {
-      {RobotSpheresFormat::kCurobo, "collision_spheres:\n  a:\n    - center: [1, 2]\n      radius: 1\n",
+      {RobotSpheresFormat::kCurobo,
+       "collision_spheres:\n  a:\n    - center: [1, 2]\n      radius: 1\n",
        "line 3: link 'a' sphere 0 center is not a list of 3 numbers"},
       {RobotSpheresFormat::kCurobo, "collision_spheres: {a: []}\nself_collision_ignore: [a]\n",
        "line 2: self_collision_ignore is not a mapping"},
@@ -437,7 +440,8 @@ TEST(RobotSpheres, MalformedFilesAreRefusedNamingTheLineAndTheKey) {
        "line 2: collision_sphere_buffer is not a finite number"},
       {RobotSpheresFormat::kCurobo, "collision_spheres: [\n", "malformed YAML"},
       {RobotSpheresFormat::kXrdf, "format: urdf\n", "format is not xrdf"},
-      {RobotSpheresFormat::kXrdf, "format: xrdf\nformat_version: 2.0\n", "format_version is not 1.x"},
+      {RobotSpheresFormat::kXrdf, "format: xrdf\nformat_version: 2.0\n",
+       "format_version is not 1.x"},
       {RobotSpheresFormat::kXrdf,
        "format: xrdf\nformat_version: 1.0\ncollision: {geometry: g}\nself_collision: {geometry: "
        "h}\n",

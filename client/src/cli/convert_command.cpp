@@ -83,8 +83,8 @@ absl::Status RunRobotConvert(const ConvertCliOptions& options) {
     std::cout << summary.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
   } else if (!options.output_path.empty()) {
     std::cout << "wrote " << model->links.size() << " links, " << spheres << " spheres, "
-              << model->self_collision_ignore.size() << " ignored pairs to "
-              << options.output_path << " (" << robot::RobotSpheresFormatName(*to)
+              << model->self_collision_ignore.size() << " ignored pairs to " << options.output_path
+              << " (" << robot::RobotSpheresFormatName(*to)
               << (merged ? ", merged into the SRDF there" : "") << ") from "
               << robot::RobotSpheresFormatName(read_as) << "\n";
   }

@@ -35,7 +35,7 @@ struct EvaluateCliOptions {
   bool certify = false;
   CoverCertifyOptions certify_options;
   bool json = false;
-  SolidLoadOptions load;  // --scale and the repair options
+  SolidLoadOptions load;                   // --scale and the repair options
   std::vector<std::string> package_paths;  // robots: where package:// URIs are looked for
   RemoteOptions remote;
 };

@@ -27,7 +27,7 @@ struct LinkRow {
   std::size_t spheres = 0;
   bool certified = false;
   double delta = 0.0;
-  std::string note;  // why not certified, or "no geometry"
+  std::string note;                        // why not certified, or "no geometry"
   std::optional<CoverCertificate> failed;  // the first element's certificate that failed
 };
 
@@ -109,8 +109,8 @@ void PrintRows(const RobotCertifyOptions& options, robot::RobotSpheresFormat rea
   std::size_t width = 4;
   for (const LinkRow& row : rows) width = std::max(width, row.link.size());
   const int w = static_cast<int>(width);
-  std::cout << absl::StrFormat("%-*s  %8s  %7s  %-9s  %10s  %s\n", w, "link", "elements",
-                               "spheres", "cover", "delta (mm)", "note");
+  std::cout << absl::StrFormat("%-*s  %8s  %7s  %-9s  %10s  %s\n", w, "link", "elements", "spheres",
+                               "cover", "delta (mm)", "note");
   for (const LinkRow& row : rows) {
     const char* cover = row.elements == 0 ? "-" : row.certified ? "certified" : "NO";
     const std::string d = row.certified && row.elements > 0
@@ -119,9 +119,9 @@ void PrintRows(const RobotCertifyOptions& options, robot::RobotSpheresFormat rea
     std::cout << absl::StrFormat("%-*s  %8d  %7d  %-9s  %10s  %s\n", w, row.link, row.elements,
                                  row.spheres, cover, d, row.note);
   }
-  std::cout << absl::StrFormat("%s (%s) on %s: %s", options.spheres_path,
-                               robot::RobotSpheresFormatName(read_as), options.robot_path,
-                               all ? "every link is a certified cover" : "NOT every link certified");
+  std::cout << absl::StrFormat(
+      "%s (%s) on %s: %s", options.spheres_path, robot::RobotSpheresFormatName(read_as),
+      options.robot_path, all ? "every link is a certified cover" : "NOT every link certified");
   if (all) std::cout << absl::StrFormat(", delta %.6g m at most", delta);
   std::cout << "\n";
 }
@@ -199,8 +199,8 @@ absl::Status RunRobotCertify(const client::Client& client, const RobotCertifyOpt
         row.delta = verdict->delta;
         if (verdict->failed_element) {
           const robot::ElementCover& cover = (*covers)[*verdict->failed_element];
-          const std::string where = robot::DescribeUrdfElement(
-              link.elements[*verdict->failed_element], link.from_visual);
+          const std::string where =
+              robot::DescribeUrdfElement(link.elements[*verdict->failed_element], link.from_visual);
           if (cover.certificate) {
             row.failed = cover.certificate;
             row.note = where + ": " + CoverVerdict(*cover.certificate);
@@ -215,8 +215,8 @@ absl::Status RunRobotCertify(const client::Client& client, const RobotCertifyOpt
   }
   PrintRows(options, read_as, rows);
   if (failed > 0) {
-    return UnusableMeshError(absl::StrFormat("%d of %d links with geometry are not certified covers",
-                                             failed, rows.size()));
+    return UnusableMeshError(absl::StrFormat(
+        "%d of %d links with geometry are not certified covers", failed, rows.size()));
   }
   return absl::OkStatus();
 }

@@ -17,9 +17,9 @@ namespace inscribe::cli {
 bool IsRobotDescriptionPath(const std::string& path);
 
 struct RobotCertifyOptions {
-  std::string robot_path;     // URDF or MJCF
-  std::string spheres_path;   // any robot sphere format
-  std::string spheres_format; // empty: by extension and content
+  std::string robot_path;      // URDF or MJCF
+  std::string spheres_path;    // any robot sphere format
+  std::string spheres_format;  // empty: by extension and content
   std::vector<std::string> package_paths;
   CoverCertifyOptions certify;
   RepairOptions repair;

@@ -38,7 +38,8 @@ absl::StatusOr<RobotSpheresFormat> RobotOutputFormat(const std::string& to,
   }
   if (path.empty()) return UsageError("name the output format with --to (stdout has no extension)");
   absl::StatusOr<RobotSpheresFormat> by_extension = robot::RobotSpheresFormatFromPath(path);
-  if (!by_extension.ok()) return UsageError(std::string(by_extension.status().message()) + "; or give --to");
+  if (!by_extension.ok())
+    return UsageError(std::string(by_extension.status().message()) + "; or give --to");
   return *by_extension;
 }
 
@@ -58,7 +59,8 @@ absl::Status WriteRobotSpheres(const robot::RobotSpheres& model, RobotSpheresFor
     options.base = *std::move(bytes);
   }
   std::error_code error;
-  if (format == RobotSpheresFormat::kSrdf && !path.empty() && std::filesystem::exists(path, error)) {
+  if (format == RobotSpheresFormat::kSrdf && !path.empty() &&
+      std::filesystem::exists(path, error)) {
     absl::StatusOr<std::string> bytes = robot::ReadRobotFileBytes(path);
     if (!bytes.ok()) return BadInputError(bytes.status().message());
     options.base = *std::move(bytes);

@@ -451,8 +451,8 @@ absl::Status RunUrdf(const UrdfCliOptions& options) {
   }
   // The SRDF's disabled pairs, merged into the SRDF already there (its groups and other
   // pairs kept); the --spheres files with every spherized link's spheres too.
-  const robot::RobotSpheres model = robot::RobotSpheresFromSpherized(
-      results, robot.name, matrix ? &*matrix : nullptr, {});
+  const robot::RobotSpheres model =
+      robot::RobotSpheresFromSpherized(results, robot.name, matrix ? &*matrix : nullptr, {});
   const std::string comment = matrix ? robot::SelfCollisionComment(*matrix) : "inscribe urdf";
   if (!options.srdf_path.empty()) {
     robot::RobotSpheres pairs = model;

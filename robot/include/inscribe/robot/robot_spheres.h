@@ -125,8 +125,8 @@ absl::StatusOr<RobotSpheres> ParseRobotSpheres(absl::string_view bytes, RobotSph
 
 // Reads the file at `path` (at most 256 MiB) in `format`, or when unset by its extension for
 // .xrdf and .srdf and by DetectRobotSpheresFormat for the others (.yml may hold XRDF, .urdf
-// either layout); *read_as, when given, is set to the format read. NOT_FOUND for a missing file; INVALID_ARGUMENT with
-// "PATH: " before ParseRobotSpheres' message.
+// either layout); *read_as, when given, is set to the format read. NOT_FOUND for a missing file;
+// INVALID_ARGUMENT with "PATH: " before ParseRobotSpheres' message.
 absl::StatusOr<RobotSpheres> ReadRobotSpheresFile(
     const std::string& path, std::optional<RobotSpheresFormat> format = std::nullopt,
     RobotSpheresFormat* read_as = nullptr);

@@ -149,8 +149,14 @@ void ReplaceLinkCollisions(XMLDocument& document, XMLElement& link,
 absl::StatusOr<RobotSpheres> ParseUrdfRobotSpheres(absl::string_view bytes) {
   absl::StatusOr<UrdfRobot> robot = ParseUrdf(bytes);
   if (!robot.ok()) return robot.status();
-  std::map<std::string, const UrdfJoint*> fixed_by_child;
+  std::map<std::string, const UrdfJoint*> fixed_by_child, by_child;
   for (const UrdfJoint& joint : robot->joints) {
+    // Which joint places a sphere link must be clear: a link has one parent joint.
+    if (const auto [seen, first] = by_child.emplace(joint.child, &joint); !first) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "line ", joint.line, ": joint '", joint.name, "' has child link '", joint.child,
+          "', the child of joint '", seen->second->name, "' (line ", seen->second->line, ") too"));
+    }
     if (joint.type == UrdfJointType::kFixed) fixed_by_child[joint.child] = &joint;
   }
   // Per link, its own sphere collisions in the link frame; false when it has none.
@@ -228,9 +234,11 @@ absl::StatusOr<std::string> FormatUrdfRobotSpheres(const RobotSpheres& model, bo
     links.emplace(AttributeOf(link, "name"), link);
   }
   std::set<std::string> joints;
+  std::multiset<std::string> joint_children;
   for (XMLElement* joint = robot.FirstChildElement("joint"); joint != nullptr;
        joint = joint->NextSiblingElement("joint")) {
     joints.insert(AttributeOf(joint, "name"));
+    joint_children.insert(AttributeOf(joint->FirstChildElement("child"), "link"));
   }
   for (const LinkSpheres& link : model.links) {
     if (!link.spheres.empty() && links.count(link.link) == 0) {
@@ -246,9 +254,13 @@ absl::StatusOr<std::string> FormatUrdfRobotSpheres(const RobotSpheres& model, bo
   for (const auto& [child, parent_joint] : MorphitChildren(robot)) {
     if (written.count(parent_joint.first) == 0) continue;
     joints.erase(AttributeOf(parent_joint.second, "name"));
+    joint_children.erase(joint_children.find(child));
     robot.DeleteChild(parent_joint.second);
-    robot.DeleteChild(links.at(child));
-    links.erase(child);
+    // The joint may name a link the document lacks (the tree is Kinematics' to check).
+    if (const auto link = links.find(child); link != links.end()) {
+      robot.DeleteChild(link->second);
+      links.erase(link);
+    }
   }
   const std::string comment_start = options.comment.empty() ? "inscribe" : options.comment;
   for (const LinkSpheres& link : model.links) {
@@ -271,6 +283,11 @@ absl::StatusOr<std::string> FormatUrdfRobotSpheres(const RobotSpheres& model, bo
       const Sphere& s = link.spheres[k];
       const std::string child = absl::StrCat(link.link, "_sphere", k);
       const std::string joint_name = absl::StrCat(link.link, "_to_", child);
+      if (joint_children.count(child) != 0) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("the base URDF has a joint to a link named '", child,
+                         "', the name of a MorphIt sphere of link '", link.link, "'"));
+      }
       if (links.count(child) != 0 || joints.count(joint_name) != 0) {
         return absl::InvalidArgumentError(
             absl::StrCat("the base URDF already has a ", links.count(child) != 0 ? "link" : "joint",

@@ -473,6 +473,11 @@ TEST(RobotSpheres, MalformedFilesAreRefusedNamingTheLineAndTheKey) {
        "1\"/></geometry></collision></link></robot>",
        "line 3 (<collision>) of link 'a' is not a sphere"},
       {RobotSpheresFormat::kMorphit,
+       "<robot name=\"r\"><link name=\"a\"/><link name=\"a_sphere0\"/>\n<joint name=\"j\" "
+       "type=\"fixed\"><parent link=\"a\"/><child link=\"a_sphere0\"/></joint>\n<joint "
+       "name=\"k\" type=\"fixed\"><parent link=\"a\"/><child link=\"a_sphere0\"/></joint></robot>",
+       "line 3: joint 'k' has child link 'a_sphere0', the child of joint 'j' (line 2) too"},
+      {RobotSpheresFormat::kMorphit,
        "<robot name=\"r\"><link name=\"a\"/>\n<link name=\"a_sphere0\"/><joint name=\"j\" "
        "type=\"fixed\"><parent link=\"a\"/><child link=\"a_sphere0\"/></joint></robot>",
        "line 2: MorphIt sphere link 'a_sphere0' has no sphere <collision>"},

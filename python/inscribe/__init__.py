@@ -43,10 +43,13 @@ from ._inscribe import (
     load_mesh,
     parse_curobo_yaml,
     prepare,
+    read_robot_sphere_file,
+    read_robot_spheres,
     read_spheres,
     spherize_robot,
     spherize_urdf,
     write_mesh,
+    write_robot_spheres,
     write_spheres,
 )
 from ._client import (
@@ -67,6 +70,6 @@ __all__ = [
     "MeshWarning",
     "QualityReport", "Repair", "RetryPolicy", "Scene", "SceneFrame", "Severity", "Solid", "SphereSet", "SpherizedRobot",
     "certified_distance", "certify", "distance", "evaluate", "format_curobo_yaml", "generate",
-    "load_mesh", "parse_curobo_yaml", "prepare", "read_spheres", "spherize_robot", "spherize_urdf",
-    "write_mesh", "write_spheres",
+    "load_mesh", "parse_curobo_yaml", "prepare", "read_robot_sphere_file", "read_robot_spheres", "read_spheres", "spherize_robot", "spherize_urdf",
+    "write_mesh", "write_robot_spheres", "write_spheres",
 ]

@@ -366,6 +366,20 @@ class SpherizedRobot:
                        always_fraction: float = 0.95,
                        progress: Optional[Callable[[float], object]] = None) -> SelfCollision: ...
     def curobo_yaml(self, self_collision: Optional[SelfCollision] = None) -> str: ...
+    # format: "curobo", "xrdf", "srdf", "urdf" (VAMP), "morphit"; default: path's extension.
+    def write(self, path: str, *, format: Optional[str] = None,
+              self_collision: Optional[SelfCollision] = None) -> None: ...
+
+# Robot sphere files in every planner format (robot_spheres.h): link -> (N, 4) [x, y, z, r].
+def read_robot_spheres(path: str, *, format: Optional[str] = None) -> dict[str, Float64Array]: ...
+# {"format", "robot_name", "spheres", "self_collision_ignore": [(a, b, reason)],
+#  "self_collision_buffer": {link: m}, "collision_buffer": {link: m}}
+def read_robot_sphere_file(path: str, *, format: Optional[str] = None) -> dict: ...
+def write_robot_spheres(path: str, spheres: Mapping[str, Float64Array], *,
+                        format: Optional[str] = None, robot: str = "", robot_name: str = "",
+                        self_collision_ignore: Sequence[tuple[str, str, str]] = (),
+                        self_collision_buffer: Mapping[str, float] = ...,
+                        collision_buffer: Mapping[str, float] = ...) -> None: ...
 
 def spherize_robot(path: str, *, kind: str = "cover", max_spheres: Optional[int] = None,
                    max_spheres_per_link: Optional[int] = None,

@@ -15,9 +15,11 @@
 
 #include "absl/strings/str_cat.h"
 #include "bindings.h"
+#include "inscribe/base/atomic_file.h"
 #include "inscribe/generation/sphere_set_generation.h"
 #include "inscribe/robot/kinematics.h"
 #include "inscribe/robot/robot_file.h"
+#include "inscribe/robot/robot_spheres.h"
 #include "inscribe/robot/self_collision.h"
 #include "inscribe/robot/self_collision_srdf.h"
 #include "inscribe/robot/spherized_mjcf.h"
@@ -90,6 +92,58 @@ SpherizedRobot Spherize(
     return spherized.status();
   }));
   return SpherizedRobot{*std::move(file), std::move(spherized->links)};
+}
+
+std::optional<robot::RobotSpheresFormat> FormatArgument(const std::optional<std::string>& name) {
+  if (!name) return std::nullopt;
+  return ValueOrRaise(robot::ParseRobotSpheresFormat(*name));
+}
+
+// The format `path` is written in: `format`, else its extension (.urdf: the urdf layout).
+robot::RobotSpheresFormat OutputFormat(const std::string& path,
+                                       const std::optional<std::string>& format) {
+  if (format) return *FormatArgument(format);
+  return ValueOrRaise(robot::RobotSpheresFormatFromPath(path));
+}
+
+// Writes `model` to `path` as the CLI does: URDF layouts into `robot` (a URDF path), SRDF
+// merged into the one already at `path`.
+void WriteModel(const robot::RobotSpheres& model, const std::string& path,
+                robot::RobotSpheresFormat format, const std::string& robot_urdf,
+                const std::string& comment) {
+  robot::RobotSpheresWriteOptions options;
+  options.comment = comment;
+  if (format == robot::RobotSpheresFormat::kUrdf || format == robot::RobotSpheresFormat::kMorphit) {
+    if (robot_urdf.empty()) {
+      RaiseStatus(absl::InvalidArgumentError(
+          "urdf and morphit files are the robot's URDF with spheres: pass robot=URDF_PATH"));
+    }
+    options.base = ValueOrRaise(robot::ReadRobotFileBytes(robot_urdf));
+  }
+  std::error_code error;
+  if (format == robot::RobotSpheresFormat::kSrdf && fs::exists(path, error)) {
+    options.base = ValueOrRaise(robot::ReadRobotFileBytes(path));
+  }
+  const std::string text = ValueOrRaise(robot::FormatRobotSpheres(model, format, options));
+  OkOrRaise(WriteFileAtomically(path, text));
+}
+
+py::dict ModelDict(const robot::RobotSpheres& model, robot::RobotSpheresFormat format) {
+  py::dict spheres;
+  for (const LinkSpheres& link : model.links)
+    spheres[py::str(link.link)] = SphereArray(link.spheres);
+  py::list pairs;
+  for (const auto& [pair, reason] : model.self_collision_ignore) {
+    pairs.append(py::make_tuple(pair.first, pair.second, reason));
+  }
+  py::dict out;
+  out["format"] = robot::RobotSpheresFormatName(format);
+  out["robot_name"] = model.robot_name;
+  out["spheres"] = spheres;
+  out["self_collision_ignore"] = pairs;
+  out["self_collision_buffer"] = model.self_collision_buffer;
+  out["collision_buffer"] = model.collision_buffer;
+  return out;
 }
 
 // The keyword arguments spherize_robot and spherize_urdf share, documented once.
@@ -265,7 +319,91 @@ void BindRobot(py::module_& m) {
           py::arg("self_collision") = py::none(),
           "cuRobo's collision_spheres YAML of the spherized links; with a SelfCollision "
           "(self_collision()), followed by self_collision_ignore and self_collision_buffer "
-          "(0: padding is in the radii), as `inscribe urdf` writes it.");
+          "(0: padding is in the radii), as `inscribe urdf` writes it.")
+      .def(
+          "write",
+          [](const SpherizedRobot& r, const std::string& path,
+             const std::optional<std::string>& format, const PySelfCollision* self_collision) {
+            const robot::RobotSpheres model = robot::RobotSpheresFromSpherized(
+                r.links, r.file.robot().name,
+                self_collision == nullptr ? nullptr : &self_collision->matrix, {});
+            const robot::RobotSpheresFormat target = OutputFormat(path, format);
+            if (r.file.format != robot::RobotFormat::kUrdf &&
+                (target == robot::RobotSpheresFormat::kUrdf ||
+                 target == robot::RobotSpheresFormat::kMorphit)) {
+              RaiseStatus(absl::InvalidArgumentError(
+                  r.file.path + " is an MJCF model: there is no URDF to write spheres into"));
+            }
+            WriteModel(model, path, target, r.file.path,
+                       self_collision == nullptr
+                           ? std::string("inscribe")
+                           : robot::SelfCollisionComment(self_collision->matrix));
+          },
+          py::arg("path"), py::kw_only(), py::arg("format") = py::none(),
+          py::arg("self_collision") = py::none(),
+          "Writes the spherized links' spheres (and, with a SelfCollision, its disabled pairs "
+          "with their classes) as a planner reads them: format 'curobo', 'xrdf', 'srdf' (merged "
+          "into an SRDF already at path), 'urdf' (VAMP's layout) or 'morphit', else by path's "
+          "extension (.yml, .xrdf, .srdf, .urdf), as `inscribe urdf --spheres` does.");
+
+  m.def(
+      "read_robot_spheres",
+      [](const std::string& path, const std::optional<std::string>& format) {
+        const robot::RobotSpheres model =
+            ValueOrRaise(robot::ReadRobotSpheresFile(path, FormatArgument(format)));
+        py::dict out;
+        for (const LinkSpheres& link : model.links) {
+          out[py::str(link.link)] = SphereArray(link.spheres);
+        }
+        return out;
+      },
+      py::arg("path"), py::kw_only(), py::arg("format") = py::none(),
+      "{link: (N, 4) float64 [x, y, z, r]} of a robot sphere file in any planner format: "
+      "'curobo' (.yml), 'xrdf', 'srdf', 'urdf' (VAMP's layout) or 'morphit' (the parent "
+      "link's frame), by format, else extension and content. Link frames, metres.");
+  m.def(
+      "read_robot_sphere_file",
+      [](const std::string& path, const std::optional<std::string>& format) {
+        robot::RobotSpheresFormat read_as = robot::RobotSpheresFormat::kCurobo;
+        const robot::RobotSpheres model =
+            ValueOrRaise(robot::ReadRobotSpheresFile(path, FormatArgument(format), &read_as));
+        return ModelDict(model, read_as);
+      },
+      py::arg("path"), py::kw_only(), py::arg("format") = py::none(),
+      "Everything read_robot_spheres reads and more: a dict with format, robot_name, spheres "
+      "({link: (N, 4)}), self_collision_ignore ([(link_a, link_b, reason)], a < b, reason '' "
+      "when the file gives none), self_collision_buffer and collision_buffer ({link: "
+      "metres}).");
+  m.def(
+      "write_robot_spheres",
+      [](const std::string& path, const py::dict& spheres, const std::optional<std::string>& format,
+         const std::string& robot_urdf, const std::string& robot_name,
+         const std::vector<std::tuple<std::string, std::string, std::string>>& ignore,
+         const std::map<std::string, double>& self_collision_buffer,
+         const std::map<std::string, double>& collision_buffer) {
+        robot::RobotSpheres model;
+        model.robot_name = robot_name;
+        for (const auto& [link, array] : spheres) {
+          model.links.push_back({py::cast<std::string>(link), SpheresOf(array)});
+        }
+        for (const auto& [a, b, reason] : ignore) {
+          if (a == b) RaiseStatus(absl::InvalidArgumentError("link '" + a + "' ignores itself"));
+          model.self_collision_ignore[std::minmax(a, b)] = reason;
+        }
+        model.self_collision_buffer = self_collision_buffer;
+        model.collision_buffer = collision_buffer;
+        WriteModel(model, path, OutputFormat(path, format), robot_urdf, "inscribe");
+      },
+      py::arg("path"), py::arg("spheres"), py::kw_only(), py::arg("format") = py::none(),
+      py::arg("robot") = "", py::arg("robot_name") = "",
+      py::arg("self_collision_ignore") =
+          std::vector<std::tuple<std::string, std::string, std::string>>{},
+      py::arg("self_collision_buffer") = std::map<std::string, double>{},
+      py::arg("collision_buffer") = std::map<std::string, double>{},
+      "Writes {link: (N, 4) spheres} in a planner's format (format, else path's extension), "
+      "with optional self_collision_ignore [(a, b, reason)] and per-link buffers (metres). "
+      "'urdf' and 'morphit' are written into the robot's URDF at `robot`; 'srdf' merges into "
+      "an SRDF already at path. Links are written in the dict's order.");
 
   py::class_<PySelfCollision>(m, "SelfCollision", "A robot's self-collision matrix.")
       .def_property_readonly("samples", [](const PySelfCollision& c) { return c.matrix.samples; })

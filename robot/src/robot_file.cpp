@@ -47,7 +47,7 @@ RobotFormat DetectRobotFormat(absl::string_view bytes) {
                                                                   : RobotFormat::kUrdf;
 }
 
-absl::StatusOr<RobotFile> ReadRobotFile(const std::string& path, const MjcfReadOptions& mjcf) {
+absl::StatusOr<std::string> ReadRobotFileBytes(const std::string& path) {
   std::error_code error;
   if (!fs::exists(path, error)) return absl::NotFoundError(path + ": no such file");
   if (fs::is_directory(path, error)) return absl::InvalidArgumentError(path + ": is a directory");
@@ -62,10 +62,16 @@ absl::StatusOr<RobotFile> ReadRobotFile(const std::string& path, const MjcfReadO
   std::ostringstream contents;
   contents << in.rdbuf();
   if (in.bad()) return absl::InvalidArgumentError(path + ": read error");
+  return contents.str();
+}
+
+absl::StatusOr<RobotFile> ReadRobotFile(const std::string& path, const MjcfReadOptions& mjcf) {
+  absl::StatusOr<std::string> bytes = ReadRobotFileBytes(path);
+  if (!bytes.ok()) return bytes.status();
   RobotFile file;
   file.path = path;
   file.directory = fs::absolute(path).parent_path().string();
-  file.bytes = contents.str();
+  file.bytes = *std::move(bytes);
   file.format = DetectRobotFormat(file.bytes);
   if (file.format == RobotFormat::kMjcf) {
     absl::StatusOr<MjcfModel> model = ParseMjcf(file.bytes, path, mjcf);

@@ -1,45 +1,33 @@
 #include "inscribe/robot/self_collision_srdf.h"
 
-#include <tinyxml2.h>
-
-#include <algorithm>
-#include <tuple>
-#include <vector>
+#include <cassert>
+#include <utility>
 
 #include "absl/strings/str_cat.h"
-#include "absl/strings/str_replace.h"
+#include "inscribe/robot/robot_spheres.h"
 
 namespace inscribe::robot {
 
 std::string SelfCollisionSrdf(const SelfCollisionMatrix& matrix, const std::string& robot_name) {
-  std::vector<std::tuple<std::string, std::string, const char*>> disabled;
+  RobotSpheres model;
+  model.robot_name = robot_name;
   for (const LinkPairCollision& pair : matrix.pairs) {
     if (!CollisionDisabled(pair.type)) continue;
-    std::string a = matrix.links[pair.link_a], b = matrix.links[pair.link_b];
-    if (b < a) std::swap(a, b);
-    disabled.emplace_back(std::move(a), std::move(b), CollisionPairClassName(pair.type));
+    model.self_collision_ignore[std::minmax(matrix.links[pair.link_a], matrix.links[pair.link_b])] =
+        CollisionPairClassName(pair.type);
   }
-  std::sort(disabled.begin(), disabled.end());
+  RobotSpheresWriteOptions options;
+  options.comment = SelfCollisionComment(matrix);
+  absl::StatusOr<std::string> srdf = FormatRobotSpheres(model, RobotSpheresFormat::kSrdf, options);
+  assert(srdf.ok());  // the matrix's pairs are distinct, named links, ordered
+  return *std::move(srdf);
+}
 
-  tinyxml2::XMLDocument document;
-  document.InsertEndChild(document.NewDeclaration());
-  std::string comment = absl::StrCat(
-      " inscribe: self-collision matrix over ", matrix.samples, " random configurations (seed ",
+std::string SelfCollisionComment(const SelfCollisionMatrix& matrix) {
+  return absl::StrCat(
+      "inscribe: self-collision matrix over ", matrix.samples, " random configurations (seed ",
       matrix.seed, "), always at ", matrix.always_fraction, "; bounds ",
-      matrix.certified ? "certified for the links' solids" : "for the spheres only", " ");
-  document.InsertEndChild(document.NewComment(comment.c_str()));
-  tinyxml2::XMLElement* robot = document.NewElement("robot");
-  robot->SetAttribute("name", robot_name.c_str());
-  document.InsertEndChild(robot);
-  for (const auto& [a, b, reason] : disabled) {
-    tinyxml2::XMLElement* element = robot->InsertNewChildElement("disable_collisions");
-    element->SetAttribute("link1", a.c_str());
-    element->SetAttribute("link2", b.c_str());
-    element->SetAttribute("reason", reason);
-  }
-  tinyxml2::XMLPrinter printer;
-  document.Print(&printer);
-  return std::string(printer.CStr(), static_cast<std::size_t>(printer.CStrSize() - 1));
+      matrix.certified ? "certified for the links' solids" : "for the spheres only");
 }
 
 }  // namespace inscribe::robot

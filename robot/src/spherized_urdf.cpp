@@ -16,6 +16,8 @@
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_replace.h"
 #include "inscribe/balls/sphere_io.h"
+#include "inscribe/robot/robot_spheres.h"
+#include "robot_spheres_formats.h"
 
 namespace inscribe::robot {
 namespace {
@@ -24,55 +26,15 @@ using tinyxml2::XMLDocument;
 using tinyxml2::XMLElement;
 using tinyxml2::XMLNode;
 
-// Text that is safe inside <!-- -->: no "--", and no '-' just before the closing "-->".
-std::string CommentText(const std::string& text) {
-  std::string safe = text;
-  while (safe.find("--") != std::string::npos) safe = absl::StrReplaceAll(safe, {{"--", "- -"}});
-  return " " + safe + " ";
-}
-
-XMLElement* SphereCollision(XMLDocument& document, const Sphere& sphere) {
-  XMLElement* collision = document.NewElement("collision");
-  XMLElement* origin = collision->InsertNewChildElement("origin");
-  const std::string xyz =
-      absl::StrCat(ShortestDecimal(sphere.center.x()), " ", ShortestDecimal(sphere.center.y()), " ",
-                   ShortestDecimal(sphere.center.z()));
-  origin->SetAttribute("xyz", xyz.c_str());
-  origin->SetAttribute("rpy", "0 0 0");
-  XMLElement* geometry = collision->InsertNewChildElement("geometry");
-  geometry->InsertNewChildElement("sphere")->SetAttribute("radius",
-                                                          ShortestDecimal(sphere.radius).c_str());
-  return collision;
-}
-
-// Replaces the link's <collision> children by the comment and one <collision> per sphere.
-void ReplaceCollisions(XMLDocument& document, XMLElement& link, const LinkSpherizeResult& result) {
-  // Where the new elements go: after `anchor`, or first when it is null.
-  XMLNode* anchor = nullptr;
-  if (XMLElement* first = link.FirstChildElement("collision"); first != nullptr) {
-    anchor = first->PreviousSibling();
-  } else {
-    for (XMLElement* visual = link.FirstChildElement("visual"); visual != nullptr;
-         visual = visual->NextSiblingElement("visual")) {
-      anchor = visual;
-    }
-    if (anchor == nullptr) anchor = link.LastChild();
+// The YAML's header comment. The robot's name goes into a comment line: no control character
+// may end it early.
+std::string CuroboComment(const std::string& robot_name) {
+  std::string name = robot_name;
+  for (char& c : name) {
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
   }
-  while (XMLElement* collision = link.FirstChildElement("collision")) link.DeleteChild(collision);
-
-  XMLNode* last = document.NewComment(
-      CommentText(absl::StrCat("inscribe urdf: ", result.spheres.size(),
-                               " spheres in place of the link's ",
-                               result.from_visual ? "visual" : "collision", " geometry"))
-          .c_str());
-  if (anchor == nullptr) {
-    link.InsertFirstChild(last);
-  } else {
-    link.InsertAfterChild(anchor, last);
-  }
-  for (const Sphere& sphere : result.spheres) {
-    last = link.InsertAfterChild(last, SphereCollision(document, sphere));
-  }
+  return absl::StrCat("inscribe urdf", name.empty() ? "" : " of robot " + name,
+                      ": collision spheres per link, link frames, metres");
 }
 
 // The <mesh filename> of a relative path (plain or file://), written relative to
@@ -135,10 +97,13 @@ absl::StatusOr<std::string> SpherizedUrdf(absl::string_view urdf_bytes,
     if (found == by_name.end()) continue;
     const LinkSpherizeResult& result = *found->second;
     if (result.status == LinkStatus::kSpherized) {
-      ReplaceCollisions(document, *link, result);
+      internal::ReplaceLinkCollisions(
+          document, *link, result.spheres,
+          absl::StrCat("inscribe urdf: ", result.spheres.size(), " spheres in place of the link's ",
+                       result.from_visual ? "visual" : "collision", " geometry"));
     } else if (result.status == LinkStatus::kSkipped) {
       link->InsertFirstChild(document.NewComment(
-          CommentText(
+          internal::XmlCommentText(
               absl::StrCat("inscribe urdf: not spherized, geometry kept as it was: ", result.error))
               .c_str()));
     }
@@ -156,21 +121,13 @@ std::string SpherizedCuroboYaml(const std::vector<LinkSpherizeResult>& links,
   std::vector<LinkSpheres> spheres;
   for (const LinkSpherizeResult& result : links) {
     if (result.status != LinkStatus::kSpherized) continue;
-    // The name alone decides: the spheres passed CheckSphere's rules when they were made.
-    if (!FormatCuroboYaml({LinkSpheres{result.link, {}}}).ok()) {
+    if (!IsCuroboLinkName(result.link)) {
       left_out->push_back(result.link);
       continue;
     }
     spheres.push_back({result.link, result.spheres});
   }
-  // The robot's name goes into a comment line: no control character may end it early.
-  std::string name = robot_name;
-  for (char& c : name) {
-    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
-  }
-  absl::StatusOr<std::string> yaml = FormatCuroboYaml(
-      spheres, absl::StrCat("inscribe urdf", name.empty() ? "" : " of robot " + name,
-                            ": collision spheres per link, link frames, metres"));
+  absl::StatusOr<std::string> yaml = FormatCuroboYaml(spheres, CuroboComment(robot_name));
   // Only a bad name or a bad sphere is refused, and neither is left.
   assert(yaml.ok());
   return *std::move(yaml);
@@ -187,48 +144,29 @@ absl::StatusOr<std::string> SpherizedCuroboYaml(const std::vector<LinkSpherizeRe
           absl::StrCat("self_collision_buffer of link '", link, "' is not finite"));
     }
   }
-  const std::size_t left_before = left_out->size();
-  std::string yaml = SpherizedCuroboYaml(links, robot_name, left_out);
-  const std::set<std::string> left(left_out->begin() + static_cast<std::ptrdiff_t>(left_before),
-                                   left_out->end());
-  std::vector<std::string> written;
+  // The model of the links written, each with a buffer (0 when absent), and the pairs among
+  // them `matrix` disables.
+  std::vector<LinkSpherizeResult> written;
+  std::map<std::string, double> written_buffers;
   for (const LinkSpherizeResult& result : links) {
-    if (result.status == LinkStatus::kSpherized && left.count(result.link) == 0) {
-      written.push_back(result.link);
+    if (result.status != LinkStatus::kSpherized) continue;
+    if (!IsCuroboLinkName(result.link)) {
+      left_out->push_back(result.link);
+    } else {
+      written.push_back(result);
+      const auto found = buffers.find(result.link);
+      written_buffers[result.link] = found == buffers.end() ? 0.0 : found->second;
     }
   }
-  std::set<std::pair<std::string, std::string>> disabled;
-  for (const LinkPairCollision& pair : matrix.pairs) {
-    if (!CollisionDisabled(pair.type)) continue;
-    disabled.emplace(matrix.links[pair.link_a], matrix.links[pair.link_b]);
-    disabled.emplace(matrix.links[pair.link_b], matrix.links[pair.link_a]);
+  RobotSpheres model = RobotSpheresFromSpherized(written, robot_name, &matrix, written_buffers);
+  for (auto it = model.self_collision_ignore.begin(); it != model.self_collision_ignore.end();) {
+    const bool both =
+        written_buffers.count(it->first.first) != 0 && written_buffers.count(it->first.second) != 0;
+    it = both ? std::next(it) : model.self_collision_ignore.erase(it);
   }
-  // Names are quoted as FormatCuroboYaml quotes them (plain keys such as `null` or `1` would
-  // be read as other types); they hold only letters, digits and _ - . /.
-  std::string ignore;
-  for (std::size_t i = 0; i < written.size(); ++i) {
-    std::vector<std::string> ignored;
-    for (std::size_t j = i + 1; j < written.size(); ++j) {
-      if (disabled.count({written[i], written[j]}) != 0) {
-        ignored.push_back(absl::StrCat("\"", written[j], "\""));
-      }
-    }
-    if (ignored.empty()) continue;
-    absl::StrAppend(&ignore, "  \"", written[i], "\": [", absl::StrJoin(ignored, ", "), "]\n");
-  }
-  absl::StrAppend(&yaml, "self_collision_ignore:", ignore.empty() ? " {}\n" : "\n", ignore);
-  absl::StrAppend(&yaml, "self_collision_buffer:", written.empty() ? " {}\n" : "\n");
-  for (const std::string& link : written) {
-    const auto found = buffers.find(link);
-    // A YAML 1.1 float for PyYAML (cuRobo's loader): a '.' in the mantissa.
-    std::string value = ShortestDecimal(found == buffers.end() ? 0.0 : found->second);
-    if (value.find_first_of(".") == std::string::npos) {
-      const std::size_t e = value.find_first_of("eE");
-      value.insert(e == std::string::npos ? value.size() : e, ".0");
-    }
-    absl::StrAppend(&yaml, "  \"", link, "\": ", value, "\n");
-  }
-  return yaml;
+  RobotSpheresWriteOptions options;
+  options.comment = CuroboComment(robot_name);
+  return FormatRobotSpheres(model, RobotSpheresFormat::kCurobo, options);
 }
 
 }  // namespace inscribe::robot

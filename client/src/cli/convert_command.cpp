@@ -9,6 +9,8 @@
 #include "absl/strings/str_join.h"
 #include "command_outcome.h"
 #include "inscribe/balls/sphere_io.h"
+#include "inscribe/robot/robot_spheres.h"
+#include "robot_sphere_files.h"
 #include "sphere_output.h"
 
 namespace inscribe::cli {
@@ -23,8 +25,77 @@ struct ConvertCliOptions {
   double scale = 1.0;  // centres and radii multiplied by it (ScaledSphereFile)
   std::string link;       // the cuRobo YAML link to read
   std::string yaml_link;  // the cuRobo YAML link to write under
+  std::string robot;      // the URDF that urdf and morphit output is written into
   bool json = false;
 };
+
+// Whether the run converts a whole robot's spheres (robot_spheres.h) rather than one set: a
+// robot format named by --to / --from or by either file's extension.
+bool IsRobotConversion(const ConvertCliOptions& options) {
+  return RobotFormatNamed(options.to) || RobotFormatNamed(options.from) ||
+         RobotFormatOfPath(options.output_path) || RobotFormatOfPath(options.input_path) ||
+         !options.robot.empty();
+}
+
+absl::Status RunRobotConvert(const ConvertCliOptions& options) {
+  if (!options.link.empty() || !options.yaml_link.empty() || options.sph_level != -1) {
+    return UsageError(
+        "--link, --yaml-link and --sph-level pick one sphere set; a robot conversion keeps "
+        "every link");
+  }
+  if (options.scale != 1.0) {
+    return UsageError(
+        "--scale converts one sphere set; a robot's spheres are in its links' frames, in "
+        "metres: scale the robot's meshes (URDF <mesh scale>) and spherize it again");
+  }
+  if (options.json && options.output_path.empty()) {
+    return UsageError("--json prints a summary on stdout, so it needs -o for the file");
+  }
+  absl::StatusOr<robot::RobotSpheresFormat> to = RobotOutputFormat(options.to, options.output_path);
+  if (!to.ok()) return to.status();
+  std::optional<robot::RobotSpheresFormat> from;
+  if (!options.from.empty()) from = *robot::ParseRobotSpheresFormat(options.from);
+  robot::RobotSpheresFormat read_as = robot::RobotSpheresFormat::kCurobo;
+  absl::StatusOr<robot::RobotSpheres> model =
+      robot::ReadRobotSpheresFile(options.input_path, from, &read_as);
+  if (!model.ok()) return BadInputError(model.status().message());
+  // A URDF layout is rewritten into itself unless another robot is named.
+  std::string base = options.robot;
+  if (base.empty() && (read_as == robot::RobotSpheresFormat::kUrdf ||
+                       read_as == robot::RobotSpheresFormat::kMorphit)) {
+    base = options.input_path;
+  }
+  bool merged = false;
+  if (absl::Status written =
+          WriteRobotSpheres(*model, *to, options.output_path, base,
+                            "inscribe convert from " + options.input_path, &merged);
+      !written.ok()) {
+    return written;
+  }
+  const std::vector<std::string> dropped = NoteDroppedParts(*model, *to);
+  std::size_t spheres = 0;
+  for (const LinkSpheres& link : model->links) spheres += link.spheres.size();
+  if (options.json) {
+    nlohmann::json summary;
+    summary["input"] = options.input_path;
+    summary["from"] = robot::RobotSpheresFormatName(read_as);
+    summary["output"] = options.output_path;
+    summary["format"] = robot::RobotSpheresFormatName(*to);
+    summary["links"] = model->links.size();
+    summary["spheres"] = spheres;
+    summary["ignored_pairs"] = model->self_collision_ignore.size();
+    summary["merged"] = merged;
+    summary["left_out"] = dropped;
+    std::cout << summary.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
+  } else if (!options.output_path.empty()) {
+    std::cout << "wrote " << model->links.size() << " links, " << spheres << " spheres, "
+              << model->self_collision_ignore.size() << " ignored pairs to " << options.output_path
+              << " (" << robot::RobotSpheresFormatName(*to)
+              << (merged ? ", merged into the SRDF there" : "") << ") from "
+              << robot::RobotSpheresFormatName(read_as) << "\n";
+  }
+  return absl::OkStatus();
+}
 
 // What the output format leaves out of `file`, e.g. {"contacts", "params"}: only JSON keeps
 // more than the spheres.
@@ -39,6 +110,7 @@ std::vector<std::string> DroppedParts(const SphereFile& file, SphereFileFormat t
 }
 
 absl::Status RunConvert(const ConvertCliOptions& options) {
+  if (IsRobotConversion(options)) return RunRobotConvert(options);
   if (options.json && options.output_path.empty()) {
     return UsageError("--json prints a summary on stdout, so it needs -o for the file");
   }
@@ -121,16 +193,28 @@ void AddConvertCommand(CLI::App& app, CommandOutcome* outcome) {
   CLI::App* cmd = app.add_subcommand(
       "convert",
       "A sphere file in another format: inscribe JSON, spheretree .sph, CSV, cuRobo YAML, or "
-      "OBJ meshes of the spheres; the spheres are copied bit for bit");
+      "OBJ meshes of the spheres; or a robot's spheres between planner formats (cuRobo's "
+      "robot configuration, XRDF, SRDF, spherized URDF as VAMP reads it, MorphIt's URDF), "
+      "saying what the target leaves out; the spheres are copied bit for bit");
   cmd->add_option("SPHERES", options->input_path,
-                  "Sphere file (.json, .sph, .csv, cuRobo .yml/.yaml)")
+                  "Sphere file (.json, .sph, .csv, cuRobo .yml/.yaml), or a robot's (.yml, .xrdf, "
+                  ".srdf, .urdf)")
       ->required();
   cmd->add_option("-o,--output", options->output_path,
                   "Output file, written atomically (default: stdout)");
   cmd->add_option("--from", options->from, "Input format (default: from extension or content)")
-      ->check(CLI::IsMember({"json", "sph", "csv", "yaml", "yml"}, CLI::ignore_case));
-  cmd->add_option("--to", options->to, "Output format (default: from -o's extension, else json)")
-      ->check(CLI::IsMember({"json", "sph", "csv", "obj", "yaml", "yml"}, CLI::ignore_case));
+      ->check(CLI::IsMember({"json", "sph", "csv", "yaml", "yml", "curobo", "xrdf", "srdf", "urdf",
+                             "vamp", "morphit"},
+                            CLI::ignore_case));
+  cmd->add_option("--to", options->to,
+                  "Output format (default: from -o's extension, else json); a robot's: curobo, "
+                  "xrdf, srdf, urdf (VAMP's layout), morphit")
+      ->check(CLI::IsMember({"json", "sph", "csv", "obj", "yaml", "yml", "curobo", "xrdf", "srdf",
+                             "urdf", "vamp", "morphit"},
+                            CLI::ignore_case));
+  cmd->add_option("--robot", options->robot,
+                  "Robot conversions to urdf or morphit: the robot's URDF the spheres are written "
+                  "into (default: the input, when it is a URDF)");
   cmd->add_option("--sph-level", options->sph_level, ".sph tree level to read (-1 = the leaves)")
       ->capture_default_str();
   cmd->add_option("--link", options->link,

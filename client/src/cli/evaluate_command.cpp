@@ -16,6 +16,7 @@
 #include "inscribe/generation/sphere_file_record.h"
 #include "inscribe/view/report_json.h"
 #include "remote_options.h"
+#include "robot_certify.h"
 #include "service_session.h"
 #include "solid_loading.h"
 
@@ -34,7 +35,8 @@ struct EvaluateCliOptions {
   bool certify = false;
   CoverCertifyOptions certify_options;
   bool json = false;
-  SolidLoadOptions load;  // --scale and the repair options
+  SolidLoadOptions load;                   // --scale and the repair options
+  std::vector<std::string> package_paths;  // robots: where package:// URIs are looked for
   RemoteOptions remote;
 };
 
@@ -146,9 +148,40 @@ absl::Status RunCertify(const client::Client& client, const EvaluateCliOptions& 
   return absl::OkStatus();
 }
 
+// `evaluate --certify ROBOT SPHERES`: the robot's links, each against its spheres.
+absl::Status RunRobotEvaluate(const EvaluateCliOptions& options) {
+  if (!options.certify) {
+    return UsageError(options.mesh_path +
+                      " is a robot: robot sphere files are checked link by link with --certify");
+  }
+  if (options.load.scale != 1.0 || !options.link.empty() || options.sph_level != -1) {
+    return UsageError("--scale, --link and --sph-level are for one mesh, not a robot");
+  }
+  absl::StatusOr<std::unique_ptr<ServiceSession>> session = ServiceSession::Open(options.remote);
+  if (!session.ok()) return session.status();
+  RobotCertifyOptions robot;
+  robot.robot_path = options.mesh_path;
+  robot.spheres_path = options.spheres_path;
+  robot.spheres_format = options.format;
+  robot.package_paths = options.package_paths;
+  robot.certify = options.certify_options;
+  robot.repair = options.load.repair;
+  robot.json = options.json;
+  if (options.remote.enabled()) robot.server = options.remote.server;
+  return RunRobotCertify((*session)->client(), robot);
+}
+
 absl::Status RunEvaluate(const EvaluateCliOptions& options) {
+  if (IsRobotDescriptionPath(options.mesh_path)) return RunRobotEvaluate(options);
   SphereFileReadOptions read;
-  if (!options.format.empty()) read.format = *ParseSphereFileFormat(options.format);
+  if (!options.format.empty()) {
+    absl::StatusOr<SphereFileFormat> format = ParseSphereFileFormat(options.format);
+    if (!format.ok()) {
+      return UsageError(std::string(format.status().message()) +
+                        "; robot sphere formats go with a robot (.urdf, .xml) and --certify");
+    }
+    read.format = *format;
+  }
   read.sph_level = options.sph_level;
   read.yaml_link = options.link;
   absl::StatusOr<SphereFile> file = ReadSphereFile(options.spheres_path, read);
@@ -192,12 +225,21 @@ void AddEvaluateCommand(CLI::App& app, CommandOutcome* outcome) {
       "evaluate",
       "Quality of any sphere set against a mesh: exact nerr (or its lower bound for spheres "
       "that stick out), protrusion, coverage, boundary-to-union distance, fatness");
-  cmd->add_option("MESH", options->mesh_path, "Mesh file (.off, .obj, .stl, .ply)")->required();
-  cmd->add_option("SPHERES", options->spheres_path,
-                  "Sphere file (.json, .sph, .csv, cuRobo .yml/.yaml)")
+  cmd->add_option("MESH", options->mesh_path,
+                  "Mesh file (.off, .obj, .stl, .ply), or with --certify a robot (.urdf, MJCF "
+                  ".xml) whose links are checked one by one")
       ->required();
-  cmd->add_option("--format", options->format, "Sphere file format (default: from extension)")
-      ->check(CLI::IsMember({"json", "sph", "csv", "yaml", "yml"}, CLI::ignore_case));
+  cmd->add_option("SPHERES", options->spheres_path,
+                  "Sphere file (.json, .sph, .csv, cuRobo .yml/.yaml); for a robot its sphere "
+                  "file in any planner format (.yml cuRobo, .xrdf, .srdf, .urdf VAMP or MorphIt)")
+      ->required();
+  cmd->add_option("--format", options->format,
+                  "Sphere file format (default: from extension; for a robot, also the content)")
+      ->check(CLI::IsMember({"json", "sph", "csv", "yaml", "yml", "curobo", "xrdf", "srdf", "urdf",
+                             "vamp", "morphit"},
+                            CLI::ignore_case));
+  cmd->add_option("--package-path", options->package_paths,
+                  "Robots: a directory holding ROS packages for package:// URIs; repeatable");
   cmd->add_option("--link", options->link,
                   "cuRobo YAML with several links: the link whose spheres to evaluate");
   cmd->add_option("--sph-level", options->sph_level,

@@ -21,6 +21,7 @@
 #include "inscribe/generation/sphere_set_generation.h"
 #include "inscribe/robot/kinematics.h"
 #include "inscribe/robot/robot_file.h"
+#include "inscribe/robot/robot_spheres.h"
 #include "inscribe/robot/self_collision.h"
 #include "inscribe/robot/self_collision_srdf.h"
 #include "inscribe/robot/spherized_mjcf.h"
@@ -28,6 +29,7 @@
 #include "inscribe/robot/urdf_robot.h"
 #include "inscribe/robot/urdf_spherize.h"
 #include "nlohmann/json.hpp"
+#include "robot_sphere_files.h"
 #include "solid_loading.h"
 
 namespace inscribe::cli {
@@ -63,6 +65,8 @@ struct UrdfCliOptions {
   std::string output_path;
   std::string yaml_path;
   std::string srdf_path;
+  std::vector<std::string> sphere_paths;  // --spheres [FORMAT:]PATH
+  std::string sphere_format;
   std::int64_t samples = robot::SelfCollisionOptions{}.samples;
   std::uint64_t seed = robot::SelfCollisionOptions{}.seed;
   bool json = false;
@@ -210,6 +214,7 @@ void PrintJson(const UrdfCliOptions& options, const UrdfSpherizeOptions& spheriz
   report["robot"] = file.robot().name;
   report["output"] = options.output_path;
   report["yaml"] = yaml_path;
+  report["spheres_files"] = options.sphere_paths;
   report["kind"] = SphereSetKindName(spherize.kind);
   report["padding"] = spherize.padding;
   AddMode(robot::WithDefaultMode(spherize), &report);
@@ -259,8 +264,8 @@ void PrintJson(const UrdfCliOptions& options, const UrdfSpherizeOptions& spheriz
 void PrintTable(const robot::RobotFile& file, const RobotSpherizeResult& result,
                 const std::optional<robot::SelfCollisionMatrix>& matrix,
                 const std::string& output_path, const std::string& yaml_path,
-                const std::string& srdf_path, const std::vector<std::string>& left_out,
-                double seconds) {
+                const std::string& srdf_path, const std::vector<std::string>& sphere_paths,
+                const std::vector<std::string>& left_out, double seconds) {
   std::size_t width = 4;
   for (const LinkSpherizeResult& link : result.links) width = std::max(width, link.link.size());
   const int w = static_cast<int>(width);
@@ -282,7 +287,8 @@ void PrintTable(const robot::RobotFile& file, const RobotSpherizeResult& result,
     spheres += static_cast<std::int64_t>(link.spheres.size());
   }
   if (matrix) std::cout << MatrixSummary(*matrix) << "\n";
-  const std::string written = output_path + ", " + yaml_path;
+  std::string written = output_path + ", " + yaml_path;
+  for (const std::string& path : sphere_paths) written += ", " + path;
   std::cout << absl::StrFormat("wrote %s%s (%d spheres) in %.3f s", written,
                                srdf_path.empty() ? "" : " and " + srdf_path, spheres, seconds);
   if (skipped > 0) std::cout << absl::StrFormat("; %d link(s) skipped, kept as they were", skipped);
@@ -321,13 +327,51 @@ absl::Status RunUrdf(const UrdfCliOptions& options) {
                                      SameFile(options.srdf_path, yaml_path))) {
     return UsageError("--srdf " + options.srdf_path + " would overwrite another output");
   }
+  std::vector<robot::RobotSpheresFormat> sphere_formats;
+  std::vector<std::string> sphere_paths;
+  for (const std::string& spec : options.sphere_paths) {
+    // FORMAT:PATH names the format of that file; otherwise the extension decides where it
+    // names one, and --format picks the layout of .urdf files (urdf or morphit) and the
+    // format of files with other extensions.
+    std::string path = spec;
+    std::optional<robot::RobotSpheresFormat> named;
+    if (const std::size_t colon = spec.find(':'); colon != std::string::npos) {
+      absl::StatusOr<robot::RobotSpheresFormat> prefix =
+          robot::ParseRobotSpheresFormat(spec.substr(0, colon));
+      if (prefix.ok()) {
+        named = *prefix;
+        path = spec.substr(colon + 1);
+      }
+    }
+    const absl::StatusOr<robot::RobotSpheresFormat> by_extension =
+        robot::RobotSpheresFormatFromPath(path);
+    const bool settled = by_extension.ok() && *by_extension != robot::RobotSpheresFormat::kUrdf;
+    absl::StatusOr<robot::RobotSpheresFormat> format =
+        named     ? *named
+        : settled ? *by_extension
+                  : RobotOutputFormat(options.sphere_format, path);
+    if (!format.ok()) return format.status();
+    if (is_mjcf && (*format == robot::RobotSpheresFormat::kUrdf ||
+                    *format == robot::RobotSpheresFormat::kMorphit)) {
+      return UsageError("--spheres " + path + ": " + options.urdf_path +
+                        " is an MJCF model, with no URDF to write spheres into");
+    }
+    if (SameFile(path, options.output_path) || SameFile(path, yaml_path) ||
+        (!options.srdf_path.empty() && SameFile(path, options.srdf_path))) {
+      return UsageError("--spheres " + path + " would overwrite another output");
+    }
+    sphere_formats.push_back(*format);
+    sphere_paths.push_back(path);
+  }
   if (options.samples < 1 || options.samples > robot::kMaxSelfCollisionSamples) {
     return UsageError(absl::StrFormat("--samples must lie in 1..%d, got %d",
                                       robot::kMaxSelfCollisionSamples, options.samples));
   }
 
   // Before any work: a missing output directory would otherwise only show at the end.
-  for (const std::string& path : {options.output_path, yaml_path, options.srdf_path}) {
+  std::vector<std::string> written_paths = {options.output_path, yaml_path, options.srdf_path};
+  written_paths.insert(written_paths.end(), sphere_paths.begin(), sphere_paths.end());
+  for (const std::string& path : written_paths) {
     if (path.empty()) continue;
     const fs::path directory = fs::absolute(path).parent_path();
     std::error_code error;
@@ -401,12 +445,31 @@ absl::Status RunUrdf(const UrdfCliOptions& options) {
               << ": cuRobo YAML link names are letters, digits and _ - . /\n";
   }
   outputs.emplace_back(yaml_path, yaml);
-  if (!options.srdf_path.empty()) {
-    outputs.emplace_back(options.srdf_path, robot::SelfCollisionSrdf(*matrix, robot.name));
-  }
   for (const auto& [path, contents] : outputs) {
     if (absl::Status written = WriteFileAtomically(path, contents); !written.ok()) {
       return BadInputError(written.message());
+    }
+  }
+  // The SRDF's disabled pairs, merged into the SRDF already there (its groups and other
+  // pairs kept); the --spheres files with every spherized link's spheres too.
+  const robot::RobotSpheres model =
+      robot::RobotSpheresFromSpherized(results, robot.name, matrix ? &*matrix : nullptr, {});
+  const std::string comment = matrix ? robot::SelfCollisionComment(*matrix) : "inscribe urdf";
+  if (!options.srdf_path.empty()) {
+    robot::RobotSpheres pairs = model;
+    pairs.links.clear();
+    if (absl::Status written = WriteRobotSpheres(pairs, robot::RobotSpheresFormat::kSrdf,
+                                                 options.srdf_path, "", comment);
+        !written.ok()) {
+      return written;
+    }
+  }
+  for (std::size_t i = 0; i < sphere_paths.size(); ++i) {
+    NoteDroppedParts(model, sphere_formats[i]);
+    if (absl::Status written = WriteRobotSpheres(model, sphere_formats[i], sphere_paths[i],
+                                                 options.urdf_path, comment);
+        !written.ok()) {
+      return written;
     }
   }
 
@@ -416,7 +479,7 @@ absl::Status RunUrdf(const UrdfCliOptions& options) {
     PrintJson(options, *spherize, *file, *spherized, matrix, yaml_path, left_out, seconds);
   } else {
     PrintTable(*file, *spherized, matrix, options.output_path, yaml_path, options.srdf_path,
-               left_out, seconds);
+               sphere_paths, left_out, seconds);
   }
   const auto skipped = std::count_if(results.begin(), results.end(), [](const auto& result) {
     return result.status == LinkStatus::kSkipped;
@@ -505,7 +568,20 @@ void AddUrdfCommand(CLI::App& app, CommandOutcome* outcome) {
                   "cuRobo collision_spheres YAML to write (default: -o with extension .yml)");
   cmd->add_option("--srdf", options->srdf_path,
                   "Write MoveIt's SRDF with the self-collision matrix's disabled pairs "
-                  "(disable_collisions, reason Adjacent, Default, Always or Never)");
+                  "(disable_collisions, reason Adjacent, Default, Always or Never); into an SRDF "
+                  "already there they are merged, its groups, states and other pairs kept");
+  cmd->add_option("--spheres", options->sphere_paths,
+                  "Also write the spheres (and the matrix's disabled pairs) as a planner reads "
+                  "them, in the format --format names or the extension says: .yml cuRobo's "
+                  "robot configuration, .xrdf cuMotion, .srdf MoveIt (merged into an SRDF "
+                  "already there), .urdf VAMP's spherized URDF; FORMAT:PATH names the format "
+                  "of one file (e.g. morphit:arm_spheres.urdf); repeatable");
+  cmd->add_option("--format", options->sphere_format,
+                  "The layout of .urdf --spheres files, urdf (VAMP, cricket; the default) or "
+                  "morphit (a child link per sphere), and the format of files whose extension "
+                  "names none (curobo, xrdf, srdf, urdf, morphit)")
+      ->check(CLI::IsMember({"curobo", "yaml", "xrdf", "srdf", "urdf", "vamp", "morphit"},
+                            CLI::ignore_case));
   cmd->add_option("--samples", options->samples,
                   "Random joint configurations the self-collision matrix is sampled at (MoveIt's "
                   "default density)")

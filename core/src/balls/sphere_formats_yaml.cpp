@@ -31,13 +31,6 @@ std::string YamlDouble(double value) {
   return s;
 }
 
-bool IsLinkName(absl::string_view name) {
-  return !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
-    return absl::ascii_isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.' ||
-           c == '/';
-  });
-}
-
 // "line L" (1-based) of a node, for messages.
 std::string Where(const YAML::Node& node) {
   const YAML::Mark mark = node.Mark();
@@ -127,6 +120,13 @@ absl::StatusOr<std::vector<Sphere>> LinkSpheresFromYaml(const std::string& link,
 
 }  // namespace
 
+bool IsCuroboLinkName(absl::string_view name) {
+  return !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
+    return absl::ascii_isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.' ||
+           c == '/';
+  });
+}
+
 absl::StatusOr<std::string> FormatCuroboYaml(const std::vector<LinkSpheres>& links,
                                              absl::string_view comment) {
   std::set<std::string> seen;
@@ -136,7 +136,7 @@ absl::StatusOr<std::string> FormatCuroboYaml(const std::vector<LinkSpheres>& lin
   }
   absl::StrAppend(&out, "collision_spheres:", links.empty() ? " {}\n" : "\n");
   for (const LinkSpheres& link : links) {
-    if (!IsLinkName(link.link)) {
+    if (!IsCuroboLinkName(link.link)) {
       return absl::InvalidArgumentError(
           absl::StrCat("yaml link name ", internal::QuoteToken(link.link),
                        " is not a non-empty run of letters, digits and _ - . /"));

@@ -147,6 +147,11 @@ struct LinkSpheres {
   std::vector<Sphere> spheres;
 };
 
+// Whether cuRobo YAML as inscribe writes it carries `name` as a link key: a non-empty run of
+// letters, digits and _ - . / (the keys are quoted, so words YAML would resolve to other types,
+// such as null or 1, are fine). The one rule FormatCuroboYaml and the robot writers share.
+bool IsCuroboLinkName(absl::string_view name);
+
 // cuRobo's `collision_spheres:` YAML for several links, in the order given, under a
 // `# comment` header line. INVALID_ARGUMENT naming the link for a bad or repeated link name,
 // and naming the link and sphere for a sphere CheckSphere refuses. A link with no spheres is

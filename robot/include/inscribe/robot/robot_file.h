@@ -34,6 +34,11 @@ struct RobotFile {
 // then names what is wrong with anything else). O(size).
 RobotFormat DetectRobotFormat(absl::string_view bytes);
 
+// The bytes of the file at `path`, at most 256 MiB (robot descriptions and the sphere files
+// made for them). NOT_FOUND for a missing file; INVALID_ARGUMENT ("PATH: why") for a directory,
+// a larger or unreadable file.
+absl::StatusOr<std::string> ReadRobotFileBytes(const std::string& path);
+
 // Reads the file at `path` (at most 256 MiB): ParseUrdf or ParseMjcf (with `mjcf`) by content.
 // NOT_FOUND for a missing file; INVALID_ARGUMENT for a directory, an unreadable file or one the
 // parser refuses (its message after "PATH: ").

@@ -13,6 +13,11 @@ namespace inscribe::robot {
 // (byte order) and R one of Adjacent, Default, Always, Never; sorted by (A, B), as MoveIt's
 // setup assistant orders its pairs. A leading comment states the samples, seed and whether the
 // bounds are certified. Names are escaped by tinyxml2's printer. O(#pairs log #pairs).
+// Written through FormatRobotSpheres (kSrdf), the one SRDF writer.
 std::string SelfCollisionSrdf(const SelfCollisionMatrix& matrix, const std::string& robot_name);
+
+// "inscribe: self-collision matrix over N random configurations (seed S), ...": the comment the
+// SRDF and the other sphere files made with a matrix start with.
+std::string SelfCollisionComment(const SelfCollisionMatrix& matrix);
 
 }  // namespace inscribe::robot

@@ -38,12 +38,11 @@ absl::StatusOr<std::string> SpherizedUrdf(absl::string_view urdf_bytes,
 std::string SpherizedCuroboYaml(const std::vector<LinkSpherizeResult>& links,
                                 const std::string& robot_name, std::vector<std::string>* left_out);
 
-// SpherizedCuroboYaml followed by cuRobo's self-collision settings for the links it wrote
-// (robot_cfg.kinematics keys, as in cuRobo's robot configurations):
-//   self_collision_ignore: per link, the links whose pair with it `matrix` disables (every
-//     class but Sometimes), each pair once, under the link that comes first in `links`; links
-//     with nothing to ignore are left out ({} when none is left). cuRobo skips a pair listed
-//     in either direction.
+// cuRobo's robot configuration fragment (FormatRobotSpheres, kCurobo) of the links
+// SpherizedCuroboYaml writes: collision_link_names, collision_spheres and
+//   self_collision_ignore: the pairs of written links `matrix` disables (every class but
+//     Sometimes), each pair once under its first link by name ({} when none is left). cuRobo
+//     skips a pair listed in either direction.
 //   self_collision_buffer: every written link's value in `buffers` (metres, 0 when absent),
 //     which cuRobo adds to that link's sphere radii in self-collision checks only.
 // Pairs are matched by link name. INVALID_ARGUMENT for a buffer that is not finite.

@@ -5,6 +5,7 @@
 #include <CGAL/Simple_cartesian.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstdint>
@@ -159,11 +160,19 @@ void ForEachOwned(const Mesh& mesh, const std::vector<Sphere>& spheres,
         const Vector3 centroid = (p + q + r) / 3.0;
         std::vector<double> at(candidates.size());
         double best = std::numeric_limits<double>::infinity();
+        std::array<double, 3> corner_best;
+        corner_best.fill(std::numeric_limits<double>::infinity());
         for (std::size_t k = 0; k < candidates.size(); ++k) {
           best = std::min(best, at[k] = growth(candidates[k], centroid));
+          corner_best[0] = std::min(corner_best[0], growth(candidates[k], p));
+          corner_best[1] = std::min(corner_best[1], growth(candidates[k], q));
+          corner_best[2] = std::min(corner_best[2], growth(candidates[k], r));
         }
-        // Whole, when splitting could save at most `edge` of growth (or the piece is small).
-        if (diameter <= edge || least <= std::max(best, 0.0) + edge) {
+        // No split holds the centroid or a corner with less growth than the least any sphere
+        // needs there. Whole, when splitting could save at most `edge` of growth over that (or
+        // the piece is small).
+        const double floor = std::max({best, corner_best[0], corner_best[1], corner_best[2], 0.0});
+        if (diameter <= edge || least <= floor + edge) {
           visit(item, pick, p);
           visit(item, pick, q);
           visit(item, pick, r);

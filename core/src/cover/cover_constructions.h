@@ -36,8 +36,8 @@ std::vector<Sphere> LadderCandidates(const Solid& solid, const std::vector<Ladde
 
 // What each sphere alone must hold: every mesh triangle goes whole to the sphere whose radius
 // must grow least to hold its corners, or is split in four until that costs at most `edge`
-// more than the least growth any sphere needs at its centroid (or its edges are at most
-// `edge`); each `interior` point goes to the sphere that must grow least to reach it. Per
+// more than the least growth any sphere needs at its centroid or at one of its corners (or its
+// edges are at most `edge`); each `interior` point goes to the sphere that must grow least to reach it. Per
 // sphere, the corners of its pieces and its interior points (a ball holding them holds the
 // pieces: it is convex). Deterministic; parallel over triangles. `spheres` not empty.
 std::vector<std::vector<Vector3>> OwnedPoints(const Mesh& mesh, const std::vector<Sphere>& spheres,

@@ -30,10 +30,15 @@ constexpr std::uint64_t kGrowthSeed = 0x636f766572;  // "cover"
 constexpr int kMaxRounds = 8;
 // Rounds of holding a point the certificate found in no sphere, and of tightening.
 constexpr int kWitnessRounds = 6;
-constexpr int kTightenRounds = 3;
+constexpr int kTightenRounds = 2;
 // The pieces that guide tightening and splitting are this many times coarser than the ones a
 // cover holds (HoldBoundary holds the fine ones afterwards).
 constexpr double kGuideEdge = 8.0;
+// The compass search of a tightened sphere's centre: its first step (times the radius) and
+// halvings.
+constexpr double kCompassFirstStep = 0.25;
+constexpr int kCompassHalvings = 5;
+constexpr int kCompassMoves = 8;  // per step size
 // Ladder bases per sphere of the budget (besides the vertices).
 constexpr std::int64_t kBasesPerSphere = 8;
 // The first rung of the ladders and the sample grid's cell, as fractions of the bounding
@@ -332,19 +337,42 @@ absl::StatusOr<GeneratedCover> PreparedCover::Tighten(GeneratedCover cover,
         internal::OwnedPoints(s.solid->mesh(), spheres, s.interior, kGuideEdge * s.edge);
     internal::ParallelFor(std::size_t{0}, spheres.size(), [&](std::size_t i) {
       if (owned[i].empty()) return;
-      // Centres from the sphere's own to its part's enclosing ball's; the one whose ball,
-      // holding the part with the margin, protrudes least.
+      // The ball at centre c holding the part with the margin, and how far it protrudes.
+      const auto ball_at = [&](const Vector3& c, double* protrusion) {
+        double reach = 0.0;
+        for (const Vector3& p : owned[i]) reach = std::max(reach, (p - c).norm());
+        const Sphere ball{c, (reach + s.margin) * (1.0 + internal::kReachMargin)};
+        *protrusion = ball.radius - Depth(*s.solid, c);
+        return ball;
+      };
+      // From the better of the sphere's own centre, its part's enclosing ball's and halfway, a
+      // compass search: steps along the axes while one protrudes less, halved when none does.
       const Vector3 from = spheres[i].center, to = internal::EnclosingBall(owned[i]).center;
       double least = std::numeric_limits<double>::infinity();
       for (const double t : {0.0, 0.5, 1.0}) {
-        const Vector3 c = from + t * (to - from);
-        double reach = 0.0;
-        for (const Vector3& p : owned[i]) reach = std::max(reach, (p - c).norm());
-        const double radius = (reach + s.margin) * (1.0 + internal::kReachMargin);
-        const double protrusion = radius - Depth(*s.solid, c);
+        double protrusion = 0.0;
+        const Sphere ball = ball_at(from + t * (to - from), &protrusion);
         if (protrusion < least) {
           least = protrusion;
-          spheres[i] = Sphere{c, radius};
+          spheres[i] = ball;
+        }
+      }
+      double step = kCompassFirstStep * spheres[i].radius;
+      for (int halving = 0; halving < kCompassHalvings; ++halving, step *= 0.5) {
+        bool moved = true;
+        for (int move = 0; moved && move < kCompassMoves; ++move) {
+          moved = false;
+          for (int axis = 0; axis < 6; ++axis) {
+            Vector3 c = spheres[i].center;
+            c[axis / 2] += axis % 2 == 0 ? step : -step;
+            double protrusion = 0.0;
+            const Sphere ball = ball_at(c, &protrusion);
+            if (protrusion < least) {
+              least = protrusion;
+              spheres[i] = ball;
+              moved = true;
+            }
+          }
         }
       }
     });
@@ -372,9 +400,7 @@ absl::StatusOr<GeneratedCover> PreparedCover::SplitWorst(const GeneratedCover& c
   std::vector<Sphere> spheres = cover.set.spheres;
   spheres[worst] = two[0];
   spheres.push_back(two[1]);
-  absl::StatusOr<GeneratedCover> split = Finish(std::move(spheres), control);
-  if (!split.ok()) return split.status();
-  return Tighten(*std::move(split), control);
+  return Finish(std::move(spheres), control);
 }
 
 absl::StatusOr<GeneratedCover> PreparedCover::Construct(std::int64_t max_spheres,
@@ -390,7 +416,6 @@ absl::StatusOr<GeneratedCover> PreparedCover::Construct(std::int64_t max_spheres
     std::vector<Sphere> spheres;
     for (const std::size_t i : chosen) spheres.push_back(s.candidates[i]);
     absl::StatusOr<GeneratedCover> ladder = Finish(std::move(spheres), control);
-    if (ladder.ok()) ladder = Tighten(*std::move(ladder), control);
     // Fewer than the budget: split the most protruding sphere while that lowers delta.
     while (ladder.ok() && ladder->set.size() < budget) {
       absl::StatusOr<GeneratedCover> split = SplitWorst(*ladder, control);
@@ -399,7 +424,8 @@ absl::StatusOr<GeneratedCover> PreparedCover::Construct(std::int64_t max_spheres
     }
     if (absl::Status kept = Keep(std::move(ladder), &best); !kept.ok()) return kept;
   }
-  if (use.enclosing_ball) {
+  // The enclosing ball at one sphere (larger budgets start from it when monotone).
+  if (use.enclosing_ball && (max_spheres == 1 || !use.monotone)) {
     const Vertices& vertices = s.solid->mesh().vertices;
     std::vector<Vector3> points(static_cast<std::size_t>(vertices.rows()));
     for (Eigen::Index v = 0; v < vertices.rows(); ++v) {
@@ -410,11 +436,12 @@ absl::StatusOr<GeneratedCover> PreparedCover::Construct(std::int64_t max_spheres
       return kept;
     }
   }
-  if (use.k_center && budget > 1) {
-    absl::StatusOr<GeneratedCover> clusters =
-        Finish(internal::KCenterBalls(s.samples.points, budget), control);
-    if (clusters.ok()) clusters = Tighten(*std::move(clusters), control);
-    if (absl::Status kept = Keep(std::move(clusters), &best); !kept.ok()) return kept;
+  if (use.k_center) {
+    if (absl::Status kept =
+            Keep(Finish(internal::KCenterBalls(s.samples.points, budget), control), &best);
+        !kept.ok()) {
+      return kept;
+    }
   }
   if (!best) {
     return absl::InternalError(
@@ -443,12 +470,20 @@ absl::StatusOr<GeneratedCover> PreparedCover::Generate(std::int64_t max_spheres,
   absl::StatusOr<GeneratedCover> made = Construct(max_spheres, control);
   if (!made.ok()) return made.status();
   std::optional<GeneratedCover> best = *std::move(made);
+  std::optional<GeneratedCover> fewer;
   if (monotone && max_spheres > 1) {
     // The best cover of one sphere fewer (the same rule, so never worse than any before it),
     // and it with its most protruding sphere split.
-    absl::StatusOr<GeneratedCover> fewer = Generate(max_spheres - 1, control);
-    if (!fewer.ok()) return fewer.status();
+    absl::StatusOr<GeneratedCover> made_fewer = Generate(max_spheres - 1, control);
+    if (!made_fewer.ok()) return made_fewer.status();
+    fewer = *std::move(made_fewer);
     if (absl::Status kept = Keep(SplitWorst(*fewer, control), &best); !kept.ok()) return kept;
+  }
+  // The best construction tightened; then the cover of one sphere fewer if still better.
+  absl::StatusOr<GeneratedCover> tightened = Tighten(*std::move(best), control);
+  if (!tightened.ok()) return tightened.status();
+  best = *std::move(tightened);
+  if (fewer) {
     if (absl::Status kept = Keep(*std::move(fewer), &best); !kept.ok()) return kept;
   }
   GeneratedCover out = *std::move(best);

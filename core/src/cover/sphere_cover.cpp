@@ -250,6 +250,16 @@ std::vector<double> PreparedCover::EstimatedDeltas(std::int64_t max_spheres) con
 
 namespace {
 
+// The budgets up to kMonotoneCoverBudget at which every construction runs: 1..8, then about
+// every factor of sqrt(2) (11, 16, 23, 32, 45, 64).
+bool ConstructionBudget(std::int64_t n) {
+  if (n <= 8 || n == kMonotoneCoverBudget) return true;
+  const double steps = 2.0 * std::log2(static_cast<double>(n) / 8.0);
+  const std::int64_t below = static_cast<std::int64_t>(std::round(8.0 * std::exp2(std::floor(steps) / 2.0)));
+  const std::int64_t above = static_cast<std::int64_t>(std::round(8.0 * std::exp2(std::ceil(steps) / 2.0)));
+  return n == below || n == above;
+}
+
 // The sum of a cover's positive protrusions: the second key of the comparison.
 double SummedProtrusion(const GeneratedCover& cover) {
   double sum = 0.0;
@@ -467,9 +477,14 @@ absl::StatusOr<GeneratedCover> PreparedCover::Generate(std::int64_t max_spheres,
       return out;
     }
   }
-  absl::StatusOr<GeneratedCover> made = Construct(max_spheres, control);
-  if (!made.ok()) return made.status();
-  std::optional<GeneratedCover> best = *std::move(made);
+  // Up to kMonotoneCoverBudget the constructions run at the budgets of ConstructionBudget
+  // only; between them the cover grows from the one before by splitting.
+  std::optional<GeneratedCover> best;
+  if (!monotone || ConstructionBudget(max_spheres)) {
+    absl::StatusOr<GeneratedCover> made = Construct(max_spheres, control);
+    if (!made.ok()) return made.status();
+    best = *std::move(made);
+  }
   std::optional<GeneratedCover> fewer;
   if (monotone && max_spheres > 1) {
     // The best cover of one sphere fewer (the same rule, so never worse than any before it),
@@ -477,12 +492,17 @@ absl::StatusOr<GeneratedCover> PreparedCover::Generate(std::int64_t max_spheres,
     absl::StatusOr<GeneratedCover> made_fewer = Generate(max_spheres - 1, control);
     if (!made_fewer.ok()) return made_fewer.status();
     fewer = *std::move(made_fewer);
-    if (absl::Status kept = Keep(SplitWorst(*fewer, control), &best); !kept.ok()) return kept;
+    // A cover carried from a smaller budget was split there already (the same split).
+    if (fewer->set.size() == static_cast<std::size_t>(max_spheres - 1)) {
+      if (absl::Status kept = Keep(SplitWorst(*fewer, control), &best); !kept.ok()) return kept;
+    }
   }
   // The best construction tightened; then the cover of one sphere fewer if still better.
-  absl::StatusOr<GeneratedCover> tightened = Tighten(*std::move(best), control);
-  if (!tightened.ok()) return tightened.status();
-  best = *std::move(tightened);
+  if (best) {
+    absl::StatusOr<GeneratedCover> tightened = Tighten(*std::move(best), control);
+    if (!tightened.ok()) return tightened.status();
+    best = *std::move(tightened);
+  }
   if (fewer) {
     if (absl::Status kept = Keep(*std::move(fewer), &best); !kept.ok()) return kept;
   }

@@ -16,14 +16,16 @@
 // and it certifies again): the result is always certified. delta is about t plus the margin
 // plus the growth the boundary between samples needs.
 //
-// A budget's cover is the best (least certified delta, then least summed protrusion) of
-// several certified constructions (CoverConstructions): that choice; the minimum enclosing
-// ball of the vertices; k-center clusters of the samples with an enclosing ball each; and,
-// for budgets up to kMonotoneCoverBudget, the best cover of one sphere fewer with its most
-// protruding sphere split in two. Each is tightened: per sphere, the enclosing ball of what
-// it alone holds (cover_constructions.h), certified again, while delta falls. A construction
-// that does not certify is dropped. So one sphere is at most the enclosing ball (plus the
-// certificate's margin), and up to kMonotoneCoverBudget delta never rises with the budget.
+// A budget's cover is the best (least certified delta, then least summed protrusion, then
+// fewest spheres) of several certified constructions (CoverConstructions): that choice; the
+// minimum enclosing ball of the vertices; k-center clusters of the samples with an enclosing
+// ball each; and, with CoverConstructions::monotone, the best cover of one sphere fewer, as it
+// is and with its most protruding sphere split in two. The best is tightened: per sphere, the
+// ball holding what it alone holds whose centre protrudes least (cover_constructions.h),
+// certified again, while delta falls. A construction that does not certify is dropped. So one
+// sphere is at most the enclosing ball (plus the certificate's margin), and a budget is no
+// worse than each construction alone; with `monotone`, delta never rises with the budget up
+// to kMonotoneCoverBudget.
 #pragma once
 
 #include <cstdint>
@@ -41,7 +43,7 @@
 namespace inscribe {
 
 // Budgets up to which a cover at N is never worse than at N - 1 (it also tries the best cover
-// at N - 1 with one sphere split): the counts planners give a link.
+// at N - 1, and it with one sphere split): the counts planners give a link.
 inline constexpr std::int64_t kMonotoneCoverBudget = 64;
 
 // The certified constructions a budget's cover is the best of (each can be turned off, for
@@ -54,8 +56,12 @@ struct CoverConstructions {
   // alone holds (its centre moved toward that ball's where that protrudes less), certified.
   bool tighten = true;
   // Up to kMonotoneCoverBudget: also the best cover at N - 1 (made the same way, so
-  // recursively) and that cover with its most protruding sphere split in two.
-  bool monotone = true;
+  // recursively) and that cover with its most protruding sphere split in two, the other
+  // constructions only at 1..8, 11, 16, 23, 32, 45 and 64: delta never rises with N. Off by
+  // default: a budget then costs about as many constructions as those budgets below it
+  // (5-50x one construction), and between those budgets the split covers are looser than
+  // the constructions made at the budget itself.
+  bool monotone = false;
 };
 
 struct CoverParameters {

@@ -1,13 +1,13 @@
 // Certified covers at planner budgets: delta against the sphere count N on each link of the
 // demo arm (tests/support/mesh_arm.h, links fitted to 0.1-0.25 m) and on eight, cow and
 // elephant, for the cover GenerateCover makes by default and with CoverConstructions::monotone,
-// beside each construction alone in the same run: the ladder choice as it was before the constructions were added (no
-// tightening, no monotone recursion), one minimum enclosing ball, and k-center clusters with an
-// enclosing ball each (untightened). Every set printed is certified (CertifyCover passed inside
-// the generator; the program certifies the best set again from scratch and exits 1 if that
-// fails). Also: whether delta ever rises with N, how many budgets came back short (with the
-// reason), and the seconds of one cold GenerateCover at the counts in --cold (a fresh
-// PreparedCover, so the recursion over smaller budgets is paid).
+// beside each construction alone in the same run: the ladder choice as it was before the
+// constructions were added (no tightening, no monotone recursion), one minimum enclosing ball, and
+// k-center clusters with an enclosing ball each (untightened). Every set printed is certified
+// (CertifyCover passed inside the generator; the program certifies the best set again from scratch
+// and exits 1 if that fails). Also: whether delta ever rises with N, how many budgets came back
+// short (with the reason), and the seconds of one cold GenerateCover at the counts in --cold (a
+// fresh PreparedCover, so the recursion over smaller budgets is paid).
 //
 //   cover_curve_bench [--counts 1-64] [--cold 9,16,32,64] [--models eight,cow,elephant]
 //                     [--no-arm] [--data DIR] [--quick]
@@ -129,10 +129,11 @@ bool RunModel(const Named& model, const std::vector<std::int64_t>& counts,
     }
     seconds[m] = SecondsSince(start);
   }
-  absl::PrintF("\n### %s (delta in %s)\n\n| N | default | spheres | monotone | spheres | "
-               "ladder (before) | enclosing ball | k-center | default / before | monotone / "
-               "before |\n|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
-               model.name, model.unit_name);
+  absl::PrintF(
+      "\n### %s (delta in %s)\n\n| N | default | spheres | monotone | spheres | "
+      "ladder (before) | enclosing ball | k-center | default / before | monotone / "
+      "before |\n|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+      model.name, model.unit_name);
   bool monotone = true;
   for (std::size_t k = 0; k < counts.size(); ++k) {
     if (k > 0 && deltas[1][k] > deltas[1][k - 1] && counts[k] > counts[k - 1] &&
@@ -148,12 +149,12 @@ bool RunModel(const Named& model, const std::vector<std::int64_t>& counts,
                  deltas[0][k] / std::max(deltas[2][k], 1e-300),
                  deltas[1][k] / std::max(deltas[2][k], 1e-300));
   }
-  absl::PrintF("\nseconds for the whole curve: default %.2f, monotone %.2f, ladder %.2f, "
-               "enclosing ball %.2f, k-center %.2f; monotone: delta %s with N, %d budgets short "
-               "of N%s%s\n",
-               seconds[0], seconds[1], seconds[2], seconds[3], seconds[4],
-               monotone ? "never rises" : "RISES", short_budgets,
-               reason.empty() ? "" : ", e.g. ", reason);
+  absl::PrintF(
+      "\nseconds for the whole curve: default %.2f, monotone %.2f, ladder %.2f, "
+      "enclosing ball %.2f, k-center %.2f; monotone: delta %s with N, %d budgets short "
+      "of N%s%s\n",
+      seconds[0], seconds[1], seconds[2], seconds[3], seconds[4],
+      monotone ? "never rises" : "RISES", short_budgets, reason.empty() ? "" : ", e.g. ", reason);
   if (!monotone) ok = false;
   for (const std::int64_t n : cold) {
     CoverParameters parameters;
@@ -169,9 +170,11 @@ bool RunModel(const Named& model, const std::vector<std::int64_t>& counts,
       ok = false;
       continue;
     }
-    absl::PrintF("cold GenerateCover, N=%d: default %.2f s (delta %.2f), monotone %.2f s "
-                 "(delta %.2f)\n", n, s, cover->certificate.delta * model.unit, monotone_s,
-                 monotone_cover->certificate.delta * model.unit);
+    absl::PrintF(
+        "cold GenerateCover, N=%d: default %.2f s (delta %.2f), monotone %.2f s "
+        "(delta %.2f)\n",
+        n, s, cover->certificate.delta * model.unit, monotone_s,
+        monotone_cover->certificate.delta * model.unit);
   }
   return ok;
 }
@@ -241,8 +244,8 @@ int main(int argc, char** argv) {
     absl::StatusOr<Solid> solid = PrepareSolid(*std::move(mesh));
     if (!solid.ok()) return 2;
     const double largest = ComputeBoundingBox(solid->mesh().vertices).extent().maxCoeff();
-    models.push_back({std::string(name), *std::move(solid), 100.0 / largest,
-                      "% of the largest side"});
+    models.push_back(
+        {std::string(name), *std::move(solid), 100.0 / largest, "% of the largest side"});
   }
   bool ok = true;
   for (const Named& model : models) ok = RunModel(model, counts, cold) && ok;

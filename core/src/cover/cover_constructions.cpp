@@ -235,17 +235,17 @@ std::vector<Sphere> HoldBoundary(const Mesh& mesh, const std::vector<Sphere>& sp
   for (std::atomic<std::uint64_t>& r : reach) r.store(0);
   std::vector<std::atomic<bool>> owns(spheres.size());
   for (std::atomic<bool>& o : owns) o.store(false);
-  ForEachOwned(mesh, spheres, interior, edge,
-               [&](std::size_t, std::size_t sphere, const Vector3& p) {
-                 const double d = (p - spheres[sphere].center).norm();
-                 std::uint64_t bits = 0;
-                 std::memcpy(&bits, &d, sizeof bits);
-                 std::uint64_t seen = reach[sphere].load(std::memory_order_relaxed);
-                 while (seen < bits &&
-                        !reach[sphere].compare_exchange_weak(seen, bits, std::memory_order_relaxed)) {
-                 }
-                 if (!owns[sphere].load(std::memory_order_relaxed)) owns[sphere].store(true);
-               });
+  ForEachOwned(
+      mesh, spheres, interior, edge, [&](std::size_t, std::size_t sphere, const Vector3& p) {
+        const double d = (p - spheres[sphere].center).norm();
+        std::uint64_t bits = 0;
+        std::memcpy(&bits, &d, sizeof bits);
+        std::uint64_t seen = reach[sphere].load(std::memory_order_relaxed);
+        while (seen < bits &&
+               !reach[sphere].compare_exchange_weak(seen, bits, std::memory_order_relaxed)) {
+        }
+        if (!owns[sphere].load(std::memory_order_relaxed)) owns[sphere].store(true);
+      });
   std::vector<Sphere> out = spheres;
   for (std::size_t i = 0; i < out.size(); ++i) {
     if (!owns[i].load()) continue;
@@ -327,6 +327,45 @@ std::vector<Sphere> KCenterBalls(const std::vector<Vector3>& points, std::size_t
     });
   }
   return balls;
+}
+
+// The budgets up to kMonotoneCoverBudget at which every construction runs: 1..8, then about
+// every factor of sqrt(2) (11, 16, 23, 32, 45, 64).
+bool ConstructionBudget(std::int64_t n) {
+  if (n <= 8 || n == kMonotoneCoverBudget) return true;
+  const double steps = 2.0 * std::log2(static_cast<double>(n) / 8.0);
+  const std::int64_t below =
+      static_cast<std::int64_t>(std::round(8.0 * std::exp2(std::floor(steps) / 2.0)));
+  const std::int64_t above =
+      static_cast<std::int64_t>(std::round(8.0 * std::exp2(std::ceil(steps) / 2.0)));
+  return n == below || n == above;
+}
+
+namespace {
+
+// The sum of a cover's positive protrusions: the second key of the comparison.
+double SummedProtrusion(const GeneratedCover& cover) {
+  double sum = 0.0;
+  for (const double p : cover.certificate.protrusions) sum += std::max(p, 0.0);
+  return sum;
+}
+
+}  // namespace
+
+// The better of two certified covers: the lesser delta, then the lesser summed protrusion,
+// then fewer spheres.
+bool BetterCover(const GeneratedCover& a, const GeneratedCover& b) {
+  const double da = a.certificate.delta, db = b.certificate.delta;
+  if (da != db) return da < db;
+  const double sa = SummedProtrusion(a), sb = SummedProtrusion(b);
+  if (sa != sb) return sa < sb;
+  return a.set.size() < b.set.size();
+}
+
+// Depth of a point: its distance to the boundary, negative outside.
+double Depth(const Solid& solid, const Vector3& p) {
+  const BoundaryPoint closest = solid.oracle.ClosestPoint(p);
+  return solid.oracle.Classify(p, closest) == Side::kInside ? closest.distance : -closest.distance;
 }
 
 }  // namespace inscribe::internal

@@ -8,6 +8,7 @@
 #include <utility>
 #include <vector>
 
+#include "inscribe/cover/sphere_cover.h"
 #include "inscribe/geometry/mesh.h"
 #include "inscribe/geometry/sphere.h"
 #include "inscribe/solid/solid.h"
@@ -37,8 +38,8 @@ std::vector<Sphere> LadderCandidates(const Solid& solid, const std::vector<Ladde
 // What each sphere alone must hold: every mesh triangle goes whole to the sphere whose radius
 // must grow least to hold its corners, or is split in four until that costs at most `edge`
 // more than the least growth any sphere needs at its centroid or at one of its corners (or its
-// edges are at most `edge`); each `interior` point goes to the sphere that must grow least to reach it. Per
-// sphere, the corners of its pieces and its interior points (a ball holding them holds the
+// edges are at most `edge`); each `interior` point goes to the sphere that must grow least to reach
+// it. Per sphere, the corners of its pieces and its interior points (a ball holding them holds the
 // pieces: it is convex). Deterministic; parallel over triangles. `spheres` not empty.
 std::vector<std::vector<Vector3>> OwnedPoints(const Mesh& mesh, const std::vector<Sphere>& spheres,
                                               const std::vector<Vector3>& interior, double edge);
@@ -58,5 +59,17 @@ Sphere EnclosingBall(const std::vector<Vector3>& points);
 // cluster's enclosing ball and each point to the ball it is deepest in relative to its radius
 // (least |p - c| - r). At most k balls, one per non-empty cluster. Deterministic.
 std::vector<Sphere> KCenterBalls(const std::vector<Vector3>& points, std::size_t k);
+
+// The budgets up to kMonotoneCoverBudget at which every construction runs with
+// CoverConstructions::monotone: 1..8, then about every factor of sqrt(2) (11, 16, 23, 32, 45,
+// 64).
+bool ConstructionBudget(std::int64_t n);
+
+// The better of two certified covers: the lesser delta, then the lesser summed (positive)
+// protrusion, then fewer spheres.
+bool BetterCover(const GeneratedCover& a, const GeneratedCover& b);
+
+// Depth of a point: its distance to the boundary, negative outside.
+double Depth(const Solid& solid, const Vector3& p);
 
 }  // namespace inscribe::internal

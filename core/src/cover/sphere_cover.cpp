@@ -1,17 +1,14 @@
 #include "inscribe/cover/sphere_cover.h"
 
 #include <algorithm>
-#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
-#include <functional>
 #include <limits>
 #include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
-#include <queue>
 #include <utility>
 #include <vector>
 
@@ -221,8 +218,8 @@ absl::StatusOr<PreparedCover> PreparedCover::Prepare(const Solid& solid,
   for (Eigen::Index i = 0; i < std::min<Eigen::Index>(drawn.rows(), per_kind); ++i) {
     bases.push_back({drawn.row(i).transpose(), -1});
   }
-  state->candidates =
-      internal::LadderCandidates(solid, bases, state->scale * kFirstRung, state->scale / 2, &state->interior);
+  state->candidates = internal::LadderCandidates(solid, bases, state->scale * kFirstRung,
+                                                 state->scale / 2, &state->interior);
   if (state->candidates.empty()) {
     return absl::FailedPreconditionError("cover: the solid has no interior to cover");
   }
@@ -250,33 +247,6 @@ std::vector<double> PreparedCover::EstimatedDeltas(std::int64_t max_spheres) con
 
 namespace {
 
-// The budgets up to kMonotoneCoverBudget at which every construction runs: 1..8, then about
-// every factor of sqrt(2) (11, 16, 23, 32, 45, 64).
-bool ConstructionBudget(std::int64_t n) {
-  if (n <= 8 || n == kMonotoneCoverBudget) return true;
-  const double steps = 2.0 * std::log2(static_cast<double>(n) / 8.0);
-  const std::int64_t below = static_cast<std::int64_t>(std::round(8.0 * std::exp2(std::floor(steps) / 2.0)));
-  const std::int64_t above = static_cast<std::int64_t>(std::round(8.0 * std::exp2(std::ceil(steps) / 2.0)));
-  return n == below || n == above;
-}
-
-// The sum of a cover's positive protrusions: the second key of the comparison.
-double SummedProtrusion(const GeneratedCover& cover) {
-  double sum = 0.0;
-  for (const double p : cover.certificate.protrusions) sum += std::max(p, 0.0);
-  return sum;
-}
-
-// The better of two certified covers: the lesser delta, then the lesser summed protrusion,
-// then fewer spheres.
-bool Better(const GeneratedCover& a, const GeneratedCover& b) {
-  const double da = a.certificate.delta, db = b.certificate.delta;
-  if (da != db) return da < db;
-  const double sa = SummedProtrusion(a), sb = SummedProtrusion(b);
-  if (sa != sb) return sa < sb;
-  return a.set.size() < b.set.size();
-}
-
 // Keeps the better of `best` and `tried`; a construction that failed (not certified, not
 // certifiable) is dropped, a cancellation passed on.
 absl::Status Keep(absl::StatusOr<GeneratedCover> tried, std::optional<GeneratedCover>* best) {
@@ -284,14 +254,8 @@ absl::Status Keep(absl::StatusOr<GeneratedCover> tried, std::optional<GeneratedC
     return tried.status().code() == absl::StatusCode::kCancelled ? tried.status()
                                                                  : absl::OkStatus();
   }
-  if (!*best || Better(*tried, **best)) *best = *std::move(tried);
+  if (!*best || internal::BetterCover(*tried, **best)) *best = *std::move(tried);
   return absl::OkStatus();
-}
-
-// Depth of a point: its distance to the boundary, negative outside.
-double Depth(const Solid& solid, const Vector3& p) {
-  const BoundaryPoint closest = solid.oracle.ClosestPoint(p);
-  return solid.oracle.Classify(p, closest) == Side::kInside ? closest.distance : -closest.distance;
 }
 
 }  // namespace
@@ -352,7 +316,7 @@ absl::StatusOr<GeneratedCover> PreparedCover::Tighten(GeneratedCover cover,
         double reach = 0.0;
         for (const Vector3& p : owned[i]) reach = std::max(reach, (p - c).norm());
         const Sphere ball{c, (reach + s.margin) * (1.0 + internal::kReachMargin)};
-        *protrusion = ball.radius - Depth(*s.solid, c);
+        *protrusion = ball.radius - internal::Depth(*s.solid, c);
         return ball;
       };
       // From the better of the sphere's own centre, its part's enclosing ball's and halfway, a
@@ -391,7 +355,7 @@ absl::StatusOr<GeneratedCover> PreparedCover::Tighten(GeneratedCover cover,
       if (tighter.status().code() == absl::StatusCode::kCancelled) return tighter.status();
       break;
     }
-    if (!Better(*tighter, cover)) break;
+    if (!internal::BetterCover(*tighter, cover)) break;
     cover = *std::move(tighter);
   }
   return cover;
@@ -429,7 +393,7 @@ absl::StatusOr<GeneratedCover> PreparedCover::Construct(std::int64_t max_spheres
     // Fewer than the budget: split the most protruding sphere while that lowers delta.
     while (ladder.ok() && ladder->set.size() < budget) {
       absl::StatusOr<GeneratedCover> split = SplitWorst(*ladder, control);
-      if (!split.ok() || !Better(*split, *ladder)) break;
+      if (!split.ok() || !internal::BetterCover(*split, *ladder)) break;
       ladder = *std::move(split);
     }
     if (absl::Status kept = Keep(std::move(ladder), &best); !kept.ok()) return kept;
@@ -480,7 +444,7 @@ absl::StatusOr<GeneratedCover> PreparedCover::Generate(std::int64_t max_spheres,
   // Up to kMonotoneCoverBudget the constructions run at the budgets of ConstructionBudget
   // only; between them the cover grows from the one before by splitting.
   std::optional<GeneratedCover> best;
-  if (!monotone || ConstructionBudget(max_spheres)) {
+  if (!monotone || internal::ConstructionBudget(max_spheres)) {
     absl::StatusOr<GeneratedCover> made = Construct(max_spheres, control);
     if (!made.ok()) return made.status();
     best = *std::move(made);
@@ -509,9 +473,9 @@ absl::StatusOr<GeneratedCover> PreparedCover::Generate(std::int64_t max_spheres,
   GeneratedCover out = *std::move(best);
   out.unused_reason.clear();
   if (out.set.size() < static_cast<std::size_t>(max_spheres)) {
-    out.unused_reason = absl::StrCat(
-        "no construction with more than ", out.set.size(), " of the ", max_spheres,
-        " spheres allowed certified a lower delta (", out.certificate.delta, ")");
+    out.unused_reason =
+        absl::StrCat("no construction with more than ", out.set.size(), " of the ", max_spheres,
+                     " spheres allowed certified a lower delta (", out.certificate.delta, ")");
   }
   if (monotone) {
     const std::lock_guard<std::mutex> lock(s.memo_mutex);

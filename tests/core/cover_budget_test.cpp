@@ -24,12 +24,12 @@
 namespace inscribe {
 namespace {
 
-// Coarse settings (as the arm's covers use) so that 64 budgets per solid stay quick.
+// Coarse settings so that 64 budgets per solid stay quick.
 CoverParameters Coarse(CoverConstructions constructions = {}) {
   CoverParameters parameters;
   parameters.max_spheres = kMonotoneCoverBudget;
-  parameters.growth_samples = 4'000;
-  parameters.certify.resolution = 1.0 / 512;
+  parameters.growth_samples = 2'000;
+  parameters.certify.resolution = 1.0 / 256;
   parameters.constructions = constructions;
   return parameters;
 }

@@ -278,6 +278,7 @@ Sphere EnclosingBall(const std::vector<Vector3>& points) {
 
 std::vector<Sphere> KCenterBalls(const std::vector<Vector3>& points, std::size_t k) {
   const std::size_t n = points.size();
+  if (n == 0) return {};
   k = std::max<std::size_t>(1, std::min(k, n));
   Vector3 mean = Vector3::Zero();
   for (const Vector3& p : points) mean += p;

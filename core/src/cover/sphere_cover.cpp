@@ -369,6 +369,8 @@ absl::StatusOr<GeneratedCover> PreparedCover::SplitWorst(const GeneratedCover& c
       std::max_element(protrusions.begin(), protrusions.end()) - protrusions.begin());
   const std::vector<std::vector<Vector3>> owned =
       internal::OwnedPoints(s.solid->mesh(), cover.set.spheres, s.interior, kGuideEdge * s.edge);
+  // A sphere holding nothing alone (or one point) has nothing to split.
+  if (owned[worst].size() < 2) return absl::FailedPreconditionError("cover: nothing to split");
   const std::vector<Sphere> two = internal::KCenterBalls(owned[worst], 2);
   if (two.size() < 2) return absl::FailedPreconditionError("cover: nothing to split");
   std::vector<Sphere> spheres = cover.set.spheres;

@@ -384,6 +384,9 @@ absl::StatusOr<GeneratedCover> PreparedCover::Construct(std::int64_t max_spheres
   const State& s = *state_;
   const CoverConstructions& use = s.parameters.constructions;
   const auto budget = static_cast<std::size_t>(max_spheres);
+  // Splitting to fill the budget, k-center and tightening at planner budgets only: above them
+  // they cost a certificate per step and rarely win.
+  const bool small = max_spheres <= kMonotoneCoverBudget;
   std::optional<GeneratedCover> best;
   if (use.ladder) {
     const std::vector<std::size_t> chosen =
@@ -393,7 +396,7 @@ absl::StatusOr<GeneratedCover> PreparedCover::Construct(std::int64_t max_spheres
     for (const std::size_t i : chosen) spheres.push_back(s.candidates[i]);
     absl::StatusOr<GeneratedCover> ladder = Finish(std::move(spheres), control);
     // Fewer than the budget: split the most protruding sphere while that lowers delta.
-    while (ladder.ok() && ladder->set.size() < budget) {
+    while (small && ladder.ok() && ladder->set.size() < budget) {
       absl::StatusOr<GeneratedCover> split = SplitWorst(*ladder, control);
       if (!split.ok() || !internal::BetterCover(*split, *ladder)) break;
       ladder = *std::move(split);
@@ -412,7 +415,7 @@ absl::StatusOr<GeneratedCover> PreparedCover::Construct(std::int64_t max_spheres
       return kept;
     }
   }
-  if (use.k_center) {
+  if (use.k_center && small) {
     if (absl::Status kept =
             Keep(Finish(internal::KCenterBalls(s.samples.points, budget), control), &best);
         !kept.ok()) {
@@ -464,7 +467,7 @@ absl::StatusOr<GeneratedCover> PreparedCover::Generate(std::int64_t max_spheres,
     }
   }
   // The best construction tightened; then the cover of one sphere fewer if still better.
-  if (best) {
+  if (best && max_spheres <= kMonotoneCoverBudget) {
     absl::StatusOr<GeneratedCover> tightened = Tighten(*std::move(best), control);
     if (!tightened.ok()) return tightened.status();
     best = *std::move(tightened);
@@ -476,8 +479,13 @@ absl::StatusOr<GeneratedCover> PreparedCover::Generate(std::int64_t max_spheres,
   out.unused_reason.clear();
   if (out.set.size() < static_cast<std::size_t>(max_spheres)) {
     out.unused_reason =
-        absl::StrCat("no construction with more than ", out.set.size(), " of the ", max_spheres,
-                     " spheres allowed certified a lower delta (", out.certificate.delta, ")");
+        max_spheres <= kMonotoneCoverBudget
+            ? absl::StrCat("no construction with more than ", out.set.size(), " of the ",
+                           max_spheres, " spheres allowed certified a lower delta (",
+                           out.certificate.delta, ")")
+            : absl::StrCat("the choice reached every sample with ", out.set.size(), " of the ",
+                           max_spheres, " spheres allowed (more are not tried above ",
+                           kMonotoneCoverBudget, ")");
   }
   if (monotone) {
     const std::lock_guard<std::mutex> lock(s.memo_mutex);

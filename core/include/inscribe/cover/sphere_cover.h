@@ -25,7 +25,8 @@
 // certified again, while delta falls. A construction that does not certify is dropped. So one
 // sphere is at most the enclosing ball (plus the certificate's margin), and a budget is no
 // worse than each construction alone; with `monotone`, delta never rises with the budget up
-// to kMonotoneCoverBudget.
+// to kMonotoneCoverBudget. k-center, tightening and splitting to fill a budget run at budgets
+// up to kMonotoneCoverBudget only (above, they cost a certificate per step and rarely win).
 #pragma once
 
 #include <cstdint>

@@ -3,7 +3,8 @@
 // from N to N + 1 for N = 1..64; exactly N spheres or a reason; every set certified again from
 // scratch and checked against the brute-force winding number (support/winding_oracle.h): random
 // points of the solid each lie in some sphere; deterministic whatever budgets were asked before.
-// On CGAL demo meshes and the links of the demo arm (support/mesh_arm.h).
+// On CGAL demo meshes (eight, cow) and the links of the demo arm (support/mesh_arm.h: fandisk,
+// cow, elephant, knot1, cow, eight, eight fitted to 0.1-0.25 m).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -141,7 +142,7 @@ TEST_P(CoverBudgetOnMesh, IsMonotoneNoWorseThanEachConstructionAndCertified) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Meshes, CoverBudgetOnMesh,
-                         ::testing::Values("eight.off", "elephant.off", "cow.off"));
+                         ::testing::Values("eight.off", "cow.off"));
 
 class CoverBudgetOnArmLink : public ::testing::TestWithParam<int> {};
 

@@ -1,5 +1,6 @@
 // Covers at planner budgets (sphere_cover.h): at one sphere no worse than the minimum enclosing
-// ball of the vertices; at any N no worse than each construction alone; delta never rises
+// ball of the vertices; at the construction budgets no worse than each construction alone;
+// with CoverConstructions::monotone, delta never rises
 // from N to N + 1 for N = 1..64; exactly N spheres or a reason; every set certified again from
 // scratch and checked against the brute-force winding number (support/winding_oracle.h): random
 // points of the solid each lie in some sphere; deterministic whatever budgets were asked before.
@@ -141,8 +142,7 @@ TEST_P(CoverBudgetOnMesh, IsMonotoneNoWorseThanEachConstructionAndCertified) {
   CheckCurve(*solid, GetParam());
 }
 
-INSTANTIATE_TEST_SUITE_P(Meshes, CoverBudgetOnMesh,
-                         ::testing::Values("eight.off", "cow.off"));
+INSTANTIATE_TEST_SUITE_P(Meshes, CoverBudgetOnMesh, ::testing::Values("eight.off", "cow.off"));
 
 class CoverBudgetOnArmLink : public ::testing::TestWithParam<int> {};
 

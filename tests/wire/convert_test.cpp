@@ -433,6 +433,7 @@ TEST(GeneratedSphereSet, ACoverRoundTripsWithItsKindAndCertificate) {
   cover.grown_spheres = 7;
   cover.candidates = 4321;
   cover.repair_rounds = 2;
+  cover.unused_reason = "no construction with more than 3 of the 4 spheres allowed";
   cover.seconds = 0.75;
   g.cover = cover;
   v1::GenerateResult wire;
@@ -448,6 +449,8 @@ TEST(GeneratedSphereSet, ACoverRoundTripsWithItsKindAndCertificate) {
   EXPECT_EQ(back->cover->certificate.cells, 99);
   EXPECT_EQ(back->cover->grown_spheres, 7);
   EXPECT_EQ(back->cover->repair_rounds, 2);
+  EXPECT_EQ(back->cover->unused_reason,
+            "no construction with more than 3 of the 4 spheres allowed");
   EXPECT_EQ(back->cover->seconds, 0.75);
   EXPECT_EQ(back->cover->candidates, 4321);
   EXPECT_FALSE(back->dilation.has_value());

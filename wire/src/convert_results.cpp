@@ -259,6 +259,7 @@ void GeneratedSphereSetToProto(const GeneratedSphereSet& g, v1::GenerateResult* 
     cover->set_candidates(g.cover->candidates);
     cover->set_repair_rounds(g.cover->repair_rounds);
     cover->set_seconds(g.cover->seconds);
+    cover->set_unused_reason(g.cover->unused_reason);
   }
 }
 
@@ -293,6 +294,7 @@ absl::StatusOr<GeneratedSphereSet> GeneratedSphereSetFromProto(const v1::Generat
     cover.grown_spheres = result.cover().grown_spheres();
     cover.repair_rounds = result.cover().repair_rounds();
     cover.seconds = result.cover().seconds();
+    cover.unused_reason = result.cover().unused_reason();
     g.cover = std::move(cover);
   }
   return g;

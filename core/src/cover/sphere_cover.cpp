@@ -1,14 +1,14 @@
 #include "inscribe/cover/sphere_cover.h"
 
 #include <algorithm>
-#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
-#include <functional>
 #include <limits>
+#include <map>
 #include <memory>
-#include <queue>
+#include <mutex>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -16,30 +16,35 @@
 #include "base/parallel.h"
 #include "cover/cover_cells.h"
 #include "cover/cover_choice.h"
+#include "cover/cover_constructions.h"
 #include "mesh/surface_sampling.h"
 
 namespace inscribe {
 namespace {
 
-// A sphere grown to reach a point or a cell's corner reaches this much farther (relative),
-// far above rounding, so the certificate's own margin (1e-12 on squares) is met.
-constexpr double kReachMargin = 1e-9;
 // Fixed, so that covers are reproducible.
 constexpr std::uint64_t kGrowthSeed = 0x636f766572;  // "cover"
 constexpr int kMaxRounds = 8;
+// Rounds of holding a point the certificate found in no sphere, and of tightening.
+constexpr int kWitnessRounds = 6;
+constexpr int kTightenRounds = 2;
+// The pieces that guide tightening and splitting are this many times coarser than the ones a
+// cover holds (HoldBoundary holds the fine ones afterwards).
+constexpr double kGuideEdge = 8.0;
+// The compass search of a tightened sphere's centre: its first step (times the radius) and
+// halvings.
+constexpr double kCompassFirstStep = 0.25;
+constexpr int kCompassHalvings = 5;
+constexpr int kCompassMoves = 8;  // per step size
 // Ladder bases per sphere of the budget (besides the vertices).
 constexpr std::int64_t kBasesPerSphere = 8;
 // The first rung of the ladders and the sample grid's cell, as fractions of the bounding
 // box's largest side.
 constexpr double kFirstRung = 1.0 / 256;
-// Halvings of the first rung tried where it lies past the medial axis (a thin part).
-constexpr int kThinHalvings = 6;
 constexpr double kGridCell = 1.0 / 64;
 // Growth a boundary piece held whole may cost beyond its best point, and the longest edge a
 // piece is split to (both a fraction of the largest side).
 constexpr double kBoundaryEdge = 1.0 / 1024;
-// Steps of the search for the deepest centre on a normal (each shrinks the interval by 0.618).
-constexpr int kGoldenSteps = 10;
 // The delta mode's budgets: the first it makes candidates for and the most; the covers it
 // generates at most, and the share of the bound it aims at when predicting a budget.
 constexpr std::int64_t kDeltaModeFirstBudget = 32;
@@ -50,114 +55,6 @@ constexpr double kDeltaModeAim = 0.95;
 // CoverParameters::growth_samples): few spheres are large, and reach far between samples.
 constexpr std::int64_t kGrowthSamplesPerSphere = 40;
 constexpr std::int64_t kMinGrowthSamples = 2'000;
-
-// A grain that cuts `count` items into about 64 chunks: enough for the threads to share, few
-// enough that each chunk's copy of a per-sphere array costs little.
-std::size_t ReduceGrain(std::size_t count) { return std::max<std::size_t>(count / 64, 1); }
-
-// The chosen spheres grown to hold the boundary exactly, with `margin` to spare: every mesh
-// triangle goes whole to the sphere whose radius must grow least to hold its corners, or is
-// split in four until that costs at most `edge` more than the least growth any sphere needs at
-// its centroid (or its edges are at most `edge`); a ball is convex, so it then holds the piece
-// and every point within `margin` of it. Large flat triangles (boxes, CAD meshes) that lie
-// mostly inside one sphere are held without splitting them down. The `interior` points go to
-// spheres the same way. Radii only grow.
-std::vector<Sphere> HoldBoundary(const Mesh& mesh, const std::vector<Sphere>& chosen,
-                                 const std::vector<Vector3>& interior, double edge, double margin) {
-  const std::size_t n = chosen.size();
-  const auto growth = [&chosen](std::size_t i, const Vector3& p) {
-    return (p - chosen[i].center).norm() - chosen[i].radius;
-  };
-  std::vector<std::size_t> all(n);
-  for (std::size_t i = 0; i < n; ++i) all[i] = i;
-  // Splits a triangle in 4 (at its edges' midpoints) until its edges are short, keeping the
-  // spheres that can still be best for a part of it: the growth to any point of a triangle is
-  // within its diameter of the growth to its centroid.
-  const std::function<void(const Vector3&, const Vector3&, const Vector3&,
-                           const std::vector<std::size_t>&, std::vector<double>&)>
-      hold = [&](const Vector3& p, const Vector3& q, const Vector3& r,
-                 const std::vector<std::size_t>& candidates, std::vector<double>& reach) {
-        const double diameter = std::max({(q - p).norm(), (r - p).norm(), (r - q).norm()});
-        // The sphere that holds the whole piece with the least growth (a ball holds a
-        // triangle when it holds its corners), and the least growth any sphere needs at the
-        // centroid, which no finer split can go below at that point.
-        std::size_t pick = candidates.front();
-        double least = std::numeric_limits<double>::infinity();
-        for (const std::size_t i : candidates) {
-          const double g = std::max({growth(i, p), growth(i, q), growth(i, r)});
-          if (g < least) {
-            least = g;
-            pick = i;
-          }
-        }
-        const Vector3 centroid = (p + q + r) / 3.0;
-        std::vector<double> at(candidates.size());
-        double best = std::numeric_limits<double>::infinity();
-        for (std::size_t k = 0; k < candidates.size(); ++k) {
-          best = std::min(best, at[k] = growth(candidates[k], centroid));
-        }
-        // Whole, when splitting could save at most `edge` of growth (or the piece is small).
-        if (diameter <= edge || least <= std::max(best, 0.0) + edge) {
-          const Vector3& o = chosen[pick].center;
-          reach[pick] = std::max({reach[pick], (p - o).norm(), (q - o).norm(), (r - o).norm()});
-          return;
-        }
-        std::vector<std::size_t> near;
-        for (std::size_t k = 0; k < candidates.size(); ++k) {
-          if (at[k] <= best + 2.0 * diameter) near.push_back(candidates[k]);
-        }
-        const Vector3 pq = 0.5 * (p + q), qr = 0.5 * (q + r), rp = 0.5 * (r + p);
-        hold(p, pq, rp, near, reach);
-        hold(pq, q, qr, near, reach);
-        hold(rp, qr, r, near, reach);
-        hold(pq, qr, rp, near, reach);
-      };
-  // Each chunk's reaches, joined by their maximum.
-  const auto farther = [](std::vector<double> a, std::vector<double> b) {
-    for (std::size_t i = 0; i < a.size(); ++i) a[i] = std::max(a[i], b[i]);
-    return a;
-  };
-  const std::vector<double> none(n, 0.0);
-  const Eigen::Index triangles = mesh.triangles.rows();
-  const std::vector<double> held = internal::ParallelReduce(
-      Eigen::Index{0}, triangles, ReduceGrain(static_cast<std::size_t>(triangles)), none,
-      [&](Eigen::Index begin, Eigen::Index end, std::vector<double> reach) {
-        for (Eigen::Index t = begin; t < end; ++t) {
-          hold(mesh.vertices.row(mesh.triangles(t, 0)).transpose(),
-               mesh.vertices.row(mesh.triangles(t, 1)).transpose(),
-               mesh.vertices.row(mesh.triangles(t, 2)).transpose(), all, reach);
-        }
-        return reach;
-      },
-      farther);
-  const std::vector<double> reach = farther(
-      held, internal::ParallelReduce(
-                std::size_t{0}, interior.size(), ReduceGrain(interior.size()), none,
-                [&](std::size_t begin, std::size_t end, std::vector<double> local) {
-                  for (std::size_t p = begin; p < end; ++p) {
-                    std::size_t pick = 0;
-                    double least = std::numeric_limits<double>::infinity();
-                    for (std::size_t i = 0; i < n; ++i) {
-                      const double g = growth(i, interior[p]);
-                      if (g < least) {
-                        least = g;
-                        pick = i;
-                      }
-                    }
-                    local[pick] = std::max(local[pick], (interior[p] - chosen[pick].center).norm());
-                  }
-                  return local;
-                },
-                farther));
-
-  std::vector<Sphere> out = chosen;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (reach[i] > 0.0) {
-      out[i].radius = std::max(out[i].radius, (reach[i] + margin) * (1.0 + kReachMargin));
-    }
-  }
-  return out;
-}
 
 // Grows, for each cell in order, the sphere that needs the least growth to contain it (its
 // farthest corner).
@@ -176,7 +73,7 @@ void GrowToContain(const std::vector<CoverCell>& cells, std::vector<Sphere>* sph
       }
     }
     Sphere& grown = (*spheres)[best];
-    grown.radius = std::max(grown.radius, best_reach * (1.0 + kReachMargin));
+    grown.radius = std::max(grown.radius, best_reach * (1.0 + internal::kReachMargin));
   }
 }
 
@@ -193,109 +90,6 @@ GenerationControl Stage(const GenerationControl& control, double from, double to
     };
   }
   return sub;
-}
-
-// Inward normals of the base points: the face normal of the triangle a point lies on, the
-// vertex normal at a vertex.
-// The spheres a cover is chosen from. From each base point p of the boundary (the first
-// `vertices` rows are mesh vertices) with inward normal n, centres c = p + s n on a ladder of
-// depths s = s0, 2 s0, 4 s0, ... while c stays inside, each with radius depth(c): internal
-// balls from tiny ones near the boundary (which reach a sharp feature with little growth) to
-// the medial ball under p (which reaches far with little growth on flat parts).
-// The deepest centre of each ladder is appended to `interior`.
-// A ladder's base: a boundary point, and the mesh vertex it is (-1: a point of a triangle).
-struct LadderBase {
-  Vector3 point;
-  std::int64_t vertex = -1;
-};
-
-std::vector<Sphere> Candidates(const Solid& solid, const std::vector<LadderBase>& base, double s0,
-                               double s_max, std::vector<Vector3>* interior) {
-  const BoundaryOracle& oracle = solid.oracle;
-  const double factor = std::sqrt(2.0);
-  int ladder = 1;
-  while (s0 * std::pow(factor, ladder) <= s_max) ++ladder;
-  const int rungs = ladder + 1;  // the last slot: the deepest centre on the normal
-  std::vector<Sphere> slots(base.size() * static_cast<std::size_t>(rungs),
-                            Sphere{Vector3::Zero(), 0.0});
-  internal::ParallelFor(std::size_t{0}, base.size(), [&](std::size_t b) {
-    const Vector3& p = base[b].point;
-    Vector3 normal;
-    if (base[b].vertex >= 0) {
-      normal = oracle.vertex_normals()[static_cast<std::size_t>(base[b].vertex)];
-    } else {
-      normal = oracle.face_normals()[static_cast<std::size_t>(oracle.ClosestPoint(p).triangle)];
-    }
-    Sphere* slot = &slots[b * static_cast<std::size_t>(rungs)];
-    // Depth of the centre at distance s along the inward normal; 0 outside.
-    const auto depth = [&](double s) {
-      const Vector3 c = p - s * normal;
-      const BoundaryPoint closest = oracle.ClosestPoint(c);
-      return oracle.Classify(c, closest) == Side::kInside ? closest.distance : 0.0;
-    };
-    // The solid may lie on the normal's other side (a triangle the mesh orients against its
-    // neighbours; a vertex where such triangles meet); a part thinner than 2 s0 has its
-    // medial axis before the first rung: start lower there.
-    if (!(normal.norm() > 0.0)) return;
-    normal.normalize();
-    double first = s0;
-    for (int halvings = 0; halvings <= kThinHalvings; ++halvings, first *= 0.5) {
-      if (depth(first) > 0.0) break;
-      if (depth(-first) > 0.0) {
-        normal = -normal;
-        break;
-      }
-    }
-    double last = 0.0, last_s = 0.0, before_s = 0.0;
-    int k = 0;
-    for (; k < ladder; ++k) {
-      const double s = first * std::pow(factor, k);
-      const double d = depth(s);
-      // Past the medial axis the centre nears another part of the boundary: stop.
-      if (d <= last) break;
-      slot[k] = Sphere{p - s * normal, d};
-      last = d;
-      before_s = last_s;
-      last_s = s;
-    }
-    if (k == 0) return;
-    // The deepest centre lies between the rung before the last and the first that failed:
-    // a golden-section search of the depth along the normal.
-    double lo = before_s, hi = k < ladder ? first * std::pow(factor, k) : last_s;
-    const double phi = 0.5 * (std::sqrt(5.0) - 1.0);
-    double m1 = hi - phi * (hi - lo), m2 = lo + phi * (hi - lo);
-    double d1 = depth(m1), d2 = depth(m2);
-    for (int step = 0; step < kGoldenSteps; ++step) {
-      if (d1 < d2) {
-        lo = m1;
-        m1 = m2;
-        d1 = d2;
-        m2 = lo + phi * (hi - lo);
-        d2 = depth(m2);
-      } else {
-        hi = m2;
-        m2 = m1;
-        d2 = d1;
-        m1 = hi - phi * (hi - lo);
-        d1 = depth(m1);
-      }
-    }
-    const double s = 0.5 * (lo + hi), d = depth(s);
-    if (d > last) slot[ladder] = Sphere{p - s * normal, d};
-  });
-  std::vector<Sphere> out;
-  for (std::size_t b = 0; b < base.size(); ++b) {
-    const Sphere* deepest = nullptr;
-    for (int k = 0; k < rungs; ++k) {
-      const Sphere& s = slots[b * static_cast<std::size_t>(rungs) + static_cast<std::size_t>(k)];
-      if (s.radius > 0.0) {
-        out.push_back(s);
-        deepest = &s;
-      }
-    }
-    if (deepest != nullptr) interior->push_back(deepest->center);
-  }
-  return out;
 }
 
 // Certifies `spheres`, growing spheres around the cells it could not settle until it passes.
@@ -342,6 +136,11 @@ absl::Status CheckCoverParameters(const CoverParameters& p) {
     return absl::InvalidArgumentError(
         absl::StrCat("cover: growth_samples must lie in 0..100,000,000, got ", p.growth_samples));
   }
+  const CoverConstructions& c = p.constructions;
+  if (!c.ladder && !c.enclosing_ball && !c.k_center) {
+    return absl::InvalidArgumentError(
+        "cover: constructions turns off ladder, enclosing_ball and k_center: turn one on");
+  }
   return CheckCoverCertifyOptions(p.certify);
 }
 
@@ -357,6 +156,10 @@ struct PreparedCover::State {
   std::vector<Vector3> interior;
   std::unique_ptr<internal::PointGrid> grid;  // over samples.points
   double prepare_seconds = 0.0;
+  // The covers made for budgets up to kMonotoneCoverBudget (each a function of its budget
+  // alone, so remembering them changes no result).
+  mutable std::mutex memo_mutex;
+  mutable std::map<std::int64_t, GeneratedCover> memo;
 };
 
 namespace {
@@ -407,7 +210,7 @@ absl::StatusOr<PreparedCover> PreparedCover::Prepare(const Solid& solid,
   const std::int64_t budget = parameters.max_spheres.value_or(kDefaultMaxSpheres);
   // As many vertices as area samples at most (evenly spread through the vertex list).
   const std::int64_t per_kind = kBasesPerSphere * budget;
-  std::vector<LadderBase> bases;
+  std::vector<internal::LadderBase> bases;
   const std::size_t stride = (sampled_vertices.size() + per_kind - 1) / per_kind;
   for (std::size_t i = 0; i < sampled_vertices.size(); i += stride) {
     bases.push_back({samples.points[i], sampled_vertices[i]});
@@ -415,8 +218,8 @@ absl::StatusOr<PreparedCover> PreparedCover::Prepare(const Solid& solid,
   for (Eigen::Index i = 0; i < std::min<Eigen::Index>(drawn.rows(), per_kind); ++i) {
     bases.push_back({drawn.row(i).transpose(), -1});
   }
-  state->candidates =
-      Candidates(solid, bases, state->scale * kFirstRung, state->scale / 2, &state->interior);
+  state->candidates = internal::LadderCandidates(solid, bases, state->scale * kFirstRung,
+                                                 state->scale / 2, &state->interior);
   if (state->candidates.empty()) {
     return absl::FailedPreconditionError("cover: the solid has no interior to cover");
   }
@@ -442,25 +245,188 @@ std::vector<double> PreparedCover::EstimatedDeltas(std::int64_t max_spheres) con
   return out;
 }
 
-absl::StatusOr<GeneratedCover> PreparedCover::Finish(const std::vector<std::size_t>& chosen,
+namespace {
+
+// Keeps the better of `best` and `tried`; a construction that failed (not certified, not
+// certifiable) is dropped, a cancellation passed on.
+absl::Status Keep(absl::StatusOr<GeneratedCover> tried, std::optional<GeneratedCover>* best) {
+  if (!tried.ok()) {
+    return tried.status().code() == absl::StatusCode::kCancelled ? tried.status()
+                                                                 : absl::OkStatus();
+  }
+  if (!*best || internal::BetterCover(*tried, **best)) *best = *std::move(tried);
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+absl::StatusOr<GeneratedCover> PreparedCover::Finish(std::vector<Sphere> spheres,
                                                      const GenerationControl& stage) const {
   const State& s = *state_;
-  std::vector<Sphere> spheres;
-  spheres.reserve(chosen.size());
-  for (const std::size_t i : chosen) spheres.push_back(s.candidates[i]);
-  spheres = HoldBoundary(s.solid->mesh(), spheres, s.interior, s.edge, s.margin);
-  GeneratedCover out;
-  out.candidates = static_cast<std::int64_t>(s.candidates.size());
-  const std::vector<Sphere> held = spheres;
-  absl::StatusOr<CoverCertificate> certificate =
-      CertifyAndRepair(*s.solid, s.parameters, &spheres, &out.repair_rounds, stage);
-  if (!certificate.ok()) return certificate.status();
-  out.certificate = *std::move(certificate);
-  for (std::size_t i = 0; i < spheres.size(); ++i) {
-    out.grown_spheres += spheres[i].radius > held[i].radius;
+  GenerationControl quiet;
+  quiet.cancel = stage.cancel;
+  CoverCertifyOptions certify = s.parameters.certify;
+  certify.stop_at_witness = true;
+  // Every sphere holds its boundary pieces; a point of the solid the certificate finds in no
+  // sphere is held too, by the sphere that grows least to reach it, and it certifies again.
+  std::vector<Vector3> held_points = s.interior;
+  for (int round = 0; round < kWitnessRounds; ++round) {
+    std::vector<Sphere> held =
+        internal::HoldBoundary(s.solid->mesh(), spheres, held_points, s.edge, s.margin);
+    absl::StatusOr<CoverCertificate> certificate = CertifyCover(*s.solid, held, certify, quiet);
+    if (!certificate.ok()) return certificate.status();
+    if (!certificate->certified && certificate->uncovered_point) {
+      held_points.push_back(*certificate->uncovered_point);
+      continue;
+    }
+    GeneratedCover out;
+    out.candidates = static_cast<std::int64_t>(s.candidates.size());
+    if (!certificate->certified) {
+      // Only cells too fine to settle are left (no point of the solid outside the spheres):
+      // grow the spheres around them.
+      const std::vector<Sphere> before = held;
+      certificate = CertifyAndRepair(*s.solid, s.parameters, &held, &out.repair_rounds, quiet);
+      if (!certificate.ok()) return certificate.status();
+      for (std::size_t i = 0; i < held.size(); ++i) {
+        out.grown_spheres += held[i].radius > before[i].radius;
+      }
+    }
+    out.certificate = *std::move(certificate);
+    out.set.spheres = std::move(held);
+    return out;
   }
-  out.set.spheres = std::move(spheres);
-  return out;
+  return absl::FailedPreconditionError(
+      absl::StrCat("cover: a construction left points of the solid uncovered after ",
+                   kWitnessRounds, " rounds"));
+}
+
+absl::StatusOr<GeneratedCover> PreparedCover::Tighten(GeneratedCover cover,
+                                                      const GenerationControl& control) const {
+  const State& s = *state_;
+  if (!s.parameters.constructions.tighten) return cover;
+  for (int round = 0; round < kTightenRounds; ++round) {
+    if (control.cancelled()) return absl::CancelledError("cover generation cancelled");
+    std::vector<Sphere> spheres = cover.set.spheres;
+    const std::vector<std::vector<Vector3>> owned =
+        internal::OwnedPoints(s.solid->mesh(), spheres, s.interior, kGuideEdge * s.edge);
+    internal::ParallelFor(std::size_t{0}, spheres.size(), [&](std::size_t i) {
+      if (owned[i].empty()) return;
+      // The ball at centre c holding the part with the margin, and how far it protrudes.
+      const auto ball_at = [&](const Vector3& c, double* protrusion) {
+        double reach = 0.0;
+        for (const Vector3& p : owned[i]) reach = std::max(reach, (p - c).norm());
+        const Sphere ball{c, (reach + s.margin) * (1.0 + internal::kReachMargin)};
+        *protrusion = ball.radius - internal::Depth(*s.solid, c);
+        return ball;
+      };
+      // From the better of the sphere's own centre, its part's enclosing ball's and halfway, a
+      // compass search: steps along the axes while one protrudes less, halved when none does.
+      const Vector3 from = spheres[i].center, to = internal::EnclosingBall(owned[i]).center;
+      double least = std::numeric_limits<double>::infinity();
+      for (const double t : {0.0, 0.5, 1.0}) {
+        double protrusion = 0.0;
+        const Sphere ball = ball_at(from + t * (to - from), &protrusion);
+        if (protrusion < least) {
+          least = protrusion;
+          spheres[i] = ball;
+        }
+      }
+      double step = kCompassFirstStep * spheres[i].radius;
+      for (int halving = 0; halving < kCompassHalvings; ++halving, step *= 0.5) {
+        bool moved = true;
+        for (int move = 0; moved && move < kCompassMoves; ++move) {
+          moved = false;
+          for (int axis = 0; axis < 6; ++axis) {
+            Vector3 c = spheres[i].center;
+            c[axis / 2] += axis % 2 == 0 ? step : -step;
+            double protrusion = 0.0;
+            const Sphere ball = ball_at(c, &protrusion);
+            if (protrusion < least) {
+              least = protrusion;
+              spheres[i] = ball;
+              moved = true;
+            }
+          }
+        }
+      }
+    });
+    absl::StatusOr<GeneratedCover> tighter = Finish(std::move(spheres), control);
+    if (!tighter.ok()) {
+      if (tighter.status().code() == absl::StatusCode::kCancelled) return tighter.status();
+      break;
+    }
+    if (!internal::BetterCover(*tighter, cover)) break;
+    cover = *std::move(tighter);
+  }
+  return cover;
+}
+
+absl::StatusOr<GeneratedCover> PreparedCover::SplitWorst(const GeneratedCover& cover,
+                                                         const GenerationControl& control) const {
+  const State& s = *state_;
+  const std::vector<double>& protrusions = cover.certificate.protrusions;
+  const auto worst = static_cast<std::size_t>(
+      std::max_element(protrusions.begin(), protrusions.end()) - protrusions.begin());
+  const std::vector<std::vector<Vector3>> owned =
+      internal::OwnedPoints(s.solid->mesh(), cover.set.spheres, s.interior, kGuideEdge * s.edge);
+  // A sphere holding nothing alone (or one point) has nothing to split.
+  if (owned[worst].size() < 2) return absl::FailedPreconditionError("cover: nothing to split");
+  const std::vector<Sphere> two = internal::KCenterBalls(owned[worst], 2);
+  if (two.size() < 2) return absl::FailedPreconditionError("cover: nothing to split");
+  std::vector<Sphere> spheres = cover.set.spheres;
+  spheres[worst] = two[0];
+  spheres.push_back(two[1]);
+  return Finish(std::move(spheres), control);
+}
+
+absl::StatusOr<GeneratedCover> PreparedCover::Construct(std::int64_t max_spheres,
+                                                        const GenerationControl& control) const {
+  const State& s = *state_;
+  const CoverConstructions& use = s.parameters.constructions;
+  const auto budget = static_cast<std::size_t>(max_spheres);
+  // Splitting to fill the budget, k-center and tightening at planner budgets only: above them
+  // they cost a certificate per step and rarely win.
+  const bool small = max_spheres <= kMonotoneCoverBudget;
+  std::optional<GeneratedCover> best;
+  if (use.ladder) {
+    const std::vector<std::size_t> chosen =
+        internal::ChooseForBudget(s.candidates, s.samples, *s.grid, budget, control);
+    if (control.cancelled()) return absl::CancelledError("cover generation cancelled");
+    std::vector<Sphere> spheres;
+    for (const std::size_t i : chosen) spheres.push_back(s.candidates[i]);
+    absl::StatusOr<GeneratedCover> ladder = Finish(std::move(spheres), control);
+    // Fewer than the budget: split the most protruding sphere while that lowers delta.
+    while (small && ladder.ok() && ladder->set.size() < budget) {
+      absl::StatusOr<GeneratedCover> split = SplitWorst(*ladder, control);
+      if (!split.ok() || !internal::BetterCover(*split, *ladder)) break;
+      ladder = *std::move(split);
+    }
+    if (absl::Status kept = Keep(std::move(ladder), &best); !kept.ok()) return kept;
+  }
+  // The enclosing ball at one sphere (larger budgets start from it when monotone).
+  if (use.enclosing_ball && (max_spheres == 1 || !use.monotone)) {
+    const Vertices& vertices = s.solid->mesh().vertices;
+    std::vector<Vector3> points(static_cast<std::size_t>(vertices.rows()));
+    for (Eigen::Index v = 0; v < vertices.rows(); ++v) {
+      points[static_cast<std::size_t>(v)] = vertices.row(v).transpose();
+    }
+    if (absl::Status kept = Keep(Finish({internal::EnclosingBall(points)}, control), &best);
+        !kept.ok()) {
+      return kept;
+    }
+  }
+  if (use.k_center && small) {
+    if (absl::Status kept =
+            Keep(Finish(internal::KCenterBalls(s.samples.points, budget), control), &best);
+        !kept.ok()) {
+      return kept;
+    }
+  }
+  if (!best) {
+    return absl::InternalError(
+        absl::StrCat("cover: no construction certified a cover with ", max_spheres, " spheres"));
+  }
+  return *std::move(best);
 }
 
 absl::StatusOr<GeneratedCover> PreparedCover::Generate(std::int64_t max_spheres,
@@ -471,14 +437,62 @@ absl::StatusOr<GeneratedCover> PreparedCover::Generate(std::int64_t max_spheres,
         absl::StrCat("cover: max_spheres must be positive, got ", max_spheres));
   }
   const State& s = *state_;
-  const std::vector<std::size_t> chosen = internal::ChooseForBudget(
-      s.candidates, s.samples, *s.grid, static_cast<std::size_t>(max_spheres), control);
-  if (control.cancelled()) return absl::CancelledError("cover generation cancelled");
-  if (control.on_progress) control.on_progress(0.5);
-  absl::StatusOr<GeneratedCover> out = Finish(chosen, Stage(control, 0.5, 1.0));
-  if (!out.ok()) return out.status();
+  const bool monotone = s.parameters.constructions.monotone && max_spheres <= kMonotoneCoverBudget;
+  if (monotone) {
+    const std::lock_guard<std::mutex> lock(s.memo_mutex);
+    if (const auto found = s.memo.find(max_spheres); found != s.memo.end()) {
+      GeneratedCover out = found->second;
+      out.seconds = SecondsSince(start);
+      return out;
+    }
+  }
+  // Up to kMonotoneCoverBudget the constructions run at the budgets of ConstructionBudget
+  // only; between them the cover grows from the one before by splitting.
+  std::optional<GeneratedCover> best;
+  if (!monotone || internal::ConstructionBudget(max_spheres)) {
+    absl::StatusOr<GeneratedCover> made = Construct(max_spheres, control);
+    if (!made.ok()) return made.status();
+    best = *std::move(made);
+  }
+  std::optional<GeneratedCover> fewer;
+  if (monotone && max_spheres > 1) {
+    // The best cover of one sphere fewer (the same rule, so never worse than any before it),
+    // and it with its most protruding sphere split.
+    absl::StatusOr<GeneratedCover> made_fewer = Generate(max_spheres - 1, control);
+    if (!made_fewer.ok()) return made_fewer.status();
+    fewer = *std::move(made_fewer);
+    // A cover carried from a smaller budget was split there already (the same split).
+    if (fewer->set.size() == static_cast<std::size_t>(max_spheres - 1)) {
+      if (absl::Status kept = Keep(SplitWorst(*fewer, control), &best); !kept.ok()) return kept;
+    }
+  }
+  // The best construction tightened; then the cover of one sphere fewer if still better.
+  if (best && max_spheres <= kMonotoneCoverBudget) {
+    absl::StatusOr<GeneratedCover> tightened = Tighten(*std::move(best), control);
+    if (!tightened.ok()) return tightened.status();
+    best = *std::move(tightened);
+  }
+  if (fewer) {
+    if (absl::Status kept = Keep(*std::move(fewer), &best); !kept.ok()) return kept;
+  }
+  GeneratedCover out = *std::move(best);
+  out.unused_reason.clear();
+  if (out.set.size() < static_cast<std::size_t>(max_spheres)) {
+    out.unused_reason =
+        max_spheres <= kMonotoneCoverBudget
+            ? absl::StrCat("no construction with more than ", out.set.size(), " of the ",
+                           max_spheres, " spheres allowed certified a lower delta (",
+                           out.certificate.delta, ")")
+            : absl::StrCat("the choice reached every sample with ", out.set.size(), " of the ",
+                           max_spheres, " spheres allowed (more are not tried above ",
+                           kMonotoneCoverBudget, ")");
+  }
+  if (monotone) {
+    const std::lock_guard<std::mutex> lock(s.memo_mutex);
+    s.memo.emplace(max_spheres, out);
+  }
   if (control.on_progress) control.on_progress(1.0);
-  out->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  out.seconds = SecondsSince(start);
   return out;
 }
 

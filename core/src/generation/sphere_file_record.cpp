@@ -148,6 +148,7 @@ NamedValues CoverFigures(const GeneratedCover& cover) {
   stats.emplace_back("grown_spheres", cover.grown_spheres);
   stats.emplace_back("cover_candidates", cover.candidates);
   stats.emplace_back("repair_rounds", static_cast<std::int64_t>(cover.repair_rounds));
+  if (!cover.unused_reason.empty()) stats.emplace_back("unused_reason", cover.unused_reason);
   return stats;
 }
 

@@ -15,11 +15,24 @@
 // The certificate then passes (failed cells, if any, grow the ball needing the least growth
 // and it certifies again): the result is always certified. delta is about t plus the margin
 // plus the growth the boundary between samples needs.
+//
+// A budget's cover is the best (least certified delta, then least summed protrusion, then
+// fewest spheres) of several certified constructions (CoverConstructions): that choice; the
+// minimum enclosing ball of the vertices; k-center clusters of the samples with an enclosing
+// ball each; and, with CoverConstructions::monotone, the best cover of one sphere fewer, as it
+// is and with its most protruding sphere split in two. The best is tightened: per sphere, the
+// ball holding what it alone holds whose centre protrudes least (cover_constructions.h),
+// certified again, while delta falls. A construction that does not certify is dropped. So one
+// sphere is at most the enclosing ball (plus the certificate's margin), and a budget is no
+// worse than each construction alone; with `monotone`, delta never rises with the budget up
+// to kMonotoneCoverBudget. k-center, tightening and splitting to fill a budget run at budgets
+// up to kMonotoneCoverBudget only (above, they cost a certificate per step and rarely win).
 #pragma once
 
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "absl/status/statusor.h"
@@ -29,6 +42,28 @@
 #include "inscribe/solid/solid.h"
 
 namespace inscribe {
+
+// Budgets up to which a cover at N is never worse than at N - 1 (it also tries the best cover
+// at N - 1, and it with one sphere split): the counts planners give a link.
+inline constexpr std::int64_t kMonotoneCoverBudget = 64;
+
+// The certified constructions a budget's cover is the best of (each can be turned off, for
+// comparisons; at least one of the first three must be on).
+struct CoverConstructions {
+  bool ladder = true;          // internal ladder balls chosen by a threshold search, grown
+  bool enclosing_ball = true;  // one sphere: the minimum enclosing ball of the vertices
+  bool k_center = true;        // farthest-point clusters of the samples, an enclosing ball each
+  // Rounds of: per sphere, the enclosing ball of the boundary pieces and interior points it
+  // alone holds (its centre moved toward that ball's where that protrudes less), certified.
+  bool tighten = true;
+  // Up to kMonotoneCoverBudget: also the best cover at N - 1 (made the same way, so
+  // recursively) and that cover with its most protruding sphere split in two, the other
+  // constructions only at 1..8, 11, 16, 23, 32, 45 and 64: delta never rises with N. Off by
+  // default: a budget then costs about as many constructions as those budgets below it
+  // (5-50x one construction), and between those budgets the split covers are looser than
+  // the constructions made at the budget itself.
+  bool monotone = false;
+};
 
 struct CoverParameters {
   // The two modes, at most one set: at most N spheres with the smallest delta reached (> 0),
@@ -43,6 +78,7 @@ struct CoverParameters {
   // boundary (so the certificate settles the cells there), which delta includes: a finer
   // resolution allows a smaller delta and costs more cells.
   CoverCertifyOptions certify;
+  CoverConstructions constructions;
 };
 
 // OK, or INVALID_ARGUMENT naming the first bad field. O(1).
@@ -55,6 +91,9 @@ struct GeneratedCover {
   std::int64_t grown_spheres = 0;  // spheres the repairs grew (after the first certificate)
   int repair_rounds = 0;           // certificates that failed before the one that passed
   double seconds = 0.0;            // all of it, the internal set included
+  // Empty when the cover has as many spheres as the budget allowed; else why it has fewer
+  // (no construction with more spheres certified a lower delta).
+  std::string unused_reason;
 };
 
 // What GenerateCover chooses from, made once and asked for several budgets: the boundary
@@ -78,8 +117,11 @@ class PreparedCover {
   // ends near half the farthest-first one). O(max_spheres * (#samples + #candidates)).
   std::vector<double> EstimatedDeltas(std::int64_t max_spheres) const;
 
-  // The budget mode: at most max_spheres (> 0) spheres, certified. INVALID_ARGUMENT for a
-  // budget <= 0, CANCELLED. Deterministic.
+  // The budget mode: at most max_spheres (> 0) spheres, certified, the best of the
+  // constructions (see above); fewer than max_spheres only with GeneratedCover::unused_reason
+  // saying why. INVALID_ARGUMENT for a budget <= 0, CANCELLED. Deterministic: the covers for
+  // budgets up to kMonotoneCoverBudget are remembered (each needs the one before it), which
+  // changes no result, only the time of a later call. Safe to call from several threads.
   absl::StatusOr<GeneratedCover> Generate(std::int64_t max_spheres,
                                           const GenerationControl& control = {}) const;
 
@@ -90,8 +132,14 @@ class PreparedCover {
  private:
   struct State;
   explicit PreparedCover(std::shared_ptr<const State> state);
-  absl::StatusOr<GeneratedCover> Finish(const std::vector<std::size_t>& chosen,
+  absl::StatusOr<GeneratedCover> Finish(std::vector<Sphere> spheres,
                                         const GenerationControl& control) const;
+  absl::StatusOr<GeneratedCover> Construct(std::int64_t max_spheres,
+                                           const GenerationControl& control) const;
+  absl::StatusOr<GeneratedCover> Tighten(GeneratedCover cover,
+                                         const GenerationControl& control) const;
+  absl::StatusOr<GeneratedCover> SplitWorst(const GeneratedCover& cover,
+                                            const GenerationControl& control) const;
   std::shared_ptr<const State> state_;
 };
 

@@ -60,7 +60,8 @@ std::optional<double> InternalProtrusionOverInput(const MeshReport& mesh);
 NamedValues QualityFigures(const QualityReport& quality);
 // v_points, edge_points, grown, max_growth, dilation_seconds.
 NamedValues DilationFigures(const DilationResult& dilation);
-// CoverCertificateStats, then grown_spheres, cover_candidates, repair_rounds.
+// CoverCertificateStats, then grown_spheres, cover_candidates, repair_rounds, and
+// unused_reason when the cover has fewer spheres than its budget (GeneratedCover).
 NamedValues CoverFigures(const GeneratedCover& cover);
 
 // The certificate's figures as stats: delta and certificate_resolution (mesh units),

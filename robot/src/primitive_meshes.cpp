@@ -1,7 +1,7 @@
 #include "inscribe/robot/primitive_meshes.h"
 
-#include <cassert>
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <utility>
 #include <vector>
@@ -161,9 +161,8 @@ double CylinderExcess(double radius, PrimitiveFit fit, int sides) {
 double CapsuleExcess(double radius, PrimitiveFit fit, int sides, int quarter_bands) {
   // Inside: the mesh holds the ball of the smallest face distance. Enclosing: the mesh lies in
   // the ball of its vertices' radius. Both swept along the axis for the capsule.
-  return fit == PrimitiveFit::kInside
-             ? radius * (1.0 - SmallestFaceDistance(sides, quarter_bands))
-             : radius * (EnclosingScale(sides, quarter_bands) - 1.0);
+  return fit == PrimitiveFit::kInside ? radius * (1.0 - SmallestFaceDistance(sides, quarter_bands))
+                                      : radius * (EnclosingScale(sides, quarter_bands) - 1.0);
 }
 
 double EllipsoidExcess(const Vector3& radii, PrimitiveFit fit, int sides, int quarter_bands) {

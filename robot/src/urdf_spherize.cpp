@@ -169,11 +169,10 @@ absl::StatusOr<ElementSpheres> GenerateElement(const PreparedElement& element,
   out.spheres = std::move(result->set.spheres);
   if (options.kind == SphereSetKind::kInternal) out.cores = out.spheres;
   if (!options.voxel_size && static_cast<std::int64_t>(out.spheres.size()) < element.budget) {
-    out.short_reason =
-        result->selection == SphereSelection::kOptimised
-            ? absl::StrCat("the optimised selection found no more among its ", result->pool_size,
-                           " medial candidates")
-            : std::string("the finest voxel grid within the budget gives no more");
+    out.short_reason = result->selection == SphereSelection::kOptimised
+                           ? absl::StrCat("the optimised selection found no more among its ",
+                                          result->pool_size, " medial candidates")
+                           : std::string("the finest voxel grid within the budget gives no more");
   }
   return out;
 }
@@ -508,11 +507,11 @@ absl::StatusOr<RobotSpherizeResult> SpherizeRobot(const UrdfRobot& robot,
     if (element.budget > 0 && !generated->short_reason.empty() &&
         static_cast<std::int64_t>(generated->spheres.size()) < element.budget) {
       const UrdfLink& link = robot.links[static_cast<std::size_t>(element.link)];
-      result.warnings.push_back(absl::StrCat(
-          DescribeUrdfElement(link.elements[static_cast<std::size_t>(element.element)],
-                              link.from_visual),
-          ": ", generated->spheres.size(), " of its budget of ", element.budget,
-          " spheres: ", generated->short_reason));
+      result.warnings.push_back(
+          absl::StrCat(DescribeUrdfElement(link.elements[static_cast<std::size_t>(element.element)],
+                                           link.from_visual),
+                       ": ", generated->spheres.size(), " of its budget of ", element.budget,
+                       " spheres: ", generated->short_reason));
     }
     for (Sphere sphere : generated->spheres) {
       sphere.radius += options.padding;

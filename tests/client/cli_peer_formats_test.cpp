@@ -148,8 +148,8 @@ TEST_F(CliPeerFormats, ConvertScalesACoverMadeInMillimetresBackToMetres) {
   ASSERT_EQ(made.exit_code, 0) << made.err;
   const CliRun converted = RunCli("convert --json " + Quote(mm) + " --scale 0.001 -o " + Quote(m));
   ASSERT_EQ(converted.exit_code, 0) << converted.err;
-  EXPECT_THAT(converted.err, AllOf(HasSubstr("--scale 0.001"), HasSubstr("mesh hash"),
-                                   HasSubstr("certificate")));
+  EXPECT_THAT(converted.err,
+              AllOf(HasSubstr("--scale 0.001"), HasSubstr("mesh hash"), HasSubstr("certificate")));
   const nlohmann::json summary = nlohmann::json::parse(converted.out);
   EXPECT_EQ(summary.at("scale").get<double>(), 0.001);
   EXPECT_EQ(summary.at("mesh_sha256").get<std::string>(), "");

@@ -137,8 +137,7 @@ TEST(CliRepairCorpusRobot, EveryLinkIsSpherizedWithRepairAuto) {
     WriteOff(corpus[i].mesh, mesh);
     const bool millimetres = corpus[i].name.find("millimetres") != std::string::npos;
     links += "  <link name=\"" + corpus[i].name + "\"><collision><geometry><mesh filename=\"" +
-             FileName(corpus[i]) + "\"" +
-             (millimetres ? " scale=\"0.001 0.001 0.001\"" : "") +
+             FileName(corpus[i]) + "\"" + (millimetres ? " scale=\"0.001 0.001 0.001\"" : "") +
              "/></geometry></collision></link>\n";
     if (i > 0) {
       joints += "  <joint name=\"j" + std::to_string(i) + "\" type=\"fixed\"><parent link=\"" +
@@ -150,8 +149,7 @@ TEST(CliRepairCorpusRobot, EveryLinkIsSpherizedWithRepairAuto) {
   std::ofstream(urdf) << "<?xml version=\"1.0\"?>\n<robot name=\"corpus\">\n"
                       << links << joints << "</robot>\n";
   const std::string args = "urdf " + Quote(urdf.string()) + " --max-spheres-per-link 8 --json ";
-  const CliRun all =
-      RunCli(args + "--repair auto -o " + Quote((Dir() / "auto.urdf").string()));
+  const CliRun all = RunCli(args + "--repair auto -o " + Quote((Dir() / "auto.urdf").string()));
   ASSERT_EQ(all.exit_code, 0) << all.err;
   const nlohmann::json report = nlohmann::json::parse(all.out);
   EXPECT_EQ(report.at("spherized").get<int>(), static_cast<int>(corpus.size()));

@@ -8,9 +8,9 @@
 #include <cmath>
 #include <cstdio>
 #include <optional>
-#include <variant>
 #include <random>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "inscribe/generation/sphere_file_record.h"

@@ -11,9 +11,9 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <utility>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
@@ -372,8 +372,8 @@ int ExpectMujocoContactsAreOurs(const std::string& path, int samples) {
       ++contacts;
       const std::pair<int, int> key(a, b);
       EXPECT_TRUE(colliding[key]) << matrix->links[a] << " / " << matrix->links[b]
-                                     << ": MuJoCo reports a contact at depth " << -contact.dist
-                                     << " that our interval rules out";
+                                  << ": MuJoCo reports a contact at depth " << -contact.dist
+                                  << " that our interval rules out";
       EXPECT_NE(type[key], CollisionPairClass::kNever)
           << matrix->links[a] << " / " << matrix->links[b] << " is Never, MuJoCo has a contact";
     }

@@ -97,9 +97,12 @@ Shape Ellipsoid(const Vector3& a, int sides, int bands) {
 }
 
 std::vector<Shape> Shapes() {
-  return {Cylinder(0.3, 1.2, 3),         Cylinder(0.04, 0.1, 7),
-          Cylinder(0.05, 0.3, kCylinderSides), Capsule(0.2, 0.5, 5, 2),
-          Capsule(0.03, 0.0, 9, 3),       Capsule(0.05, 0.2, kCylinderSides, kQuarterBands),
+  return {Cylinder(0.3, 1.2, 3),
+          Cylinder(0.04, 0.1, 7),
+          Cylinder(0.05, 0.3, kCylinderSides),
+          Capsule(0.2, 0.5, 5, 2),
+          Capsule(0.03, 0.0, 9, 3),
+          Capsule(0.05, 0.2, kCylinderSides, kQuarterBands),
           Ellipsoid(Vector3(0.1, 0.3, 0.05), 6, 3),
           Ellipsoid(Vector3(0.2, 0.1, 0.4), kCylinderSides, kQuarterBands)};
 }
@@ -179,7 +182,8 @@ struct PlacedShape {
 
 TEST(PrimitiveFits, RobotCoversHoldTheTrueShapesAndTheirCoresAndInternalSetsLieInside) {
   const std::vector<PlacedShape> placed = {
-      {Placed(UrdfShape::kCylinder, Vector3::Zero(), 0.05, 0.3), Cylinder(0.05, 0.3, kCylinderSides)},
+      {Placed(UrdfShape::kCylinder, Vector3::Zero(), 0.05, 0.3),
+       Cylinder(0.05, 0.3, kCylinderSides)},
       {Placed(UrdfShape::kCapsule, Vector3::Zero(), 0.04, 0.2),
        Capsule(0.04, 0.2, kCylinderSides, kQuarterBands)},
       {Placed(UrdfShape::kEllipsoid, Vector3(0.1, 0.05, 0.2), 0, 0),

@@ -1,14 +1,13 @@
 #include "broken_meshes.h"
 
-#include <algorithm>
-#include <cmath>
-#include <utility>
-
-#include <assimp/Exporter.hpp>
 #include <assimp/scene.h>
 
+#include <algorithm>
+#include <assimp/Exporter.hpp>
+#include <cmath>
 #include <memory>
 #include <string>
+#include <utility>
 
 #include "inscribe/mesh/mesh_io.h"
 #include "support/assimp_scenes.h"
@@ -61,8 +60,8 @@ Mesh ColladaAssembly() {
   const Eigen::Matrix4d beside = turned.matrix();
   Eigen::Matrix4d above = Eigen::Matrix4d::Identity();
   above.block<3, 1>(0, 3) = Vector3(1.0, 0.5, 1.1);
-  const std::unique_ptr<aiScene> scene = MakeScene(
-      {box, sphere}, {{0, Eigen::Matrix4d::Identity()}, {0, beside}, {1, above}});
+  const std::unique_ptr<aiScene> scene =
+      MakeScene({box, sphere}, {{0, Eigen::Matrix4d::Identity()}, {0, beside}, {1, above}});
   Assimp::Exporter exporter;
   const aiExportDataBlob* blob = exporter.ExportToBlob(scene.get(), "collada");
   if (blob == nullptr) return Mesh{};

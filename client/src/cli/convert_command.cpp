@@ -22,7 +22,7 @@ struct ConvertCliOptions {
   std::string from;  // input format; empty: ReadSphereFile's choice (extension, else sniffed)
   std::string to;    // output format; empty: from the output's extension, else JSON
   int sph_level = -1;
-  double scale = 1.0;  // centres and radii multiplied by it (ScaledSphereFile)
+  double scale = 1.0;     // centres and radii multiplied by it (ScaledSphereFile)
   std::string link;       // the cuRobo YAML link to read
   std::string yaml_link;  // the cuRobo YAML link to write under
   std::string robot;      // the URDF that urdf and morphit output is written into

@@ -54,8 +54,8 @@ std::vector<Sphere> HoldBoundary(const Mesh& mesh, const std::vector<Sphere>& sp
 // so that every point lies inside.
 Sphere EnclosingBall(const std::vector<Vector3>& points);
 
-// k-center clusters of `points` (none for no points): k centres by farthest-first traversal (from the
-// point farthest from their mean), each point to its nearest centre, then two rounds of each
+// k-center clusters of `points` (none for no points): k centres by farthest-first traversal (from
+// the point farthest from their mean), each point to its nearest centre, then two rounds of each
 // cluster's enclosing ball and each point to the ball it is deepest in relative to its radius
 // (least |p - c| - r). At most k balls, one per non-empty cluster. Deterministic.
 std::vector<Sphere> KCenterBalls(const std::vector<Vector3>& points, std::size_t k);

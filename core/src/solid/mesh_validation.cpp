@@ -18,13 +18,12 @@
 namespace inscribe {
 namespace {
 
+using internal::AddIssue;
 using internal::DisjointSets;
 using internal::EdgeGroups;
 using internal::EdgeUse;
 using internal::GroupEdges;
-using internal::AddIssue;
 using internal::Plural;
-
 
 // Checks that every coordinate is finite and every index names a vertex. Returns false when
 // the mesh cannot be examined further.

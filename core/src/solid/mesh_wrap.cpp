@@ -213,8 +213,8 @@ double WrapReachBound(const Mesh& wrap, const Mesh& input) {
   // (a part stopped early returns at most what is already in the maximum, and the parts that
   // make the maximum are refined as that rule refines them), whatever the order or threads.
   std::atomic<double> returned{padded(floor)};
-  auto refine = [&](auto&& self, const Corner& a, const Corner& b, const Corner& c,
-                    double here, int depth) -> double {
+  auto refine = [&](auto&& self, const Corner& a, const Corner& b, const Corner& c, double here,
+                    int depth) -> double {
     if (depth == 0 || here <= std::max(1.25 * floor, returned.load(std::memory_order_relaxed))) {
       return here;
     }
@@ -233,30 +233,29 @@ double WrapReachBound(const Mesh& wrap, const Mesh& input) {
     return corners[static_cast<std::size_t>(wrap.triangles(t, k))];
   };
   std::vector<double> first(static_cast<std::size_t>(n));
-  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, n),
-                    [&](const tbb::blocked_range<Eigen::Index>& r) {
-                      for (Eigen::Index t = r.begin(); t != r.end(); ++t) {
-                        first[static_cast<std::size_t>(t)] =
-                            bound(corner(t, 0), corner(t, 1), corner(t, 2));
-                      }
-                    });
+  tbb::parallel_for(
+      tbb::blocked_range<Eigen::Index>(0, n), [&](const tbb::blocked_range<Eigen::Index>& r) {
+        for (Eigen::Index t = r.begin(); t != r.end(); ++t) {
+          first[static_cast<std::size_t>(t)] = bound(corner(t, 0), corner(t, 1), corner(t, 2));
+        }
+      });
   std::vector<Eigen::Index> order(static_cast<std::size_t>(n));
   std::iota(order.begin(), order.end(), Eigen::Index{0});
   std::stable_sort(order.begin(), order.end(), [&](Eigen::Index x, Eigen::Index y) {
     return first[static_cast<std::size_t>(x)] > first[static_cast<std::size_t>(y)];
   });
-  tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, order.size(), 16),
-      [&](const tbb::blocked_range<std::size_t>& r) {
-        for (std::size_t i = r.begin(); i != r.end(); ++i) {
-          const Eigen::Index t = order[i];
-          const double value = refine(refine, corner(t, 0), corner(t, 1), corner(t, 2),
-                                      first[static_cast<std::size_t>(t)], 4);
-          double seen = returned.load(std::memory_order_relaxed);
-          while (value > seen && !returned.compare_exchange_weak(seen, value)) {
-          }
-        }
-      });
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, order.size(), 16),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                        const Eigen::Index t = order[i];
+                        const double value =
+                            refine(refine, corner(t, 0), corner(t, 1), corner(t, 2),
+                                   first[static_cast<std::size_t>(t)], 4);
+                        double seen = returned.load(std::memory_order_relaxed);
+                        while (value > seen && !returned.compare_exchange_weak(seen, value)) {
+                        }
+                      }
+                    });
   return returned.load();
 }
 

@@ -116,13 +116,8 @@ TEST_P(CliRepairCorpus, InfoGenerateAndCoverHoldTheInputTriangles) {
 
 INSTANTIATE_TEST_SUITE_P(Corpus, CliRepairCorpus,
                          ::testing::Range(0, static_cast<int>(BrokenMeshCorpus().size())),
-                         [](const ::testing::TestParamInfo<int>& info) {
-                           std::string name =
-                               BrokenMeshCorpus()[static_cast<std::size_t>(info.param)].name;
-                           for (char& c : name) {
-                             if (c == '-') c = '_';
-                           }
-                           return name;
+                         [](const ::testing::TestParamInfo<int>& param) {
+                           return testing::BrokenMeshTestName(param.param);
                          });
 
 // One robot, a link per corpus mesh (millimetre ones scaled by the URDF, as robots ship them):

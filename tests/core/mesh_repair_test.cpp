@@ -133,13 +133,8 @@ TEST_P(CorpusRepair, UsableAtTheLevelItNeedsAndAutoAndRefusedBelow) {
 
 INSTANTIATE_TEST_SUITE_P(Corpus, CorpusRepair,
                          ::testing::Range(0, static_cast<int>(BrokenMeshCorpus().size())),
-                         [](const ::testing::TestParamInfo<int>& info) {
-                           std::string name =
-                               BrokenMeshCorpus()[static_cast<std::size_t>(info.param)].name;
-                           for (char& c : name) {
-                             if (c == '-') c = '_';
-                           }
-                           return name;
+                         [](const ::testing::TestParamInfo<int>& param) {
+                           return testing::BrokenMeshTestName(param.param);
                          });
 
 // The wrap, checked without core's code: every input triangle's sample points strictly inside

@@ -214,4 +214,10 @@ std::vector<BrokenMesh> BrokenMeshCorpus() {
   return corpus;
 }
 
+std::string BrokenMeshTestName(int index) {
+  std::string name = BrokenMeshCorpus()[static_cast<std::size_t>(index)].name;
+  std::replace(name.begin(), name.end(), '-', '_');
+  return name;
+}
+
 }  // namespace inscribe::testing

@@ -36,4 +36,7 @@ Mesh BoxesSharingAWall();
 // entries (about 1000).
 std::vector<BrokenMesh> BrokenMeshCorpus();
 
+// Entry `index`'s name as a test name ('-' as '_'), for suites parameterized over the corpus.
+std::string BrokenMeshTestName(int index);
+
 }  // namespace inscribe::testing

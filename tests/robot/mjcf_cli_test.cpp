@@ -81,6 +81,37 @@ TEST(MjcfCli, EveryBodySpherizedIntoTheYaml) {
   EXPECT_THAT(table.out, ::testing::Not(HasSubstr("fore/elbow")));
 }
 
+// The MJCF model's spheres in a planner format (here XRDF) are checked body by body against
+// the model's own solid geoms: every spherized body certified, with a delta no looser than the
+// spherizer's; one body's spheres shrunk is named as not covered.
+TEST(MjcfCli, EvaluateCertifyChecksAnMjcfModelBodyByBody) {
+  const std::string folder = FreshFolder("mjcf_cli_certify");
+  const std::string model = WriteArm(folder);
+  const std::string xrdf = folder + "/arm.xrdf";
+  const CliRun made =
+      RunCli("robot " + model + " -o " + folder +
+             "/out.xml --max-spheres-per-link 5 --samples 100 --json --spheres " + xrdf);
+  ASSERT_EQ(made.exit_code, 0) << made.err;
+  std::map<std::string, double> generated;
+  const nlohmann::json report = nlohmann::json::parse(made.out);
+  for (const nlohmann::json& link : report.at("links")) {
+    if (link.contains("delta")) generated[link.at("link")] = link.at("delta");
+  }
+  ASSERT_FALSE(generated.empty());
+  const CliRun run = RunCli("evaluate --certify " + model + " " + xrdf + " --json");
+  ASSERT_EQ(run.exit_code, 0) << run.err << run.out;
+  const nlohmann::json j = nlohmann::json::parse(run.out);
+  EXPECT_TRUE(j.at("certified").get<bool>());
+  int checked = 0;
+  for (const nlohmann::json& link : j.at("links")) {
+    const std::string name = link.at("link");
+    if (!generated.count(name)) continue;
+    ++checked;
+    EXPECT_LE(link.at("delta").get<double>(), generated.at(name) * (1 + 1e-9) + 1e-12) << link;
+  }
+  EXPECT_EQ(checked, static_cast<int>(generated.size()));
+}
+
 TEST(MjcfCli, SolidByGroupAndRefusals) {
   const std::string folder = FreshFolder("mjcf_cli_refusals");
   const std::string model = WriteArm(folder);

@@ -24,7 +24,7 @@ from typing import Callable, Optional, Sequence
 import grpc
 import numpy as np
 
-from . import _inscribe
+from . import _inscribe, _progress
 from ._errors import Error
 
 
@@ -254,13 +254,15 @@ class Client:
 
     # ---- calls ---------------------------------------------------------------------------
 
-    def put_mesh(self, mesh: _inscribe.Mesh, *, repair="safe", fill_holes: bool = False,
+    def put_mesh(self, mesh, *, repair="safe", fill_holes: bool = False,
                  weld_tolerance: float = 0.0, timeout: Optional[float] = None) -> str:
-        """Validates and stores `mesh` on its replica; returns its key "sha256:<hex>" (of the
+        """Validates and stores `mesh` (an inscribe.Mesh, a path, a (vertices, faces) pair or a
+        trimesh, as every in-process call takes a mesh) on its replica; returns its key "sha256:<hex>" (of the
         mesh as the server repaired it: `repair` is an inscribe.Repair or a level name, as in
         inscribe.prepare; fill_holes=True is "fill"; coincident vertices are always welded,
         also those within weld_tolerance). inscribe.Error FAILED_PRECONDITION for an unusable
         mesh."""
+        mesh = _inscribe._mesh_of(mesh)
         request = _inscribe._put_mesh_request(
             mesh, repair=_inscribe._repair_argument(repair, fill_holes=fill_holes,
                                                     weld_tolerance=weld_tolerance))
@@ -276,14 +278,16 @@ class Client:
                  cover_resolution: Optional[float] = None, evaluate: bool = True,
                  quality_samples: Optional[int] = None, repair="safe",
                  fill_holes: bool = False, selection: Optional[str] = None,
-                 progress: Optional[Callable[[float], None]] = None,
+                 progress=None,
                  progress_interval: float = 0.0,
                  timeout: Optional[float] = None) -> GenerateResult:
-        """Spheres for `mesh` (an inscribe.Mesh, uploaded first, or the key of a stored one),
+        """Spheres for `mesh` (the key "sha256:<hex>" of a stored mesh, or any other mesh
+        put_mesh takes, uploaded first),
         with the settings of inscribe.generate (None: core's defaults), checked before anything
         is sent (ValueError naming the field); an uploaded mesh is repaired as `repair` says
-        (put_mesh). progress(fraction) is called on this thread as
-        the server reports it, at most every progress_interval seconds (0: the server's 0.5 s).
+        (put_mesh). progress(fraction) (or a tqdm bar, as inscribe.generate takes) is called on
+        this thread as the server reports it, at most every progress_interval seconds (0: the
+        server's 0.5 s). The result's .spheres is the SphereSet inscribe.generate returns.
         The result is cached on the server by content. A mesh uploaded here that the server
         lost before Generate (evicted) is uploaded once more."""
         asked = _inscribe._repair_argument(repair, fill_holes=fill_holes, weld_tolerance=0.0)
@@ -294,7 +298,10 @@ class Client:
             max_protrusion=max_protrusion, cover_resolution=cover_resolution, evaluate=evaluate,
             quality_samples=quality_samples, selection=selection, repair=asked,
             progress_interval=progress_interval)
-        uploaded = isinstance(mesh, _inscribe.Mesh)
+        report = _progress.progress_callback(progress)
+        uploaded = not (isinstance(mesh, str) and mesh.startswith("sha256:"))
+        if uploaded:
+            mesh = _inscribe._mesh_of(mesh)
         key = self.put_mesh(mesh, repair=asked, timeout=timeout) if uploaded else mesh
 
         def attempt(rpc, left):
@@ -302,8 +309,8 @@ class Client:
             for message in rpc["Generate"](call.request(key), timeout=left,
                                            metadata=self._metadata):
                 fraction, answer = call.read(message)
-                if fraction is not None and progress is not None:
-                    progress(fraction)
+                if fraction is not None and report is not None:
+                    report(fraction)
                 if answer is not None:
                     result = answer
             if result is None:
@@ -378,11 +385,12 @@ class Client:
                             request, timeout)
         return DeformationResult(**_inscribe._update_deformation_reply(reply, bounds=bounds))
 
-    def inspect_mesh(self, mesh: _inscribe.Mesh, *, skip_self_intersections: bool = False,
+    def inspect_mesh(self, mesh, *, skip_self_intersections: bool = False,
                      repair="safe", fill_holes: bool = False, weld_tolerance: float = 0.0,
                      timeout: Optional[float] = None) -> InspectMeshResult:
         """The server's validation of `mesh` (nothing stored): its key after the server's
-        repairs (`repair` as in put_mesh) and its MeshReport."""
+        repairs (`repair` as in put_mesh) and its MeshReport; `mesh` as put_mesh takes it."""
+        mesh = _inscribe._mesh_of(mesh)
         request = _inscribe._inspect_mesh_request(
             mesh, skip_self_intersections=skip_self_intersections,
             repair=_inscribe._repair_argument(repair, fill_holes=fill_holes,

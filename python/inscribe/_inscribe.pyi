@@ -1,13 +1,19 @@
 # Type stubs of the _inscribe extension (python/src/*.cpp), for editors and type checkers.
 # Shapes: (N, 4) float64 [x, y, z, r]; poses (7,) or (N, 7) float64 [qw, qx, qy, qz, tx, ty, tz].
-from typing import Callable, Mapping, Optional, Sequence, Tuple, Union
+import os
+from typing import Any, Callable, Iterator, Mapping, Optional, Protocol, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
 
 Float64Array = npt.NDArray[np.float64]
 Int32Array = npt.NDArray[np.int32]
-Progress = Optional[Callable[[float], None]]
+class ProgressBar(Protocol):  # tqdm.tqdm: advanced to fraction * total
+    total: Optional[float]
+    def update(self, n: float) -> Any: ...
+
+Progress = Union[None, Callable[[float], None], ProgressBar]
+PathLike = Union[str, os.PathLike]
 Spheres = Union["SphereSet", Float64Array]
 
 DEFAULT_MAX_SPHERES_PER_LINK: int
@@ -78,12 +84,21 @@ class Repair:
 
 RepairLike = Union[Repair, str]
 
+class HasVerticesAndFaces(Protocol):  # trimesh.Trimesh
+    @property
+    def vertices(self) -> npt.ArrayLike: ...
+    @property
+    def faces(self) -> npt.ArrayLike: ...
+
 class Mesh:
-    def __init__(self, vertices: Float64Array, triangles: Int32Array) -> None: ...
+    # vertices: any float dtype, triangles: any integer dtype; converted once to float64, int32.
+    def __init__(self, vertices: npt.ArrayLike, triangles: npt.ArrayLike) -> None: ...
     @property
     def vertices(self) -> Float64Array: ...
     @property
     def triangles(self) -> Int32Array: ...
+    @property
+    def faces(self) -> Int32Array: ...
     @property
     def num_vertices(self) -> int: ...
     @property
@@ -103,9 +118,13 @@ class Solid:
     @property
     def mesh(self) -> Mesh: ...
 
-def load_mesh(path: str) -> Mesh: ...
-def write_mesh(mesh: Mesh, path: str) -> None: ...
-def prepare(mesh: Mesh, *, repair: RepairLike = "safe", fill_holes: bool = False,
+# Every argument taking a mesh takes these.
+MeshLike = Union[Mesh, PathLike, Tuple[npt.ArrayLike, npt.ArrayLike], HasVerticesAndFaces]
+MeshOrSolid = Union[MeshLike, Solid]
+
+def load_mesh(path: PathLike) -> Mesh: ...
+def write_mesh(mesh: MeshLike, path: PathLike) -> None: ...
+def prepare(mesh: MeshLike, *, repair: RepairLike = "safe", fill_holes: bool = False,
             check_self_intersections: bool = True) -> Solid: ...
 
 class QualityReport:
@@ -176,20 +195,27 @@ class SphereSet:
     @property
     def reference_index(self) -> Optional[Int32Array]: ...
     def __len__(self) -> int: ...
+    def __array__(self, dtype: Optional[npt.DTypeLike] = None,
+                  copy: Optional[bool] = None) -> Float64Array: ...
+    @property
+    def shape(self) -> Tuple[int, int]: ...
+    def __getitem__(self, index: Any) -> Any: ...
+    def __iter__(self) -> Iterator[Float64Array]: ...
+    def to_mesh(self, subdivision: int = 1) -> Mesh: ...
 
-def generate(mesh: Union[Mesh, Solid], *, max_spheres: Optional[int] = None,
+def generate(mesh: MeshOrSolid, *, max_spheres: Optional[int] = None,
              voxel_size: Optional[float] = None, kind: str = "internal",
              object_angle: Optional[float] = None, epsilon: Optional[float] = None,
              samples: Optional[int] = None, subdivide_boundary: Optional[bool] = None,
              max_voxels: Optional[int] = None, dilation_growth: Optional[float] = None,
              max_protrusion: Optional[float] = None, cover_resolution: Optional[float] = None,
              evaluate: bool = True, quality_samples: Optional[int] = None,
-             progress: Progress = None) -> SphereSet: ...
-def evaluate(mesh: Union[Mesh, Solid], spheres: Spheres, *,
+             selection: Optional[str] = None, progress: Progress = None) -> SphereSet: ...
+def evaluate(mesh: MeshOrSolid, spheres: Spheres, *,
              surface_samples: Optional[int] = None, voxel_size: Optional[float] = None,
              coverage_tolerance: Optional[float] = None,
              seed: Optional[int] = None) -> QualityReport: ...
-def certify(mesh: Union[Mesh, Solid], spheres: Spheres, *, resolution: Optional[float] = None,
+def certify(mesh: MeshOrSolid, spheres: Spheres, *, resolution: Optional[float] = None,
             stop_at_witness: Optional[bool] = None,
             progress: Progress = None) -> CoverCertificate: ...
 def read_spheres(path: str, *, format: Optional[str] = None, sph_level: int = -1,
@@ -313,7 +339,7 @@ class DeformationErrorBounds:
     seconds: float
 
 class Deformer:
-    def __init__(self, reference: Union[Mesh, Solid], spheres: SphereSet, *,
+    def __init__(self, reference: MeshOrSolid, spheres: SphereSet, *,
                  xi: Optional[float] = None, strict: bool = False,
                  interpolated_normal: bool = False) -> None: ...
     @property
@@ -416,6 +442,7 @@ def _rpc_methods() -> list[Tuple[str, str, bool, bool]]: ...
 def _inspect_mesh_request(mesh: Mesh, *, skip_self_intersections: bool,
                           repair: RepairLike) -> bytes: ...
 def _put_mesh_request(mesh: Mesh, *, repair: RepairLike) -> bytes: ...
+def _mesh_of(mesh: MeshLike) -> Mesh: ...
 def _repair_argument(repair: RepairLike, *, fill_holes: bool,
                      weld_tolerance: float) -> Repair: ...
 

@@ -5,6 +5,7 @@
 #include <pybind11/pybind11.h>
 
 #include <memory>
+#include <string>
 
 #include "inscribe/geometry/mesh.h"
 #include "inscribe/solid/solid.h"
@@ -38,8 +39,16 @@ RepairOptions RepairArgument(RepairOptions repair, bool fill_holes, double weld_
 std::shared_ptr<Solid> PrepareSolidReleasingGil(const Mesh& mesh, const RepairOptions& repair,
                                                 bool check_self_intersections);
 
-// An inscribe.Solid as given, or one prepared from an inscribe.Mesh (default validation);
-// TypeError for anything else.
+// The mesh of any argument that takes one: an inscribe.Mesh as it is; a path (str or
+// os.PathLike) read as load_mesh reads it; a (vertices, faces) tuple or list of two arrays, or
+// an object with .vertices and .faces (trimesh.Trimesh), converted as Mesh(vertices, triangles)
+// converts. TypeError naming what was given for anything else.
+std::shared_ptr<Mesh> MeshOf(py::handle mesh);
+
+// A path argument (str or os.PathLike) as a string; TypeError naming `name` otherwise.
+std::string PathOf(py::handle path, const char* name);
+
+// An inscribe.Solid as given, or one prepared (default validation) from anything MeshOf takes.
 std::shared_ptr<Solid> SolidOf(py::handle mesh_or_solid);
 
 }  // namespace inscribe::python

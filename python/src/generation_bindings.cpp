@@ -61,8 +61,9 @@ const std::string& GenerateDoc() {
     const MedialSphereOptions medial;
     return absl::StrCat(R"doc(Spheres for a closed mesh: the pipeline `inscribe generate` runs.
 
-mesh: an inscribe.Mesh (validated and prepared on each call) or an inscribe.Solid
-    (inscribe.prepare(mesh), reusable).
+mesh: an inscribe.Solid (inscribe.prepare(mesh), reusable), or a mesh validated and
+    prepared on each call: an inscribe.Mesh, a path, a (vertices, faces) pair of arrays or an
+    object with .vertices and .faces (trimesh.Trimesh).
 max_spheres: at most N spheres, spent as `selection` says (internal, dilated), or the
     smallest protrusion reached with N (cover). voxel_size: sigma, the voxel side in
     mesh units (internal, dilated only). At most one of the two; neither: a budget of )doc",
@@ -84,8 +85,9 @@ object_angle (radians, in (0, pi); default )doc",
     a budget), cover_resolution (the certificate's finest cell, a fraction of the largest
     bounding-box side). None means core's default for every one of them.
 evaluate: compute .quality (exact union volume, surface samples; quality_samples of them).
-progress: called on this thread with the fraction done in [0, 1]. Ctrl-C cancels the run
-    (KeyboardInterrupt) within about 50 ms of the core noticing.
+progress: a callable, called on this thread with the fraction done in [0, 1], or a
+    progress bar (tqdm.tqdm(total=100)) advanced to that fraction of its total. Ctrl-C
+    cancels the run (KeyboardInterrupt) within about 50 ms of the core noticing.
 
 Returns a SphereSet: .spheres (N, 4) float64 [x, y, z, r] in the mesh's units and frame,
 .kind, .mesh_sha256 (the validated mesh's), .quality, .certificate (covers), .stats.

@@ -14,6 +14,8 @@ namespace inscribe::python {
 
 absl::Status RunInterruptible(const py::object& progress,
                               const std::function<absl::Status(const GenerationControl&)>& work) {
+  const py::object report =
+      py::module_::import("inscribe._progress").attr("progress_callback")(progress);
   std::atomic<bool> cancel{false};
   std::atomic<double> fraction{-1.0};
   std::mutex mutex;
@@ -51,9 +53,9 @@ absl::Status RunInterruptible(const py::object& progress,
     try {
       if (PyErr_CheckSignals() != 0) throw py::error_already_set();
       const double now = fraction.load(std::memory_order_relaxed);
-      if (!progress.is_none() && now >= 0.0 && now != reported) {
+      if (!report.is_none() && now >= 0.0 && now != reported) {
         reported = now;
-        progress(now);
+        report(now);
       }
     } catch (py::error_already_set& error) {
       raised.emplace(std::move(error));

@@ -16,7 +16,8 @@ namespace py = pybind11;
 // Runs `work` on a worker thread while the calling thread, without the GIL, waits for it. Every
 // 50 ms (and once at the end) the calling thread takes the GIL, checks for signals
 // (PyErr_CheckSignals: Ctrl-C raises KeyboardInterrupt there) and passes the latest progress
-// fraction, when it changed, to `progress` (None: no callback). A signal, or an exception from
+// fraction, when it changed, to `progress` (None: no callback; a progress bar such as tqdm's is
+// advanced as inscribe._progress.progress_callback says). A signal, or an exception from
 // `progress`, sets the control's cancel flag, waits for `work` to return (core polls the flag
 // and returns CANCELLED promptly) and re-raises that exception. Otherwise returns what `work`
 // returned. `work` must not touch Python objects.

@@ -18,12 +18,13 @@ namespace inscribe::python {
 namespace {
 
 Mesh MeshFromArrays(py::handle vertices, py::handle triangles) {
-  py::array_t<double> v = RequireMatrix<double>(vertices, 3, "vertices");
-  py::array_t<std::int32_t> t = RequireMatrix<std::int32_t>(triangles, 3, "triangles");
+  py::array_t<double> v = ConvertMatrix<double>(vertices, 3, "vertices");
+  py::array_t<std::int32_t> t = ConvertMatrix<std::int32_t>(triangles, 3, "triangles");
   Mesh mesh;
   mesh.vertices.resize(v.shape(0), 3);
   mesh.triangles.resize(t.shape(0), 3);
-  // The one copy: Mesh owns Eigen storage with the same row-major layout.
+  // The one copy (after ConvertMatrix's, for other dtypes): Mesh owns Eigen storage with the
+  // same row-major layout.
   if (v.size() > 0) std::memcpy(mesh.vertices.data(), v.data(), v.size() * sizeof(double));
   if (t.size() > 0) std::memcpy(mesh.triangles.data(), t.data(), t.size() * sizeof(std::int32_t));
   return mesh;
@@ -91,13 +92,50 @@ std::shared_ptr<Solid> PrepareSolidReleasingGil(const Mesh& mesh, const RepairOp
   return prepared;
 }
 
+namespace {
+
+bool IsPath(py::handle value) {
+  return py::isinstance<py::str>(value) || py::hasattr(value, "__fspath__");
+}
+
+std::shared_ptr<Mesh> LoadMesh(const std::string& path) {
+  absl::StatusOr<Mesh> mesh;
+  {
+    py::gil_scoped_release release;
+    mesh = ReadMesh(path);
+  }
+  return std::make_shared<Mesh>(ValueOrRaise(std::move(mesh)));
+}
+
+}  // namespace
+
+std::string PathOf(py::handle path, const char* name) {
+  if (!IsPath(path)) {
+    throw py::type_error(absl::StrCat(name, " must be a str or os.PathLike, got ",
+                                      std::string(py::str(py::type::of(path).attr("__name__")))));
+  }
+  return py::module_::import("os").attr("fsdecode")(path).cast<std::string>();
+}
+
+std::shared_ptr<Mesh> MeshOf(py::handle mesh) {
+  if (py::isinstance<Mesh>(mesh)) return mesh.cast<std::shared_ptr<Mesh>>();
+  if (IsPath(mesh)) return LoadMesh(PathOf(mesh, "mesh"));
+  if ((py::isinstance<py::tuple>(mesh) || py::isinstance<py::list>(mesh)) && py::len(mesh) == 2) {
+    const py::sequence pair = py::reinterpret_borrow<py::sequence>(mesh);
+    return std::make_shared<Mesh>(MeshFromArrays(pair[0], pair[1]));
+  }
+  if (py::hasattr(mesh, "vertices") && py::hasattr(mesh, "faces")) {
+    return std::make_shared<Mesh>(MeshFromArrays(mesh.attr("vertices"), mesh.attr("faces")));
+  }
+  throw py::type_error(absl::StrCat(
+      "a mesh must be an inscribe.Mesh, a path, a (vertices, faces) pair or an object with "
+      ".vertices and .faces (trimesh), got ",
+      std::string(py::str(py::type::of(mesh).attr("__name__")))));
+}
+
 std::shared_ptr<Solid> SolidOf(py::handle mesh_or_solid) {
   if (py::isinstance<Solid>(mesh_or_solid)) return mesh_or_solid.cast<std::shared_ptr<Solid>>();
-  if (py::isinstance<Mesh>(mesh_or_solid)) {
-    return PrepareSolidReleasingGil(mesh_or_solid.cast<const Mesh&>(), RepairOptions{}, true);
-  }
-  throw py::type_error(absl::StrCat("expected an inscribe.Mesh or inscribe.Solid, got ",
-                                    std::string(py::str(py::type::of(mesh_or_solid)))));
+  return PrepareSolidReleasingGil(*MeshOf(mesh_or_solid), RepairOptions{}, true);
 }
 
 void BindMesh(py::module_& m) {
@@ -222,12 +260,16 @@ void BindMesh(py::module_& m) {
   py::class_<Mesh, std::shared_ptr<Mesh>>(
       m, "Mesh",
       "A triangle mesh: vertices (V, 3) float64 in the mesh's own units and frame, triangles "
-      "(T, 3) int32, 0-based, counter-clockwise seen from outside.")
+      "(T, 3) int32, 0-based, counter-clockwise seen from outside. Every call taking a mesh "
+      "also takes a path, a (vertices, faces) pair or an object with .vertices and .faces "
+      "(trimesh.Trimesh), converted as Mesh(vertices, triangles) converts.")
       .def(py::init(&MeshFromArrays), py::arg("vertices"), py::arg("triangles"),
-           "Mesh(vertices, triangles): vertices a C-contiguous (V, 3) float64 array, triangles a "
-           "C-contiguous (T, 3) int32 array (copied once). Other dtypes raise TypeError, other "
-           "shapes or non-contiguous arrays ValueError. Nothing is validated here: see "
-           "validate() and prepare().")
+           "Mesh(vertices, triangles): vertices a (V, 3) array of any float dtype (float64, "
+           "float32, ...), triangles a (T, 3) array of any integer dtype (int32, int64, uint32, "
+           "...), in any layout, or Python sequences; converted once to float64 and int32 and "
+           "copied into the mesh. TypeError for another dtype, ValueError for another shape or "
+           "an index int32 cannot hold. Nothing is validated here: see validate() and "
+           "prepare().")
       .def_property_readonly(
           "vertices", [](py::object self) { return VerticesView(self.cast<const Mesh&>(), self); },
           "(V, 3) float64, read-only view (no copy), mesh units")
@@ -235,6 +277,9 @@ void BindMesh(py::module_& m) {
           "triangles",
           [](py::object self) { return TrianglesView(self.cast<const Mesh&>(), self); },
           "(T, 3) int32, read-only view (no copy)")
+      .def_property_readonly(
+          "faces", [](py::object self) { return TrianglesView(self.cast<const Mesh&>(), self); },
+          "the triangles under trimesh's name: (T, 3) int32, read-only view (no copy)")
       .def_property_readonly("num_vertices", &Mesh::num_vertices)
       .def_property_readonly("num_triangles", &Mesh::num_triangles)
       .def_property_readonly(
@@ -283,34 +328,31 @@ void BindMesh(py::module_& m) {
       });
 
   m.def(
-      "load_mesh",
-      [](const std::string& path) {
-        absl::StatusOr<Mesh> mesh;
-        {
-          py::gil_scoped_release release;
-          mesh = ReadMesh(path);
-        }
-        return std::make_shared<Mesh>(ValueOrRaise(std::move(mesh)));
-      },
+      "load_mesh", [](py::handle path) { return LoadMesh(PathOf(path, "path")); },
       py::arg("path"),
       "Reads an OFF, OBJ, STL, PLY, COLLADA (.dae) or glTF (.gltf, .glb) file (by extension) "
-      "into a Mesh, polygons triangulated (COLLADA and glTF: every node's mesh placed by its "
+      "(a str or os.PathLike) into a Mesh, polygons triangulated (COLLADA and glTF: every node's mesh placed by its "
       "transform, in metres, in the file's own axes). "
       "FileNotFoundError for a missing file, ValueError for a malformed one. Not validated.");
 
   m.def(
       "write_mesh",
-      [](const Mesh& mesh, const std::string& path) {
+      [](py::handle mesh_like, py::handle path_like) {
+        const std::shared_ptr<Mesh> mesh = MeshOf(mesh_like);
+        const std::string path = PathOf(path_like, "path");
         absl::Status status;
         {
           py::gil_scoped_release release;
-          status = WriteMesh(path, mesh);
+          status = WriteMesh(path, *mesh);
         }
         OkOrRaise(status);
       },
       py::arg("mesh"), py::arg("path"),
-      "Writes `mesh` as OFF, OBJ, PLY or STL (by extension) with 17 significant digits, so "
+      "Writes `mesh` (anything a mesh argument takes) to `path` as OFF, OBJ, PLY or STL (by extension) with 17 significant digits, so "
       "load_mesh reads back the same doubles; atomically. ValueError for another extension.");
+
+  m.def("_mesh_of", [](py::handle mesh) { return MeshOf(mesh); }, py::arg("mesh"),
+        "The inscribe.Mesh of anything a mesh argument takes (inscribe.Client's uploads).");
 
   py::class_<Solid, std::shared_ptr<Solid>>(
       m, "Solid",
@@ -331,14 +373,15 @@ void BindMesh(py::module_& m) {
 
   m.def(
       "prepare",
-      [](const Mesh& mesh, const RepairOptions& repair, bool fill_holes,
+      [](py::handle mesh, const RepairOptions& repair, bool fill_holes,
          bool check_self_intersections) {
-        return PrepareSolidReleasingGil(mesh, RepairArgument(repair, fill_holes, 0.0),
+        return PrepareSolidReleasingGil(*MeshOf(mesh), RepairArgument(repair, fill_holes, 0.0),
                                         check_self_intersections);
       },
       py::arg("mesh"), py::kw_only(), py::arg("repair") = RepairOptions{},
       py::arg("fill_holes") = false, py::arg("check_self_intersections") = true,
-      "Validates `mesh` (repaired as `repair` allows: an inscribe.Repair or a level name, "
+      "Validates `mesh` (an inscribe.Mesh, a path, a (vertices, faces) pair or a trimesh; "
+      "repaired as `repair` allows: an inscribe.Repair or a level name, "
       "default 'safe'; fill_holes=True is 'fill'; every change is warned about as "
       "inscribe.MeshWarning) and builds its "
       "boundary oracle. inscribe.Error with code FAILED_PRECONDITION naming the first problem "

@@ -13,6 +13,7 @@
 #include "bindings.h"
 #include "inscribe/balls/sphere_io.h"
 #include "inscribe/generation/sphere_file_record.h"
+#include "inscribe/mesh/mesh_io.h"
 #include "sphere_set.h"
 #include "status_errors.h"
 
@@ -110,6 +111,13 @@ SphereFile FileOf(const PySphereSet& spheres) {
   return file;
 }
 
+// The (N, 4) read-only view of an inscribe.SphereSet's spheres, keeping it alive.
+py::array SpheresView(py::handle self) {
+  const SphereSet& set = self.cast<const PySphereSet&>().set;
+  const double* data = set.spheres.empty() ? nullptr : set.spheres.front().center.data();
+  return ReadOnlyView(data, static_cast<py::ssize_t>(set.size()), 4, sizeof(Sphere), self);
+}
+
 std::optional<SphereFileFormat> FormatOf(const std::optional<std::string>& name) {
   if (!name) return std::nullopt;
   return ValueOrRaise(ParseSphereFileFormat(*name));
@@ -121,7 +129,9 @@ void BindSpheres(py::module_& m) {
   py::class_<PySphereSet, std::shared_ptr<PySphereSet>>(
       m, "SphereSet",
       "Spheres approximating a solid, in the mesh's units and frame. `.spheres` is an (N, 4) "
-      "float64 array of [x, y, z, r] rows (read-only view, no copy).")
+      "float64 array of [x, y, z, r] rows (read-only view, no copy); the set itself is "
+      "array-like: np.asarray(set) is that array, and len, shape, indexing and iteration "
+      "are the array's.")
       .def(py::init(&MakeSphereSet), py::arg("spheres"), py::arg("contact_triangles") = py::none(),
            py::arg("contact_barycentrics") = py::none(), py::kw_only(), py::arg("kind") = "",
            py::arg("mesh_sha256") = "",
@@ -130,14 +140,49 @@ void BindSpheres(py::module_& m) {
            "r > 0, else ValueError naming the sphere); contacts, for deformation, an (N,) int32 "
            "array of triangle indices and an (N, 3) float64 array of barycentric weights.")
       .def_property_readonly(
-          "spheres",
-          [](py::object self) {
-            const SphereSet& set = self.cast<const PySphereSet&>().set;
-            const double* data = set.spheres.empty() ? nullptr : set.spheres.front().center.data();
-            return ReadOnlyView(data, static_cast<py::ssize_t>(set.size()), 4, sizeof(Sphere),
-                                self);
-          },
+          "spheres", &SpheresView,
           "(N, 4) float64 [x, y, z, r], mesh units and frame; a read-only view of the set")
+      .def(
+          "__array__",
+          [](py::handle self, py::object dtype, py::object copy) {
+            py::object array = SpheresView(self);
+            if (!dtype.is_none()) array = py::module_::import("numpy").attr("asarray")(array, dtype);
+            if (!copy.is_none() && copy.cast<bool>()) array = array.attr("copy")();
+            return array;
+          },
+          py::arg("dtype") = py::none(), py::arg("copy") = py::none(),
+          "numpy's protocol: the (N, 4) view (.spheres), converted to `dtype` or copied when "
+          "asked")
+      .def_property_readonly(
+          "shape", [](const PySphereSet& s) { return py::make_tuple(s.set.size(), 4); },
+          "(N, 4), as .spheres")
+      .def(
+          "__getitem__", [](py::handle self, py::handle index) { return py::object(SpheresView(self)[index]); },
+          "indexes .spheres: set[i] is row i [x, y, z, r], set[:, 3] the radii")
+      .def(
+          "__iter__", [](py::handle self) { return SpheresView(self).attr("__iter__")(); },
+          "the rows of .spheres")
+      .def(
+          "to_mesh",
+          [](const PySphereSet& s, int subdivision) {
+            SphereFile file;
+            file.set.spheres = s.set.spheres;
+            SphereFileWriteOptions options;
+            options.obj_subdivision = subdivision;
+            absl::StatusOr<Mesh> mesh;
+            {
+              py::gil_scoped_release release;
+              absl::StatusOr<std::string> obj = FormatSphereFile(file, SphereFileFormat::kObj,
+                                                                 options);
+              mesh = obj.ok() ? ParseMesh(*obj, "obj") : absl::StatusOr<Mesh>(obj.status());
+            }
+            return std::make_shared<Mesh>(ValueOrRaise(std::move(mesh)));
+          },
+          py::arg("subdivision") = 1,
+          "The spheres as one triangle mesh for viewing (an inscribe.Mesh: .vertices, .faces, "
+          "so trimesh.Trimesh(m.vertices, m.faces)): each sphere an icosphere with its vertices "
+          "on the sphere, subdivided `subdivision` times (0..5: 10 * 4^s + 2 vertices each), "
+          "as write_spheres writes .obj. The spheres overlap: it is not a closed solid.")
       .def_property_readonly(
           "centers",
           [](py::object self) {

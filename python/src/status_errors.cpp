@@ -1,7 +1,9 @@
 #include "status_errors.h"
 
 #include <cstdint>
+#include <limits>
 #include <string>
+#include <type_traits>
 
 #include "absl/strings/str_cat.h"
 
@@ -76,6 +78,42 @@ py::array_t<T> RequireMatrix(py::handle value, py::ssize_t cols, const char* nam
 }
 
 template <typename T>
+py::array_t<T> ConvertMatrix(py::handle value, py::ssize_t cols, const char* name) {
+  if (!py::isinstance<py::array>(value)) return RequireMatrix<T>(value, cols, name);
+  py::array array = py::reinterpret_borrow<py::array>(value);
+  if (array.ndim() != 2 || array.shape(1) != cols) {
+    throw py::value_error(
+        absl::StrCat(name, " must have shape (N, ", cols, "), got a ", Describe(array)));
+  }
+  const char kind = array.dtype().kind();
+  if constexpr (std::is_floating_point_v<T>) {
+    if (kind != 'f') {
+      throw py::type_error(absl::StrCat(name, " must be a float array (float64, float32, ...), ",
+                                        "got a ", Describe(array)));
+    }
+  } else {
+    if (kind != 'i' && kind != 'u') {
+      throw py::type_error(absl::StrCat(name, " must be an integer array (int32, int64, ...), ",
+                                        "got a ", Describe(array)));
+    }
+    if (array.size() > 0 && !py::isinstance<py::array_t<T>>(array)) {
+      const py::int_ lowest(std::numeric_limits<T>::min());
+      const py::int_ highest(std::numeric_limits<T>::max());
+      for (const char* extreme : {"min", "max"}) {
+        const py::object value = array.attr(extreme)().attr("item")();
+        if (value < lowest || value > highest) {
+          throw py::value_error(absl::StrCat(name, " holds ", std::string(py::str(value)),
+                                             ", which int32 cannot hold: indices must be in "
+                                             "[0, 2^31)"));
+        }
+      }
+    }
+  }
+  return py::reinterpret_borrow<py::array_t<T>>(
+      py::module_::import("numpy").attr("ascontiguousarray")(array, py::dtype::of<T>()));
+}
+
+template <typename T>
 py::array_t<T> RequireRowOrMatrix(py::handle value, py::ssize_t length, const char* name) {
   py::array_t<T> array = RequireArray<T>(value, name);
   if (array.ndim() == 1 && array.shape(0) == length) {
@@ -101,6 +139,9 @@ py::array ReadOnlyView(const T* data, py::ssize_t rows, py::ssize_t cols, py::ss
 
 template py::array_t<double> RequireMatrix<double>(py::handle, py::ssize_t, const char*);
 template py::array_t<std::int32_t> RequireMatrix<std::int32_t>(py::handle, py::ssize_t,
+                                                               const char*);
+template py::array_t<double> ConvertMatrix<double>(py::handle, py::ssize_t, const char*);
+template py::array_t<std::int32_t> ConvertMatrix<std::int32_t>(py::handle, py::ssize_t,
                                                                const char*);
 template py::array_t<double> RequireRowOrMatrix<double>(py::handle, py::ssize_t, const char*);
 template py::array ReadOnlyView<double>(const double*, py::ssize_t, py::ssize_t, py::ssize_t,

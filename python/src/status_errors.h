@@ -40,6 +40,15 @@ inline void OkOrRaise(const absl::Status& status) {
 template <typename T>
 py::array_t<T> RequireMatrix(py::handle value, py::ssize_t cols, const char* name);
 
+// `value` as a C-contiguous (N, cols) array of T (double or std::int32_t), converted once from a
+// numpy array of any dtype of T's kind (floating for double; signed or unsigned integer for
+// int32, every value checked to fit: ValueError naming the first that does not) and any layout,
+// or from a Python sequence; no copy when `value` already is one. TypeError for another kind,
+// ValueError for another shape, each naming `name` and what was given. Meshes' arrays only:
+// everything else is taken as RequireMatrix takes it.
+template <typename T>
+py::array_t<T> ConvertMatrix(py::handle value, py::ssize_t cols, const char* name);
+
 // A C-contiguous array of dtype T of shape (length,) or (N, length); same refusals as
 // RequireMatrix. Returns it as 2-D (one row for a 1-D array), without copying.
 template <typename T>

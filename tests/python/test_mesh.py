@@ -32,10 +32,11 @@ def test_views_share_the_mesh_memory():
 
 
 @pytest.mark.parametrize("vertices, error, text", [
-    (lambda v: v.astype(np.float32), TypeError, "vertices must be a float64 array, got a float32"),
-    (lambda v: np.asfortranarray(v), ValueError, "vertices must be C-contiguous"),
+    (lambda v: v.astype(np.int64), TypeError,
+     "vertices must be a float array (float64, float32, ...), got a int64 array of shape (8, 3)"),
     (lambda v: v[:, :2].copy(), ValueError, "vertices must have shape (N, 3), got a float64 array of shape (8, 2)"),
     (lambda v: v.ravel(), ValueError, "vertices must have shape (N, 3)"),
+    (lambda v: v.astype(np.float32)[:, :2], ValueError, "vertices must have shape (N, 3), got a float32"),
 ])
 def test_wrong_vertex_arrays_are_refused_by_name(vertices, error, text):
     v, t = cube()
@@ -44,10 +45,21 @@ def test_wrong_vertex_arrays_are_refused_by_name(vertices, error, text):
     assert text in str(raised.value)
 
 
-def test_int64_triangles_are_refused_with_the_conversion_to_make():
+@pytest.mark.parametrize("triangles, error, text", [
+    (lambda t: t.astype(np.float64), TypeError,
+     "triangles must be an integer array (int32, int64, ...), got a float64 array of shape (12, 3)"),
+    (lambda t: t[:, :2].astype(np.int64), ValueError,
+     "triangles must have shape (N, 3), got a int64 array of shape (12, 2)"),
+    (lambda t: np.where(t == 7, 2**31, t).astype(np.int64), ValueError,
+     "triangles holds 2147483648, which int32 cannot hold"),
+    (lambda t: np.where(t == 7, -2**40, t).astype(np.int64), ValueError,
+     "triangles holds -1099511627776, which int32 cannot hold"),
+])
+def test_wrong_triangle_arrays_are_refused_by_name(triangles, error, text):
     v, t = cube()
-    with pytest.raises(TypeError, match=r"triangles must be a int32 array, got a int64 .*astype\(np.int32\)"):
-        inscribe.Mesh(v, t.astype(np.int64))
+    with pytest.raises(error) as raised:
+        inscribe.Mesh(v, triangles(t))
+    assert text in str(raised.value)
 
 
 def test_load_mesh_missing_file_is_file_not_found():

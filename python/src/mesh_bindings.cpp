@@ -122,10 +122,14 @@ std::shared_ptr<Mesh> MeshOf(py::handle mesh) {
   if (IsPath(mesh)) return LoadMesh(PathOf(mesh, "mesh"));
   if ((py::isinstance<py::tuple>(mesh) || py::isinstance<py::list>(mesh)) && py::len(mesh) == 2) {
     const py::sequence pair = py::reinterpret_borrow<py::sequence>(mesh);
-    return std::make_shared<Mesh>(MeshFromArrays(pair[0], pair[1]));
+    const py::object vertices = pair[0];
+    const py::object faces = pair[1];
+    return std::make_shared<Mesh>(MeshFromArrays(vertices, faces));
   }
   if (py::hasattr(mesh, "vertices") && py::hasattr(mesh, "faces")) {
-    return std::make_shared<Mesh>(MeshFromArrays(mesh.attr("vertices"), mesh.attr("faces")));
+    const py::object vertices = mesh.attr("vertices");
+    const py::object faces = mesh.attr("faces");
+    return std::make_shared<Mesh>(MeshFromArrays(vertices, faces));
   }
   throw py::type_error(absl::StrCat(
       "a mesh must be an inscribe.Mesh, a path, a (vertices, faces) pair or an object with "
@@ -328,10 +332,10 @@ void BindMesh(py::module_& m) {
       });
 
   m.def(
-      "load_mesh", [](py::handle path) { return LoadMesh(PathOf(path, "path")); },
-      py::arg("path"),
+      "load_mesh", [](py::handle path) { return LoadMesh(PathOf(path, "path")); }, py::arg("path"),
       "Reads an OFF, OBJ, STL, PLY, COLLADA (.dae) or glTF (.gltf, .glb) file (by extension) "
-      "(a str or os.PathLike) into a Mesh, polygons triangulated (COLLADA and glTF: every node's mesh placed by its "
+      "(a str or os.PathLike) into a Mesh, polygons triangulated (COLLADA and glTF: every node's "
+      "mesh placed by its "
       "transform, in metres, in the file's own axes). "
       "FileNotFoundError for a missing file, ValueError for a malformed one. Not validated.");
 
@@ -348,11 +352,13 @@ void BindMesh(py::module_& m) {
         OkOrRaise(status);
       },
       py::arg("mesh"), py::arg("path"),
-      "Writes `mesh` (anything a mesh argument takes) to `path` as OFF, OBJ, PLY or STL (by extension) with 17 significant digits, so "
+      "Writes `mesh` (anything a mesh argument takes) to `path` as OFF, OBJ, PLY or STL (by "
+      "extension) with 17 significant digits, so "
       "load_mesh reads back the same doubles; atomically. ValueError for another extension.");
 
-  m.def("_mesh_of", [](py::handle mesh) { return MeshOf(mesh); }, py::arg("mesh"),
-        "The inscribe.Mesh of anything a mesh argument takes (inscribe.Client's uploads).");
+  m.def(
+      "_mesh_of", [](py::handle mesh) { return MeshOf(mesh); }, py::arg("mesh"),
+      "The inscribe.Mesh of anything a mesh argument takes (inscribe.Client's uploads).");
 
   py::class_<Solid, std::shared_ptr<Solid>>(
       m, "Solid",

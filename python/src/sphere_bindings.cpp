@@ -146,7 +146,8 @@ void BindSpheres(py::module_& m) {
           "__array__",
           [](py::handle self, py::object dtype, py::object copy) {
             py::object array = SpheresView(self);
-            if (!dtype.is_none()) array = py::module_::import("numpy").attr("asarray")(array, dtype);
+            if (!dtype.is_none())
+              array = py::module_::import("numpy").attr("asarray")(array, dtype);
             if (!copy.is_none() && copy.cast<bool>()) array = array.attr("copy")();
             return array;
           },
@@ -157,7 +158,8 @@ void BindSpheres(py::module_& m) {
           "shape", [](const PySphereSet& s) { return py::make_tuple(s.set.size(), 4); },
           "(N, 4), as .spheres")
       .def(
-          "__getitem__", [](py::handle self, py::handle index) { return py::object(SpheresView(self)[index]); },
+          "__getitem__",
+          [](py::handle self, py::handle index) { return py::object(SpheresView(self)[index]); },
           "indexes .spheres: set[i] is row i [x, y, z, r], set[:, 3] the radii")
       .def(
           "__iter__", [](py::handle self) { return SpheresView(self).attr("__iter__")(); },
@@ -172,8 +174,8 @@ void BindSpheres(py::module_& m) {
             absl::StatusOr<Mesh> mesh;
             {
               py::gil_scoped_release release;
-              absl::StatusOr<std::string> obj = FormatSphereFile(file, SphereFileFormat::kObj,
-                                                                 options);
+              absl::StatusOr<std::string> obj =
+                  FormatSphereFile(file, SphereFileFormat::kObj, options);
               mesh = obj.ok() ? ParseMesh(*obj, "obj") : absl::StatusOr<Mesh>(obj.status());
             }
             return std::make_shared<Mesh>(ValueOrRaise(std::move(mesh)));

@@ -118,6 +118,10 @@ def _run(command):
 
 def build_package():
     """Builds the inscribe_python target for this interpreter; returns <build>/python/inscribe."""
+    if not (TOP / "CMakeLists.txt").exists():
+        raise BuildError(f"{HERE} is not inside inscribe's source tree (no {TOP}/CMakeLists.txt): "
+                         "pip older than 21.3 copies the folder away; upgrade pip, or install "
+                         "from the source tree")
     build, configure = build_directory()
     if configure:
         _run(["cmake", "-S", str(TOP), "-B", str(build),

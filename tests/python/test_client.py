@@ -66,6 +66,29 @@ def test_generate_on_the_server_is_in_process_generation_bit_for_bit(server, eig
             client.generate(eight, max_spheres=60, selection="greedy")
 
 
+class TrimeshLike:
+    def __init__(self, mesh):
+        self.vertices = np.array(mesh.vertices)
+        self.faces = np.array(mesh.triangles, dtype=np.int64)
+
+
+def test_the_client_takes_every_mesh_form_and_gives_the_same_sphere_set(server, eight, tmp_path):
+    local = inscribe.generate(eight, max_spheres=30, evaluate=False)
+    path = tmp_path / "eight.ply"
+    inscribe.write_mesh(eight, path)
+    with inscribe.Client(server.address) as client:
+        for mesh in (path, (np.array(eight.vertices), np.array(eight.triangles, dtype=np.int64)),
+                     TrimeshLike(eight)):
+            result = client.generate(mesh, max_spheres=30, evaluate=False)
+            # The same type as in-process: a SphereSet, array-like as local.spheres is.
+            assert type(result.spheres) is type(local)
+            assert np.array_equal(np.asarray(result.spheres), np.asarray(local))
+            assert result.spheres.shape == local.spheres.shape
+            assert np.array_equal(result.spheres[:, 3], local.spheres[:, 3])
+        assert client.put_mesh(path) == inscribe.prepare(eight).sha256
+        assert client.inspect_mesh(str(path)).mesh_sha256 == inscribe.prepare(eight).sha256
+
+
 def test_distance_batch_and_session_match_in_process(server, eight):
     with inscribe.Client(server.address) as client:
         key = client.generate(eight, max_spheres=60).sphere_set_key

@@ -48,6 +48,15 @@ def pip_install(python, *flags):
     run(python, "-m", "pip", "install", "--quiet", *flags, SOURCE_DIR / "python")
 
 
+def preferred_linux_tag(python):
+    """The most specific tag pip's vendored `packaging` gives `python` for a wheel built
+    against this machine's libraries (linux_<arch>: not manylinux, which promises
+    portability)."""
+    return run(python, "-c", "from pip._vendor.packaging import tags; print(next("
+                             "t for t in tags.sys_tags() if t.platform.startswith('linux_')))"
+               ).strip()
+
+
 def test_a_bare_venv_installs_and_imports_without_numpy_or_grpcio(tmp_path):
     python = make_venv(DEBIAN_PYTHON, tmp_path / "bare")
     pip_install(python, "--no-build-isolation", "--no-deps")
@@ -61,27 +70,8 @@ def test_a_bare_venv_installs_and_imports_without_numpy_or_grpcio(tmp_path):
               "    print(e)\n")
     assert "inscribe.Client needs grpcio, which is not installed: pip install grpcio" in \
         run(python, "-c", script)
-
-
-def test_pip_with_build_isolation_needs_nothing_from_an_index(tmp_path):
-    python = make_venv(DEBIAN_PYTHON, tmp_path / "isolated")
-    pip_install(python, "--no-deps")
-    assert run(python, "-c", "import inscribe; print(inscribe.__version__)").strip() == VERSION
-
-
-def preferred_linux_tag(python):
-    """The most specific tag pip's vendored `packaging` gives `python` for a wheel built
-    against this machine's libraries (linux_<arch>: not manylinux, which promises
-    portability)."""
-    return run(python, "-c", "from pip._vendor.packaging import tags; print(next("
-                             "t for t in tags.sys_tags() if t.platform.startswith('linux_')))"
-               ).strip()
-
-
-def test_the_wheel_tag_is_the_one_pip_prefers_and_metadata_is_honest(tmp_path):
-    python = make_venv(DEBIAN_PYTHON, tmp_path / "tags")
-    pip_install(python, "--no-build-isolation", "--no-deps")
-    dist_info = pathlib.Path(glob.glob(str(tmp_path / f"tags/lib/python3*/site-packages/"
+    # The wheel's tag is the one pip prefers for a wheel of this machine; metadata is honest.
+    dist_info = pathlib.Path(glob.glob(str(tmp_path / f"bare/lib/python3*/site-packages/"
                                            f"inscribe-{VERSION}.dist-info"))[0])
     tag = re.search(r"^Tag: (.*)$", (dist_info / "WHEEL").read_text(), re.M).group(1)
     assert tag == preferred_linux_tag(python)
@@ -92,6 +82,12 @@ def test_the_wheel_tag_is_the_one_pip_prefers_and_metadata_is_honest(tmp_path):
     # RECORD lists every installed file with its hash (pip checks them on install).
     record = (dist_info / "RECORD").read_text()
     assert re.search(r"^inscribe/_inscribe\.cpython-[^,]+\.so,sha256=", record, re.M)
+
+
+def test_pip_with_build_isolation_needs_nothing_from_an_index(tmp_path):
+    python = make_venv(DEBIAN_PYTHON, tmp_path / "isolated")
+    pip_install(python, "--no-deps")
+    assert run(python, "-c", "import inscribe; print(inscribe.__version__)").strip() == VERSION
 
 
 def test_a_system_site_packages_venv_generates_the_suites_spheres(tmp_path):

@@ -13,7 +13,10 @@ The build directory, in this order:
     .cpython-311-x86_64-linux-gnu.so): the extension built there loads here;
   - else build/python-<SOABI>, configured here for this interpreter, CMAKE_BUILD_TYPE Release
     (INSCRIBE_BUILD_TYPE overrides), without tests and benchmarks.
-CMAKE_BUILD_PARALLEL_LEVEL sets the build's parallelism (default: every core).
+CMAKE_BUILD_PARALLEL_LEVEL sets the build's parallelism (default: every core). The wheel's
+extension has its debug information stripped (`strip --strip-debug`, binutils; a
+RelWithDebInfo build's 240 MB are 9 MB without it); an editable install imports the build
+folder's, debug information and all.
 Needs cmake, a C++17 compiler and the C++ dependencies (scripts/install-deps) on the machine.
 """
 
@@ -23,8 +26,10 @@ import os
 import pathlib
 import re
 import subprocess
+import shutil
 import sys
 import sysconfig
+import tempfile
 import zipfile
 
 HERE = pathlib.Path(__file__).resolve().parent.parent  # python/
@@ -138,6 +143,18 @@ def build_package():
     return package
 
 
+def without_debug_information(extension):
+    """The extension's bytes without debug sections (strip --strip-debug), or as they are
+    when binutils' strip is not there."""
+    strip = shutil.which("strip")
+    if strip is None:
+        return extension.read_bytes()
+    with tempfile.TemporaryDirectory() as scratch:
+        stripped = pathlib.Path(scratch) / extension.name
+        _run([strip, "--strip-debug", "-o", str(stripped), str(extension)])
+        return stripped.read_bytes()
+
+
 def version_of(package):
     """The version CMake wrote into _version.py (the top CMakeLists.txt's project VERSION)."""
     text = (package / "_version.py").read_text()
@@ -209,9 +226,10 @@ def get_requires_for_build_editable(config_settings=None):
 
 def build_wheel(wheel_directory, config_settings=None, metadata_directory=None):
     package = build_package()
-    suffix = sysconfig.get_config_var("EXT_SUFFIX")
+    extension = f"_inscribe{sysconfig.get_config_var('EXT_SUFFIX')}"
     files = {f"{NAME}/{path.name}": path.read_bytes() for path in sorted(package.iterdir())
-             if PACKAGE_FILES.fullmatch(path.name) or path.name == f"_inscribe{suffix}"}
+             if PACKAGE_FILES.fullmatch(path.name)}
+    files[f"{NAME}/{extension}"] = without_debug_information(package / extension)
     return write_wheel(wheel_directory, files, version_of(package), wheel_tag())
 
 

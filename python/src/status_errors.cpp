@@ -100,9 +100,9 @@ py::array_t<T> ConvertMatrix(py::handle value, py::ssize_t cols, const char* nam
       const py::int_ lowest(std::numeric_limits<T>::min());
       const py::int_ highest(std::numeric_limits<T>::max());
       for (const char* extreme : {"min", "max"}) {
-        const py::object value = array.attr(extreme)().attr("item")();
-        if (value < lowest || value > highest) {
-          throw py::value_error(absl::StrCat(name, " holds ", std::string(py::str(value)),
+        const py::object bound = array.attr(extreme)().attr("item")();
+        if (bound < lowest || bound > highest) {
+          throw py::value_error(absl::StrCat(name, " holds ", std::string(py::str(bound)),
                                              ", which int32 cannot hold: indices must be in "
                                              "[0, 2^31)"));
         }

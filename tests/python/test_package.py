@@ -82,6 +82,9 @@ def test_a_bare_venv_installs_and_imports_without_numpy_or_grpcio(tmp_path):
     # RECORD lists every installed file with its hash (pip checks them on install).
     record = (dist_info / "RECORD").read_text()
     assert re.search(r"^inscribe/_inscribe\.cpython-[^,]+\.so,sha256=", record, re.M)
+    # The installed extension carries no debug information (whatever the build type).
+    extension = next(dist_info.parent.glob("inscribe/_inscribe.cpython-*.so"))
+    assert b".debug_info" not in extension.read_bytes()
 
 
 def test_pip_with_build_isolation_needs_nothing_from_an_index(tmp_path):

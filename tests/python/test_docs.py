@@ -31,7 +31,8 @@ def test_type_stubs_cover_the_extension_exactly():
     stub = ast.parse((SOURCE_DIR / "python" / "inscribe" / "_inscribe.pyi").read_text())
     names = {node.name for node in stub.body if isinstance(node, (ast.FunctionDef, ast.ClassDef))}
     names |= {node.target.id for node in stub.body if isinstance(node, ast.AnnAssign)}
-    aliases = {"Float64Array", "Int32Array", "Progress", "Spheres"}
+    aliases = {"Float64Array", "Int32Array", "Progress", "ProgressBar", "Spheres",
+               "HasVerticesAndFaces"}
     public = {name for name in dir(extension) if not name.startswith("__")}
     assert names - aliases == public
 

@@ -93,6 +93,13 @@ def test_pip_with_build_isolation_needs_nothing_from_an_index(tmp_path):
     assert run(python, "-c", "import inscribe; print(inscribe.__version__)").strip() == VERSION
 
 
+def test_an_editable_install_imports_the_build_folders_package(tmp_path):
+    python = make_venv(DEBIAN_PYTHON, tmp_path / "editable")
+    pip_install(python, "--no-build-isolation", "--no-deps", "--editable")
+    where = run(python, "-c", "import inscribe; print(inscribe.__file__)").strip()
+    assert where == str(BUILD_DIR.resolve() / "python" / "inscribe" / "__init__.py")
+
+
 def test_a_system_site_packages_venv_generates_the_suites_spheres(tmp_path):
     import inscribe  # the suite's own, from build/python
 

@@ -218,9 +218,9 @@ def evaluate(mesh: MeshOrSolid, spheres: Spheres, *,
 def certify(mesh: MeshOrSolid, spheres: Spheres, *, resolution: Optional[float] = None,
             stop_at_witness: Optional[bool] = None,
             progress: Progress = None) -> CoverCertificate: ...
-def read_spheres(path: str, *, format: Optional[str] = None, sph_level: int = -1,
+def read_spheres(path: PathLike, *, format: Optional[str] = None, sph_level: int = -1,
                  yaml_link: str = "") -> SphereSet: ...
-def write_spheres(sphere_set: SphereSet, path: str, *, format: Optional[str] = None,
+def write_spheres(sphere_set: SphereSet, path: PathLike, *, format: Optional[str] = None,
                   csv_header: bool = True, obj_subdivision: int = 1,
                   yaml_link_name: str = "mesh") -> None: ...
 def format_curobo_yaml(links: Sequence[Tuple[str, Spheres]],
@@ -393,21 +393,21 @@ class SpherizedRobot:
                        progress: Optional[Callable[[float], object]] = None) -> SelfCollision: ...
     def curobo_yaml(self, self_collision: Optional[SelfCollision] = None) -> str: ...
     # format: "curobo", "xrdf", "srdf", "urdf" (VAMP), "morphit"; default: path's extension.
-    def write(self, path: str, *, format: Optional[str] = None,
+    def write(self, path: PathLike, *, format: Optional[str] = None,
               self_collision: Optional[SelfCollision] = None) -> None: ...
 
 # Robot sphere files in every planner format (robot_spheres.h): link -> (N, 4) [x, y, z, r].
-def read_robot_spheres(path: str, *, format: Optional[str] = None) -> dict[str, Float64Array]: ...
+def read_robot_spheres(path: PathLike, *, format: Optional[str] = None) -> dict[str, Float64Array]: ...
 # {"format", "robot_name", "spheres", "self_collision_ignore": [(a, b, reason)],
 #  "self_collision_buffer": {link: m}, "collision_buffer": {link: m}}
-def read_robot_sphere_file(path: str, *, format: Optional[str] = None) -> dict: ...
-def write_robot_spheres(path: str, spheres: Mapping[str, Float64Array], *,
+def read_robot_sphere_file(path: PathLike, *, format: Optional[str] = None) -> dict: ...
+def write_robot_spheres(path: PathLike, spheres: Mapping[str, Float64Array], *,
                         format: Optional[str] = None, robot: str = "", robot_name: str = "",
                         self_collision_ignore: Sequence[tuple[str, str, str]] = (),
                         self_collision_buffer: Mapping[str, float] = ...,
                         collision_buffer: Mapping[str, float] = ...) -> None: ...
 
-def spherize_robot(path: str, *, kind: str = "cover", max_spheres: Optional[int] = None,
+def spherize_robot(path: PathLike, *, kind: str = "cover", max_spheres: Optional[int] = None,
                    max_spheres_per_link: Optional[int] = None,
                    max_protrusion: Optional[float] = None,
                    voxel_size: Optional[float] = None,
@@ -421,7 +421,7 @@ def spherize_robot(path: str, *, kind: str = "cover", max_spheres: Optional[int]
                    link_repair: Mapping[str, RepairLike] = ...,
                    progress: Optional[Callable[[float], object]] = None) -> SpherizedRobot: ...
 
-def spherize_urdf(path: str, *, kind: str = "cover", max_spheres: Optional[int] = None,
+def spherize_urdf(path: PathLike, *, kind: str = "cover", max_spheres: Optional[int] = None,
                   max_spheres_per_link: Optional[int] = None,
                   max_protrusion: Optional[float] = None,
                   voxel_size: Optional[float] = None,

@@ -322,8 +322,9 @@ void BindRobot(py::module_& m) {
           "(0: padding is in the radii), as `inscribe urdf` writes it.")
       .def(
           "write",
-          [](const SpherizedRobot& r, const std::string& path,
+          [](const SpherizedRobot& r, py::handle path_like,
              const std::optional<std::string>& format, const PySelfCollision* self_collision) {
+            const std::string path = PathOf(path_like, "path");
             const robot::RobotSpheres model = robot::RobotSpheresFromSpherized(
                 r.links, r.file.robot().name,
                 self_collision == nullptr ? nullptr : &self_collision->matrix, {});
@@ -348,7 +349,8 @@ void BindRobot(py::module_& m) {
 
   m.def(
       "read_robot_spheres",
-      [](const std::string& path, const std::optional<std::string>& format) {
+      [](py::handle path_like, const std::optional<std::string>& format) {
+        const std::string path = PathOf(path_like, "path");
         const robot::RobotSpheres model =
             ValueOrRaise(robot::ReadRobotSpheresFile(path, FormatArgument(format)));
         py::dict out;
@@ -363,7 +365,8 @@ void BindRobot(py::module_& m) {
       "link's frame), by format, else extension and content. Link frames, metres.");
   m.def(
       "read_robot_sphere_file",
-      [](const std::string& path, const std::optional<std::string>& format) {
+      [](py::handle path_like, const std::optional<std::string>& format) {
+        const std::string path = PathOf(path_like, "path");
         robot::RobotSpheresFormat read_as = robot::RobotSpheresFormat::kCurobo;
         const robot::RobotSpheres model =
             ValueOrRaise(robot::ReadRobotSpheresFile(path, FormatArgument(format), &read_as));
@@ -376,11 +379,12 @@ void BindRobot(py::module_& m) {
       "metres}).");
   m.def(
       "write_robot_spheres",
-      [](const std::string& path, const py::dict& spheres, const std::optional<std::string>& format,
+      [](py::handle path_like, const py::dict& spheres, const std::optional<std::string>& format,
          const std::string& robot_urdf, const std::string& robot_name,
          const std::vector<std::tuple<std::string, std::string, std::string>>& ignore,
          const std::map<std::string, double>& self_collision_buffer,
          const std::map<std::string, double>& collision_buffer) {
+        const std::string path = PathOf(path_like, "path");
         robot::RobotSpheres model;
         model.robot_name = robot_name;
         for (const auto& [link, array] : spheres) {
@@ -442,7 +446,7 @@ void BindRobot(py::module_& m) {
 
   m.def(
       "spherize_robot",
-      [](const std::string& path, const std::string& kind, std::optional<std::int64_t> max_spheres,
+      [](py::handle path_like, const std::string& kind, std::optional<std::int64_t> max_spheres,
          std::optional<std::int64_t> max_spheres_per_link, std::optional<double> max_protrusion,
          std::optional<double> voxel_size,
          const std::map<std::string, std::int64_t>& link_max_spheres, double padding,
@@ -450,6 +454,7 @@ void BindRobot(py::module_& m) {
          const std::vector<std::string>& solid_classes, const std::vector<int>& solid_groups,
          const RepairOptions& repair, const std::map<std::string, RepairOptions>& link_repair,
          const py::object& progress) {
+        const std::string path = PathOf(path_like, "path");
         robot::MjcfReadOptions mjcf;
         mjcf.solid.classes = solid_classes;
         mjcf.solid.groups = solid_groups;
@@ -468,13 +473,14 @@ void BindRobot(py::module_& m) {
       py::arg("progress") = py::none(), robot_doc.c_str());
   m.def(
       "spherize_urdf",
-      [](const std::string& path, const std::string& kind, std::optional<std::int64_t> max_spheres,
+      [](py::handle path_like, const std::string& kind, std::optional<std::int64_t> max_spheres,
          std::optional<std::int64_t> max_spheres_per_link, std::optional<double> max_protrusion,
          std::optional<double> voxel_size,
          const std::map<std::string, std::int64_t>& link_max_spheres, double padding,
          const ClipPlanes& clip_planes, const std::vector<std::string>& package_paths,
          const RepairOptions& repair, const std::map<std::string, RepairOptions>& link_repair,
          const py::object& progress) {
+        const std::string path = PathOf(path_like, "path");
         return Spherize(path, kind, max_spheres, max_spheres_per_link, max_protrusion, voxel_size,
                         link_max_spheres, padding, clip_planes, package_paths, {}, repair,
                         link_repair, progress);

@@ -257,8 +257,9 @@ void BindSpheres(py::module_& m) {
 
   m.def(
       "read_spheres",
-      [](const std::string& path, std::optional<std::string> format, int sph_level,
+      [](py::handle path_like, std::optional<std::string> format, int sph_level,
          const std::string& yaml_link) {
+        const std::string path = PathOf(path_like, "path");
         SphereFileReadOptions options;
         options.format = FormatOf(format);
         options.sph_level = sph_level;
@@ -292,8 +293,9 @@ void BindSpheres(py::module_& m) {
 
   m.def(
       "write_spheres",
-      [](const PySphereSet& spheres, const std::string& path, std::optional<std::string> format,
+      [](const PySphereSet& spheres, py::handle path_like, std::optional<std::string> format,
          bool csv_header, int obj_subdivision, const std::string& yaml_link_name) {
+        const std::string path = PathOf(path_like, "path");
         SphereFileWriteOptions options;
         options.format = FormatOf(format);
         options.csv_header = csv_header;

@@ -170,3 +170,22 @@ def test_version_is_the_projects():
     version = re.search(r"project\(inscribe VERSION ([0-9.]+)",
                         pathlib.Path(SOURCE_DIR / "CMakeLists.txt").read_text()).group(1)
     assert inscribe.__version__ == version
+
+
+def test_every_path_argument_takes_a_pathlib_path(eight, tmp_path):
+    s = inscribe.generate(eight, max_spheres=20, evaluate=False)
+    inscribe.write_spheres(s, tmp_path / "eight.json")
+    assert np.array_equal(inscribe.read_spheres(tmp_path / "eight.json").spheres, s.spheres)
+    urdf = tmp_path / "box.urdf"
+    urdf.write_text('<robot name="r"><link name="base"><collision><geometry>'
+                    '<box size="0.3 0.2 0.1"/></geometry></collision></link></robot>')
+    robot = inscribe.spherize_robot(urdf, max_spheres_per_link=8)
+    robot.write(tmp_path / "box.yml")
+    back = inscribe.read_robot_spheres(tmp_path / "box.yml")
+    assert np.array_equal(back["base"], robot.spheres["base"])
+    assert inscribe.read_robot_sphere_file(tmp_path / "box.yml")["format"] == "curobo"
+    inscribe.write_robot_spheres(tmp_path / "again.yml", back)
+    assert np.array_equal(inscribe.read_robot_spheres(str(tmp_path / "again.yml"))["base"],
+                          back["base"])
+    with pytest.raises(TypeError, match="path must be a str or os.PathLike, got float"):
+        inscribe.read_spheres(1.5)

@@ -257,11 +257,11 @@ class Client:
     def put_mesh(self, mesh, *, repair="safe", fill_holes: bool = False,
                  weld_tolerance: float = 0.0, timeout: Optional[float] = None) -> str:
         """Validates and stores `mesh` (an inscribe.Mesh, a path, a (vertices, faces) pair or a
-        trimesh, as every in-process call takes a mesh) on its replica; returns its key "sha256:<hex>" (of the
-        mesh as the server repaired it: `repair` is an inscribe.Repair or a level name, as in
-        inscribe.prepare; fill_holes=True is "fill"; coincident vertices are always welded,
-        also those within weld_tolerance). inscribe.Error FAILED_PRECONDITION for an unusable
-        mesh."""
+        trimesh, as every in-process call takes a mesh) on its replica; returns its key
+        "sha256:<hex>" (of the mesh as the server repaired it: `repair` is an inscribe.Repair
+        or a level name, as in inscribe.prepare; fill_holes=True is "fill"; coincident vertices
+        are always welded, also those within weld_tolerance). inscribe.Error
+        FAILED_PRECONDITION for an unusable mesh."""
         mesh = _inscribe._mesh_of(mesh)
         request = _inscribe._put_mesh_request(
             mesh, repair=_inscribe._repair_argument(repair, fill_holes=fill_holes,

@@ -8,6 +8,7 @@
 #include <variant>
 
 #include "absl/strings/str_format.h"
+#include "cli_help.h"
 #include "command_outcome.h"
 #include "cover_verdict.h"
 #include "inscribe/balls/sphere_io.h"
@@ -265,6 +266,7 @@ void AddEvaluateCommand(CLI::App& app, CommandOutcome* outcome) {
       ->capture_default_str();
   cmd->add_flag("--json", options->json, "Print one JSON object on stdout");
   AddRemoteOptions(cmd, &options->remote, 60.0);
+  SetExitStatusHelp(cmd, "the mesh cannot be used, or with --certify the spheres are not a certified cover");
   cmd->callback([options, outcome] {
     *outcome = CommandOutcome{RunEvaluate(*options), options->remote.server};
   });

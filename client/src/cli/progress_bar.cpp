@@ -37,11 +37,15 @@ ProgressBar::ProgressBar(std::string label)
   const ProgressMode m = mode.load();
   terminal_ = m != ProgressMode::kOff && StderrIsTerminal();
   lines_ = m == ProgressMode::kLines && !terminal_;
+  if (lines_) {
+    std::fprintf(stderr, "inscribe: %s\n", label_.c_str());
+    std::fflush(stderr);
+  }
 }
 
 ProgressBar::~ProgressBar() {
   if (drawn_) std::fprintf(stderr, "\r\033[K");
-  if (lines_ && next_quarter_ > 0) {
+  if (lines_) {
     std::fprintf(stderr, "inscribe: %s: done in %.1f s\n", label_.c_str(), Since(start_));
   }
 }
@@ -49,7 +53,7 @@ ProgressBar::~ProgressBar() {
 void ProgressBar::Update(double fraction) {
   fraction = std::clamp(fraction, 0.0, 1.0);
   if (lines_) {
-    // A line as the stage starts (quarter 0), then one as each further quarter is reached.
+    // A line as each quarter is reached (the constructor said it started).
     if (fraction * 4.0 >= next_quarter_ && next_quarter_ < 4) {
       std::fprintf(stderr, "inscribe: %s %3d%% %.1f s\n", label_.c_str(),
                    static_cast<int>(fraction * 100.0), Since(start_));

@@ -37,7 +37,7 @@ class ProgressBar {
   bool terminal_ = false;
   bool lines_ = false;
   bool drawn_ = false;
-  int next_quarter_ = 0;  // lines mode: the next quarter to print a line at
+  int next_quarter_ = 1;  // lines mode: the next quarter to print a line at
   std::chrono::steady_clock::time_point start_;
   std::chrono::steady_clock::time_point last_draw_;
 };

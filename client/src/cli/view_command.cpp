@@ -216,7 +216,7 @@ void AddViewCommand(CLI::App& app, CommandOutcome* outcome) {
                   "cuRobo YAML with several links: the link whose spheres to show");
   cmd->add_option("--sph-level", options->sph_level, ".sph tree level to show (-1 = the leaves)")
       ->capture_default_str();
-  cmd->add_option("--samples", options->samples,
+  cmd->add_option("--quality-samples,--samples", options->samples,
                   "Points sampled on the boundary and on the envelope for coverage, Hausdorff "
                   "distance and the histograms")
       ->capture_default_str()

@@ -56,13 +56,15 @@ void AddRepairOptions(CLI::App* cmd, RepairOptions* repair) {
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   cmd->add_option("--wrap-alpha", repair->wrap_alpha,
-                  "The wrap's alpha (mesh units): gaps and holes narrower than about this are "
-                  "bridged; smaller costs more (about 1/alpha^2). Default: the bounding box's "
-                  "diagonal / 50")
+                  absl::StrCat("The wrap's alpha (mesh units): gaps and holes narrower than "
+                               "about this are bridged; smaller costs more (about 1/alpha^2). "
+                               "Default: the bounding box's diagonal / ",
+                               kWrapAlphaDivisor))
       ->check(CLI::PositiveNumber);
   cmd->add_option("--wrap-offset", repair->wrap_offset,
-                  "How far outside the input triangles the wrap lies (mesh units). Default: "
-                  "alpha / 30")
+                  absl::StrCat("How far outside the input triangles the wrap lies (mesh "
+                               "units). Default: alpha / ",
+                               kWrapOffsetDivisor))
       ->check(CLI::PositiveNumber);
 }
 

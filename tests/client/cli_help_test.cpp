@@ -167,7 +167,7 @@ TEST(CliProgress, PlainLinesOffATerminalOnlyWhenAskedFor) {
   ASSERT_EQ(run.exit_code, 0) << run.err;
   EXPECT_THAT(run.err, HasSubstr("inscribe: reading "));
   EXPECT_THAT(run.err, HasSubstr("inscribe: validating "));
-  EXPECT_THAT(run.err, HasSubstr("inscribe: generating "));
+  EXPECT_THAT(run.err, HasSubstr("inscribe: generating\n"));
   EXPECT_THAT(run.err, HasSubstr(": done in "));
   ::setenv("INSCRIBE_PROGRESS", "1", 1);
   run = RunCli(args);

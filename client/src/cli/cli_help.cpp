@@ -127,7 +127,7 @@ void SetExitStatusHelp(CLI::App* cmd, absl::string_view unusable) {
                     kExitNotAuthorized,
                     " the --server refused the call (missing or wrong --token-file)");
   }
-  absl::StrAppend(&text, "; ", kExitInternal, " internal error.");
+  absl::StrAppend(&text, "; ", kExitInternal, " internal error.\n");
   cmd->footer(text);
 }
 

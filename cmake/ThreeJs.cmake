@@ -1,13 +1,19 @@
 # three.js for `inscribe view`: the page embeds three.min.js and OrbitControls.js from the npm
 # package three@0.147.0 (the last release with the classic UMD build/three.min.js and
 # examples/js/, which attach THREE and THREE.OrbitControls as globals), and three's MIT
-# licence text. scripts/install-deps installs it (`npm install -g three@0.147.0`); nothing is
-# downloaded here. Sets INSCRIBE_THREE_DIR (cache) and INSCRIBE_THREE_{JS,ORBIT_CONTROLS,LICENSE}.
+# licence text. scripts/fetch-three (run by scripts/install-deps) puts it in deps/three, checked
+# against its pinned integrity hash; a global npm install (`npm install -g three@0.147.0`) is
+# found too. Nothing is downloaded here. Sets INSCRIBE_THREE_DIR (cache) and
+# INSCRIBE_THREE_{JS,ORBIT_CONTROLS,LICENSE}.
 include(${CMAKE_CURRENT_LIST_DIR}/EmbedFiles.cmake)
 
 set(INSCRIBE_THREE_VERSION 0.147.0)
+if(NOT INSCRIBE_THREE_DIR AND EXISTS ${PROJECT_SOURCE_DIR}/deps/three/package.json)
+  set(INSCRIBE_THREE_DIR "${PROJECT_SOURCE_DIR}/deps/three" CACHE PATH
+      "Directory of the npm package three@${INSCRIBE_THREE_VERSION} (default: deps/three)")
+endif()
 if(NOT INSCRIBE_THREE_DIR)
-  # Default: the global npm package directory. Asked once; the answer is cached.
+  # Else the global npm package directory. Asked once; the answer is cached.
   find_program(INSCRIBE_NPM npm)
   set(npm_root "")
   if(INSCRIBE_NPM)
@@ -19,8 +25,8 @@ if(NOT INSCRIBE_THREE_DIR)
   endif()
   if(npm_root STREQUAL "")
     message(FATAL_ERROR
-      "three.js ${INSCRIBE_THREE_VERSION} not found: `npm root -g` gave no directory (is npm "
-      "installed?): run scripts/install-deps or set INSCRIBE_THREE_DIR to the package directory")
+      "three.js ${INSCRIBE_THREE_VERSION} not found: no deps/three and `npm root -g` gave no "
+      "directory: run scripts/fetch-three or set INSCRIBE_THREE_DIR to the package directory")
   endif()
   set(INSCRIBE_THREE_DIR "${npm_root}/three" CACHE PATH
       "Directory of the npm package three@${INSCRIBE_THREE_VERSION} (default: `npm root -g`/three)")
@@ -52,6 +58,6 @@ endforeach()
 if(NOT three_problem STREQUAL "")
   message(FATAL_ERROR
     "three.js ${INSCRIBE_THREE_VERSION} not found under ${INSCRIBE_THREE_DIR} (${three_problem}): "
-    "run scripts/install-deps or set INSCRIBE_THREE_DIR")
+    "run scripts/fetch-three or set INSCRIBE_THREE_DIR")
 endif()
 message(STATUS "inscribe: three.js ${INSCRIBE_THREE_VERSION} from ${INSCRIBE_THREE_DIR}")

@@ -7,7 +7,9 @@
 #include <vector>
 
 #include "absl/strings/str_join.h"
+#include "cli_help.h"
 #include "command_outcome.h"
+#include "output_files.h"
 #include "inscribe/balls/sphere_io.h"
 #include "inscribe/robot/robot_spheres.h"
 #include "robot_sphere_files.h"
@@ -201,7 +203,8 @@ void AddConvertCommand(CLI::App& app, CommandOutcome* outcome) {
                   ".srdf, .urdf)")
       ->required();
   cmd->add_option("-o,--output", options->output_path,
-                  "Output file, written atomically (default: stdout)");
+                  "Output file, written atomically (default: stdout)")
+      ->check(WritableFile());
   cmd->add_option("--from", options->from, "Input format (default: from extension or content)")
       ->check(CLI::IsMember({"json", "sph", "csv", "yaml", "yml", "curobo", "xrdf", "srdf", "urdf",
                              "vamp", "morphit"},
@@ -228,6 +231,7 @@ void AddConvertCommand(CLI::App& app, CommandOutcome* outcome) {
                   "unscaled mesh")
       ->capture_default_str();
   cmd->add_flag("--json", options->json, "Print one JSON summary on stdout (needs -o)");
+  SetExitStatusHelp(cmd, "");
   cmd->callback([options, outcome] { outcome->status = RunConvert(*options); });
 }
 

@@ -8,7 +8,9 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "cli_help.h"
 #include "command_outcome.h"
+#include "output_files.h"
 #include "inscribe/balls/sphere_io.h"
 #include "inscribe/geometry/mesh_hash.h"
 #include "inscribe/medial/sphere_deformation.h"
@@ -238,6 +240,10 @@ void PrintSummary(const DeformCliOptions& options, const DeformInputs& in,
 }
 
 absl::Status RunDeform(const DeformCliOptions& options) {
+  if (absl::Status output = CheckSphereOutputFormat(options.output_path, options.format);
+      !output.ok()) {
+    return output;
+  }
   const auto load_start = std::chrono::steady_clock::now();
   absl::StatusOr<DeformInputs> in = ReadInputs(options);
   if (!in.ok()) return in.status();
@@ -310,7 +316,8 @@ void AddDeformCommand(CLI::App& app, CommandOutcome* outcome) {
   cmd->add_flag("--fill-holes", options->fill_holes,
                 "Close the reference's holes first, as generate --fill-holes did");
   cmd->add_option("-o,--output", options->output_path,
-                  "Write the moved spheres here (format from --format or the extension)");
+                  "Write the moved spheres here (format from --format or the extension)")
+      ->check(WritableFile());
   cmd->add_option("--format", options->format, "Sphere file format (output; input by extension)")
       ->check(CLI::IsMember({"json", "sph", "csv", "obj", "yaml", "yml"}, CLI::ignore_case));
   cmd->add_option("--link", options->link,
@@ -319,6 +326,7 @@ void AddDeformCommand(CLI::App& app, CommandOutcome* outcome) {
                 "Print one JSON summary on stdout (spheres, seconds, nerr_lower, nerr_upper, "
                 "max_protrusion, ...)");
   AddRemoteOptions(cmd, &options->remote, 60.0);
+  SetExitStatusHelp(cmd, "a mesh cannot be used");
   cmd->callback([options, outcome] {
     *outcome = CommandOutcome{RunDeform(*options), options->remote.server};
   });

@@ -12,7 +12,10 @@
 #include <vector>
 
 #include "absl/strings/str_format.h"
+#include "cli_help.h"
 #include "command_outcome.h"
+#include "inscribe/base/atomic_file.h"
+#include "output_files.h"
 #include "cover_verdict.h"
 #include "inscribe/balls/sphere_io.h"
 #include "inscribe/distance/certified_distance.h"
@@ -321,9 +324,10 @@ absl::Status RunDistance(const DistanceCliOptions& options) {
   const std::string csv =
       FormatCsv(d->results, d->certified, std::isfinite(options.request.closer_than));
   if (!options.output_path.empty()) {
-    std::ofstream out(options.output_path, std::ios::binary | std::ios::trunc);
-    out << csv;
-    if (!out.flush()) return BadInputError(options.output_path + ": cannot write");
+    if (absl::Status written = WriteFileAtomically(options.output_path, csv); !written.ok()) {
+      return BadInputError(written.message());
+    }
+    ReportWritten(options.output_path, absl::StrCat(d->results.size(), " poses, CSV"));
   } else if (!options.json) {
     std::cout << csv;
   }
@@ -387,10 +391,12 @@ void AddDistanceCommand(CLI::App& app, CommandOutcome* outcome) {
       ->needs(cover_b);
   cmd->add_option("-o,--output", options->output_path,
                   "Write the CSV here: pose,distance,sphere_a,sphere_b,ax,ay,az,bx,by,bz (with "
-                  "covers also lower,upper, and closer with --closer-than)");
+                  "covers also lower,upper, and closer with --closer-than)")
+      ->check(WritableFile());
   cmd->add_flag("--json", options->json,
                 "Print one JSON summary (queries, seconds, us_per_query, ...) on stdout");
   AddRemoteOptions(cmd, &options->remote, 60.0);
+  SetExitStatusHelp(cmd, "a mesh cannot be used, or a --cover-a/--cover-b is not a certified cover");
   cmd->callback([options, outcome] {
     *outcome = CommandOutcome{RunDistance(*options), options->remote.server};
   });

@@ -8,6 +8,7 @@
 #include <variant>
 
 #include "absl/strings/str_format.h"
+#include "cli_help.h"
 #include "command_outcome.h"
 #include "cover_verdict.h"
 #include "inscribe/balls/sphere_io.h"
@@ -245,8 +246,8 @@ void AddEvaluateCommand(CLI::App& app, CommandOutcome* outcome) {
   cmd->add_option("--sph-level", options->sph_level,
                   ".sph tree level to evaluate (-1 = the leaves)")
       ->capture_default_str();
-  cmd->add_option("--samples", options->quality.surface_samples,
-                  "Boundary samples for coverage and Hausdorff distance")
+  cmd->add_option("--quality-samples,--samples", options->quality.surface_samples,
+                  "Boundary samples for coverage and Hausdorff distance (as generate's)")
       ->capture_default_str();
   cmd->add_option("--coverage-tolerance", options->quality.coverage_tolerance,
                   "Covered = within this of the union, mesh units (default 1e-3 of the "
@@ -258,13 +259,14 @@ void AddEvaluateCommand(CLI::App& app, CommandOutcome* outcome) {
                 "Instead of the quality report: prove that the spheres contain the whole solid "
                 "(a cover), or give a point of the solid in no sphere; with delta, a sound bound "
                 "on how far they reach outside it. Exit 1 when not certified");
-  cmd->add_option("--certify-resolution", options->certify_options.resolution,
+  cmd->add_option("--cover-resolution,--certify-resolution", options->certify_options.resolution,
                   "With --certify: the proof's finest cell side, as a fraction of the largest "
                   "bounding-box side")
       ->check(CLI::Range(1e-6, 1.0))
       ->capture_default_str();
   cmd->add_flag("--json", options->json, "Print one JSON object on stdout");
   AddRemoteOptions(cmd, &options->remote, 60.0);
+  SetExitStatusHelp(cmd, "the mesh cannot be used, or with --certify the spheres are not a certified cover");
   cmd->callback([options, outcome] {
     *outcome = CommandOutcome{RunEvaluate(*options), options->remote.server};
   });

@@ -10,7 +10,9 @@
 #include <vector>
 
 #include "absl/strings/str_format.h"
+#include "cli_help.h"
 #include "command_outcome.h"
+#include "output_files.h"
 #include "inscribe/balls/sphere_io.h"
 #include "inscribe/generation/sphere_file_record.h"
 #include "inscribe/generation/sphere_set_generation.h"
@@ -46,6 +48,9 @@ struct Generated {
   // certificate are then about the repaired mesh, mesh_sha256, only.
   MeshReport mesh_report;
   double load_seconds = 0.0;  // reading, storing and validation
+  // This call's Generate, wall clock: on a cache hit far less than result.generation_seconds,
+  // the original computation's.
+  double call_seconds = 0.0;
   // Remote mode only: the server's key of the set and where it came from ("computed",
   // "memory", "disk", "joined").
   std::string sphere_set_key, cache;
@@ -64,8 +69,11 @@ absl::StatusOr<Generated> Generate(const client::Client& client,
   client::GenerateOptions call;
   call.on_progress = [&progress](double fraction) { progress.Update(fraction); };
   // The client uploads the mesh again if the service evicted it after StoreSolid.
+  const auto start = std::chrono::steady_clock::now();
   absl::StatusOr<client::GenerateResult> result =
       client.Generate(solid->sha256, solid->mesh, settings, call);
+  const double call_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!result.ok()) {
     // Parameters the service refuses are a bad command line.
     if (result.status().code() == absl::StatusCode::kInvalidArgument) {
@@ -84,6 +92,7 @@ absl::StatusOr<Generated> Generate(const client::Client& client,
   g.triangles = solid->report.triangles;
   g.mesh_report = solid->report;
   g.load_seconds = solid->seconds;
+  g.call_seconds = call_seconds;
   return g;
 }
 
@@ -104,7 +113,8 @@ void PrintSummary(const GenerateCliOptions& options, const Generated& g) {
     summary["max_spheres"] = *budget;
   }
   if (p.max_protrusion) summary["max_protrusion"] = *p.max_protrusion;
-  summary["seconds"] = r.generation_seconds;
+  summary["seconds"] = g.call_seconds;
+  summary["generation_seconds"] = r.generation_seconds;
   summary["load_seconds"] = g.load_seconds;
   if (r.kind != SphereSetKind::kCover) {  // figures of the medial run (as GenerationSphereFile)
     summary["epsilon"] = r.epsilon;
@@ -144,7 +154,30 @@ void PrintSummary(const GenerateCliOptions& options, const Generated& g) {
   std::cout << summary.dump() << "\n";
 }
 
+// One line on stderr: what was made, in how long, and where it came from on a cache hit.
+void PrintLine(const GenerateCliOptions& options, const Generated& g) {
+  const GeneratedSphereSet& r = g.result;
+  std::string line = absl::StrFormat("inscribe: %d %s spheres for %s", r.set.spheres.size(),
+                                     SphereSetKindName(r.kind), options.mesh_path);
+  if (r.cover) {
+    absl::StrAppendFormat(&line, ", delta %.4g", r.cover->certificate.delta);
+  } else if (r.quality) {
+    absl::StrAppendFormat(&line, ", nerr %.4g", r.quality->nerr);
+  }
+  if (g.cache.empty() || g.cache == "computed" || g.cache == "joined") {
+    absl::StrAppendFormat(&line, " in %.2f s", g.call_seconds);
+  } else {
+    absl::StrAppendFormat(&line, " from the server's %s cache in %.2f s (computed in %.2f s)",
+                          g.cache, g.call_seconds, r.generation_seconds);
+  }
+  std::cerr << line << "\n";
+}
+
 absl::Status RunGenerate(const GenerateCliOptions& options) {
+  if (absl::Status output = CheckSphereOutputFormat(options.output_path, options.format);
+      !output.ok()) {
+    return output;
+  }
   absl::StatusOr<std::unique_ptr<ServiceSession>> session = ServiceSession::Open(options.remote);
   if (!session.ok()) return session.status();
   absl::StatusOr<Generated> generated = Generate((*session)->client(), options);
@@ -159,7 +192,11 @@ absl::Status RunGenerate(const GenerateCliOptions& options) {
       !written.ok()) {
     return written;
   }
-  if (options.json) PrintSummary(options, *generated);
+  if (options.json) {
+    PrintSummary(options, *generated);
+  } else {
+    PrintLine(options, *generated);
+  }
   return absl::OkStatus();
 }
 
@@ -250,7 +287,8 @@ void AddGenerateCommand(CLI::App& app, CommandOutcome* outcome) {
                   "Boundary samples for coverage and Hausdorff distance in the stats")
       ->capture_default_str();
   cmd->add_option("-o,--output", options->output_path,
-                  "Write the sphere set here (format from --format or the extension)");
+                  "Write the sphere set here (format from --format or the extension)")
+      ->check(WritableFile());
   cmd->add_option("--format", options->format, "Sphere file format")
       ->check(CLI::IsMember({"json", "sph", "csv", "obj", "yaml", "yml"}, CLI::ignore_case));
   cmd->add_option("--link", options->link,
@@ -270,6 +308,7 @@ void AddGenerateCommand(CLI::App& app, CommandOutcome* outcome) {
                 "Print one JSON summary on stdout (spheres, voxel_size, seconds, volumes, nerr, "
                 "quality figures)");
   AddRemoteOptions(cmd, &options->remote, 600.0);
+  SetExitStatusHelp(cmd, "the mesh cannot be used");
   cmd->callback([options, outcome] {
     *outcome = CommandOutcome{RunGenerate(*options), options->remote.server};
   });

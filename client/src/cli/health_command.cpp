@@ -7,6 +7,8 @@
 #include <vector>
 
 #include "absl/strings/str_format.h"
+#include "cli_help.h"
+#include "inscribe/wire/service_address.h"
 #include "command_outcome.h"
 #include "grpc/health/v1/health.grpc.pb.h"
 #include "grpcpp/client_context.h"
@@ -31,7 +33,7 @@ absl::StatusOr<HealthCheckResponse::ServingStatus> Check(const std::string& targ
                                                          const HealthCliOptions& options) {
   const auto credentials =
       channel.credentials ? channel.credentials : grpc::InsecureChannelCredentials();
-  auto stub = grpc::health::v1::Health::NewStub(grpc::CreateChannel(target, credentials));
+  auto stub = grpc::health::v1::Health::NewStub(grpc::CreateChannel(wire::TargetWithDefaultPort(target), credentials));
   grpc::ClientContext context;
   context.set_deadline(std::chrono::system_clock::now() +
                        std::chrono::duration_cast<std::chrono::system_clock::duration>(
@@ -91,6 +93,7 @@ void AddHealthCommand(CLI::App& app, CommandOutcome* outcome) {
                   "Service to ask about; empty = the server as a whole")
       ->capture_default_str();
   AddRemoteOptions(cmd, &options->remote, 5.0, /*server_required=*/true);
+  SetExitStatusHelp(cmd, "");
   cmd->callback([options, outcome] {
     *outcome = CommandOutcome{RunHealth(*options), options->remote.server};
   });

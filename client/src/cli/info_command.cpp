@@ -8,7 +8,9 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "cli_help.h"
 #include "command_outcome.h"
+#include "output_files.h"
 #include "inscribe/geometry/mesh_hash.h"
 #include "inscribe/mesh/mesh_io.h"
 #include "inscribe/solid/mesh_validation.h"
@@ -103,6 +105,8 @@ absl::Status WriteRepaired(const InfoOptions& options, Mesh mesh, const std::str
   if (absl::Status written = WriteMesh(options.output_path, validated.mesh); !written.ok()) {
     return BadInputError(written.message());
   }
+  ReportWritten(options.output_path,
+                absl::StrCat(validated.mesh.num_triangles(), " triangles, as validated"));
   return absl::OkStatus();
 }
 
@@ -152,8 +156,10 @@ void AddInfoCommand(CLI::App& app, CommandOutcome* outcome) {
   AddSolidLoadOptions(cmd, &options->load);
   cmd->add_option("-o,--output", options->output_path,
                   "Write the mesh as validated and repaired (OFF, OBJ, PLY or STL by extension) "
-                  "when it is usable");
+                  "when it is usable")
+      ->check(WritableFile());
   AddRemoteOptions(cmd, &options->remote, 60.0);
+  SetExitStatusHelp(cmd, "the mesh cannot be used (not a closed solid at the --repair level given)");
   cmd->callback([options, outcome] {
     *outcome = CommandOutcome{RunInfo(*options), options->remote.server};
   });

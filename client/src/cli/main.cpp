@@ -5,7 +5,11 @@
 #include <CLI/CLI.hpp>
 #include <exception>
 #include <iostream>
+#include <optional>
+#include <string>
+#include <vector>
 
+#include "cli_help.h"
 #include "command_outcome.h"
 #include "convert_command.h"
 #include "deform_command.h"
@@ -14,6 +18,7 @@
 #include "generate_command.h"
 #include "health_command.h"
 #include "info_command.h"
+#include "progress_bar.h"
 #include "scene_command.h"
 #include "stats_command.h"
 #include "urdf_command.h"
@@ -22,13 +27,16 @@
 int main(int argc, char** argv) {
   CLI::App app{"inscribe: approximate closed triangle meshes by unions of medial spheres"};
   app.require_subcommand(1);
-  app.set_version_flag("--version", "inscribe 0.1.0");
-  app.footer(
-      "Exit status: 0 done; 1 the mesh cannot be used (evaluate --certify: the spheres are "
-      "not a certified cover); 2 missing, unreadable or malformed "
-      "input; 64 bad command line; 69 the --server could not be reached or did not answer "
-      "within --timeout; 70 internal error; 77 the --server refused the call (missing or wrong "
-      "--token-file, UNAUTHENTICATED or PERMISSION_DENIED).");
+  app.set_version_flag("--version", "inscribe " INSCRIBE_VERSION);
+  app.footer("Each subcommand's --help lists its options and exit statuses.");
+  inscribe::cli::SetProgressMode(inscribe::cli::ProgressModeFromEnvironment());
+  // Taken before or after the subcommand (fallthrough): `inscribe generate m.off --progress`.
+  app.add_flag_callback(
+      "--progress",
+      [] { inscribe::cli::SetProgressMode(inscribe::cli::ProgressMode::kLines); },
+      "Report progress on stderr as plain lines when it is not a terminal (a log, CI); the "
+      "same as INSCRIBE_PROGRESS=1 (0 turns progress off everywhere)");
+  app.fallthrough();
   inscribe::cli::CommandOutcome outcome;
   inscribe::cli::AddInfoCommand(app, &outcome);
   inscribe::cli::AddGenerateCommand(app, &outcome);
@@ -41,6 +49,11 @@ int main(int argc, char** argv) {
   inscribe::cli::AddUrdfCommand(app, &outcome);
   inscribe::cli::AddViewCommand(app, &outcome);
   inscribe::cli::AddConvertCommand(app, &outcome);
+  if (const std::optional<std::string> unknown =
+          inscribe::cli::UnknownSubcommandMessage(app, argc, argv)) {
+    std::cerr << "inscribe: " << *unknown << "\n";
+    return inscribe::cli::kExitUsage;
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -48,7 +61,12 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    app.exit(e);
+    const std::vector<std::string> unknown = inscribe::cli::UnknownOptionMessages(app);
+    if (unknown.empty()) {
+      app.exit(e);
+    } else {
+      for (const std::string& message : unknown) std::cerr << message << "\n";
+    }
     return inscribe::cli::kExitUsage;
   } catch (const std::exception& e) {
     std::cerr << "inscribe: internal error: " << e.what() << "\n";

@@ -14,7 +14,10 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "cli_help.h"
 #include "command_outcome.h"
+#include "inscribe/base/atomic_file.h"
+#include "output_files.h"
 #include "cover_verdict.h"
 #include "exit_codes.h"
 #include "inscribe/balls/sphere_io.h"
@@ -275,9 +278,10 @@ absl::Status RunScene(const SceneCliOptions& options) {
     for (const AnsweredFrame& f : frames) AppendCsv(f, &text);
   }
   if (!options.output_path.empty()) {
-    std::ofstream out(options.output_path, std::ios::binary | std::ios::trunc);
-    out << text;
-    if (!out.flush()) return BadInputError(options.output_path + ": cannot write");
+    if (absl::Status written = WriteFileAtomically(options.output_path, text); !written.ok()) {
+      return BadInputError(written.message());
+    }
+    ReportWritten(options.output_path, absl::StrCat(frames.size(), options.json ? " frames, JSON" : " frames, CSV"));
   } else {
     std::cout << text;
   }
@@ -304,10 +308,12 @@ void AddSceneCommand(CLI::App& app, CommandOutcome* outcome) {
       ->required();
   cmd->add_option("--threshold", options->threshold,
                   "Report pairs closer than this (mesh units), instead of the scene file's");
-  cmd->add_option("-o,--output", options->output_path, "Write the CSV (or JSON) here");
+  cmd->add_option("-o,--output", options->output_path, "Write the CSV (or JSON) here")
+      ->check(WritableFile());
   cmd->add_flag("--json", options->json,
                 "Print the frames as JSON (frame, counts, pairs with witnesses) instead of CSV");
   AddRemoteOptions(cmd, &options->remote, 60.0);
+  SetExitStatusHelp(cmd, "a mesh cannot be used");
   cmd->callback([options, outcome] {
     *outcome = CommandOutcome{RunScene(*options), options->remote.server};
   });

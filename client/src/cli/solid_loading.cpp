@@ -4,7 +4,9 @@
 #include <iostream>
 #include <utility>
 
+#include "absl/strings/str_cat.h"
 #include "command_outcome.h"
+#include "progress_bar.h"
 #include "inscribe/mesh/mesh_io.h"
 
 namespace inscribe::cli {
@@ -54,13 +56,15 @@ void AddRepairOptions(CLI::App* cmd, RepairOptions* repair) {
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   cmd->add_option("--wrap-alpha", repair->wrap_alpha,
-                  "The wrap's alpha (mesh units): gaps and holes narrower than about this are "
-                  "bridged; smaller costs more (about 1/alpha^2). Default: the bounding box's "
-                  "diagonal / 50")
+                  absl::StrCat("The wrap's alpha (mesh units): gaps and holes narrower than "
+                               "about this are bridged; smaller costs more (about 1/alpha^2). "
+                               "Default: the bounding box's diagonal / ",
+                               kWrapAlphaDivisor))
       ->check(CLI::PositiveNumber);
   cmd->add_option("--wrap-offset", repair->wrap_offset,
-                  "How far outside the input triangles the wrap lies (mesh units). Default: "
-                  "alpha / 30")
+                  absl::StrCat("How far outside the input triangles the wrap lies (mesh "
+                               "units). Default: alpha / ",
+                               kWrapOffsetDivisor))
       ->check(CLI::PositiveNumber);
 }
 
@@ -74,7 +78,11 @@ void AddSolidLoadOptions(CLI::App* cmd, SolidLoadOptions* options) {
 }
 
 absl::StatusOr<Mesh> ReadScaledMesh(const std::string& path, double scale, ReadMeshInfo* info) {
-  absl::StatusOr<Mesh> mesh = ReadMesh(path, info);
+  absl::StatusOr<Mesh> mesh;
+  {
+    const ProgressStage stage("reading " + path);
+    mesh = ReadMesh(path, info);
+  }
   if (!mesh.ok()) return BadInputError(mesh.status().message());
   if (scale != 1.0) mesh->vertices *= scale;
   return mesh;
@@ -86,7 +94,11 @@ absl::StatusOr<LoadedSolid> LoadSolid(const std::string& path, const SolidLoadOp
   if (!mesh.ok()) return mesh.status();
   SolidOptions solid_options;
   solid_options.validate.repair = options.repair;
-  absl::StatusOr<Solid> solid = PrepareSolid(*std::move(mesh), solid_options);
+  absl::StatusOr<Solid> solid = absl::UnknownError("not prepared");
+  {
+    const ProgressStage stage(absl::StrCat("validating ", mesh->num_triangles(), " triangles"));
+    solid = PrepareSolid(*std::move(mesh), solid_options);
+  }
   if (!solid.ok()) return UnusableMeshError(path + ": " + std::string(solid.status().message()));
   NoteRepairs(path, solid->report, solid->sha256);
   return LoadedSolid{*std::move(solid), SecondsSince(start)};
@@ -99,7 +111,11 @@ absl::StatusOr<StoredSolid> StoreSolid(const client::Client& client, const std::
   if (!mesh.ok()) return mesh.status();
   client::PutMeshOptions put;
   put.repair = options.repair;
-  absl::StatusOr<client::PutMeshResult> stored = client.PutMesh(*mesh, put);
+  absl::StatusOr<client::PutMeshResult> stored;
+  {
+    const ProgressStage stage(absl::StrCat("validating ", mesh->num_triangles(), " triangles"));
+    stored = client.PutMesh(*mesh, put);
+  }
   if (!stored.ok()) {
     if (stored.status().code() == absl::StatusCode::kFailedPrecondition) {
       return WithContext(path, stored.status());

@@ -2,7 +2,9 @@
 
 #include <iostream>
 
+#include "absl/strings/str_format.h"
 #include "command_outcome.h"
+#include "output_files.h"
 
 namespace inscribe::cli {
 
@@ -16,6 +18,11 @@ absl::Status EmitSphereFile(const SphereFile& file, const std::string& output_pa
     if (absl::Status status = WriteSphereFile(output_path, file, write); !status.ok()) {
       return BadInputError(status.message());
     }
+    const absl::StatusOr<SphereFileFormat> chosen =
+        write.format ? *write.format : SphereFileFormatFromPath(output_path);
+    ReportWritten(output_path,
+                  absl::StrFormat("%d spheres, %s", file.set.spheres.size(),
+                                  chosen.ok() ? SphereFileFormatName(*chosen) : "?"));
     return absl::OkStatus();
   }
   if (json_summary) return absl::OkStatus();

@@ -4,6 +4,7 @@
 #include <memory>
 
 #include "absl/strings/str_format.h"
+#include "cli_help.h"
 #include "command_outcome.h"
 #include "inscribe/wire/cache_stats.h"
 #include "nlohmann/json.hpp"
@@ -52,6 +53,7 @@ void AddStatsCommand(CLI::App& app, CommandOutcome* outcome) {
       "availability");
   cmd->add_flag("--json", options->json, "Print one JSON object on stdout");
   AddRemoteOptions(cmd, &options->remote, 60.0, /*server_required=*/true);
+  SetExitStatusHelp(cmd, "");
   cmd->callback([options, outcome] {
     *outcome = CommandOutcome{RunStats(*options), options->remote.server};
   });

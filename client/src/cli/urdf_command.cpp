@@ -16,7 +16,9 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_split.h"
+#include "cli_help.h"
 #include "command_outcome.h"
+#include "output_files.h"
 #include "inscribe/base/atomic_file.h"
 #include "inscribe/generation/sphere_set_generation.h"
 #include "inscribe/robot/kinematics.h"
@@ -563,13 +565,16 @@ void AddUrdfCommand(CLI::App& app, CommandOutcome* outcome) {
   cmd->add_option("-o,--output", options->output_path,
                   "The spherized URDF to write; for an MJCF model, the spherized MJCF (one file, "
                   "includes inlined)")
-      ->required();
+      ->required()
+      ->check(WritableFile());
   cmd->add_option("--yaml", options->yaml_path,
-                  "cuRobo collision_spheres YAML to write (default: -o with extension .yml)");
+                  "cuRobo collision_spheres YAML to write (default: -o with extension .yml)")
+      ->check(WritableFile());
   cmd->add_option("--srdf", options->srdf_path,
                   "Write MoveIt's SRDF with the self-collision matrix's disabled pairs "
                   "(disable_collisions, reason Adjacent, Default, Always or Never); into an SRDF "
-                  "already there they are merged, its groups, states and other pairs kept");
+                  "already there they are merged, its groups, states and other pairs kept")
+      ->check(WritableFile());
   cmd->add_option("--spheres", options->sphere_paths,
                   "Also write the spheres (and the matrix's disabled pairs) as a planner reads "
                   "them, in the format --format names or the extension says: .yml cuRobo's "
@@ -593,6 +598,7 @@ void AddUrdfCommand(CLI::App& app, CommandOutcome* outcome) {
   cmd->add_flag("--json", options->json,
                 "Print one JSON report on stdout: per link status, spheres, budget, delta, "
                 "certified, seconds, error");
+  SetExitStatusHelp(cmd, "a link was skipped or left out of the output (the summary says why)");
   cmd->callback([options, outcome] { outcome->status = RunUrdf(*options); });
 }
 

@@ -17,7 +17,9 @@
 
 #include "absl/strings/ascii.h"
 #include "absl/strings/str_format.h"
+#include "cli_help.h"
 #include "command_outcome.h"
+#include "output_files.h"
 #include "inscribe/balls/sphere_io.h"
 #include "inscribe/balls/sphere_quality.h"
 #include "inscribe/base/atomic_file.h"
@@ -129,8 +131,8 @@ absl::Status RunRobotView(const ViewCliOptions& options) {
     return BadInputError(written.message());
   }
   std::cout << *output << "\n";
-  std::cerr << absl::StrFormat("inscribe: %.0f KB page, %.2f s\n", page->size() / 1024.0,
-                               SecondsSince(start));
+  ReportWritten(*output,
+                absl::StrFormat("%.0f KB page, %.2f s", page->size() / 1024.0, SecondsSince(start)));
   return absl::OkStatus();
 }
 
@@ -183,8 +185,8 @@ absl::Status RunView(const ViewCliOptions& options) {
     return BadInputError(written.message());
   }
   std::cout << output << "\n";
-  std::cerr << absl::StrFormat("inscribe: %d spheres, %.0f KB page, %.2f s\n", spheres.size(),
-                               page->size() / 1024.0, SecondsSince(start));
+  ReportWritten(output, absl::StrFormat("%d spheres, %.0f KB page, %.2f s", spheres.size(),
+                                        page->size() / 1024.0, SecondsSince(start)));
   return absl::OkStatus();
 }
 
@@ -206,14 +208,15 @@ void AddViewCommand(CLI::App& app, CommandOutcome* outcome) {
                   "`inscribe urdf` wrote: the spherized URDF or the cuRobo YAML")
       ->required();
   cmd->add_option("-o,--output", options->output_path,
-                  "HTML file to write (default: SPHERES with the extension .html)");
+                  "HTML file to write (default: SPHERES with the extension .html)")
+      ->check(WritableFile());
   cmd->add_option("--format", options->format, "Sphere file format (default: from extension)")
       ->check(CLI::IsMember({"json", "sph", "csv", "yaml", "yml"}, CLI::ignore_case));
   cmd->add_option("--link", options->link,
                   "cuRobo YAML with several links: the link whose spheres to show");
   cmd->add_option("--sph-level", options->sph_level, ".sph tree level to show (-1 = the leaves)")
       ->capture_default_str();
-  cmd->add_option("--samples", options->samples,
+  cmd->add_option("--quality-samples,--samples", options->samples,
                   "Points sampled on the boundary and on the envelope for coverage, Hausdorff "
                   "distance and the histograms")
       ->capture_default_str()
@@ -226,6 +229,7 @@ void AddViewCommand(CLI::App& app, CommandOutcome* outcome) {
                   "Robots: a directory where package://NAME/... meshes are looked for (NAME "
                   "under it, or it itself when named NAME); before ROS_PACKAGE_PATH and "
                   "AMENT_PREFIX_PATH. Repeatable");
+  SetExitStatusHelp(cmd, "the mesh cannot be used");
   cmd->callback([cmd, options, outcome] {
     for (const char* name :
          {"--format", "--link", "--sph-level", "--samples", "--seed", "--fill-holes", "--repair",

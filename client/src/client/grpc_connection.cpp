@@ -22,6 +22,7 @@
 #include "inscribe/client/connection.h"
 #include "inscribe/v1/service.grpc.pb.h"
 #include "inscribe/wire/convert.h"
+#include "inscribe/wire/service_address.h"
 
 namespace inscribe::client {
 namespace {
@@ -349,7 +350,8 @@ std::shared_ptr<Connection> MakeGrpcConnection(const std::string& target,
   arguments.SetMaxSendMessageSize(options.max_message_bytes);
   std::shared_ptr<grpc::ChannelCredentials> credentials =
       options.credentials ? options.credentials : grpc::InsecureChannelCredentials();
-  return MakeGrpcConnection(grpc::CreateCustomChannel(target, credentials, arguments),
+  return MakeGrpcConnection(
+      grpc::CreateCustomChannel(wire::TargetWithDefaultPort(target), credentials, arguments),
                             options.bearer_token);
 }
 

@@ -86,6 +86,17 @@ absl::Status CheckSphereSetParameters(const SphereSetParameters& p) {
     return absl::InvalidArgumentError(
         absl::StrCat("the sphere budget must be at least 1, got ", *p.max_spheres));
   }
+  // One sphere per voxel (up to 8 per subdivided boundary voxel): a budget the finest grid
+  // allowed cannot hold would refine to that grid, minutes of work, and still fall short.
+  const double most_spheres =
+      static_cast<double>(p.medial.max_voxels) * (p.medial.subdivide_boundary ? 8.0 : 1.0);
+  if (!cover && p.max_spheres && static_cast<double>(*p.max_spheres) > most_spheres) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "a budget of ", *p.max_spheres, " spheres (max_spheres) is more than a grid of at most ",
+        p.medial.max_voxels, " voxels (max_voxels) can hold, one sphere per voxel",
+        p.medial.subdivide_boundary ? " (8 in a subdivided boundary voxel)" : "",
+        "; lower max_spheres or raise max_voxels"));
+  }
   if (p.selection != SphereSelection::kPaper && p.selection != SphereSelection::kOptimised) {
     return absl::InvalidArgumentError(
         absl::StrCat("selection must be paper or optimised, got ", static_cast<int>(p.selection)));

@@ -21,9 +21,10 @@ namespace internal {
 // Appends to the errors a repair can fix the levels above `tried` that would fix them, with
 // what they cost.
 void AppendRemedies(MeshReport& report, MeshRepair tried) {
-  const char* wrap =
-      "--repair wrap wraps any mesh in a watertight surface (about alpha/30 outside it; a "
-      "second or two per 100k triangles), --repair auto tries each level in turn";
+  const std::string wrap = absl::StrCat(
+      "--repair wrap wraps any mesh in a watertight surface (about alpha/", kWrapOffsetDivisor,
+      " outside it; a second or two per 100k triangles), --repair auto tries each level in "
+      "turn");
   for (MeshIssue& issue : report.issues) {
     if (issue.severity != Severity::kError) continue;
     std::string remedy;
@@ -261,8 +262,8 @@ double CrackWeldTolerance(const Mesh& mesh) {
   return std::max(tolerance, 1e-9 * diagonal);
 }
 
-double DefaultWrapAlpha(double diagonal) { return diagonal / 50.0; }
-double DefaultWrapOffset(double alpha) { return alpha / 30.0; }
+double DefaultWrapAlpha(double diagonal) { return diagonal / kWrapAlphaDivisor; }
+double DefaultWrapOffset(double alpha) { return alpha / kWrapOffsetDivisor; }
 
 namespace internal {
 

@@ -133,8 +133,9 @@ absl::StatusOr<std::shared_ptr<grpc::ChannelCredentials>> MakeTlsCredentials(con
 // token, or the token has a character outside printable ASCII (or a space).
 absl::StatusOr<std::string> ReadBearerToken(const std::string& path);
 
-// A Connection over one gRPC channel to `target` ("HOST:PORT", or any gRPC target URI such as
-// "dns:///host:port"). The channel connects lazily on the first call, so this never fails; an
+// A Connection over one gRPC channel to `target` ("HOST:PORT", "HOST" for the default port
+// 50051 (wire::TargetWithDefaultPort), or any gRPC target URI such as "dns:///host:port"). The
+// channel connects lazily on the first call, so this never fails; an
 // unreachable server shows up as UNAVAILABLE from the calls.
 std::shared_ptr<Connection> MakeGrpcConnection(const std::string& target,
                                                const ConnectionOptions& options = {});

@@ -156,7 +156,10 @@ absl::StatusOr<MeshRepair> ParseMeshRepair(const std::string& name);
 double CrackWeldTolerance(const Mesh& mesh);
 
 // The wrap's default parameters for a mesh whose bounding box has diagonal `diagonal`:
-// alpha = diagonal / 50, offset = alpha / 30 (CGAL's recommended ratio).
+// alpha = diagonal / kWrapAlphaDivisor, offset = alpha / kWrapOffsetDivisor. The offset sits
+// at CGAL's faster end (its examples use alpha / 30: 1.5x closer, about 1.4x the time).
+inline constexpr int kWrapAlphaDivisor = 50;
+inline constexpr int kWrapOffsetDivisor = 20;
 double DefaultWrapAlpha(double diagonal);
 double DefaultWrapOffset(double alpha);
 

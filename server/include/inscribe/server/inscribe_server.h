@@ -9,7 +9,9 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "absl/strings/str_cat.h"
 #include "inscribe/server/inscribe_service.h"
+#include "inscribe/wire/service_address.h"
 
 namespace grpc {
 class Channel;
@@ -34,7 +36,7 @@ struct ServerOptions {
   // --listen: HOST:PORT to bind (plaintext unless `tls` is enabled). Loopback by default; port
   // 0 picks a free port (read it back from InscribeServer::port()). Empty: no port at all, the
   // server is reached only through InProcessChannel (the CLI's embedded mode).
-  std::string listen = "127.0.0.1:50051";
+  std::string listen = absl::StrCat("127.0.0.1:", wire::kDefaultPort);
   // --jobs: requests computed at the same time. 0 = one per hardware thread.
   int jobs = 0;
   // --max-queue: requests queued or running at once; more get RESOURCE_EXHAUSTED.

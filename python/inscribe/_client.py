@@ -166,8 +166,9 @@ class Client:
                    ("grpc.max_receive_message_length", max_message_bytes)]
         self._replicas = []
         for name in names:
-            channel = (grpc.secure_channel(name, credentials, options) if credentials
-                       else grpc.insecure_channel(name, options))
+            target = _inscribe._target_with_default_port(name)
+            channel = (grpc.secure_channel(target, credentials, options) if credentials
+                       else grpc.insecure_channel(target, options))
             self._replicas.append(_Replica(name, channel))
         self._names = names
         self._metadata = (("authorization", f"Bearer {token}"),) if token else ()

@@ -1,4 +1,5 @@
-// The service's routing rules, for inscribe.Client: written once in wire/src/keys.cpp.
+// The service's routing and addressing rules, for inscribe.Client: written once in wire/
+// (keys.cpp, service_address.cpp).
 #include <pybind11/stl.h>
 
 #include <string>
@@ -6,6 +7,7 @@
 
 #include "bindings.h"
 #include "inscribe/wire/keys.h"
+#include "inscribe/wire/service_address.h"
 
 namespace inscribe::python {
 
@@ -20,6 +22,12 @@ void BindRouting(py::module_& m) {
       },
       py::arg("route_key"), py::arg("names"),
       "Replica indices for `route_key`, best first (wire::RendezvousOrder).");
+  m.def(
+      "_target_with_default_port",
+      [](const std::string& target) { return wire::TargetWithDefaultPort(target); },
+      py::arg("target"),
+      "`target` as gRPC should dial it: HOST alone gets inscribed's default port "
+      "(wire::TargetWithDefaultPort).");
 }
 
 }  // namespace inscribe::python

@@ -406,3 +406,12 @@ def test_mutual_tls(tmp_path, eight):
             assert raised.value.code == "UNAVAILABLE"
     finally:
         server.stop()
+
+
+def test_an_endpoint_without_a_port_dials_the_default_one():
+    # The one rule (wire::TargetWithDefaultPort), the CLI's and the C++ client's too.
+    from inscribe import _inscribe
+    assert _inscribe._target_with_default_port("localhost") == "localhost:50051"
+    assert _inscribe._target_with_default_port("::1") == "[::1]:50051"
+    assert _inscribe._target_with_default_port("localhost:7000") == "localhost:7000"
+    assert _inscribe._target_with_default_port("dns:///h:1") == "dns:///h:1"

@@ -173,8 +173,10 @@ void BindMesh(py::module_& m) {
            }),
            py::arg("level") = "safe", py::kw_only(), py::arg("weld_tolerance") = 0.0,
            py::arg("wrap_alpha") = 0.0, py::arg("wrap_offset") = 0.0,
-           "weld_tolerance: also weld vertices this close (mesh units). wrap_alpha, wrap_offset: "
-           "the wrap's parameters (mesh units; 0: diagonal / 50 and alpha / 30).")
+           absl::StrCat("weld_tolerance: also weld vertices this close (mesh units). wrap_alpha, "
+                        "wrap_offset: the wrap's parameters (mesh units; 0: diagonal / ",
+                        kWrapAlphaDivisor, " and alpha / ", kWrapOffsetDivisor, ").")
+               .c_str())
       .def_property_readonly("level",
                              [](const RepairOptions& r) { return MeshRepairName(r.level); })
       .def_readonly("weld_tolerance", &RepairOptions::weld_tolerance)

@@ -1,6 +1,8 @@
 // What the command line says when it is used wrongly: near matches for mistyped subcommands and
 // options, each subcommand's own exit statuses, output paths and budgets refused before any
 // work, the line naming what was written, progress lines off a terminal; and the default port.
+#include "cli_help.h"
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -11,7 +13,6 @@
 #include <string>
 #include <vector>
 
-#include "cli_help.h"
 #include "client/cli_run.h"
 #include "inscribe/wire/service_address.h"
 #include "support/test_meshes.h"
@@ -44,14 +45,14 @@ TEST(EditDistance, CountsEditsAndNeighbourSwapsOnce) {
 }
 
 TEST(NearNames, FindsTheIntendedNameAndNothingForNonsense) {
-  const std::vector<std::string> commands = {"info", "generate", "evaluate", "deform",
-                                             "distance", "scene", "urdf", "view", "convert"};
+  const std::vector<std::string> commands = {"info",  "generate", "evaluate", "deform", "distance",
+                                             "scene", "urdf",     "view",     "convert"};
   EXPECT_THAT(NearNames("genrate", commands), ElementsAre("generate"));
   EXPECT_THAT(NearNames("evalute", commands), ElementsAre("evaluate"));
   EXPECT_THAT(NearNames("dist", commands), ElementsAre("distance"));  // a prefix
   EXPECT_THAT(NearNames("xyzzy", commands), IsEmpty());
   const std::vector<std::string> options = {"--max-spheres", "--max-voxels", "--voxel-size",
-                                            "--cover", "-o", "--output"};
+                                            "--cover",       "-o",           "--output"};
   EXPECT_THAT(NearNames("--max-sphere", options), ElementsAre("--max-spheres"));
   EXPECT_THAT(NearNames("--voxelsize", options), ElementsAre("--voxel-size"));
   EXPECT_EQ(DidYouMean({"a", "b", "c"}), " (did you mean a, b or c?)");
@@ -74,6 +75,7 @@ TEST(TargetWithDefaultPort, AddsThePortOnlyWhereNoneIsGiven) {
 }
 
 TEST(CliHelp, AMistypedSubcommandGetsTheNearestName) {
+  EXPECT_EQ(RunCli("robot --help").exit_code, 0);  // an alias (of urdf) is a subcommand too
   const CliRun run = RunCli("genrate x.off");
   EXPECT_EQ(run.exit_code, 64);
   EXPECT_THAT(run.err, HasSubstr("unknown subcommand 'genrate' (did you mean generate?)"));
@@ -108,12 +110,12 @@ TEST(CliHelp, EachSubcommandListsOnlyItsOwnExitStatuses) {
 TEST(CliOutputs, AnUnwritablePathOrUnknownFormatIsRefusedBeforeAnyWork) {
   INSCRIBE_REQUIRE_MESH("eight.off");
   CliRun run = RunCli("generate " + Eight() + " -o /nonexistent-folder/spheres.json");
-  EXPECT_EQ(run.exit_code, 64);
-  EXPECT_THAT(run.err, HasSubstr("folder /nonexistent-folder does not exist"));
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_THAT(run.err, HasSubstr("directory /nonexistent-folder does not exist"));
   const fs::path dir = TempDir();
   run = RunCli("generate " + Eight() + " -o " + Quote(dir.string()));
-  EXPECT_EQ(run.exit_code, 64);
-  EXPECT_THAT(run.err, HasSubstr("is a folder, not a file"));
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_THAT(run.err, HasSubstr("it is a directory"));
   run = RunCli("generate " + Eight() + " -o " + Quote((dir / "spheres.xyz").string()));
   EXPECT_EQ(run.exit_code, 64);
   EXPECT_THAT(run.err, HasSubstr("--format"));

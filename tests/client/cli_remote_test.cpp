@@ -169,7 +169,8 @@ class CliRemote : public ::testing::Test {
 };
 
 // What the server does not send (see generate_command.cpp) and what it adds.
-const Keys kGenerateTimings = {"seconds", "load_seconds", "evaluate_seconds", "dilation_seconds"};
+const Keys kGenerateTimings = {"seconds", "generation_seconds", "load_seconds", "evaluate_seconds",
+                               "dilation_seconds"};
 
 TEST_F(CliRemote, InfoPrintsTheSameReport) {
   RunBothJson("info --json " + Eight(), {"seconds"});

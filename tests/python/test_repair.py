@@ -57,7 +57,7 @@ def test_the_wrap_encloses_the_input_and_matches_the_cli(tmp_path):
     wrap = inscribe.Repair("wrap", wrap_alpha=0.1)
     fixed, report = cup.repaired(wrap)
     assert report.usable and report.wrapped and report.closed
-    assert report.wrap_alpha == 0.1 and report.wrap_offset == pytest.approx(0.1 / 30)
+    assert report.wrap_alpha == 0.1 and report.wrap_offset == pytest.approx(0.1 / 20)
     assert fixed.num_triangles == report.wrap_triangles
     rng = np.random.default_rng(3)
     tri = cup.vertices[cup.triangles]

@@ -54,9 +54,8 @@ std::vector<std::string> NearNames(absl::string_view typed,
 std::string DidYouMean(const std::vector<std::string>& near) {
   if (near.empty()) return "";
   if (near.size() == 1) return absl::StrCat(" (did you mean ", near[0], "?)");
-  return absl::StrCat(" (did you mean ",
-                      absl::StrJoin(near.begin(), near.end() - 1, ", "), " or ", near.back(),
-                      "?)");
+  return absl::StrCat(" (did you mean ", absl::StrJoin(near.begin(), near.end() - 1, ", "), " or ",
+                      near.back(), "?)");
 }
 
 namespace {
@@ -65,6 +64,7 @@ std::vector<std::string> SubcommandNames(const CLI::App& app) {
   std::vector<std::string> names;
   for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) {
     names.push_back(sub->get_name());
+    for (const std::string& alias : sub->get_aliases()) names.push_back(alias);
   }
   return names;
 }
@@ -88,8 +88,12 @@ std::optional<std::string> UnknownSubcommandMessage(const CLI::App& app, int arg
   if (first.empty() || first[0] == '-') return std::nullopt;
   const std::vector<std::string> names = SubcommandNames(app);
   if (std::find(names.begin(), names.end(), first) != names.end()) return std::nullopt;
+  std::vector<std::string> listed;
+  for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) {
+    listed.push_back(sub->get_name());
+  }
   return absl::StrCat("unknown subcommand '", first, "'", DidYouMean(NearNames(first, names)),
-                      "; the subcommands are ", absl::StrJoin(names, ", "),
+                      "; the subcommands are ", absl::StrJoin(listed, ", "),
                       " (inscribe --help, inscribe SUBCOMMAND --help)");
 }
 

@@ -9,9 +9,9 @@
 #include "absl/strings/str_join.h"
 #include "cli_help.h"
 #include "command_outcome.h"
-#include "output_files.h"
 #include "inscribe/balls/sphere_io.h"
 #include "inscribe/robot/robot_spheres.h"
+#include "output_files.h"
 #include "robot_sphere_files.h"
 #include "sphere_output.h"
 

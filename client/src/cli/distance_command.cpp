@@ -14,14 +14,14 @@
 #include "absl/strings/str_format.h"
 #include "cli_help.h"
 #include "command_outcome.h"
-#include "inscribe/base/atomic_file.h"
-#include "output_files.h"
 #include "cover_verdict.h"
 #include "inscribe/balls/sphere_io.h"
+#include "inscribe/base/atomic_file.h"
 #include "inscribe/distance/certified_distance.h"
 #include "inscribe/distance/separation_distance.h"
 #include "inscribe/generation/sphere_file_record.h"
 #include "nlohmann/json.hpp"
+#include "output_files.h"
 #include "pose_file.h"
 #include "remote_options.h"
 #include "service_session.h"
@@ -396,7 +396,8 @@ void AddDistanceCommand(CLI::App& app, CommandOutcome* outcome) {
   cmd->add_flag("--json", options->json,
                 "Print one JSON summary (queries, seconds, us_per_query, ...) on stdout");
   AddRemoteOptions(cmd, &options->remote, 60.0);
-  SetExitStatusHelp(cmd, "a mesh cannot be used, or a --cover-a/--cover-b is not a certified cover");
+  SetExitStatusHelp(cmd,
+                    "a mesh cannot be used, or a --cover-a/--cover-b is not a certified cover");
   cmd->callback([options, outcome] {
     *outcome = CommandOutcome{RunDistance(*options), options->remote.server};
   });

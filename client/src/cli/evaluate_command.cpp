@@ -266,7 +266,8 @@ void AddEvaluateCommand(CLI::App& app, CommandOutcome* outcome) {
       ->capture_default_str();
   cmd->add_flag("--json", options->json, "Print one JSON object on stdout");
   AddRemoteOptions(cmd, &options->remote, 60.0);
-  SetExitStatusHelp(cmd, "the mesh cannot be used, or with --certify the spheres are not a certified cover");
+  SetExitStatusHelp(
+      cmd, "the mesh cannot be used, or with --certify the spheres are not a certified cover");
   cmd->callback([options, outcome] {
     *outcome = CommandOutcome{RunEvaluate(*options), options->remote.server};
   });

@@ -8,13 +8,13 @@
 
 #include "absl/strings/str_format.h"
 #include "cli_help.h"
-#include "inscribe/wire/service_address.h"
 #include "command_outcome.h"
 #include "grpc/health/v1/health.grpc.pb.h"
 #include "grpcpp/client_context.h"
 #include "grpcpp/create_channel.h"
 #include "grpcpp/security/credentials.h"
 #include "inscribe/wire/convert.h"
+#include "inscribe/wire/service_address.h"
 #include "remote_options.h"
 
 namespace inscribe::cli {
@@ -33,7 +33,8 @@ absl::StatusOr<HealthCheckResponse::ServingStatus> Check(const std::string& targ
                                                          const HealthCliOptions& options) {
   const auto credentials =
       channel.credentials ? channel.credentials : grpc::InsecureChannelCredentials();
-  auto stub = grpc::health::v1::Health::NewStub(grpc::CreateChannel(wire::TargetWithDefaultPort(target), credentials));
+  auto stub = grpc::health::v1::Health::NewStub(
+      grpc::CreateChannel(wire::TargetWithDefaultPort(target), credentials));
   grpc::ClientContext context;
   context.set_deadline(std::chrono::system_clock::now() +
                        std::chrono::duration_cast<std::chrono::system_clock::duration>(

@@ -10,11 +10,11 @@
 #include "absl/strings/str_format.h"
 #include "cli_help.h"
 #include "command_outcome.h"
-#include "output_files.h"
 #include "inscribe/geometry/mesh_hash.h"
 #include "inscribe/mesh/mesh_io.h"
 #include "inscribe/solid/mesh_validation.h"
 #include "inscribe/view/report_json.h"
+#include "output_files.h"
 #include "remote_options.h"
 #include "service_session.h"
 #include "solid_loading.h"
@@ -159,7 +159,8 @@ void AddInfoCommand(CLI::App& app, CommandOutcome* outcome) {
                   "when it is usable")
       ->check(WritableFile());
   AddRemoteOptions(cmd, &options->remote, 60.0);
-  SetExitStatusHelp(cmd, "the mesh cannot be used (not a closed solid at the --repair level given)");
+  SetExitStatusHelp(cmd,
+                    "the mesh cannot be used (not a closed solid at the --repair level given)");
   cmd->callback([options, outcome] {
     *outcome = CommandOutcome{RunInfo(*options), options->remote.server};
   });

@@ -18,6 +18,7 @@
 #include "generate_command.h"
 #include "health_command.h"
 #include "info_command.h"
+#include "output_files.h"
 #include "progress_bar.h"
 #include "scene_command.h"
 #include "stats_command.h"
@@ -32,8 +33,7 @@ int main(int argc, char** argv) {
   inscribe::cli::SetProgressMode(inscribe::cli::ProgressModeFromEnvironment());
   // Taken before or after the subcommand (fallthrough): `inscribe generate m.off --progress`.
   app.add_flag_callback(
-      "--progress",
-      [] { inscribe::cli::SetProgressMode(inscribe::cli::ProgressMode::kLines); },
+      "--progress", [] { inscribe::cli::SetProgressMode(inscribe::cli::ProgressMode::kLines); },
       "Report progress on stderr as plain lines when it is not a terminal (a log, CI); the "
       "same as INSCRIBE_PROGRESS=1 (0 turns progress off everywhere)");
   app.fallthrough();
@@ -67,7 +67,10 @@ int main(int argc, char** argv) {
     } else {
       for (const std::string& message : unknown) std::cerr << message << "\n";
     }
-    return inscribe::cli::kExitUsage;
+    // An output that cannot be written is a file problem (2), like an input that cannot be
+    // read, found here before any work.
+    return inscribe::cli::OutputPathRefused() ? inscribe::cli::kExitBadInput
+                                              : inscribe::cli::kExitUsage;
   } catch (const std::exception& e) {
     std::cerr << "inscribe: internal error: " << e.what() << "\n";
     return inscribe::cli::kExitInternal;

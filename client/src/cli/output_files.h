@@ -14,6 +14,9 @@ namespace inscribe::cli {
 // this process may write there. Fails the parse ("-o: folder out/ does not exist") so that a
 // wrong path costs nothing.
 CLI::Validator WritableFile();
+// Whether WritableFile refused a path in this process: main then exits kExitBadInput (2), as
+// for any file that cannot be written, not kExitUsage.
+bool OutputPathRefused();
 
 // The sphere file format `path` gets: `format` when given, else its extension's. UsageError
 // naming --format and the formats when neither says: checked before any work.

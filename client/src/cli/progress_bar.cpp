@@ -31,9 +31,7 @@ ProgressMode ProgressModeFromEnvironment() {
 void SetProgressMode(ProgressMode m) { mode.store(m); }
 
 ProgressBar::ProgressBar(std::string label)
-    : label_(std::move(label)),
-      start_(std::chrono::steady_clock::now()),
-      last_draw_(start_) {
+    : label_(std::move(label)), start_(std::chrono::steady_clock::now()), last_draw_(start_) {
   const ProgressMode m = mode.load();
   terminal_ = m != ProgressMode::kOff && StderrIsTerminal();
   lines_ = m == ProgressMode::kLines && !terminal_;

@@ -16,7 +16,8 @@ void AddRemoteOptions(CLI::App* cmd, RemoteOptions* options, double default_time
   options->timeout_seconds = default_timeout_seconds;
   CLI::Option* server = cmd->add_option(
       "--server", options->server,
-      "Run on the inscribed server at HOST:PORT (HOST alone: port 50051) instead of in this process (the output is the "
+      "Run on the inscribed server at HOST:PORT (HOST alone: port 50051) instead of in this "
+      "process (the output is the "
       "same); several replicas separated by commas: each mesh's calls go to one of them, "
       "failing over to the next when it is down");
   if (server_required) server->required();

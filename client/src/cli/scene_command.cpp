@@ -16,14 +16,14 @@
 #include "absl/strings/str_format.h"
 #include "cli_help.h"
 #include "command_outcome.h"
-#include "inscribe/base/atomic_file.h"
-#include "output_files.h"
 #include "cover_verdict.h"
 #include "exit_codes.h"
 #include "inscribe/balls/sphere_io.h"
+#include "inscribe/base/atomic_file.h"
 #include "inscribe/generation/sphere_file_record.h"
 #include "inscribe/scene/scene.h"
 #include "nlohmann/json.hpp"
+#include "output_files.h"
 #include "remote_options.h"
 #include "scene_files.h"
 #include "service_session.h"
@@ -281,7 +281,8 @@ absl::Status RunScene(const SceneCliOptions& options) {
     if (absl::Status written = WriteFileAtomically(options.output_path, text); !written.ok()) {
       return BadInputError(written.message());
     }
-    ReportWritten(options.output_path, absl::StrCat(frames.size(), options.json ? " frames, JSON" : " frames, CSV"));
+    ReportWritten(options.output_path,
+                  absl::StrCat(frames.size(), options.json ? " frames, JSON" : " frames, CSV"));
   } else {
     std::cout << text;
   }

@@ -6,8 +6,8 @@
 
 #include "absl/strings/str_cat.h"
 #include "command_outcome.h"
-#include "progress_bar.h"
 #include "inscribe/mesh/mesh_io.h"
+#include "progress_bar.h"
 
 namespace inscribe::cli {
 namespace {

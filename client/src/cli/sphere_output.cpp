@@ -20,9 +20,8 @@ absl::Status EmitSphereFile(const SphereFile& file, const std::string& output_pa
     }
     const absl::StatusOr<SphereFileFormat> chosen =
         write.format ? *write.format : SphereFileFormatFromPath(output_path);
-    ReportWritten(output_path,
-                  absl::StrFormat("%d spheres, %s", file.set.spheres.size(),
-                                  chosen.ok() ? SphereFileFormatName(*chosen) : "?"));
+    ReportWritten(output_path, absl::StrFormat("%d spheres, %s", file.set.spheres.size(),
+                                               chosen.ok() ? SphereFileFormatName(*chosen) : "?"));
     return absl::OkStatus();
   }
   if (json_summary) return absl::OkStatus();

@@ -18,7 +18,6 @@
 #include "absl/strings/str_split.h"
 #include "cli_help.h"
 #include "command_outcome.h"
-#include "output_files.h"
 #include "inscribe/base/atomic_file.h"
 #include "inscribe/generation/sphere_set_generation.h"
 #include "inscribe/robot/kinematics.h"
@@ -31,6 +30,7 @@
 #include "inscribe/robot/urdf_robot.h"
 #include "inscribe/robot/urdf_spherize.h"
 #include "nlohmann/json.hpp"
+#include "output_files.h"
 #include "robot_sphere_files.h"
 #include "solid_loading.h"
 

@@ -19,13 +19,13 @@
 #include "absl/strings/str_format.h"
 #include "cli_help.h"
 #include "command_outcome.h"
-#include "output_files.h"
 #include "inscribe/balls/sphere_io.h"
 #include "inscribe/balls/sphere_quality.h"
 #include "inscribe/base/atomic_file.h"
 #include "inscribe/robot/urdf_robot.h"
 #include "inscribe/view/robot_view.h"
 #include "inscribe/view/view_report.h"
+#include "output_files.h"
 #include "solid_loading.h"
 
 namespace inscribe::cli {
@@ -131,8 +131,8 @@ absl::Status RunRobotView(const ViewCliOptions& options) {
     return BadInputError(written.message());
   }
   std::cout << *output << "\n";
-  ReportWritten(*output,
-                absl::StrFormat("%.0f KB page, %.2f s", page->size() / 1024.0, SecondsSince(start)));
+  ReportWritten(
+      *output, absl::StrFormat("%.0f KB page, %.2f s", page->size() / 1024.0, SecondsSince(start)));
   return absl::OkStatus();
 }
 

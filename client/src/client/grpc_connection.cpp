@@ -352,7 +352,7 @@ std::shared_ptr<Connection> MakeGrpcConnection(const std::string& target,
       options.credentials ? options.credentials : grpc::InsecureChannelCredentials();
   return MakeGrpcConnection(
       grpc::CreateCustomChannel(wire::TargetWithDefaultPort(target), credentials, arguments),
-                            options.bearer_token);
+      options.bearer_token);
 }
 
 std::shared_ptr<Connection> MakeGrpcConnection(std::shared_ptr<grpc::Channel> channel,

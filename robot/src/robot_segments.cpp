@@ -142,8 +142,10 @@ absl::StatusOr<SegmentResult> RobotStateChecker::CheckSegment(absl::Span<const d
     for (std::size_t i = 0; i < fast.size(); ++i) {
       ClearanceInterval interval = fast[i];
       const double needed = lipschitz * travel[i];
-      if (interval.lower <= needed) {  // tighten up to what the segment needs
-        const ClearanceRequest request{0.0, std::max(needed, 1e-300)};
+      // Tighten up to twice what the segment needs, plus 1 nm: an answer "beyond
+      // max_distance" is max_distance less the margin, which must still exceed `needed`.
+      if (interval.lower <= needed) {
+        const ClearanceRequest request{0.0, 2.0 * needed + 1e-9};
         environment.Clearances(absl::MakeConstSpan(&state.world[i], 1), request,
                                absl::MakeSpan(&interval, 1));
       }

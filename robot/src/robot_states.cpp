@@ -306,9 +306,14 @@ absl::StatusOr<StateBatchResult> RobotStateChecker::CheckStates(absl::Span<const
       } else {
         for (int k = 0; k < links && !world; ++k) {
           const Model::LinkSpheresRange& link = model.links[k];
+          // The bounding ball's O(1) bound only: an exact search over its larger reach would
+          // cost more than the link's spheres.
           const Sphere bound{state.poses[link.link] * link.bound_centre, link.bound_world};
+          ClearanceInterval bound_interval;
+          environment.Clearances(absl::MakeConstSpan(&bound, 1), fast,
+                                 absl::MakeSpan(&bound_interval, 1));
           ++result.ball_queries;
-          if (environment.FirstColliding(absl::MakeConstSpan(&bound, 1)) < 0) continue;
+          if (bound_interval.clear()) continue;
           PoseLinkSpheres(model, k, &state);
           result.ball_queries += link.end - link.begin;
           world = environment.FirstColliding(absl::MakeConstSpan(state.world.data() + link.begin,

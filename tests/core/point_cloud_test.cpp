@@ -162,7 +162,7 @@ TEST(PointCloud, TinyCellBudgetStillSound) {
   ASSERT_TRUE(cloud.ok()) << cloud.status();
   EXPECT_LE(cloud->cells(), 64);
   EXPECT_GT(cloud->cell_size(), 0.001);
-  ExpectMatchesBruteForce(*cloud, random.points, random.radii, 300, rng, 1.3);
+  ExpectMatchesBruteForce(*cloud, random.points, random.radii, 300, rng, 1.0);
 }
 
 TEST(PointCloud, EmptyAndSinglePointClouds) {

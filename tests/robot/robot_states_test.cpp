@@ -84,7 +84,10 @@ struct Fixture {
     for (std::size_t i = 0; i < posed.centre.size(); ++i) {
       for (std::size_t j = i + 1; j < posed.centre.size(); ++j) {
         const int a = posed.link[i], b = posed.link[j];
-        if (a == b || std::abs(a - b) == 1) continue;  // the ignored (adjacent) pairs
+        if (a == b || arm.spheres.self_collision_ignore.count(
+                          {arm.spheres.links[a].link, arm.spheres.links[b].link}) > 0) {
+          continue;
+        }
         if ((posed.centre[i] - posed.centre[j]).norm() <= posed.radius[i] + posed.radius[j]) {
           return true;
         }

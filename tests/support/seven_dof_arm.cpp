@@ -43,6 +43,25 @@ SevenDofArm BuildSevenDofArm() {
     arm.spheres.self_collision_ignore[{arm.robot.links[j - 1].name, arm.robot.links[j].name}] =
         "Adjacent";
   }
+  // MoveIt's "Default" pairs: links whose spheres overlap with every joint at 0 (the arm
+  // straight up along z, link i's frame at the sum of the lengths below it).
+  std::vector<double> height(8, 0.0);
+  for (int i = 1; i < 8; ++i) height[i] = height[i - 1] + lengths[i - 1];
+  for (int a = 0; a < 8; ++a) {
+    for (int b = a + 2; b < 8; ++b) {
+      bool overlap = false;
+      for (const Sphere& sa : arm.spheres.links[a].spheres) {
+        for (const Sphere& sb : arm.spheres.links[b].spheres) {
+          const double gap = std::abs((sb.center.z() + height[b]) - (sa.center.z() + height[a]));
+          overlap = overlap || gap <= sa.radius + sb.radius;
+        }
+      }
+      if (overlap) {
+        arm.spheres.self_collision_ignore[{arm.robot.links[a].name, arm.robot.links[b].name}] =
+            "Default";
+      }
+    }
+  }
   return arm;
 }
 

@@ -17,7 +17,8 @@ struct SevenDofArm {
   robot::UrdfRobot robot;  // links "base", "link1".."link7"; joints "joint1".."joint7"
   // Per link (robot order), its capsule: radius, and length along +z from the link origin.
   std::vector<double> radius, length;
-  // The sphere model: adjacent links in self_collision_ignore ("Adjacent"), no buffers.
+  // The sphere model: in self_collision_ignore the adjacent links ("Adjacent") and the links
+  // whose spheres overlap with every joint at 0 ("Default"); no buffers.
   robot::RobotSpheres spheres;
 };
 

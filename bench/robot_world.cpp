@@ -224,6 +224,7 @@ bool MatchesBruteForce(const RobotStateChecker& checker, const std::vector<Vecto
 int main(int argc, char** argv) {
   CLI::App app{"robot states against point clouds, a distance grid and primitives, with FCL"};
   int states = 20000, grid_n = 256, fcl_states = 200;
+  double cell_size = 0.0;
   std::vector<std::int64_t> clouds = {10000, 100000, 1000000};
   bool quick = false;
   app.add_option("--states", states, "random states per measurement")
@@ -231,6 +232,8 @@ int main(int argc, char** argv) {
   app.add_option("--clouds", clouds, "cloud sizes")->delimiter(',');
   app.add_option("--grid", grid_n, "voxels per axis of the grid")->check(CLI::Range(8, 512));
   app.add_option("--fcl-states", fcl_states, "states FCL collides")->check(CLI::Range(10, 100000));
+  app.add_option("--cell-size", cell_size, "the clouds' cell side, metres (0: the query radius)")
+      ->check(CLI::Range(0.0, 1.0));
   app.add_flag("--quick", quick, "a short run: 2,000 states, clouds of 10k and 100k, a 64^3 grid");
   CLI11_PARSE(app, argc, argv);
   if (quick) {
@@ -279,6 +282,7 @@ int main(int argc, char** argv) {
     inscribe::PointCloudOptions options;
     options.point_radius = kPointRadius;
     options.query_radius = 0.06;
+    options.cell_size = cell_size;
     const Clock::time_point build = Clock::now();
     const inscribe::PointCloud cloud = *inscribe::PointCloud::Create(points, {}, options);
     const double build_ms = Since(build) * 1e3;
@@ -304,6 +308,29 @@ int main(int argc, char** argv) {
         static_cast<long long>(n), build_ms, a.us_per_state, 1e6 / a.us_per_state,
         100 * a.colliding, p50, p99, b.us_per_state, c.us_per_state, fcl.collide_us,
         fcl.collide_us / a.us_per_state, fcl.distance_us, fcl.distance_us / c.us_per_state);
+  }
+
+  // Where a state's time goes: forward kinematics alone, and yes/no without self-collision.
+  {
+    std::vector<Eigen::Isometry3d> poses;
+    const Clock::time_point start = Clock::now();
+    for (const auto& q : configurations) {
+      if (!checker.kinematics().LinkPoses(q, &poses).ok()) return 1;
+    }
+    const double fk_us = Since(start) * 1e6 / states;
+    std::vector<Vector3> points = points_100k.empty() ? ScenePoints(scene, 100000, 2) : points_100k;
+    inscribe::PointCloudOptions options;
+    options.point_radius = kPointRadius;
+    options.query_radius = 0.06;
+    options.cell_size = cell_size;
+    const inscribe::PointCloud cloud = *inscribe::PointCloud::Create(points, {}, options);
+    StateQuery world_only = yes_no;
+    world_only.self_collision = false;
+    const Timed w = TimeStates(checker, flat, states, cloud, world_only, min_seconds);
+    std::printf(
+        "| cloud 100000, world only (no self-collision) | | %.3f | %.0f | %.0f%% | | | | | | | "
+        "|\n| forward kinematics alone | | %.3f | | | | | | | | | |\n",
+        w.us_per_state, 1e6 / w.us_per_state, 100 * w.colliding, fk_us);
   }
 
   // The grid: the scene's primitives' signed distance sampled at the voxels.
@@ -357,6 +384,7 @@ int main(int argc, char** argv) {
   inscribe::PointCloudOptions options;
   options.point_radius = kPointRadius;
   options.query_radius = 0.06;
+  options.cell_size = cell_size;
   const inscribe::PointCloud cloud = *inscribe::PointCloud::Create(points_100k, {}, options);
 
   // A motion: a random walk of 0.01 rad steps per joint from a clear state; with and without

@@ -47,6 +47,7 @@ struct PosedState {
   std::vector<Sphere> world;  // world-padded spheres
   std::vector<Vector3> centres;
   std::vector<std::uint8_t> link_posed;  // per checked link
+  std::vector<Vector3> bound_centres;    // per checked link, its bounding balls' centre
 };
 
 // The link poses at `q` into *state, no sphere posed yet. Errors: Kinematics::LinkPoses'.

@@ -60,6 +60,10 @@ absl::Status PoseLinks(const Model& model, absl::Span<const double> q, PosedStat
   state->world.resize(n);
   state->centres.resize(n);
   state->link_posed.assign(model.links.size(), 0);
+  state->bound_centres.resize(model.links.size());
+  for (std::size_t k = 0; k < model.links.size(); ++k) {
+    state->bound_centres[k] = state->poses[model.links[k].link] * model.links[k].bound_centre;
+  }
   return absl::OkStatus();
 }
 
@@ -85,17 +89,23 @@ bool LinksCollide(const Model& model, PosedState* posed, int a, int b, double* d
   const Model::LinkSpheresRange& lb = model.links[b];
   const double margin = RobotMargin(model);
   if (distance == nullptr) {
-    const Vector3 ca = posed->poses[la.link] * la.bound_centre;
-    const Vector3 cb = posed->poses[lb.link] * lb.bound_centre;
+    const Vector3& ca = posed->bound_centres[a];
+    const Vector3& cb = posed->bound_centres[b];
     const double reach = la.bound_self + lb.bound_self + margin;
     if ((ca - cb).squaredNorm() > reach * reach) return false;
   }
   PoseLinkSpheres(model, a, posed);
   PoseLinkSpheres(model, b, posed);
   const PosedState& state = *posed;
+  const Vector3& cb = state.bound_centres[b];
   bool collide = false;
   double best = kInf;
   for (int i = la.begin; i < la.end; ++i) {
+    // A row of a's spheres that cannot reach b's bounding ball is skipped (yes/no only).
+    if (distance == nullptr) {
+      const double row = model.self_radius[i] + lb.bound_self + margin;
+      if ((state.centres[i] - cb).squaredNorm() > row * row) continue;
+    }
     for (int j = lb.begin; j < lb.end; ++j) {
       const double d2 = (state.centres[i] - state.centres[j]).squaredNorm();
       const double reach = model.self_radius[i] + model.self_radius[j];
@@ -308,7 +318,7 @@ absl::StatusOr<StateBatchResult> RobotStateChecker::CheckStates(absl::Span<const
           const Model::LinkSpheresRange& link = model.links[k];
           // The bounding ball's O(1) bound only: an exact search over its larger reach would
           // cost more than the link's spheres.
-          const Sphere bound{state.poses[link.link] * link.bound_centre, link.bound_world};
+          const Sphere bound{state.bound_centres[k], link.bound_world};
           ClearanceInterval bound_interval;
           environment.Clearances(absl::MakeConstSpan(&bound, 1), fast,
                                  absl::MakeSpan(&bound_interval, 1));

@@ -27,6 +27,12 @@ struct PointCloud::Index {
   std::vector<std::int64_t> nearest_d2;  // per cell, D^2 in cell units^2 (exact)
   std::vector<std::uint32_t> rep;        // per cell, a point of the nearest occupied cell
   double bin_radius = 0.0;               // largest |point - its cell's centre|
+  // The finer transform behind the O(1) lower bounds: cells of side h / fine over the same box
+  // (fine 3, 2 or 1, as max_cells allows).
+  int fine = 1;
+  int fine_n[3] = {1, 1, 1};
+  std::vector<float> fine_nearest;  // per fine cell, as `nearest`
+  double fine_bin_radius = 0.0;
   double max_radius = 0.0;
   double scale = 0.0;  // largest |coordinate| of the grid and points, plus max_radius
 
@@ -121,10 +127,21 @@ Bounds FastBounds(const Index& index, const Vector3& c) {
   Bounds b;
   for (int axis = 0; axis < 3; ++axis) b.cell[axis] = index.AxisCell(c[axis], axis);
   const std::int64_t k = index.Cell(b.cell[0], b.cell[1], b.cell[2]);
-  const Vector3 centre(index.Centre(b.cell[0], 0), index.Centre(b.cell[1], 1),
-                       index.Centre(b.cell[2], 2));
-  b.lower = static_cast<double>(index.nearest[k]) - index.bin_radius - (c - centre).norm() -
-            index.max_radius;
+  // The lower bound from the fine cell of c (any cell gives a valid bound; this one is tight).
+  const double hf = index.h / index.fine;
+  int fi[3];
+  Vector3 centre;
+  for (int axis = 0; axis < 3; ++axis) {
+    const double t = std::floor((c[axis] - index.origin[axis]) / hf);
+    fi[axis] = !(t >= 0.0)                   ? 0
+               : t >= index.fine_n[axis] - 1 ? index.fine_n[axis] - 1
+                                             : static_cast<int>(t);
+    centre[axis] = index.origin[axis] + (fi[axis] + 0.5) * hf;
+  }
+  const std::int64_t kf =
+      (static_cast<std::int64_t>(fi[0]) * index.fine_n[1] + fi[1]) * index.fine_n[2] + fi[2];
+  b.lower = static_cast<double>(index.fine_nearest[kf]) - index.fine_bin_radius -
+            (c - centre).norm() - index.max_radius;
   const Index::Point& p = index.points[index.rep[k]];
   b.upper = Distance(c, p) - p.r;
   b.d2 = index.nearest_d2[k];
@@ -265,6 +282,53 @@ absl::StatusOr<PointCloud> PointCloud::Create(absl::Span<const Vector3> points,
     index->rep[k] = index->start[transform.site[k]];
   }
   index->nearest_d2 = std::move(transform.d2);
+
+  // The finer transform for the lower bounds.
+  int f = 3;
+  auto fits = [&](int factor) {
+    if (static_cast<double>(cells) * factor * factor * factor >
+        static_cast<double>(options.max_cells)) {
+      return false;
+    }
+    for (int axis = 0; axis < 3; ++axis) {
+      if (static_cast<std::int64_t>(index->n[axis]) * factor > 65536) return false;
+    }
+    return true;
+  };
+  while (f > 1 && !fits(f)) --f;
+  index->fine = f;
+  const double hf = h / f;
+  for (int axis = 0; axis < 3; ++axis) index->fine_n[axis] = index->n[axis] * f;
+  const std::int64_t fine_cells =
+      static_cast<std::int64_t>(index->fine_n[0]) * index->fine_n[1] * index->fine_n[2];
+  std::vector<std::uint8_t> fine_occupied(static_cast<std::size_t>(fine_cells), 0);
+  for (const Index::Point& p : index->points) {
+    int fi[3];
+    Vector3 centre;
+    const double v[3] = {p.x, p.y, p.z};
+    for (int axis = 0; axis < 3; ++axis) {
+      const double t = std::floor((v[axis] - lo[axis]) / hf);
+      fi[axis] = !(t >= 0.0)                    ? 0
+                 : t >= index->fine_n[axis] - 1 ? index->fine_n[axis] - 1
+                                                : static_cast<int>(t);
+      centre[axis] = lo[axis] + (fi[axis] + 0.5) * hf;
+    }
+    fine_occupied[(static_cast<std::int64_t>(fi[0]) * index->fine_n[1] + fi[1]) * index->fine_n[2] +
+                  fi[2]] = 1;
+    index->fine_bin_radius =
+        std::max(index->fine_bin_radius, (Vector3(p.x, p.y, p.z) - centre).norm());
+  }
+  index->fine_bin_radius =
+      index->fine_bin_radius * (1.0 + 1e-12) + kEnvironmentMargin * index->scale;
+  const internal::CellDistanceTransform fine =
+      internal::ComputeCellDistanceTransform(fine_occupied, index->fine_n);
+  index->fine_nearest.resize(static_cast<std::size_t>(fine_cells));
+  for (std::int64_t k = 0; k < fine_cells; ++k) {
+    const double d = hf * std::sqrt(static_cast<double>(fine.d2[k]));
+    float rounded = static_cast<float>(d);
+    if (static_cast<double>(rounded) > d) rounded = std::nextafter(rounded, 0.0f);
+    index->fine_nearest[k] = rounded;
+  }
   return PointCloud(std::move(index));
 }
 

@@ -11,7 +11,9 @@
 // rmax the largest point radius:
 //   clearance >= D_A - b - |c - centre(A)| - rmax - r      (lower, O(1))
 //   clearance <= |c - p| - r_p - r   for p a point of the nearest occupied cell   (upper, O(1))
-// since every point lies within b of its cell's centre. Tighter answers search the points of
+// since every point lies within b of its cell's centre. The lower bound is taken from a second
+// transform on cells of h / 3 (or h / 2, or h, as max_cells allows) over the same box, with its
+// own b: that is what makes it tight. Tighter answers search the points of
 // the cells within reach (O(cells within the search radius + their points)). Every bound is
 // moved outward by the margin of environment.h.
 #pragma once
@@ -40,7 +42,8 @@ struct PointCloudOptions {
   // The largest ball radius expected in queries (robot sphere plus padding), metres, > 0:
   // sizes the cells when cell_size is 0. Any radius may still be asked.
   double query_radius = 0.05;
-  // Largest number of cells (cells cost 20 bytes each); 1..2^28.
+  // Largest number of cells (cells cost 20 bytes each), and of the lower bounds' finer cells
+  // (4 bytes each); 1..2^28.
   std::int64_t max_cells = 1LL << 22;
 };
 
@@ -55,7 +58,8 @@ class PointCloud final : public Environment {
   // one per point, each finite and >= 0. INVALID_ARGUMENT naming the point and the option or
   // function that fixes it: a non-finite coordinate (FilterPoints drops them), a bad radius,
   // more than kMaxCloudPoints points; CheckPointCloudOptions' errors. An empty cloud is
-  // valid: every ball is clear of it. O(n + cells) time, 32 bytes per point and 20 per cell.
+  // valid: every ball is clear of it. O(n + cells) time, 32 bytes per point, 20 per cell and 4 per
+  // finer cell.
   static absl::StatusOr<PointCloud> Create(absl::Span<const Vector3> points,
                                            absl::Span<const double> radii,
                                            const PointCloudOptions& options = {});

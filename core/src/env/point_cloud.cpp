@@ -122,12 +122,9 @@ struct Bounds {
   std::int64_t d2;
 };
 
-// The O(1) bounds of the header, before the ball's radius and the margin.
-Bounds FastBounds(const Index& index, const Vector3& c) {
-  Bounds b;
-  for (int axis = 0; axis < 3; ++axis) b.cell[axis] = index.AxisCell(c[axis], axis);
-  const std::int64_t k = index.Cell(b.cell[0], b.cell[1], b.cell[2]);
-  // The lower bound from the fine cell of c (any cell gives a valid bound; this one is tight).
+// The O(1) lower bound of the header, before the ball's radius and the margin, from the fine
+// cell of c (any cell gives a valid bound; this one is tight).
+double FastLower(const Index& index, const Vector3& c) {
   const double hf = index.h / index.fine;
   int fi[3];
   Vector3 centre;
@@ -140,8 +137,17 @@ Bounds FastBounds(const Index& index, const Vector3& c) {
   }
   const std::int64_t kf =
       (static_cast<std::int64_t>(fi[0]) * index.fine_n[1] + fi[1]) * index.fine_n[2] + fi[2];
-  b.lower = static_cast<double>(index.fine_nearest[kf]) - index.fine_bin_radius -
-            (c - centre).norm() - index.max_radius;
+  return static_cast<double>(index.fine_nearest[kf]) - index.fine_bin_radius - (c - centre).norm() -
+         index.max_radius;
+}
+
+// Both O(1) bounds of the header, before the ball's radius and the margin, and the coarse cell
+// a search starts from.
+Bounds FastBounds(const Index& index, const Vector3& c) {
+  Bounds b;
+  for (int axis = 0; axis < 3; ++axis) b.cell[axis] = index.AxisCell(c[axis], axis);
+  const std::int64_t k = index.Cell(b.cell[0], b.cell[1], b.cell[2]);
+  b.lower = FastLower(index, c);
   const Index::Point& p = index.points[index.rep[k]];
   b.upper = Distance(c, p) - p.r;
   b.d2 = index.nearest_d2[k];
@@ -351,8 +357,9 @@ int PointCloud::FirstColliding(absl::Span<const Sphere> balls) const {
   for (std::size_t i = 0; i < balls.size(); ++i) {
     const Sphere& ball = balls[i];
     const double margin = index.Margin(ball);
+    // The lower bound alone first: it decides most balls, without touching the points.
+    if (FastLower(index, ball.center) - ball.radius - margin > 0.0) continue;
     const Bounds b = FastBounds(index, ball.center);
-    if (b.lower - ball.radius - margin > 0.0) continue;
     if (b.upper - ball.radius - margin <= 0.0) return static_cast<int>(i);
     const Vector3& c = ball.center;
     const double reach = ball.radius + index.max_radius + margin;

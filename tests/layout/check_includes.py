@@ -12,7 +12,7 @@ import re
 import sys
 
 ROOMS = ["base", "geometry", "mesh", "solid", "balls", "medial", "cover", "generation",
-         "distance", "scene"]
+         "distance", "scene", "env"]
 # The layers each layer may include (besides its own and proto/'s generated code).
 LAYERS = {
     "core": set(),

@@ -14,6 +14,7 @@
 #include "mesh/mesh_topology.h"
 #include "mesh/vertex_welding.h"
 #include "solid/mesh_wrap.h"
+#include "tbb/parallel_invoke.h"
 
 namespace inscribe {
 namespace internal {
@@ -271,20 +272,32 @@ namespace internal {
 // report keeps input's counts, turns its errors into warnings ("before the wrap: ...") and
 // takes the wrap's shape figures. An error "wrap_failed" when the wrap cannot be made or used,
 // or does not provably enclose the soup (CheckWrapEncloses).
-ValidatedMesh WrapSoup(ValidatedMesh input, const Mesh& soup, const ValidateOptions& options) {
+WrapParameters WrapParametersFor(const Mesh& soup, const RepairOptions& repair) {
+  WrapParameters p;
+  const BoundingBox box = ComputeBoundingBox(soup.vertices);
+  p.diagonal = (box.max - box.min).norm();
+  p.alpha = repair.wrap_alpha > 0.0 ? repair.wrap_alpha : DefaultWrapAlpha(p.diagonal);
+  p.offset = repair.wrap_offset > 0.0 ? repair.wrap_offset : DefaultWrapOffset(p.alpha);
+  return p;
+}
+
+absl::StatusOr<Mesh> ComputeWrap(const Mesh& soup, const WrapParameters& parameters) {
+  if (!(parameters.diagonal > 0.0)) {
+    return absl::FailedPreconditionError("the mesh's vertices are all at one point");
+  }
+  return internal::AlphaWrap(soup, parameters.alpha, parameters.offset);
+}
+
+ValidatedMesh WrapSoup(ValidatedMesh input, const Mesh& soup, const ValidateOptions& options,
+                       std::optional<absl::StatusOr<Mesh>> computed) {
   MeshReport& report = input.report;
   auto fail = [&](const std::string& why) {
     AddIssue(report, Severity::kError, "wrap_failed", absl::StrCat("the wrap failed: ", why), 0);
     return std::move(input);
   };
-  const BoundingBox box = ComputeBoundingBox(soup.vertices);
-  const double diagonal = (box.max - box.min).norm();
-  const double alpha =
-      options.repair.wrap_alpha > 0.0 ? options.repair.wrap_alpha : DefaultWrapAlpha(diagonal);
-  const double offset =
-      options.repair.wrap_offset > 0.0 ? options.repair.wrap_offset : DefaultWrapOffset(alpha);
-  if (!(diagonal > 0.0)) return fail("the mesh's vertices are all at one point");
-  absl::StatusOr<Mesh> wrap = internal::AlphaWrap(soup, alpha, offset);
+  const WrapParameters parameters = WrapParametersFor(soup, options.repair);
+  const double alpha = parameters.alpha, offset = parameters.offset;
+  absl::StatusOr<Mesh> wrap = computed ? *std::move(computed) : ComputeWrap(soup, parameters);
   if (!wrap.ok()) return fail(std::string(wrap.status().message()));
   ValidateOptions plain;
   plain.repair.level = MeshRepair::kNone;
@@ -294,9 +307,14 @@ ValidatedMesh WrapSoup(ValidatedMesh input, const Mesh& soup, const ValidateOpti
     return fail(
         absl::StrCat("the wrap is not a usable solid (", wrapped.report.first_error(), ")"));
   }
-  if (const std::string why = internal::CheckWrapEncloses(wrapped.mesh, soup); !why.empty()) {
-    return fail(
-        absl::StrCat("it does not enclose the input (", why, "); a larger --wrap-offset may help"));
+  // The proof of enclosure and the reach bound read the same two meshes: side by side.
+  std::string encloses_not;
+  double reach = 0.0;
+  tbb::parallel_invoke([&] { encloses_not = internal::CheckWrapEncloses(wrapped.mesh, soup); },
+                       [&] { reach = internal::WrapReachBound(wrapped.mesh, soup); });
+  if (!encloses_not.empty()) {
+    return fail(absl::StrCat("it does not enclose the input (", encloses_not,
+                             "); a larger --wrap-offset may help"));
   }
   MeshReport out = std::move(report);
   // A patch tried before the wrap is not in the returned mesh.
@@ -323,7 +341,7 @@ ValidatedMesh WrapSoup(ValidatedMesh input, const Mesh& soup, const ValidateOpti
   out.wrap_offset = offset;
   out.wrap_input_triangles = soup.num_triangles();
   out.wrap_triangles = wrapped.mesh.num_triangles();
-  out.wrap_reach = internal::WrapReachBound(wrapped.mesh, soup);
+  out.wrap_reach = reach;
   out.issues.erase(std::remove_if(out.issues.begin(), out.issues.end(),
                                   [](const MeshIssue& i) {
                                     return i.code == "self_intersections_not_checked" ||

@@ -3,9 +3,11 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <utility>
 
+#include "absl/status/statusor.h"
 #include "absl/strings/str_cat.h"
 #include "inscribe/solid/mesh_validation.h"
 
@@ -31,10 +33,26 @@ void RemoveDuplicatesAndDoubleWalls(Mesh& mesh, MeshReport& report);
 // CrackWeldTolerance, kept only when it closes border edges and makes no edge non-manifold.
 void WeldCracks(Mesh& mesh, MeshReport& report);
 
+// The wrap's alpha and offset for `soup` (RepairOptions' when given, else the defaults from
+// its bounding box's diagonal), and that diagonal.
+struct WrapParameters {
+  double alpha = 0.0;
+  double offset = 0.0;
+  double diagonal = 0.0;
+};
+WrapParameters WrapParametersFor(const Mesh& soup, const RepairOptions& repair);
+
+// CGAL's alpha wrap of `soup` with `parameters` (AlphaWrap), or why it cannot be made. The
+// part of WrapSoup that needs nothing of the validation, so that --repair wrap can run it
+// beside the rest of the input's validation.
+absl::StatusOr<Mesh> ComputeWrap(const Mesh& soup, const WrapParameters& parameters);
+
 // The wrap of `soup` (the mesh `input` came from, once welded) replaces input's mesh; the
 // report keeps input's counts, turns its errors into warnings ("before the wrap: ...") and
 // takes the wrap's shape figures. An error "wrap_failed" when the wrap cannot be made or used,
-// or does not provably enclose the soup (CheckWrapEncloses).
-ValidatedMesh WrapSoup(ValidatedMesh input, const Mesh& soup, const ValidateOptions& options);
+// or does not provably enclose the soup (CheckWrapEncloses). `computed`: ComputeWrap(soup, its
+// WrapParametersFor) when already made, else made here.
+ValidatedMesh WrapSoup(ValidatedMesh input, const Mesh& soup, const ValidateOptions& options,
+                       std::optional<absl::StatusOr<Mesh>> computed = std::nullopt);
 
 }  // namespace inscribe::internal

@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <functional>
 #include <limits>
 #include <numeric>
+#include <optional>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
@@ -14,6 +16,7 @@
 #include "solid/mesh_orientation.h"
 #include "solid/mesh_repair.h"
 #include "solid/self_intersections.h"
+#include "tbb/task_group.h"
 
 namespace inscribe {
 namespace {
@@ -479,9 +482,9 @@ std::string MeshReport::first_error() const {
 namespace {
 
 // Every step but the wrap. `soup`: the mesh once welded (what a wrap wraps), when the mesh got
-// that far (*wrappable is then true).
-ValidatedMesh ValidateSteps(Mesh mesh, const ValidateOptions& options, Mesh* soup,
-                            bool* wrappable) {
+// that far (*wrappable is then true, and `soup_ready`, when given, is called then).
+ValidatedMesh ValidateSteps(Mesh mesh, const ValidateOptions& options, Mesh* soup, bool* wrappable,
+                            const std::function<void()>& soup_ready = {}) {
   *wrappable = false;
   MeshReport report;
   report.vertices = mesh.num_vertices();
@@ -511,6 +514,7 @@ ValidatedMesh ValidateSteps(Mesh mesh, const ValidateOptions& options, Mesh* sou
   }
   if (soup != nullptr) *soup = mesh;
   *wrappable = true;
+  if (soup_ready) soup_ready();
   if (options.repair.level != MeshRepair::kNone) {
     internal::RemoveDuplicatesAndDoubleWalls(mesh, report);
     if (mesh.num_triangles() == 0) {
@@ -620,25 +624,38 @@ ValidatedMesh ValidateMesh(Mesh mesh, const ValidateOptions& options) {
   }
   Mesh soup;
   bool wrappable = false;
-  ValidatedMesh validated =
-      ValidateSteps(std::move(mesh), options, may_wrap ? &soup : nullptr, &wrappable);
+  // A given alpha below 1e-4 of the diagonal is refused: the wrap's cost grows as 1/alpha^2.
+  auto alpha_too_small = [&options](const internal::WrapParameters& p) {
+    return options.repair.wrap_alpha > 0.0 && options.repair.wrap_alpha < 1e-4 * p.diagonal;
+  };
+  // --repair wrap wraps whatever the other steps find, so CGAL's wrap of the soup (most of the
+  // time) runs on a second thread beside them; auto waits to see whether it needs one.
+  // Declared before the task group: destroyed after it, which waits for the task.
+  std::optional<absl::StatusOr<Mesh>> wrap;
+  tbb::task_group wrapping;
+  auto start_wrap = [&] {
+    const internal::WrapParameters p = internal::WrapParametersFor(soup, options.repair);
+    if (alpha_too_small(p)) return;
+    wrapping.run([&soup, &wrap, p] { wrap = internal::ComputeWrap(soup, p); });
+  };
+  ValidatedMesh validated = ValidateSteps(
+      std::move(mesh), options, may_wrap ? &soup : nullptr, &wrappable,
+      options.repair.level == MeshRepair::kWrap ? std::function<void()>(start_wrap) : nullptr);
+  wrapping.wait();
   if (!may_wrap || !wrappable ||
       (options.repair.level == MeshRepair::kAuto && validated.report.usable())) {
     return validated;
   }
-  if (options.repair.wrap_alpha > 0.0) {
-    const BoundingBox box = ComputeBoundingBox(soup.vertices);
-    const double diagonal = (box.max - box.min).norm();
-    if (options.repair.wrap_alpha < 1e-4 * diagonal) {
-      AddIssue(validated.report, Severity::kError, "wrap_alpha_too_small",
-               absl::StrFormat("wrap alpha %g is below 1e-4 of the mesh's diagonal %g (the wrap's "
-                               "cost grows as 1/alpha^2); use a larger --wrap-alpha",
-                               options.repair.wrap_alpha, diagonal),
-               0);
-      return validated;
-    }
+  if (const internal::WrapParameters p = internal::WrapParametersFor(soup, options.repair);
+      alpha_too_small(p)) {
+    AddIssue(validated.report, Severity::kError, "wrap_alpha_too_small",
+             absl::StrFormat("wrap alpha %g is below 1e-4 of the mesh's diagonal %g (the wrap's "
+                             "cost grows as 1/alpha^2); use a larger --wrap-alpha",
+                             options.repair.wrap_alpha, p.diagonal),
+             0);
+    return validated;
   }
-  return internal::WrapSoup(std::move(validated), soup, options);
+  return internal::WrapSoup(std::move(validated), soup, options, std::move(wrap));
 }
 
 absl::StatusOr<ValidatedMesh> PrepareMesh(Mesh mesh, const ValidateOptions& options) {

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <cstdio>
 #include <vector>
 
 #include "inscribe/balls/union_of_balls.h"
@@ -88,6 +90,35 @@ TEST(InternalRefinement, BadOptionsNameTheField) {
   options.iterations = -1;
   EXPECT_NE(RefineInternalSpheres(solid.oracle, {}, options).status().message().find("iterations"),
             std::string::npos);
+}
+
+// A measurement, not a check (run with --gtest_also_run_disabled_tests): nerr = 1 - V_union /
+// V_solid at eight's 504 spheres before and after refinement, V_solid by the divergence theorem.
+TEST(InternalRefinement, DISABLED_EightAt504) {
+  const Solid solid = SolidOf("eight.off");
+  const Mesh& mesh = solid.mesh();
+  double solid_volume = 0.0;
+  for (Eigen::Index t = 0; t < mesh.triangles.rows(); ++t) {
+    const Vector3 a = mesh.vertices.row(mesh.triangles(t, 0)).transpose();
+    const Vector3 b = mesh.vertices.row(mesh.triangles(t, 1)).transpose();
+    const Vector3 c = mesh.vertices.row(mesh.triangles(t, 2)).transpose();
+    solid_volume += a.dot(b.cross(c)) / 6.0;
+  }
+  const std::vector<Sphere> before = Selected(solid, 504);
+  for (const int iterations : {20, 100}) {
+    InternalRefinementOptions options;
+    options.iterations = iterations;
+    const auto start = std::chrono::steady_clock::now();
+    absl::StatusOr<InternalRefinement> refined =
+        RefineInternalSpheres(solid.oracle, before, options);
+    ASSERT_TRUE(refined.ok());
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::printf("eight N=%zu iterations %d (accepted %d): nerr %.5f -> %.5f, %.2f s\n",
+                before.size(), iterations, refined->accepted,
+                1.0 - refined->volume_before / solid_volume,
+                1.0 - refined->volume_after / solid_volume, seconds);
+  }
 }
 
 }  // namespace

@@ -128,9 +128,13 @@ absl::StatusOr<InternalRefinement> RefineInternalSpheres(const BoundaryOracle& o
     if (!(largest > 0.0)) break;
     bool accepted = false;
     for (int halving = 0; halving <= 8 && !accepted; ++halving, step *= 0.5) {
-      const double scale = step / largest;
       for (std::size_t i = 0; i < spheres.size(); ++i) {
         const Sphere& b = out.spheres[i];
+        // Each ball moves up to `step` along its own gradient (a sign-like step: balls with
+        // little exposed area move as far as the others).
+        double own = grad_c[i].norm();
+        if (std::isfinite(grad_r[i])) own = std::max(own, std::abs(grad_r[i]));
+        const double scale = own > 0.0 ? step / own : 0.0;
         trial[i] = Project(oracle, b, b.center + scale * grad_c[i], b.radius + scale * grad_r[i]);
         // The distance has a kink where a ball touches at several points (every medial ball):
         // a move whose projected radius loses more than the move gains, to first order in the
@@ -147,7 +151,7 @@ absl::StatusOr<InternalRefinement> RefineInternalSpheres(const BoundaryOracle& o
         trial.resize(spheres.size());
         ++out.accepted;
         accepted = true;
-        step *= 3.0;  // the loop halves it once more: net 1.5x after a success
+        step = std::min(3.0 * step, 0.5 * mean_radius);  // halved once more by the loop
       }
     }
     if (!accepted) break;

@@ -105,7 +105,7 @@ TEST(InternalRefinement, DISABLED_EightAt504) {
     solid_volume += a.dot(b.cross(c)) / 6.0;
   }
   const std::vector<Sphere> before = Selected(solid, 504);
-  for (const int iterations : {20, 100}) {
+  for (const int iterations : {20, 100, 500}) {
     InternalRefinementOptions options;
     options.iterations = iterations;
     const auto start = std::chrono::steady_clock::now();

@@ -104,6 +104,7 @@ absl::StatusOr<InternalRefinement> RefineInternalSpheres(const BoundaryOracle& o
   std::vector<Vector3> grad_c;
   std::vector<double> raw_r;  // the gradient before the tangent balls' change of variables
   std::vector<Vector3> raw_c;
+  std::vector<Vector3> away(spheres.size());  // tangent balls: unit direction from the contact
   std::vector<Sphere> trial(spheres.size());
   for (int it = 0; it < options.iterations; ++it) {
     ++out.iterations;
@@ -116,7 +117,8 @@ absl::StatusOr<InternalRefinement> RefineInternalSpheres(const BoundaryOracle& o
       const Sphere& b = out.spheres[i];
       const BoundaryPoint foot = oracle.ClosestPoint(b.center);
       if (b.radius >= foot.distance * (1.0 - 1e-6) && foot.distance > 0.0) {
-        grad_c[i] += grad_r[i] * (b.center - foot.point) / foot.distance;
+        away[i] = (b.center - foot.point) / foot.distance;
+        grad_c[i] += grad_r[i] * away[i];
         grad_r[i] = std::numeric_limits<double>::infinity();  // r := d(c') in Project
       }
     }
@@ -131,17 +133,31 @@ absl::StatusOr<InternalRefinement> RefineInternalSpheres(const BoundaryOracle& o
       for (std::size_t i = 0; i < spheres.size(); ++i) {
         const Sphere& b = out.spheres[i];
         // Each ball moves up to `step` along its own gradient (a sign-like step: balls with
-        // little exposed area move as far as the others).
-        double own = grad_c[i].norm();
-        if (std::isfinite(grad_r[i])) own = std::max(own, std::abs(grad_r[i]));
-        const double scale = own > 0.0 ? step / own : 0.0;
-        trial[i] = Project(oracle, b, b.center + scale * grad_c[i], b.radius + scale * grad_r[i]);
-        // The distance has a kink where a ball touches at several points (every medial ball):
-        // a move whose projected radius loses more than the move gains, to first order in the
-        // volume's gradient, is not made.
-        const double gain =
-            raw_c[i].dot(trial[i].center - b.center) + raw_r[i] * (trial[i].radius - b.radius);
-        if (!(gain > 0.0)) trial[i] = b;
+        // little exposed area move as far as the others). The distance has a kink where a ball
+        // touches at several points (every medial ball), so a tangent ball tries three
+        // directions (the change of variables, the centre's own gradient, and that gradient
+        // with its part towards the known contact removed) and keeps the one whose projected
+        // move gains most to first order in the volume's gradient; no move without a gain.
+        trial[i] = b;
+        double best = 0.0;
+        auto consider = [&](const Vector3& dc, double dr) {
+          double own = dc.norm();
+          if (std::isfinite(dr)) own = std::max(own, std::abs(dr));
+          if (!(own > 0.0)) return;
+          const double scale = step / own;
+          const Sphere moved = Project(oracle, b, b.center + scale * dc, b.radius + scale * dr);
+          const double gain =
+              raw_c[i].dot(moved.center - b.center) + raw_r[i] * (moved.radius - b.radius);
+          if (gain > best) {
+            best = gain;
+            trial[i] = moved;
+          }
+        };
+        consider(grad_c[i], grad_r[i]);
+        if (!std::isfinite(grad_r[i])) {
+          consider(raw_c[i], grad_r[i]);
+          consider(raw_c[i] - raw_c[i].dot(away[i]) * away[i], grad_r[i]);
+        }
       }
       absl::StatusOr<double> v = UnionVolume(trial);
       if (!v.ok()) return v.status();

@@ -37,8 +37,10 @@ struct InternalRefinement {
 // w.r.t. r_i is the exposed area of sphere i, w.r.t. c_i the integral of the outward normal
 // over that area. After a step every ball is projected: a centre that leaves the solid keeps
 // its old ball; otherwise r := min(r', d (1 - 1e-9)) with d the oracle's distance from the new
-// centre, so a ball tangent to the boundary stays tangent. Steps are halved until the exact
-// volume grows (at most 8 halvings), so the volume never falls. Deterministic (serial).
+// centre, so a ball tangent to the boundary stays tangent (its radius follows d). A ball takes
+// only a move that gains to first order (see docs/algorithms.md for the tangent balls' three
+// directions). Steps are halved until the exact volume grows (at most 8 halvings), so the
+// volume never falls. Deterministic (serial).
 // Errors: INVALID_ARGUMENT for bad options or spheres.
 absl::StatusOr<InternalRefinement> RefineInternalSpheres(
     const BoundaryOracle& oracle, const std::vector<Sphere>& spheres,
